@@ -1,0 +1,371 @@
+"""Reading and writing the file formats facetraj uses: audio, phone labels, markers.
+
+Every reader raises :class:`~engine.errors.InputError` naming the file and the problem; every
+writer goes through :func:`atomic_write`, so an interrupted write never leaves a half-written file
+where the user's file was.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import tempfile
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .data import PhoneSegment
+from .errors import InputError
+
+log = logging.getLogger(__name__)
+
+MIN_SAMPLE_RATE = 8000
+AUDIO_SUFFIXES = (".wav", ".flac")
+LABEL_SUFFIXES = (".textgrid", ".lab", ".phn")
+
+
+# --------------------------------------------------------------------------- writing safely
+@contextlib.contextmanager
+def atomic_write(path: str | os.PathLike[str], overwrite: bool = True) -> Iterator[Path]:
+    """Yield a temporary path beside ``path``; rename it into place only if the block succeeds.
+
+    Raises :class:`FileExistsError` when ``path`` exists and ``overwrite`` is false.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> out = pathlib.Path(tempfile.mkdtemp()) / "x.txt"
+    >>> with atomic_write(out) as tmp:
+    ...     _ = tmp.write_text("done")
+    >>> out.read_text()
+    'done'
+    """
+    path = Path(path)
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{path}: exists; pass overwrite to replace it")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.part-", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        yield tmp_path
+        os.replace(tmp_path, path)
+    finally:
+        if tmp_path.exists():
+            tmp_path.unlink()
+
+
+# --------------------------------------------------------------------------- audio
+def read_audio(path: str | os.PathLike[str]) -> tuple[np.ndarray, int]:
+    """Read a WAV or FLAC file as mono float64 samples and its rate.
+
+    Stereo and multi-channel files are mixed down (a note is logged). Raises
+    :class:`InputError` for a missing, unreadable, empty file or a rate below 8 kHz.
+    """
+    import soundfile as sf
+
+    path = Path(path)
+    if not path.exists():
+        raise InputError(path, "no such audio file")
+    if path.stat().st_size == 0:
+        raise InputError(path, "the audio file is empty (0 bytes)")
+    try:
+        data, rate = sf.read(str(path), dtype="float64", always_2d=True)
+    except Exception as exc:  # soundfile raises several types for corrupt data
+        raise InputError(path, f"cannot read audio ({exc})") from exc
+    if data.shape[0] == 0:
+        raise InputError(path, "the audio file holds no samples")
+    if rate < MIN_SAMPLE_RATE:
+        raise InputError(path, f"sample rate {rate} Hz is below the {MIN_SAMPLE_RATE} Hz minimum")
+    if data.shape[1] > 1:
+        log.warning("%s: %d channels mixed down to mono", path, data.shape[1])
+    samples = data.mean(axis=1)
+    if not np.all(np.isfinite(samples)):
+        raise InputError(path, "the audio holds NaN or infinite samples")
+    return samples, int(rate)
+
+
+def write_audio(path: str | os.PathLike[str], samples: np.ndarray, rate: int,
+                overwrite: bool = True) -> None:
+    """Write mono samples as WAV (16-bit) or FLAC (16-bit), chosen by the suffix."""
+    import soundfile as sf
+
+    path = Path(path)
+    fmt = "FLAC" if path.suffix.lower() == ".flac" else "WAV"
+    with atomic_write(path, overwrite) as tmp:
+        sf.write(str(tmp), np.clip(samples, -1.0, 1.0), int(rate), subtype="PCM_16", format=fmt)
+
+
+# --------------------------------------------------------------------------- labels
+def _read_text(path: Path) -> str:
+    if not path.exists():
+        raise InputError(path, "no such label file")
+    raw = path.read_bytes()
+    for enc in ("utf-8", "utf-16"):
+        try:
+            return raw.decode(enc)
+        except UnicodeDecodeError:
+            continue
+    raise InputError(path, "the file is not UTF-8 (or UTF-16) text")
+
+
+def read_textgrid_tiers(path: str | os.PathLike[str]) -> dict[str, list[PhoneSegment]]:
+    """Read every interval tier of a Praat TextGrid (long or short text form)."""
+    from praatio import textgrid
+
+    path = Path(path)
+    _read_text(path)  # existence and encoding, with our own message
+    try:
+        tg = textgrid.openTextgrid(str(path), includeEmptyIntervals=True)
+    except Exception as exc:
+        raise InputError(path, f"not a readable TextGrid ({exc})") from exc
+    tiers: dict[str, list[PhoneSegment]] = {}
+    for name in tg.tierNames:
+        tier = tg.getTier(name)
+        if tier.tierType != textgrid.INTERVAL_TIER:
+            continue
+        tiers[name] = [PhoneSegment(float(s), float(e), str(lab).strip())
+                       for s, e, lab in tier.entries]
+    return tiers
+
+
+def read_textgrid(path: str | os.PathLike[str], tier: str = "phones") -> list[PhoneSegment]:
+    """Read one interval tier of a TextGrid; empty intervals become ``sil``."""
+    tiers = read_textgrid_tiers(path)
+    if tier not in tiers:
+        raise InputError(path, f"no interval tier named {tier!r} (tiers: {sorted(tiers)})")
+    return [PhoneSegment(s.start, s.end, s.label or "sil") for s in tiers[tier]]
+
+
+def write_textgrid(path: str | os.PathLike[str], tiers: dict[str, Sequence[PhoneSegment]],
+                   duration: float, overwrite: bool = True) -> None:
+    """Write interval tiers (name -> segments) as a long-form TextGrid."""
+    from praatio import textgrid
+
+    tg = textgrid.Textgrid()
+    for name, segs in tiers.items():
+        entries = [(round(s.start, 6), round(s.end, 6), s.label) for s in segs]
+        tg.addTier(textgrid.IntervalTier(name, entries, 0.0, float(duration)))
+    with atomic_write(path, overwrite) as tmp:
+        tg.save(str(tmp), format="long_textgrid", includeBlankSpaces=True)
+
+
+def _parse_columns(path: Path) -> list[list[str]]:
+    rows = []
+    for lineno, line in enumerate(_read_text(path).splitlines(), 1):
+        parts = line.split()
+        if not parts or parts[0].startswith(("#", "!")) or parts[0] in {".", "MillisecondsPerFrame:"}:
+            continue
+        if len(parts) < 3:
+            raise InputError(path, f"line {lineno}: expected 'start end label', got {line!r}")
+        rows.append(parts)
+    return rows
+
+
+def read_lab(path: str | os.PathLike[str]) -> list[PhoneSegment]:
+    """Read an HTK label file (times in 100 ns units) or a MOCHA ``.lab`` (times in seconds).
+
+    The unit is told apart by the magnitude: integers above 10^4 are HTK units.
+    """
+    path = Path(path)
+    rows = _parse_columns(path)
+    try:
+        times = np.array([[float(r[0]), float(r[1])] for r in rows])
+    except ValueError as exc:
+        raise InputError(path, f"a start or end time is not a number ({exc})") from exc
+    scale = 1e-7 if times.size and times.max() > 1e4 else 1.0
+    return [PhoneSegment(a * scale, b * scale, r[2]) for (a, b), r in zip(times, rows, strict=True)]
+
+
+def read_phn(path: str | os.PathLike[str], sample_rate: int = 16000) -> list[PhoneSegment]:
+    """Read a TIMIT ``.phn`` file (sample indices at ``sample_rate``); ``h#``/``pau`` -> ``sil``."""
+    path = Path(path)
+    segs = []
+    for r in _parse_columns(path):
+        try:
+            a, b = int(r[0]), int(r[1])
+        except ValueError as exc:
+            raise InputError(path, f"sample index is not an integer ({exc})") from exc
+        lab = "sil" if r[2] in {"h#", "pau", "epi"} else r[2]
+        segs.append(PhoneSegment(a / sample_rate, b / sample_rate, lab))
+    return segs
+
+
+def read_labels(path: str | os.PathLike[str], sample_rate: int = 16000,
+                tier: str = "phones") -> list[PhoneSegment]:
+    """Read phone labels from a TextGrid, an HTK/MOCHA ``.lab`` or a TIMIT ``.phn``."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".textgrid":
+        return read_textgrid(path, tier)
+    if suffix == ".lab":
+        return read_lab(path)
+    if suffix == ".phn":
+        return read_phn(path, sample_rate)
+    raise InputError(path, f"unknown label format {suffix!r} (use .TextGrid, .lab or .phn)")
+
+
+def validate_phones(phones: Sequence[PhoneSegment], duration: float,
+                    path: str | os.PathLike[str] | None = None,
+                    tolerance: float = 0.05) -> list[PhoneSegment]:
+    """Check labels are sorted, do not overlap and cover ``[0, duration]``; return them tidied.
+
+    Gaps between segments are filled with ``sil``; the first segment is extended to 0 and the last
+    to ``duration`` when they fall short by at most ``tolerance`` seconds.
+    """
+    if not phones:
+        raise InputError(path, "the label file holds no segments")
+    out: list[PhoneSegment] = []
+    for i, seg in enumerate(phones):
+        if not seg.end > seg.start:
+            raise InputError(path, f"segment {i + 1} ({seg.label!r}) ends at {seg.end:.3f} s, "
+                                   f"not after its start {seg.start:.3f} s")
+        if out and seg.start < out[-1].end - 1e-6:
+            raise InputError(path, f"segment {i + 1} ({seg.label!r}) at {seg.start:.3f} s overlaps "
+                                   f"or precedes the one before, ending {out[-1].end:.3f} s")
+        if out and seg.start > out[-1].end + 1e-6:
+            out.append(PhoneSegment(out[-1].end, seg.start, "sil"))
+        out.append(seg)
+    if out[0].start > tolerance:
+        raise InputError(path, f"labels start at {out[0].start:.3f} s, not at 0")
+    if abs(out[-1].end - duration) > max(tolerance, 0.02 * duration):
+        raise InputError(path, f"labels end at {out[-1].end:.3f} s but the audio lasts "
+                               f"{duration:.3f} s")
+    out[0] = PhoneSegment(0.0, out[0].end, out[0].label)
+    out[-1] = PhoneSegment(out[-1].start, max(duration, out[-1].start + 1e-3), out[-1].label)
+    return out
+
+
+# --------------------------------------------------------------------------- markers
+@dataclass
+class MarkerData:
+    """Marker trajectories read from a file: ``(frames, markers, 3)`` mm, NaN where unseen."""
+
+    markers: np.ndarray
+    rate: float
+    names: list[str]
+
+
+_UNIT_TO_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
+
+
+def read_c3d(path: str | os.PathLike[str]) -> MarkerData:
+    """Read 3-D points from a C3D file (any of Vicon, Optotrak, Qualisys), converted to mm."""
+    import ezc3d
+
+    path = Path(path)
+    if not path.exists():
+        raise InputError(path, "no such C3D file")
+    try:
+        c3d = ezc3d.c3d(str(path))
+    except Exception as exc:
+        raise InputError(path, f"not a readable C3D file ({exc})") from exc
+    point = c3d["parameters"]["POINT"]
+    pts = np.asarray(c3d["data"]["points"], dtype=np.float64)[:3]  # (3, M, T)
+    if pts.ndim != 3 or pts.shape[1] == 0 or pts.shape[2] == 0:
+        raise InputError(path, "the C3D file holds no points")
+    names = [str(n).strip() for n in point["LABELS"]["value"]][: pts.shape[1]]
+    unit = str(point.get("UNITS", {}).get("value", ["mm"])[0]).strip().lower() or "mm"
+    scale = _UNIT_TO_MM.get(unit)
+    if scale is None:
+        raise InputError(path, f"unknown point unit {unit!r}")
+    residuals = np.asarray(c3d["data"]["meta_points"]["residuals"])[0]  # (M, T)
+    markers = np.transpose(pts, (2, 1, 0)) * scale
+    markers[residuals.T < 0] = np.nan
+    return MarkerData(markers, float(point["RATE"]["value"][0]), names)
+
+
+C3D_INT_SCALE = 0.01  # mm per integer step in integer C3D files
+
+
+def write_c3d(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
+              names: Sequence[str], overwrite: bool = True, integer: bool | None = None) -> None:
+    """Write ``(frames, markers, 3)`` mm trajectories as C3D; NaN points are written as unseen.
+
+    By default the compact integer form (int16, 0.01 mm steps, half the size of the float form) is
+    used when every coordinate fits in +-327 mm, else the float form. Read back with
+    :func:`read_c3d` (ezc3d), which reads both.
+    """
+    import warnings
+
+    import c3d
+
+    markers = np.asarray(markers, dtype=np.float64)
+    if markers.ndim != 3 or markers.shape[2] != 3 or markers.shape[1] != len(names):
+        raise ValueError(f"markers must be (frames, {len(names)}, 3), got {markers.shape}")
+    finite = np.isfinite(markers).all(axis=2)
+    span = np.abs(markers[finite]).max() if finite.any() else 0.0
+    if integer is None:
+        integer = span < 32000 * C3D_INT_SCALE
+    scale = C3D_INT_SCALE if integer else -1.0
+    if integer:  # c3d truncates toward zero: put values on the grid, nudged away from zero
+        q = np.round(markers / C3D_INT_SCALE) * C3D_INT_SCALE
+        markers = q + np.copysign(C3D_INT_SCALE * 1e-3, q)
+    writer = c3d.Writer(point_rate=float(rate), analog_rate=0.0, point_scale=scale,
+                        point_units="mm  ")
+    frames = []
+    empty = np.zeros((0, 0))
+    for t in range(markers.shape[0]):
+        p = np.zeros((markers.shape[1], 5))
+        p[:, :3] = np.where(finite[t, :, None], markers[t], 0.0)
+        p[:, 3] = np.where(finite[t], 0.0, -1.0)
+        frames.append((p, empty))
+    writer.add_frames(frames)
+    writer.set_point_labels(list(names))
+    with atomic_write(path, overwrite) as tmp, open(tmp, "wb") as handle, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        writer.write(handle)
+
+
+def write_marker_tsv(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
+                     names: Sequence[str], overwrite: bool = True) -> None:
+    """Write trajectories as TSV: a ``time`` column then ``<name>_x <name>_y <name>_z``."""
+    t = np.arange(markers.shape[0]) / rate
+    header = ["time"] + [f"{n}_{a}" for n in names for a in "xyz"]
+    table = np.column_stack([t, markers.reshape(markers.shape[0], -1)])
+    with atomic_write(path, overwrite) as tmp:
+        np.savetxt(tmp, table, delimiter="\t", header="\t".join(header), comments="", fmt="%.4f")
+
+
+def read_marker_table(path: str | os.PathLike[str], rate: float | None = None) -> MarkerData:
+    """Read TSV/CSV trajectories with a header ``[time] name_x name_y name_z ...`` (mm).
+
+    Two-dimensional data (``name_x name_y`` only) gets z = 0. Without a time column, ``rate`` is
+    required.
+    """
+    path = Path(path)
+    text = _read_text(path)
+    lines = [ln for ln in text.splitlines() if ln.strip()]
+    if len(lines) < 2:
+        raise InputError(path, "the marker table has no data rows")
+    delim = "\t" if "\t" in lines[0] else ","
+    header = [h.strip() for h in lines[0].split(delim)]
+    try:
+        table = np.array([[float(v) if v.strip() not in {"", "nan", "NaN"} else np.nan
+                           for v in ln.split(delim)] for ln in lines[1:]])
+    except ValueError as exc:
+        raise InputError(path, f"a value is not a number ({exc})") from exc
+    if table.shape[1] != len(header):
+        raise InputError(path, f"rows have {table.shape[1]} columns but the header {len(header)}")
+    times = None
+    if header[0].lower() in {"time", "t", "time_s"}:
+        times, header, table = table[:, 0], header[1:], table[:, 1:]
+    names: list[str] = []
+    for h in header:
+        base, _, axis = h.rpartition("_")
+        if axis.lower() not in {"x", "y", "z"} or not base:
+            raise InputError(path, f"column {h!r} is not of the form <marker>_x|y|z")
+        if base not in names:
+            names.append(base)
+    markers = np.zeros((table.shape[0], len(names), 3))
+    for col, h in enumerate(header):
+        base, _, axis = h.rpartition("_")
+        markers[:, names.index(base), "xyz".index(axis.lower())] = table[:, col]
+    if times is not None and len(times) > 1:
+        rate = float(round(1.0 / np.median(np.diff(times)), 6))
+    if rate is None:
+        raise InputError(path, "no time column: give the marker rate")
+    return MarkerData(markers, rate, names)
