@@ -45,7 +45,8 @@ def atomic_write(path: str | os.PathLike[str], overwrite: bool = True) -> Iterat
     """
     path = Path(path)
     if path.exists() and not overwrite:
-        raise FileExistsError(f"{path}: exists; pass overwrite to replace it")
+        raise FileExistsError(f"{path}: already exists; choose to overwrite it (--overwrite) "
+                              "or give another name")
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.part-", suffix=path.suffix, dir=path.parent)
     os.close(fd)
@@ -146,9 +147,12 @@ def write_textgrid(path: str | os.PathLike[str], tiers: dict[str, Sequence[Phone
     from praatio import textgrid
 
     tg = textgrid.Textgrid()
+    duration = round(float(duration), 6)
     for name, segs in tiers.items():
         entries = [(round(s.start, 6), round(s.end, 6), s.label) for s in segs]
-        tg.addTier(textgrid.IntervalTier(name, entries, 0.0, float(duration)))
+        if entries and abs(entries[-1][1] - duration) < 1e-3:  # no rounding sliver at the end
+            entries[-1] = (entries[-1][0], duration, entries[-1][2])
+        tg.addTier(textgrid.IntervalTier(name, entries, 0.0, duration))
     with atomic_write(path, overwrite) as tmp:
         tg.save(str(tmp), format="long_textgrid", includeBlankSpaces=True)
 
@@ -213,13 +217,17 @@ def validate_phones(phones: Sequence[PhoneSegment], duration: float,
                     tolerance: float = 0.05) -> list[PhoneSegment]:
     """Check labels are sorted, do not overlap and cover ``[0, duration]``; return them tidied.
 
-    Gaps between segments are filled with ``sil``; the first segment is extended to 0 and the last
-    to ``duration`` when they fall short by at most ``tolerance`` seconds.
+    Gaps between segments are filled with ``sil``; slivers shorter than 1 ms (rounding left-overs)
+    are absorbed by the segment before; the first segment is extended to 0 and the last to
+    ``duration`` when they fall short by at most ``tolerance`` seconds.
     """
     if not phones:
         raise InputError(path, "the label file holds no segments")
     out: list[PhoneSegment] = []
     for i, seg in enumerate(phones):
+        if out and seg.end - seg.start < 1e-3 and seg.start >= out[-1].end - 1e-6:
+            out[-1] = PhoneSegment(out[-1].start, seg.end, out[-1].label)
+            continue
         if not seg.end > seg.start:
             raise InputError(path, f"segment {i + 1} ({seg.label!r}) ends at {seg.end:.3f} s, "
                                    f"not after its start {seg.start:.3f} s")

@@ -1,0 +1,44 @@
+# facetraj — `make run` opens the app on data_samples/, `make test` runs the whole suite.
+PYTHON ?= python3
+VENV   ?= .venv
+BIN    := $(VENV)/bin
+XVFB   := $(if $(DISPLAY),,xvfb-run -a -s "-screen 0 1600x1200x24")
+
+.PHONY: run test lint bench corpus report clean
+
+$(BIN)/python:
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install -q --upgrade pip
+
+$(VENV)/.installed-run: pyproject.toml | $(BIN)/python
+	$(BIN)/pip install -q -e .
+	touch $@
+
+$(VENV)/.installed-test: pyproject.toml | $(BIN)/python
+	$(BIN)/pip install -q -e ".[test]"
+	touch $@ $(VENV)/.installed-run
+
+$(VENV)/.installed-corpus: pyproject.toml | $(BIN)/python
+	$(BIN)/pip install -q -e ".[test,corpus]"
+	touch $@
+
+run: $(VENV)/.installed-run
+	$(BIN)/facetraj gui data_samples
+
+lint: $(VENV)/.installed-test
+	$(BIN)/ruff check .
+
+test: lint
+	$(XVFB) $(BIN)/python -m pytest
+
+bench: $(VENV)/.installed-test
+	$(XVFB) $(BIN)/python -m benchmarks
+
+corpus: $(VENV)/.installed-corpus
+	$(BIN)/facetraj corpus build data_samples
+
+report: $(VENV)/.installed-test
+	$(BIN)/facetraj report data_samples -o docs
+
+clean:
+	rm -rf $(VENV) build *.egg-info .pytest_cache .ruff_cache

@@ -1,0 +1,98 @@
+"""Configuration of training and synthesis.
+
+Every choice the paper leaves open is a field here; ``docs/algorithm.md`` explains each default.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields, replace
+from typing import Literal
+
+Placement = Literal["centres", "edges"]
+DistanceScale = Literal["max", "median", "none"]
+Mode = Literal["phonetic", "acoustic"]
+Smoothing = Literal["triangular", "spline", "none"]
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """Training settings (paper section 2.1-2.2).
+
+    Attributes
+    ----------
+    audio_rate : analysis rate; audio is resampled to it (the paper: 16 kHz).
+    lpc_order : LPC order P, also the LSF dimension.
+    window_s : Hamming analysis window, centred on each marker frame or codeword time.
+    preemphasis : first-order pre-emphasis coefficient before LPC (0 disables it).
+    max_gap_s : marker gaps up to this long are interpolated; longer ones make frames invalid.
+    n_components : number of PCs kept; ``None`` keeps the count reaching ``variance_target``.
+    variance_target : variance fraction used when ``n_components`` is ``None``.
+    context : phones of context C on each side of a context-phone (eq 4).
+    codewords_per_phone : codewords per phone token (the paper: 5).
+    placement : ``centres`` puts codeword k of n at ``start + (k + 1/2) dur / n``; ``edges`` at
+        ``start + k dur / (n - 1)`` (first and last on the boundaries).
+    nu : the constant of eq 3.
+    distance_scale : how D (eq 2) is normalised before eq 3: ``max`` divides by the largest
+        distance, ``median`` by the median off-diagonal distance, ``none`` leaves it in PC units.
+    """
+
+    audio_rate: int = 16000
+    lpc_order: int = 18
+    window_s: float = 0.025
+    preemphasis: float = 0.97
+    max_gap_s: float = 0.1
+    n_components: int | None = 20
+    variance_target: float = 0.99
+    context: int = 3
+    codewords_per_phone: int = 5
+    placement: Placement = "centres"
+    nu: float = 10.0
+    distance_scale: DistanceScale = "max"
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, obj: dict) -> TrainConfig:
+        names = {f.name for f in fields(cls)}
+        return cls(**{k: v for k, v in obj.items() if k in names})
+
+
+@dataclass(frozen=True)
+class SynthConfig:
+    """Synthesis settings (paper section 2.3).
+
+    Attributes
+    ----------
+    n_context_phones : N, the number of visually most similar context-phones searched (eq 4).
+    context : context C used in eq 4 at synthesis (at most the trained context).
+    xi : the constant of eq 4 (> 10 so that the centre phone dominates).
+    nu : override of eq 3's constant; ``None`` uses the model's.
+    mode : ``phonetic`` (labels restrict the search) or ``acoustic`` (whole codebook).
+    gamma_min, gamma_max, gamma_steps : the grid searched for gamma (eqs 6-7).
+    smoothing : ``triangular`` (100 ms zero-phase window), ``spline`` or ``none``.
+    triangle_s : the triangular window's total duration.
+    spline_knot_s : knot spacing of the spline smoother.
+    acoustic_prefilter : in acoustic mode, keep only this many nearest codewords per frame
+        before eqs 6-8 (``None`` searches all 5L).
+    """
+
+    n_context_phones: int = 3
+    context: int = 3
+    xi: float = 20.0
+    nu: float | None = None
+    mode: Mode = "phonetic"
+    gamma_min: float = 0.2
+    gamma_max: float = 2.0
+    gamma_steps: int = 10
+    smoothing: Smoothing = "triangular"
+    triangle_s: float = 0.1
+    spline_knot_s: float = 0.1
+    acoustic_prefilter: int | None = None
+
+    def with_(self, **changes) -> SynthConfig:
+        """A copy with some fields changed."""
+        return replace(self, **changes)
+
+    def to_dict(self) -> dict:
+        return asdict(self)

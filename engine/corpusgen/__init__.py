@@ -1,0 +1,1 @@
+"""Synthetic audio-visual corpus (VocalTractLab + a face rig)."""

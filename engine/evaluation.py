@@ -1,0 +1,240 @@
+"""Evaluation (paper section 3): speech-only frames by median-filtered energy, and the correlation
+between original and synthesized trajectories (Table 2, Figure 5).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+from scipy.signal import medfilt
+
+from .config import SynthConfig
+from .corpus import Corpus
+from .data import Utterance
+from .model import Model, Synthesis, resmooth, synthesize
+
+log = logging.getLogger(__name__)
+
+METRICS = ("whole_face", "lower_lip", "upper_lip")
+
+
+@dataclass(frozen=True)
+class EvalConfig:
+    """Evaluation settings.
+
+    Attributes
+    ----------
+    energy_window_s, energy_hop_s : short-time energy analysis (Hamming window, hop).
+    median_s : median filter over the energy contour (the paper: 112 ms) so that stop closures
+        inside speech are kept.
+    threshold_fraction : speech where the filtered energy in dB exceeds
+        ``floor + fraction * (peak - floor)``, floor and peak being the 5th and 99th percentiles of
+        the utterance's energy in dB.
+    moving_fraction : "whole face" averages over the coordinates whose training standard deviation
+        (head-normalised) is at least this fraction of the largest one.
+    """
+
+    energy_window_s: float = 0.02
+    energy_hop_s: float = 0.004
+    median_s: float = 0.112
+    threshold_fraction: float = 0.3
+    moving_fraction: float = 0.1
+
+
+def short_time_energy_db(audio: np.ndarray, rate: int, window_s: float = 0.02,
+                         hop_s: float = 0.004) -> tuple[np.ndarray, np.ndarray]:
+    """Short-time energy in dB and its frame-centre times."""
+    x = np.asarray(audio, dtype=np.float64)
+    n = max(1, int(round(window_s * rate)))
+    hop = max(1, int(round(hop_s * rate)))
+    pad = np.concatenate([np.zeros(n // 2), x, np.zeros(n)])
+    count = len(x) // hop + 1
+    idx = (np.arange(count) * hop)[:, None] + np.arange(n)[None, :]
+    frames = pad[idx] * np.hamming(n)
+    energy = (frames**2).sum(axis=1) / n
+    return 10 * np.log10(energy + 1e-12), np.arange(count) * hop / rate
+
+
+def speech_mask(audio: np.ndarray, rate: int, times: np.ndarray,
+                config: EvalConfig | None = None) -> np.ndarray:
+    """Speech (True) or silence per time in ``times``: energy, 112 ms median filter, threshold.
+
+    Examples
+    --------
+    >>> rate = 16000
+    >>> x = np.zeros(rate); x[4000:12000] = np.sin(np.arange(8000) * 0.3)   # 0.25-0.75 s tone
+    >>> m = speech_mask(x, rate, np.array([0.1, 0.5, 0.9]))
+    >>> m.tolist()
+    [False, True, False]
+    """
+    config = config or EvalConfig()
+    e_db, _e_t = short_time_energy_db(audio, rate, config.energy_window_s, config.energy_hop_s)
+    k = int(round(config.median_s / config.energy_hop_s))
+    k = k + 1 if k % 2 == 0 else k
+    filtered = medfilt(e_db, k) if len(e_db) >= k else e_db
+    floor, peak = np.percentile(filtered, [5, 99])
+    threshold = floor + config.threshold_fraction * (peak - floor)
+    idx = np.clip(np.round(np.asarray(times) / config.energy_hop_s).astype(int), 0, len(e_db) - 1)
+    return filtered[idx] > threshold
+
+
+def pearson(a: np.ndarray, b: np.ndarray) -> float:
+    """Pearson correlation of two 1-D series; NaN when either is constant or shorter than 3.
+
+    Examples
+    --------
+    >>> pearson(np.array([1.0, 2, 3, 4]), np.array([2.0, 4, 6, 8.5]))
+    0.9982...
+    """
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    if len(a) < 3:
+        return float("nan")
+    a = a - a.mean()
+    b = b - b.mean()
+    den = np.sqrt((a * a).sum() * (b * b).sum())
+    return float((a * b).sum() / den) if den > 0 else float("nan")
+
+
+def moving_coordinates(model: Model, fraction: float = 0.1) -> np.ndarray:
+    """Flat indices (into ``M * 3``) of the coordinates that move: training std >= ``fraction`` of
+    the largest coordinate std. These make up the "whole face" average."""
+    std = model.coord_std
+    return np.flatnonzero(std >= fraction * std.max())
+
+
+def trajectory_correlations(original: np.ndarray, synthesized: np.ndarray, mask: np.ndarray,
+                            model: Model, config: EvalConfig | None = None) -> dict[str, float]:
+    """Correlations on the frames in ``mask``: whole face (mean over moving coordinates), lower
+    lip y and upper lip y. ``original`` and ``synthesized`` are ``(T, M, 3)`` head-normalised."""
+    config = config or EvalConfig()
+    ok = mask & np.isfinite(original).all(axis=(1, 2)) & np.isfinite(synthesized).all(axis=(1, 2))
+    o = original[ok].reshape(int(ok.sum()), -1)
+    s = synthesized[ok].reshape(int(ok.sum()), -1)
+    coords = moving_coordinates(model, config.moving_fraction)
+    per = np.array([pearson(o[:, c], s[:, c]) for c in coords])
+    y = 1
+    return {
+        "whole_face": float(np.nanmean(per)) if np.isfinite(per).any() else float("nan"),
+        "lower_lip": pearson(o[:, model.lower_lip * 3 + y], s[:, model.lower_lip * 3 + y]),
+        "upper_lip": pearson(o[:, model.upper_lip * 3 + y], s[:, model.upper_lip * 3 + y]),
+    }
+
+
+@dataclass
+class UtteranceScore:
+    """Correlations of one utterance under one condition."""
+
+    utterance: str
+    split: str
+    mode: str
+    smoothing: str
+    n_context_phones: int
+    whole_face: float
+    lower_lip: float
+    upper_lip: float
+    speech_frames: int
+
+
+@dataclass
+class EvalResult:
+    """Per-utterance scores and their averages per condition."""
+
+    scores: list[UtteranceScore] = field(default_factory=list)
+
+    def mean(self, split: str, smoothing: str, mode: str = "phonetic",
+             n: int | None = None) -> dict[str, float]:
+        """Mean correlation over utterances of one condition (the paper averages utterances)."""
+        rows = [r for r in self.scores if r.split == split and r.smoothing == smoothing
+                and r.mode == mode and (n is None or r.n_context_phones == n)]
+        return {m: float(np.nanmean([getattr(r, m) for r in rows])) if rows else float("nan")
+                for m in METRICS}
+
+    def conditions(self) -> list[tuple[str, str, str, int]]:
+        seen: dict[tuple[str, str, str, int], None] = {}
+        for r in self.scores:
+            seen[(r.split, r.mode, r.smoothing, r.n_context_phones)] = None
+        return list(seen)
+
+    def table(self) -> list[dict]:
+        """One row per condition with the three mean correlations (Table 2 layout)."""
+        return [{"split": sp, "mode": mo, "smoothing": sm, "n_context_phones": n,
+                 **self.mean(sp, sm, mo, n)} for sp, mo, sm, n in self.conditions()]
+
+    def to_json(self) -> dict:
+        return {"table": self.table(), "utterances": [asdict(r) for r in self.scores]}
+
+
+def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
+                       config: SynthConfig | None = None,
+                       smoothings: Sequence[str] = ("triangular", "spline"),
+                       eval_config: EvalConfig | None = None,
+                       synthesis: Synthesis | None = None) -> list[UtteranceScore]:
+    """Synthesize one utterance and score each smoothing against its original markers."""
+    config = config or SynthConfig()
+    if utt.markers is None:
+        raise ValueError(f"{utt.name}: no original markers to compare with")
+    original = model.normalise_markers(utt.markers)
+    res = synthesis or synthesize(model, utt.audio, utt.sample_rate, utt.phones, config,
+                                  n_frames=utt.n_frames, source=utt.name)
+    mask = speech_mask(utt.audio, utt.sample_rate, res.times, eval_config)
+    out = []
+    for sm in smoothings:
+        markers = resmooth(model, res, sm)
+        c = trajectory_correlations(original, markers, mask, model, eval_config)
+        out.append(UtteranceScore(utt.name, split, config.mode, sm, config.n_context_phones,
+                                  c["whole_face"], c["lower_lip"], c["upper_lip"], int(mask.sum())))
+    return out
+
+
+def evaluate(model: Model, corpus: Corpus, splits: Iterable[str] = ("train", "test"),
+             configs: Sequence[SynthConfig] | None = None,
+             smoothings: Sequence[str] = ("triangular", "spline"),
+             eval_config: EvalConfig | None = None,
+             progress: Callable[[float, str], None] | None = None) -> EvalResult:
+    """Score every utterance of ``splits`` under each synthesis config (Table 2 and more)."""
+    configs = list(configs or [SynthConfig()])
+    splits = list(splits)
+    ids = [(sp, u) for sp in splits for u in getattr(corpus.info, sp)]
+    result = EvalResult()
+    for k, (sp, utt_id) in enumerate(ids):
+        if progress:
+            progress(k / max(len(ids), 1), f"{sp}: {utt_id}")
+        utt = corpus.utterance(utt_id)
+        for cfg in configs:
+            result.scores.extend(evaluate_utterance(model, utt, sp, cfg, smoothings, eval_config))
+    if progress:
+        progress(1.0, "done")
+    return result
+
+
+def table2(model: Model, corpus: Corpus, acoustic: bool = True,
+           eval_config: EvalConfig | None = None,
+           progress: Callable[[float, str], None] | None = None) -> EvalResult:
+    """The paper's Table 2 (train/test x triangular/spline, N = 3), plus acoustic-only rows."""
+    configs = [SynthConfig(mode="phonetic")]
+    if acoustic:
+        configs.append(SynthConfig(mode="acoustic"))
+    return evaluate(model, corpus, ("train", "test"), configs, ("triangular", "spline"),
+                    eval_config, progress)
+
+
+def sweep_n(model: Model, corpus: Corpus, ns: Sequence[int] = tuple(range(1, 11)),
+            splits: Sequence[str] = ("train", "test"), eval_config: EvalConfig | None = None,
+            progress: Callable[[float, str], None] | None = None) -> EvalResult:
+    """Correlation against N (the paper's Figure 5), triangular smoothing."""
+    configs = [SynthConfig(n_context_phones=n) for n in ns]
+    return evaluate(model, corpus, splits, configs, ("triangular",), eval_config, progress)
+
+
+def format_table2(result: EvalResult) -> str:
+    """Table 2 as text: one line per condition with whole face, lower lip, upper lip."""
+    lines = [f"{'Test condition':<34} {'Whole Face':>10} {'Lower Lip':>10} {'Upper Lip':>10}"]
+    for row in result.table():
+        name = f"{row['split'].title()} ({row['smoothing']}, {row['mode']}, N={row['n_context_phones']})"
+        lines.append(f"{name:<34} {row['whole_face']:>10.4f} {row['lower_lip']:>10.4f} "
+                     f"{row['upper_lip']:>10.4f}")
+    return "\n".join(lines)

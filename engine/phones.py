@@ -1,0 +1,98 @@
+"""Phone labels and context-phones (paper section 2.1, Figure 3)."""
+
+from __future__ import annotations
+
+import logging
+import re
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from .data import PhoneSegment
+from .errors import InputError
+
+log = logging.getLogger(__name__)
+
+SILENCE = "sil"
+
+#: The 39 ARPAbet phones of the CMU Pronouncing Dictionary, plus silence.
+ARPABET = (
+    "aa ae ah ao aw ay b ch d dh eh er ey f g hh ih iy jh k l m n ng ow oy p r s sh t th "
+    "uh uw v w y z zh"
+).split()
+
+#: Labels read as silence.
+SILENCE_LABELS = frozenset({"", "sil", "sp", "pau", "h#", "#", "spn", "breath", "<p:>", "silence"})
+
+#: Extended ARPAbet / TIMIT symbols and the nearest CMU phone used when the model lacks them.
+FALLBACK = {
+    "ax": "ah", "axr": "er", "ax-h": "ah", "ix": "ih", "ux": "uw", "el": "l", "em": "m",
+    "en": "n", "eng": "ng", "nx": "n", "dx": "t", "hv": "hh", "q": "t",
+    "bcl": "b", "dcl": "d", "gcl": "g", "pcl": "p", "tcl": "t", "kcl": "k",
+}
+
+
+def normalise_label(label: str) -> str:
+    """Lower-case, strip ARPAbet stress digits, map silence labels to ``sil``.
+
+    Examples
+    --------
+    >>> [normalise_label(x) for x in ["AH0", "sp", "T", ""]]
+    ['ah', 'sil', 't', 'sil']
+    """
+    lab = re.sub(r"[012]$", "", label.strip().lower())
+    return SILENCE if lab in SILENCE_LABELS else lab
+
+
+def map_labels(phones: Sequence[PhoneSegment], known: Sequence[str],
+               table: Mapping[str, str] | None = None, path: str | None = None,
+               strict: bool = False) -> list[PhoneSegment]:
+    """Normalise labels and map those the model does not know.
+
+    ``table`` (a user's label map, e.g. MOCHA -> ARPAbet) is applied first, then
+    :data:`FALLBACK`. A label still unknown raises :class:`InputError` listing the known phones.
+    With ``strict`` a fallback is an error too. Each fallback is logged as a warning.
+    """
+    known_set = set(known)
+    out = []
+    warned: set[str] = set()
+    for seg in phones:
+        raw = seg.label
+        lab = normalise_label(raw)
+        if table:
+            lab = normalise_label(table.get(raw, table.get(lab, lab)))
+        if lab not in known_set:
+            alt = FALLBACK.get(lab)
+            if alt in known_set and not strict:
+                if lab not in warned:
+                    log.warning("%s: phone %r is not in the model; using %r", path or "labels",
+                                lab, alt)
+                    warned.add(lab)
+                lab = alt
+            else:
+                raise InputError(path, f"phone {raw!r} at {seg.start:.3f} s is not in the model; "
+                                       f"known phones: {' '.join(sorted(known_set))}")
+        out.append(PhoneSegment(seg.start, seg.end, lab))
+    return out
+
+
+def context_ids(ids: Sequence[int], context: int, pad: int) -> np.ndarray:
+    """Context-phones of a phone sequence: ``(n, 2C + 1)`` ids ``[l_C .. l_1, c, r_1 .. r_C]``.
+
+    Positions beyond the utterance are ``pad`` (the silence id).
+
+    Examples
+    --------
+    >>> context_ids([5, 6, 7], context=1, pad=0).tolist()
+    [[0, 5, 6], [5, 6, 7], [6, 7, 0]]
+    """
+    ids = np.asarray(ids, dtype=np.int64)
+    padded = np.concatenate([np.full(context, pad), ids, np.full(context, pad)])
+    n = len(ids)
+    return np.stack([padded[i:i + n] for i in range(2 * context + 1)], axis=1)
+
+
+def segment_index(phones: Sequence[PhoneSegment], times: np.ndarray) -> np.ndarray:
+    """Index of the segment holding each time (times beyond the ends go to the first/last)."""
+    ends = np.array([s.end for s in phones])
+    return np.clip(np.searchsorted(ends, np.asarray(times), side="right"), 0, len(phones) - 1)

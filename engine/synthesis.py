@@ -1,0 +1,150 @@
+"""Codebook weighting and PC synthesis (paper section 2.3, eqs 5-8), vectorised over frames."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def perceptual_weights(w: np.ndarray) -> np.ndarray:
+    """Eq 5 (first line): ``h_k = 1 / min(|w_k - w_(k-1)|, |w_k - w_(k+1)|)``, ``w_0 = 0``,
+    ``w_(P+1) = pi``. Closely spaced LSFs (formants) get large weights (Laroia et al. 1991).
+
+    ``w`` is ``(..., P)`` LSF in radians.
+
+    Examples
+    --------
+    >>> np.round(perceptual_weights(np.array([0.5, 0.6, 2.0])), 4).tolist()
+    [10.0, 10.0, 0.876]
+    """
+    w = np.asarray(w, dtype=np.float64)
+    lead = w.shape[:-1]
+    padded = np.concatenate([np.zeros((*lead, 1)), w, np.full((*lead, 1), np.pi)], axis=-1)
+    gaps = np.diff(padded, axis=-1)
+    nearest = np.minimum(gaps[..., :-1], gaps[..., 1:])
+    return 1.0 / np.maximum(nearest, 1e-6)
+
+
+def lsf_distances(w: np.ndarray, codewords: np.ndarray, h: np.ndarray | None = None) -> np.ndarray:
+    """Eq 5 (second line): ``d_i = sum_k h_k |w_k - L_ik|``.
+
+    ``w`` is ``(..., P)``, ``codewords`` ``(..., I, P)`` broadcastable against ``w[..., None, :]``;
+    the result is ``(..., I)``.
+
+    Examples
+    --------
+    >>> w = np.array([0.5, 0.6, 2.0])
+    >>> L = np.array([[0.5, 0.6, 2.0], [0.6, 0.6, 2.0]])
+    >>> np.round(lsf_distances(w, L), 4).tolist()
+    [0.0, 1.0]
+    """
+    w = np.asarray(w, dtype=np.float64)
+    if h is None:
+        h = perceptual_weights(w)
+    return np.einsum("...ik,...k->...i", np.abs(w[..., None, :] - codewords), h)
+
+
+def codebook_weights(d: np.ndarray, gamma: float | np.ndarray) -> np.ndarray:
+    """Eq 6: ``v_i = exp(-gamma d_i) / sum_l exp(-gamma d_l)``, a numerically stable softmax.
+
+    Examples
+    --------
+    >>> v = codebook_weights(np.array([0.0, np.log(3.0)]), 1.0)
+    >>> np.round(v, 4).tolist()
+    [0.75, 0.25]
+    """
+    z = -np.asarray(gamma)[..., None] * np.asarray(d)
+    z = z - z.max(axis=-1, keepdims=True)
+    e = np.exp(z)
+    return e / e.sum(axis=-1, keepdims=True)
+
+
+def approximate_lsf(v: np.ndarray, codewords: np.ndarray) -> np.ndarray:
+    """Eq 7: ``w-hat_k = sum_i v_i L_ik``, the LSF vector rebuilt from the weighted codewords."""
+    return np.einsum("...i,...ik->...k", v, codewords)
+
+
+def gamma_grid(lo: float = 0.2, hi: float = 2.0, steps: int = 10) -> np.ndarray:
+    """The incremental search grid for gamma (eq 7's criterion): ``steps`` values in [lo, hi]."""
+    return np.linspace(lo, hi, steps)
+
+
+@dataclass
+class FrameWeights:
+    """Per-frame result of eqs 5-8.
+
+    Attributes
+    ----------
+    pcs : ``(T, K)`` the synthesized PC vectors p-hat(t) (eq 8, unsmoothed).
+    gamma : ``(T,)`` the gamma chosen per frame.
+    weights : ``(T, I)`` the weights v_i of the candidate codewords.
+    candidates : ``(T, I)`` codebook indices of the candidates.
+    lsf_hat : ``(T, P)`` the approximated LSF w-hat (eq 7).
+    error : ``(T,)`` the perceptually weighted distance between w and w-hat.
+    """
+
+    pcs: np.ndarray
+    gamma: np.ndarray
+    weights: np.ndarray
+    candidates: np.ndarray
+    lsf_hat: np.ndarray
+    error: np.ndarray
+
+
+def weight_frames(w: np.ndarray, candidates: np.ndarray, cb_lsf: np.ndarray, cb_pcs: np.ndarray,
+                  gammas: np.ndarray, chunk: int = 256) -> FrameWeights:
+    """Eqs 5-8 for every frame: distances to its candidate codewords, gamma searched on
+    ``gammas`` to minimise ``sum_k h_k |w_k - w-hat_k|``, and ``p-hat = sum_i v_i F_i``.
+
+    ``w`` is ``(T, P)`` input LSFs, ``candidates`` ``(T, I)`` codebook indices per frame,
+    ``cb_lsf`` ``(5L, P)`` the codebook LSFs L_i and ``cb_pcs`` ``(5L, K)`` its PC vectors F_i.
+    Work is chunked over frames to bound memory (about 4 million values per chunk).
+    """
+    n_frames = w.shape[0]
+    n_cand = candidates.shape[1]
+    chunk = max(1, min(chunk, int(4e6 // max(1, n_cand * max(w.shape[1], len(gammas))))))
+    pcs = np.empty((n_frames, cb_pcs.shape[1]))
+    gam = np.empty(n_frames)
+    weights = np.empty((n_frames, n_cand))
+    lsf_hat = np.empty_like(w, dtype=np.float64)
+    err = np.empty(n_frames)
+    gammas = np.asarray(gammas, dtype=np.float64)
+    for a in range(0, n_frames, chunk):
+        b = min(a + chunk, n_frames)
+        wc = w[a:b]
+        h = perceptual_weights(wc)                               # (t, P)   eq 5
+        cand_lsf = cb_lsf[candidates[a:b]]                       # (t, I, P)
+        d = lsf_distances(wc, cand_lsf, h)                       # (t, I)   eq 5
+        v = codebook_weights(d[:, None, :], gammas[None, :])     # (t, G, I) eq 6
+        what = np.einsum("tgi,tik->tgk", v, cand_lsf)            # (t, G, P) eq 7
+        e = np.einsum("tgk,tk->tg", np.abs(what - wc[:, None, :]), h)
+        best = e.argmin(axis=1)
+        rows = np.arange(b - a)
+        vb = v[rows, best]
+        gam[a:b] = gammas[best]
+        weights[a:b] = vb
+        lsf_hat[a:b] = what[rows, best]
+        err[a:b] = e[rows, best]
+        pcs[a:b] = np.einsum("ti,tik->tk", vb, cb_pcs[candidates[a:b]])  # eq 8
+    return FrameWeights(pcs, gam, weights, np.asarray(candidates), lsf_hat, err)
+
+
+def nearest_codewords(w: np.ndarray, cb_lsf: np.ndarray, count: int | None,
+                      chunk: int = 128) -> np.ndarray:
+    """Acoustic-only candidates: all ``5L`` codewords, or the ``count`` nearest by eq 5's distance.
+
+    Returns ``(T, I)`` codebook indices.
+    """
+    n_frames, n_cb = w.shape[0], cb_lsf.shape[0]
+    if count is None or count >= n_cb:
+        return np.broadcast_to(np.arange(n_cb), (n_frames, n_cb))
+    out = np.empty((n_frames, count), dtype=np.int64)
+    cb32 = cb_lsf.astype(np.float32)
+    for a in range(0, n_frames, chunk):
+        b = min(a + chunk, n_frames)
+        wc = w[a:b].astype(np.float32)
+        h = perceptual_weights(wc).astype(np.float32)
+        d = np.einsum("tik,tk->ti", np.abs(wc[:, None, :] - cb32[None]), h)
+        out[a:b] = np.argpartition(d, count - 1, axis=1)[:, :count]
+    return out
