@@ -335,7 +335,8 @@ def write_marker_tsv(path: str | os.PathLike[str], markers: np.ndarray, rate: fl
     header = ["time"] + [f"{n}_{a}" for n in names for a in "xyz"]
     table = np.column_stack([t, markers.reshape(markers.shape[0], -1)])
     with atomic_write(path, overwrite) as tmp:
-        np.savetxt(tmp, table, delimiter="\t", header="\t".join(header), comments="", fmt="%.4f")
+        np.savetxt(tmp, table, delimiter="\t", header="\t".join(header), comments="",
+                   fmt=["%.6f"] + ["%.4f"] * (table.shape[1] - 1))
 
 
 def read_marker_table(path: str | os.PathLike[str], rate: float | None = None) -> MarkerData:
@@ -373,7 +374,8 @@ def read_marker_table(path: str | os.PathLike[str], rate: float | None = None) -
         base, _, axis = h.rpartition("_")
         markers[:, names.index(base), "xyz".index(axis.lower())] = table[:, col]
     if times is not None and len(times) > 1:
-        rate = float(round(1.0 / np.median(np.diff(times)), 6))
+        rate = (len(times) - 1) / (times[-1] - times[0])
+        rate = float(round(rate)) if abs(rate - round(rate)) < 1e-3 * rate else float(rate)
     if rate is None:
         raise InputError(path, "no time column: give the marker rate")
     return MarkerData(markers, rate, names)

@@ -1,0 +1,57 @@
+"""Shared fixtures: the toy corpus (fast, made on the fly) and the default corpus (data_samples/)."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+ROOT = Path(__file__).resolve().parent.parent
+DEFAULT_CORPUS = ROOT / "data_samples"
+MOCHA = ROOT.parent / "shared" / "data" / "mocha_fsew0_001"
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _isolated_cache(tmp_path_factory):
+    """Keep the app's model cache out of the user's home during tests."""
+    os.environ.setdefault("FACETRAJ_CACHE_DIR", str(tmp_path_factory.mktemp("cache")))
+
+
+@pytest.fixture(scope="session")
+def toy_corpus_dir(tmp_path_factory) -> Path:
+    from toycorpus import build_toy_corpus
+
+    return build_toy_corpus(tmp_path_factory.mktemp("toy"))
+
+
+@pytest.fixture(scope="session")
+def toy_corpus(toy_corpus_dir):
+    from engine.corpus import load_corpus
+
+    return load_corpus(toy_corpus_dir)
+
+
+@pytest.fixture(scope="session")
+def toy_model(toy_corpus):
+    from engine.model import train
+
+    return train(toy_corpus)
+
+
+@pytest.fixture(scope="session")
+def default_corpus():
+    from engine.corpus import load_corpus
+
+    assert (DEFAULT_CORPUS / "corpus.json").exists(), "the default corpus data_samples/ is missing"
+    return load_corpus(DEFAULT_CORPUS)
+
+
+@pytest.fixture(scope="session")
+def default_model(default_corpus):
+    from engine.model import train
+
+    return train(default_corpus)

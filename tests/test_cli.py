@@ -1,0 +1,78 @@
+"""The facetraj command, run in-process: every subcommand, and exit status 2 on bad input."""
+
+import json
+
+import numpy as np
+import pytest
+
+from engine.cli import main
+from engine.formats import read_c3d, read_marker_table
+
+
+@pytest.fixture(scope="module")
+def model_file(toy_corpus_dir, tmp_path_factory):
+    out = tmp_path_factory.mktemp("cli") / "model.npz"
+    assert main(["-q", "train", str(toy_corpus_dir), "-o", str(out)]) == 0
+    return out
+
+
+def test_synth_outputs(model_file, toy_corpus_dir, tmp_path, capsys):
+    wav = toy_corpus_dir / "toy030.wav"
+    tg = toy_corpus_dir / "toy030.TextGrid"
+    assert main(["-q", "synth", str(model_file), str(wav), "--labels", str(tg),
+                 "-o", str(tmp_path / "o.c3d")]) == 0
+    c3d = read_c3d(tmp_path / "o.c3d")
+    assert c3d.markers.shape[1:] == (12, 3) and c3d.rate == 60.0
+    assert main(["-q", "synth", str(model_file), str(wav), "--smoothing", "spline", "-N", "5",
+                 "-o", str(tmp_path / "o.tsv")]) == 0
+    tsv = read_marker_table(tmp_path / "o.tsv")
+    assert tsv.markers.shape == c3d.markers.shape
+    assert main(["-q", "synth", str(model_file), str(wav), "--labels", str(tg),
+                 "-o", str(tmp_path / "o.npz")]) == 0
+    with np.load(tmp_path / "o.npz", allow_pickle=False) as z:
+        assert z["markers"].shape == c3d.markers.shape
+        np.testing.assert_allclose(z["markers"], c3d.markers, atol=0.006)
+
+
+def test_eval_sweep_similarity(model_file, toy_corpus_dir, capsys):
+    assert main(["-q", "eval", str(model_file), str(toy_corpus_dir), "--split", "test",
+                 "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    rows = {(r["split"], r["smoothing"]): r for r in out["table"]}
+    assert set(rows) == {("test", "triangular"), ("test", "spline")}
+    assert 0.5 < rows[("test", "triangular")]["lower_lip"] <= 1.0
+    assert main(["-q", "sweep", str(model_file), str(toy_corpus_dir), "--max-n", "2",
+                 "--split", "test", "--json"]) == 0
+    sweep = json.loads(capsys.readouterr().out)
+    assert sweep["n"] == [1, 2] and len(sweep["whole_face"]["test"]) == 2
+    assert main(["-q", "similarity", str(model_file)]) == 0
+    table = capsys.readouterr().out.splitlines()
+    assert table[0].split()[:2] == ["Phoneme", "Closest"] and len(table) == 1 + 7
+    assert main(["-q", "similarity", str(model_file), "--csv", "--nu", "5"]) == 0
+    csv = capsys.readouterr().out.splitlines()
+    assert csv[0].split(",")[0] == "phone" and len(csv) == 1 + 8
+
+
+@pytest.mark.parametrize("args, message", [
+    (["synth", "{model}", "{missing}", "-o", "{out}"], "missing.wav: no such audio file"),
+    (["synth", "{bad}", "{wav}", "-o", "{out}"], "bad.npz: not a facetraj model"),
+    (["synth", "{model}", "{wav}", "--labels", "{short}", "-o", "{out}"], "short.lab: labels end at"),
+    (["synth", "{model}", "{wav}", "--labels", "{unknown}", "-o", "{out}"], "unknown.lab: phone 'zz'"),
+    (["synth", "{model}", "{wav}", "-o", "{exists}"], "exists.c3d: already exists"),
+    (["train", "{empty}", "-o", "{out}"], "no corpus.json"),
+])
+def test_bad_input_exit_2(args, message, model_file, toy_corpus_dir, tmp_path, capsys):
+    (tmp_path / "bad.npz").write_text("not a model")
+    (tmp_path / "short.lab").write_text("0 0.5 sil\n")
+    (tmp_path / "unknown.lab").write_text("0 0.5 sil\n0.5 1.5 zz\n1.5 1.8333 sil\n")
+    (tmp_path / "exists.c3d").write_text("keep me")
+    (tmp_path / "empty").mkdir()
+    paths = {"model": model_file, "missing": tmp_path / "missing.wav", "out": tmp_path / "o.c3d",
+             "bad": tmp_path / "bad.npz", "wav": toy_corpus_dir / "toy030.wav",
+             "short": tmp_path / "short.lab", "unknown": tmp_path / "unknown.lab",
+             "exists": tmp_path / "exists.c3d", "empty": tmp_path / "empty"}
+    code = main(["-q", *[a.format(**paths) for a in args]])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert message in err and "Traceback" not in err
+    assert (tmp_path / "exists.c3d").read_text() == "keep me"

@@ -1,0 +1,60 @@
+"""Speech/silence detection and correlation measures (paper section 3)."""
+
+import numpy as np
+import pytest
+
+from engine.evaluation import (
+    EvalConfig,
+    moving_coordinates,
+    pearson,
+    speech_mask,
+    trajectory_correlations,
+)
+
+
+def _speech_like(rate=16000):
+    x = np.zeros(rate * 2)
+    rng = np.random.default_rng(0)
+    x[8000:24000] = 0.3 * rng.standard_normal(16000)       # speech 0.5 - 1.5 s
+    x[15200:16000] = 0.0                                     # a 50 ms stop closure inside it
+    x += 1e-4 * rng.standard_normal(len(x))
+    return x
+
+
+def test_speech_mask_keeps_stop_closures():
+    x = _speech_like()
+    t = np.array([0.2, 0.7, 0.975, 1.2, 1.8])
+    mask = speech_mask(x, 16000, t)
+    assert mask.tolist() == [False, True, True, True, False]
+    # without the 112 ms median filter the closure would be called silence
+    assert not speech_mask(x, 16000, np.array([0.975]), EvalConfig(median_s=0.004))[0]
+
+
+def test_pearson_hand_example():
+    assert pearson(np.array([1.0, 2, 3]), np.array([2.0, 4, 6])) == pytest.approx(1.0)
+    assert pearson(np.array([1.0, 2, 3]), np.array([3.0, 2, 1])) == pytest.approx(-1.0)
+    # x = [1 2 3 4], y = [1 3 2 4]: cov 1.25*4/4, r = 0.8
+    assert pearson(np.array([1.0, 2, 3, 4]), np.array([1.0, 3, 2, 4])) == pytest.approx(0.8)
+    assert np.isnan(pearson(np.ones(5), np.arange(5.0)))
+
+
+def test_moving_coordinates_and_correlations(toy_model):
+    coords = moving_coordinates(toy_model, 0.1)
+    std = toy_model.coord_std
+    assert np.all(std[coords] >= 0.1 * std.max())
+    fixed_coords = {3 * i + a for i in toy_model.fixed for a in range(3)}
+    assert not fixed_coords & set(coords.tolist())     # forehead / nose bridge never count
+    rng = np.random.default_rng(1)
+    t = 120
+    orig = np.repeat(toy_model.neutral_face()[None], t, axis=0) + rng.standard_normal((t, 12, 3))
+    synth = orig.copy()
+    synth[:, toy_model.upper_lip, 1] = -orig[:, toy_model.upper_lip, 1]
+    mask = np.ones(t, bool)
+    mask[:10] = False
+    c = trajectory_correlations(orig, synth, mask, toy_model)
+    assert c["lower_lip"] == pytest.approx(1.0)
+    assert c["upper_lip"] == pytest.approx(-1.0)
+    n = len(coords)
+    up_y = 3 * toy_model.upper_lip + 1
+    expected = (n - 1 + (-1.0)) / n if up_y in coords else 1.0
+    assert c["whole_face"] == pytest.approx(expected)

@@ -1,0 +1,96 @@
+"""LSF (paper 2.1): LPC by Levinson-Durbin and LSF from the sum/difference polynomials, checked
+against independent implementations (spectrum's poly2lsf, scipy's Toeplitz solver)."""
+
+import numpy as np
+import pytest
+from scipy.linalg import solve_toeplitz
+from scipy.signal import lfilter
+
+from engine.lsf import analysis_frames, levinson, lpc, lsf2poly, lsf_at, poly2lsf
+
+
+def _stable_poly(rng, order):
+    """A random minimum-phase LPC polynomial from random poles inside the unit circle."""
+    poles = []
+    for _ in range(order // 2):
+        r, th = rng.uniform(0.5, 0.97), rng.uniform(0.05, np.pi - 0.05)
+        poles += [r * np.exp(1j * th), r * np.exp(-1j * th)]
+    return np.real(np.poly(poles))
+
+
+@pytest.mark.parametrize("order", [2, 10, 18])
+def test_poly2lsf_matches_spectrum(order):
+    spectrum = pytest.importorskip("spectrum", reason="the test extra provides spectrum")
+    rng = np.random.default_rng(order)
+    for _ in range(20):
+        a = _stable_poly(rng, order)
+        ours = poly2lsf(a)
+        theirs = np.sort(np.asarray(spectrum.poly2lsf(a)))
+        np.testing.assert_allclose(ours, theirs, atol=1e-6)
+
+
+def test_poly2lsf_batched_equals_single():
+    rng = np.random.default_rng(3)
+    polys = np.stack([_stable_poly(rng, 18) for _ in range(7)])
+    batch = poly2lsf(polys)
+    for a, row in zip(polys, batch, strict=True):
+        np.testing.assert_allclose(poly2lsf(a), row, atol=1e-12)
+
+
+def test_lsf_properties_and_round_trip():
+    rng = np.random.default_rng(4)
+    a = _stable_poly(rng, 18)
+    w = poly2lsf(a)
+    assert np.all(np.diff(w) > 0) and w[0] > 0 and w[-1] < np.pi
+    np.testing.assert_allclose(lsf2poly(w), a, atol=1e-9)
+
+
+def test_flat_spectrum_gives_uniform_lsf():
+    # A(z) = 1: P and Q roots are the (P+1)-th roots of -1 and 1 -> LSF k*pi/(P+1)
+    w = poly2lsf(np.r_[1.0, np.zeros(18)])
+    np.testing.assert_allclose(w, np.arange(1, 19) * np.pi / 19, atol=1e-9)
+
+
+def test_levinson_matches_toeplitz_solve():
+    rng = np.random.default_rng(5)
+    x = lfilter([1], [1, -1.2, 0.7], rng.standard_normal(4000))
+    r = np.array([x[: len(x) - k] @ x[k:] for k in range(19)])
+    a, err = levinson(r, 18)
+    np.testing.assert_allclose(a[1:], -solve_toeplitz(r[:18], r[1:19]), atol=1e-10)
+    assert err == pytest.approx(r[0] + a[1:] @ r[1:19])
+
+
+def test_lpc_recovers_ar2_process():
+    rng = np.random.default_rng(6)
+    x = lfilter([1], [1, -1.2, 0.7], rng.standard_normal(40000))
+    a = lpc(x[None, :] * np.hamming(len(x)), 2)[0]
+    np.testing.assert_allclose(a, [1, -1.2, 0.7], atol=0.02)
+
+
+def test_lsf_pair_brackets_a_resonance():
+    # one sharp resonance at 1000 Hz: the closest LSF pair sits near 2 pi 1000 / 16000 rad
+    # (within the bias of a 25 ms Hamming-window LPC estimate, ~0.03 rad = 76 Hz)
+    rate, f = 16000, 1000.0
+    r = 0.99
+    x = lfilter([1], [1, -2 * r * np.cos(2 * np.pi * f / rate), r * r],
+                np.random.default_rng(7).standard_normal(rate))
+    w = lsf_at(x, rate, np.array([0.5]), order=4, preemphasis=0.0)[0]
+    target = 2 * np.pi * f / rate
+    gaps = np.diff(w)
+    k = int(np.argmin(gaps))
+    assert abs((w[k] + w[k + 1]) / 2 - target) < 0.03
+    assert gaps[k] < 0.1
+
+
+def test_frames_are_centred_on_times():
+    x = np.zeros(1000)
+    x[500] = 1.0
+    fr = analysis_frames(x, 1000, np.array([0.5]), window_s=0.011)  # 11 samples, centre index 5
+    assert np.argmax(fr[0]) == 5
+
+
+def test_resampling_to_16k():
+    rng = np.random.default_rng(8)
+    x = rng.standard_normal(44100)
+    w44 = lsf_at(x, 44100, np.array([0.3, 0.6]))
+    assert w44.shape == (2, 18) and np.all(np.isfinite(w44))
