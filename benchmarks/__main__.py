@@ -1,0 +1,142 @@
+"""``python -m benchmarks [--smoke] [--corpus DIR] [--out FILE] [--only GROUP ...]``
+
+Runs the training, synthesis and scaling benchmarks (and the app playback benchmark,
+``benchmarks/playback.py``, when it exists and a display is available), prints one table and
+writes it, with the machine described, to ``docs/benchmarks.md``.
+
+``--smoke`` runs a tiny size (a few utterances, short inputs) that CI can afford in well under a
+minute; it writes the Markdown only when ``--out`` is given, so that it never replaces the
+full-size results.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import importlib
+import importlib.util
+import logging
+import os
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+from . import scaling, synth, train
+from .common import REPO, BenchContext, BenchRow, format_table, load_context, machine_info, markdown_table
+
+log = logging.getLogger("benchmarks")
+
+GROUPS = ("train", "synth", "scaling", "playback")
+DEFAULT_OUT = REPO / "docs" / "benchmarks.md"
+
+
+def display_available() -> tuple[bool, str]:
+    """Whether a Qt window can open here, and why not."""
+    if os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
+        return True, ""
+    if os.environ.get("QT_QPA_PLATFORM") == "offscreen":
+        return True, ""
+    return False, "no DISPLAY (run under xvfb-run, as make bench does)"
+
+
+def run_playback(smoke: bool) -> list[BenchRow]:
+    """Call ``benchmarks.playback.main(argv)`` when it exists and a display is available."""
+    if importlib.util.find_spec("benchmarks.playback") is None:
+        reason = "benchmarks/playback.py does not exist yet"
+        print(f"playback benchmark skipped: {reason}")
+        return [BenchRow("playback", "app playback", float("nan"), "", note=f"skipped: {reason}")]
+    ok, reason = display_available()
+    if not ok:
+        print(f"playback benchmark skipped: {reason}")
+        return [BenchRow("playback", "app playback", float("nan"), "", note=f"skipped: {reason}")]
+    module = importlib.import_module("benchmarks.playback")
+    try:
+        out = module.main(["--smoke"] if smoke else [])
+    except Exception as exc:  # the app benchmark is another module; report, do not crash ours
+        log.exception("playback benchmark failed")
+        return [BenchRow("playback", "app playback", float("nan"), "", note=f"failed: {exc}")]
+    if isinstance(out, list) and all(isinstance(r, BenchRow) for r in out):
+        return out
+    return [BenchRow("playback", "app playback (see its own output)", float("nan"), "",
+                     note=f"benchmarks.playback.main returned {out!r}")]
+
+
+def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS) -> list[BenchRow]:
+    """Run the selected benchmark groups on ``ctx``; return all rows in order."""
+    rows: list[BenchRow] = []
+    if "train" in only:
+        rows += train.run(ctx)
+    if "synth" in only:
+        rows += synth.run(ctx)
+    if "scaling" in only:
+        rows += scaling.run(ctx)
+    if "playback" in only:
+        rows += run_playback(ctx.smoke)
+    return rows
+
+
+def write_markdown(path: Path, rows: Sequence[BenchRow], ctx: BenchContext, elapsed_s: float) -> Path:
+    """``docs/benchmarks.md``: the machine, the corpus, the table, and how to read it."""
+    info = machine_info()
+    size = (f"{len(ctx.train_utts)} training utterances ({ctx.train_audio_s / 60:.1f} min of speech), "
+            f"{len(ctx.test_utts)} test utterances")
+    lines = [
+        "# Benchmarks",
+        "",
+        f"Written by `python -m benchmarks{' --smoke' if ctx.smoke else ''}` (`make bench`) on "
+        f"{dt.datetime.now(dt.UTC):%Y-%m-%d %H:%M} UTC in {elapsed_s:.0f} s.",
+        "",
+        "## Machine",
+        "",
+        *[f"- {k}: {v}" for k, v in info.items()],
+        "",
+        f"## Corpus\n\n`{ctx.corpus.root.name}/` ({ctx.corpus.info.name or 'unnamed'}): {size}.",
+        "",
+        "## Results",
+        "",
+        markdown_table(rows),
+        "",
+        "## How to read it",
+        "",
+        "- `x RT` is the real-time factor, input duration / wall time (200 = 200 times faster than "
+        "real time). Every synthesis call includes the LSF analysis of the input, eqs 4-8, "
+        "smoothing and the rebuild of the markers from the PCs.",
+        "- Training times are measured inside one `engine.model.train()` call by wrapping the "
+        "engine's functions; the codebook row is the remainder of the call. Peak memory is traced "
+        "in a second call.",
+        "- Scaling replicates the trained codebook with jitter; the growth exponent e fits "
+        "time ~ size^e between the smallest and largest codebook, on a fixed input.",
+        "- The machine is shared (2 cores, other jobs running): numbers are the best of a few "
+        "runs where the input is short, a single run otherwise.",
+        "",
+    ]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\n".join(lines), encoding="utf-8")
+    return path
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m benchmarks", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--smoke", action="store_true", help="tiny size for CI")
+    parser.add_argument("--corpus", type=Path, default=None, help="corpus folder (default data_samples/)")
+    parser.add_argument("--out", type=Path, default=None,
+                        help=f"Markdown output (default {DEFAULT_OUT.relative_to(REPO)}; "
+                             f"none in smoke mode)")
+    parser.add_argument("--only", nargs="+", choices=GROUPS, default=list(GROUPS))
+    args = parser.parse_args(argv)
+    if not logging.getLogger().handlers:
+        logging.basicConfig(level=logging.INFO, format="%(name)s: %(message)s", stream=sys.stderr)
+    t0 = time.perf_counter()
+    ctx = load_context(args.corpus, args.smoke)
+    rows = run_all(ctx, args.only)
+    print(format_table(rows))
+    out = args.out if args.out is not None else (None if args.smoke else DEFAULT_OUT)
+    if out is not None:
+        write_markdown(out, rows, ctx, time.perf_counter() - t0)
+        print(f"written {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

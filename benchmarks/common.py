@@ -1,0 +1,265 @@
+"""Shared pieces of the benchmarks: the machine description, the benchmark context (corpus, loaded
+utterances, a trained model), timing helpers, and the result table in text and Markdown.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+import platform
+import resource
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import scipy
+
+from engine.corpus import Corpus, load_corpus
+from engine.data import PhoneSegment, Utterance
+from engine.model import MarkerSetup, Model, train
+
+log = logging.getLogger(__name__)
+
+REPO = Path(__file__).resolve().parent.parent
+
+#: utterances used in smoke mode (train, test): small enough for CI (< 60 s for everything)
+SMOKE_TRAIN = 12
+SMOKE_TEST = 3
+
+
+# ---------------------------------------------------------------------- the result table
+@dataclass
+class BenchRow:
+    """One measured number.
+
+    Attributes
+    ----------
+    group : ``train``, ``synth``, ``scaling`` or ``playback``.
+    name : what was measured.
+    value : the number (NaN when it could not be measured).
+    unit : ``s``, ``MiB``, ``x RT`` (times faster than real time), ``corr``, ``ms``...
+    aim : the issue's aim for this number, as text (empty when there is none).
+    ok : whether the aim is met (``None`` when there is no aim).
+    note : anything needed to read the number.
+    """
+
+    group: str
+    name: str
+    value: float
+    unit: str
+    aim: str = ""
+    ok: bool | None = None
+    note: str = ""
+
+    def cell(self) -> str:
+        v = self.value
+        if not math.isfinite(v):
+            return "n/a"
+        if self.unit == "corr":
+            return f"{v:.4f}"
+        if abs(v) >= 100:
+            return f"{v:,.0f}"
+        if abs(v) >= 10:
+            return f"{v:.1f}"
+        return f"{v:.3g}"
+
+    def verdict(self) -> str:
+        return "" if self.ok is None else ("met" if self.ok else "MISSED")
+
+
+def format_table(rows: Sequence[BenchRow]) -> str:
+    """The rows as a fixed-width text table (printed by ``python -m benchmarks``)."""
+    heads = ("group", "benchmark", "value", "unit", "aim", "", "note")
+    cells = [(r.group, r.name, r.cell(), r.unit, r.aim, r.verdict(), r.note) for r in rows]
+    widths = [max(len(h), *(len(c[i]) for c in cells)) if cells else len(h)
+              for i, h in enumerate(heads)]
+    widths[-1] = len(heads[-1])
+    line = "  ".join(h.ljust(w) for h, w in zip(heads, widths, strict=True)).rstrip()
+    out = [line, "-" * len(line)]
+    for c in cells:
+        out.append("  ".join(x.rjust(w) if i == 2 else x.ljust(w)
+                             for i, (x, w) in enumerate(zip(c, widths, strict=True))).rstrip())
+    return "\n".join(out)
+
+
+def markdown_table(rows: Sequence[BenchRow]) -> str:
+    """The rows as a Markdown table."""
+    out = ["| group | benchmark | value | unit | aim | | note |",
+           "|---|---|---:|---|---|---|---|"]
+    for r in rows:
+        out.append(f"| {r.group} | {r.name} | {r.cell()} | {r.unit} | {r.aim} | {r.verdict()} "
+                   f"| {r.note} |")
+    return "\n".join(out)
+
+
+# ---------------------------------------------------------------------- the machine
+def _cpu_model() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.lower().startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def _ram_gib() -> float:
+    try:
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            if line.startswith("MemTotal:"):
+                return int(line.split()[1]) / 1024**2
+    except OSError:
+        pass
+    return float("nan")
+
+
+def machine_info() -> dict[str, str]:
+    """CPU model, cores, RAM, OS, Python, numpy and scipy versions."""
+    try:
+        usable = len(os.sched_getaffinity(0))
+    except AttributeError:  # not Linux
+        usable = os.cpu_count() or 0
+    return {
+        "CPU": _cpu_model(),
+        "cores": f"{os.cpu_count()} logical ({usable} usable by this process)",
+        "RAM": f"{_ram_gib():.1f} GiB",
+        "OS": f"{platform.system()} {platform.release()}",
+        "Python": platform.python_version(),
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+    }
+
+
+def peak_rss_mib() -> float:
+    """Peak resident set size of this process so far (``getrusage``), MiB."""
+    kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return kb / 1024 if sys.platform != "darwin" else kb / 1024**2
+
+
+# ---------------------------------------------------------------------- timing
+def best_time(fn: Callable[[], object], repeat: int = 3, min_total_s: float = 0.0) -> float:
+    """Smallest wall time of ``repeat`` calls of ``fn`` (more calls while under ``min_total_s``)."""
+    best = float("inf")
+    total = 0.0
+    count = 0
+    while count < repeat or total < min_total_s:
+        t0 = time.perf_counter()
+        fn()
+        dt = time.perf_counter() - t0
+        best = min(best, dt)
+        total += dt
+        count += 1
+        if count >= 50:
+            break
+    return best
+
+
+# ---------------------------------------------------------------------- the context
+@dataclass
+class BenchContext:
+    """What every benchmark needs: the corpus, loaded utterances and a model trained once.
+
+    Attributes
+    ----------
+    corpus : the corpus (default ``data_samples/``; the toy corpus when it is missing in smoke mode).
+    smoke : the tiny CI size.
+    train_utts, test_utts : the loaded utterances of the two splits (a subset in smoke mode).
+    setup : marker roles from ``corpus.json``.
+    load_s : wall time spent reading the utterances from disk.
+    """
+
+    corpus: Corpus
+    smoke: bool
+    train_utts: list[Utterance]
+    test_utts: list[Utterance]
+    setup: MarkerSetup
+    load_s: float
+    _model: Model | None = field(default=None, repr=False)
+
+    @property
+    def model(self) -> Model:
+        """A model trained (once) on ``train_utts`` with the default configuration."""
+        if self._model is None:
+            self._model = train(self.train_utts, self.setup)
+        return self._model
+
+    @property
+    def train_audio_s(self) -> float:
+        return float(sum(u.duration for u in self.train_utts))
+
+
+def _toy_corpus() -> Path:
+    """Build the tests' toy corpus in a temporary folder (smoke mode without ``data_samples/``)."""
+    sys.path.insert(0, str(REPO / "tests"))
+    try:
+        from toycorpus import build_toy_corpus  # type: ignore[import-not-found]
+    finally:
+        sys.path.pop(0)
+    root = Path(tempfile.mkdtemp(prefix="facetraj-bench-toy-"))
+    return build_toy_corpus(root)
+
+
+def default_corpus_dir(smoke: bool) -> Path:
+    """``data_samples/`` (or ``$FACETRAJ_CORPUS``); in smoke mode the toy corpus when it is absent."""
+    from engine.cli import default_corpus
+
+    root = default_corpus()
+    if (root / "corpus.json").exists():
+        return root
+    if smoke:
+        log.warning("%s has no corpus.json; smoke benchmarks run on the toy corpus", root)
+        return _toy_corpus()
+    raise FileNotFoundError(f"{root}/corpus.json not found: build the default corpus (make corpus) "
+                            f"or pass --corpus")
+
+
+def load_context(corpus_dir: str | os.PathLike[str] | None = None, smoke: bool = False) -> BenchContext:
+    """Open the corpus and load its utterances (the first few of each split in smoke mode)."""
+    root = Path(corpus_dir) if corpus_dir is not None else default_corpus_dir(smoke)
+    corpus = load_corpus(root)
+    info = corpus.info
+    train_ids = list(info.train)[:SMOKE_TRAIN] if smoke else list(info.train)
+    test_ids = list(info.test)[:SMOKE_TEST] if smoke else list(info.test)
+    t0 = time.perf_counter()
+    train_utts = [corpus.utterance(u) for u in train_ids]
+    test_utts = [corpus.utterance(u) for u in test_ids]
+    load_s = time.perf_counter() - t0
+    setup = MarkerSetup(info.fixed_markers, info.upper_lip, info.lower_lip, info.lip_corners)
+    log.info("corpus %s: %d train, %d test utterances loaded in %.1f s", root, len(train_utts),
+             len(test_utts), load_s)
+    return BenchContext(corpus, smoke, train_utts, test_utts, setup, load_s)
+
+
+def concatenate_input(utts: Sequence[Utterance], seconds: float) -> tuple[np.ndarray, int,
+                                                                          list[PhoneSegment]]:
+    """Audio and phone labels of exactly ``seconds`` of speech, made by joining ``utts`` (cycled).
+
+    The last phone is cut at ``seconds``. All utterances must share one sample rate.
+    """
+    if not utts:
+        raise ValueError("no utterances to build the input from")
+    rate = utts[0].sample_rate
+    n_target = int(round(seconds * rate))
+    audio_parts: list[np.ndarray] = []
+    phones: list[PhoneSegment] = []
+    n = 0
+    k = 0
+    while n < n_target:
+        u = utts[k % len(utts)]
+        if u.sample_rate != rate:
+            raise ValueError("utterances with different sample rates")
+        offset = n / rate
+        audio_parts.append(u.audio)
+        phones.extend(PhoneSegment(s.start + offset, s.end + offset, s.label) for s in u.phones)
+        n += len(u.audio)
+        k += 1
+    audio = np.concatenate(audio_parts)[:n_target]
+    end = n_target / rate
+    cut = [s for s in phones if s.start < end - 1e-3]
+    cut[-1] = PhoneSegment(cut[-1].start, end, cut[-1].label)
+    return audio, rate, cut

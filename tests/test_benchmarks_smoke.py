@@ -1,0 +1,68 @@
+"""The benchmarks' smoke mode runs in-process on the toy corpus and fills its table (issue 7).
+
+No timing thresholds: only that every expected row is there with a positive finite number.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+from toycorpus import build_toy_corpus
+
+
+@pytest.fixture(scope="module")
+def toy(tmp_path_factory) -> Path:
+    return build_toy_corpus(tmp_path_factory.mktemp("toy"), n_train=12, n_test=3)
+
+
+def test_smoke_table(toy: Path, tmp_path: Path, capsys) -> None:
+    from benchmarks.__main__ import main
+
+    out = tmp_path / "benchmarks.md"
+    assert main(["--smoke", "--corpus", str(toy), "--out", str(out),
+                 "--only", "train", "synth", "scaling"]) == 0
+    printed = capsys.readouterr().out
+    text = out.read_text()
+    for needle in ("## Machine", "CPU:", "numpy:", "| group | benchmark |"):
+        assert needle in text
+    expected = [
+        "LSF extraction (lsf_at)", "PCA (fit_pca)", "train() total",
+        "train() peak traced memory (tracemalloc)",
+        "phonetic, 1 s input", "phonetic, 2 s input", "acoustic, 1 s input", "acoustic, 2 s input",
+        "acoustic, full search, codebook x1", "acoustic, full search, codebook x4",
+        "acoustic, prefilter K=32, codebook x1", "growth exponent, full search",
+        "test whole-face correlation, acoustic full search",
+    ]
+    for name in expected:
+        assert name in printed, name
+        assert name in text, name
+
+
+def test_smoke_rows_positive_finite(toy: Path) -> None:
+    from benchmarks.__main__ import run_all
+    from benchmarks.common import load_context
+
+    ctx = load_context(toy, smoke=True)
+    rows = run_all(ctx, ("train", "synth", "scaling"))
+    groups = {r.group for r in rows}
+    assert groups == {"train", "synth", "scaling"}
+    assert sum(r.group == "synth" for r in rows) == 4          # 2 modes x 2 durations
+    for r in rows:
+        assert math.isfinite(r.value), r
+        if r.unit != "e":                                       # growth exponents may be ~0
+            assert r.value > 0, r
+        assert r.ok is None                                     # smoke mode judges no aims
+
+
+def test_playback_skipped_without_module(monkeypatch) -> None:
+    import importlib.util
+
+    from benchmarks.__main__ import run_playback
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec",
+                        lambda name, *a: None if name == "benchmarks.playback" else real(name, *a))
+    rows = run_playback(smoke=True)
+    assert len(rows) == 1 and rows[0].group == "playback" and "skipped" in rows[0].note
