@@ -17,7 +17,7 @@ import io
 import logging
 import os
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -49,6 +49,16 @@ def _write_csv(path: str | os.PathLike[str], header: Sequence[str], rows: Iterab
     with atomic_write(path, overwrite) as tmp:
         tmp.write_text(buf.getvalue(), encoding="utf-8")
     return path
+
+
+def subset_corpus(corpus: Corpus, per_split: int | None) -> Corpus:
+    """The same corpus with only the first ``per_split`` utterances of each split (all when
+    ``None`` or 0): a quick look at Table 2 or the N sweep before the full run."""
+    if not per_split:
+        return corpus
+    info = replace(corpus.info, train=list(corpus.info.train[:per_split]),
+                   test=list(corpus.info.test[:per_split]))
+    return Corpus(corpus.root, info)
 
 
 # ---------------------------------------------------------------------- similarity

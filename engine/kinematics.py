@@ -250,6 +250,41 @@ def find_gestures(velocity: np.ndarray, rate: float, segments: Sequence[PhoneSeg
 
 
 @dataclass
+class GestureMeasurement:
+    """Tangential velocity and gestures of one marker in the original and the synthesized
+    trajectories (the original parts are empty/None without original markers)."""
+
+    marker: int
+    threshold: float
+    times: np.ndarray
+    v_original: np.ndarray | None
+    v_synthesized: np.ndarray
+    original: list[Gesture]
+    synthesized: list[Gesture]
+
+    def pairs(self) -> list[LandmarkTiming]:
+        """Original and synthesized gestures paired by anchor (empty without the original)."""
+        return compare_landmarks(self.original, self.synthesized) if self.v_original is not None else []
+
+
+def measure_gestures(synthesized: np.ndarray, original: np.ndarray | None, marker: int, rate: float,
+                     phones: Sequence[PhoneSegment], labels: Iterable[str] = LABIAL_PHONES,
+                     threshold: float = 0.2, smooth_s: float = 0.0, window_s: float = 0.25,
+                     t0: float = 0.0) -> GestureMeasurement:
+    """Tangential velocity of ``marker`` in ``(T, M, 3)`` synthesized (and original) markers and
+    the gestures anchored on the phone segments labelled with ``labels``."""
+    segs = gesture_anchors(phones, labels)
+    vs = tangential_velocity(synthesized[:, marker], rate, smooth_s)
+    gs = find_gestures(vs, rate, segs, threshold, window_s, t0=t0)
+    vo, go = None, []
+    if original is not None:
+        vo = tangential_velocity(original[:, marker], rate, smooth_s)
+        go = find_gestures(vo, rate, segs, threshold, window_s, t0=t0)
+    times = t0 + np.arange(len(vs)) / rate
+    return GestureMeasurement(marker, threshold, times, vo, vs, go, gs)
+
+
+@dataclass
 class LandmarkTiming:
     """One gesture found in the original and the synthesized trajectory, and the timing error
     (synthesized minus original, seconds) of each landmark."""

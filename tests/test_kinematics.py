@@ -17,6 +17,7 @@ from engine.kinematics import (
     gesture_anchors,
     lip_measures,
     mean_abs_timing_error,
+    measure_gestures,
     model_lip_measures,
     tangential_velocity,
     write_landmarks_textgrid,
@@ -152,3 +153,17 @@ def test_export_tsv_and_textgrid(tmp_path):
     assert [p.time for p in orig] == pytest.approx([0.1, 0.2, 0.3, 0.4, 0.5])
     assert len(tg.getTier("synthesized").entries) == 4      # NaN offset left out
     assert not list(tmp_path.glob(".*part*"))                # atomic writes leave no temp files
+
+
+def test_measure_gestures_original_vs_shifted_synthesis():
+    pos, _truth, _ = bell_gesture()
+    orig = np.repeat(pos[:, None], 2, axis=1)
+    syn = np.roll(orig, 3, axis=0)                          # synthesized 3 frames late
+    syn[:3] = orig[0]
+    phones = [PhoneSegment(0, 0.42, "aa"), PhoneSegment(0.42, 0.56, "m"), PhoneSegment(0.56, 1.2, "aa")]
+    gm = measure_gestures(syn, orig, 1, RATE, phones)
+    assert [g.label for g in gm.original] == ["m"]
+    err = gm.pairs()[0].errors()
+    for k in LANDMARKS:
+        assert err[k] == pytest.approx(3 / RATE, abs=1e-6), k
+    assert measure_gestures(syn, None, 1, RATE, phones).pairs() == []
