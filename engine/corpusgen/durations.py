@@ -12,7 +12,7 @@ Duration of a phone, in seconds::
 * ``rate``: one log-normal speaking-rate factor per sentence (sd 0.08, i.e. about +-8 %);
 * ``jitter``: a small log-normal factor per phone (sd 0.1).
 
-Pauses: at the start (0.22-0.32 s) and end (0.28-0.38 s) of every sentence and at commas and
+Pauses: at the start (0.20-0.30 s) and end (0.25-0.35 s) of every sentence and at commas and
 other inner punctuation (0.15-0.40 s, so that some are long enough for the lips to close).
 """
 
@@ -61,8 +61,8 @@ class DurationModel:
     rate_sd: float = 0.08
     phone_sd: float = 0.10
     min_duration: float = 0.03
-    start_pause: tuple[float, float] = (0.22, 0.32)
-    end_pause: tuple[float, float] = (0.28, 0.38)
+    start_pause: tuple[float, float] = (0.20, 0.30)
+    end_pause: tuple[float, float] = (0.25, 0.35)
     inner_pause: tuple[float, float] = (0.15, 0.40)
 
 

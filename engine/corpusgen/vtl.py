@@ -124,7 +124,7 @@ def verify_phone_map(workdir: str | os.PathLike[str] | None = None) -> list[Gest
 
     * p b m: the lips close (LD, the lip distance, below 0.1 cm);
     * f v: the lower lip rises toward the upper teeth (EMA LL at least 3 mm above its height in
-      the neighbouring vowels) and the lips nearly close (LD below 0.35 cm);
+      the neighbouring vowels) and the lips narrow (LD below 0.5 cm, half the open vowel's);
     * uw w: the lips round (LP, protrusion, at least 0.4 cm above the open vowel's);
     * th dh: the tongue tip moves forward to the teeth (EMA TT at least 3 mm ahead of /a/'s).
     """
@@ -150,7 +150,7 @@ def verify_phone_map(workdir: str | os.PathLike[str] | None = None) -> list[Gest
         elif ph in ("f", "v"):
             rise = float(10 * (out.point("LL")[e_in, 1].max() - out.point("LL")[e_vow, 1].mean()))
             checks.append(GestureCheck(ph, "lower lip rise (mm)", rise, ">= 3", rise >= 3.0))
-            checks.append(GestureCheck(ph, "min lip distance LD (cm)", ld, "< 0.35", ld < 0.35))
+            checks.append(GestureCheck(ph, "min lip distance LD (cm)", ld, "< 0.5", ld < 0.5))
         elif ph in ("uw", "w"):
             checks.append(GestureCheck(ph, "lip protrusion rise LP (cm)", lp_rise, ">= 0.4",
                                        lp_rise >= 0.4))
