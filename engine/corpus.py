@@ -15,13 +15,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .data import Utterance
+from .data import PhoneSegment, Utterance
 from .errors import InputError
 from .formats import (
-    AUDIO_SUFFIXES,
+    MARKER_SUFFIXES,
     atomic_write,
     read_audio,
-    read_c3d,
+    read_labels,
+    read_markers,
     read_textgrid,
     read_textgrid_tiers,
     validate_phones,
@@ -47,6 +48,11 @@ class CorpusInfo:
     train, test : utterance ids of the two splits.
     units, axes : always mm and x right / y up / z forward in this format.
     label_set : the phone alphabet of the ``phones`` tier (``arpabet``).
+    label_map : ``""`` (labels are ARPAbet), ``"mocha"`` or a label map file (relative to the
+        description) mapping the labels onto ARPAbet when utterances are loaded.
+    data_dir : where the utterance files are, relative to the description's folder (``""``: the
+        same folder). Lets a description point at a read-only folder of someone else's data.
+    dimensions : 3, or 2 for midsagittal data (x = 0 for every marker).
     name, description : free text.
     """
 
@@ -62,6 +68,9 @@ class CorpusInfo:
     axes: dict[str, str] = field(
         default_factory=lambda: {"x": "right", "y": "up", "z": "forward"})
     label_set: str = "arpabet"
+    label_map: str = ""
+    data_dir: str = ""
+    dimensions: int = 3
     name: str = ""
     description: str = ""
 
@@ -97,24 +106,32 @@ class CorpusInfo:
         for m in [*info.fixed_markers, info.upper_lip, info.lower_lip, *info.lip_corners]:
             if m not in info.marker_names:
                 raise InputError(path, f"marker {m!r} is not among marker_names")
-        if len(info.fixed_markers) < 3:
-            raise InputError(path, "at least 3 fixed markers are needed to remove head motion")
+        need = 2 if info.dimensions == 2 else 3
+        if len(info.fixed_markers) < need:
+            raise InputError(path, f"at least {need} fixed markers are needed to remove head motion "
+                                   f"from {info.dimensions}-D data")
         return info
 
 
+def _json_path(root: str | os.PathLike[str]) -> Path:
+    root = Path(root)
+    return root if root.suffix.lower() == ".json" else root / "corpus.json"
+
+
 def save_corpus_info(root: str | os.PathLike[str], info: CorpusInfo) -> Path:
-    """Write ``root/corpus.json``."""
-    path = Path(root) / "corpus.json"
+    """Write ``root/corpus.json`` (or ``root`` itself when it names a ``.json`` file)."""
+    path = _json_path(root)
     with atomic_write(path) as tmp:
         tmp.write_text(json.dumps(info.to_json(), indent=2) + "\n", encoding="utf-8")
     return path
 
 
 def load_corpus_info(root: str | os.PathLike[str]) -> CorpusInfo:
-    """Read ``root/corpus.json``."""
-    path = Path(root) / "corpus.json"
+    """Read ``root/corpus.json`` (or ``root`` itself when it names a ``.json`` file)."""
+    path = _json_path(root)
     if not path.exists():
-        raise InputError(path, "no corpus.json in this folder")
+        raise InputError(path, "no corpus.json in this folder" if path.name == "corpus.json"
+                         else "no such corpus description")
     try:
         obj = json.loads(path.read_text(encoding="utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
@@ -122,25 +139,57 @@ def load_corpus_info(root: str | os.PathLike[str]) -> CorpusInfo:
     return CorpusInfo.from_json(obj, path)
 
 
+def _find(root: Path, utt_id: str, suffixes: tuple[str, ...], what: str) -> Path:
+    for suffix in suffixes:
+        for cand in (suffix, suffix.upper()):
+            p = root / f"{utt_id}{cand}"
+            if p.exists():
+                return p
+    raise InputError(root / f"{utt_id}{suffixes[0]}",
+                     f"no {what} file ({', '.join(suffixes)}) for this utterance")
+
+
 def audio_path(root: str | os.PathLike[str], utt_id: str) -> Path:
     """The audio file of an utterance (FLAC or WAV)."""
-    for suffix in AUDIO_SUFFIXES[::-1]:
-        p = Path(root) / f"{utt_id}{suffix}"
-        if p.exists():
-            return p
-    raise InputError(Path(root) / f"{utt_id}.flac", "no audio file (.flac or .wav) for this utterance")
+    return _find(Path(root), utt_id, (".flac", ".wav"), "audio")
+
+
+def label_path(root: str | os.PathLike[str], utt_id: str) -> Path:
+    """The label file of an utterance (TextGrid, HTK/MOCHA .lab or TIMIT .phn)."""
+    return _find(Path(root), utt_id, (".TextGrid", ".lab", ".phn"), "label")
+
+
+def marker_path(root: str | os.PathLike[str], utt_id: str) -> Path:
+    """The marker file of an utterance (C3D, TSV/CSV or MOCHA .ema)."""
+    return _find(Path(root), utt_id, MARKER_SUFFIXES, "marker")
 
 
 @dataclass
 class Corpus:
-    """A corpus folder: its description and lazy access to its utterances."""
+    """A corpus: its description and lazy access to its utterances.
+
+    ``root`` is the folder of the description; ``data_root`` the folder of the utterance files.
+    """
 
     root: Path
     info: CorpusInfo
 
+    @property
+    def data_root(self) -> Path:
+        return (self.root / self.info.data_dir).resolve() if self.info.data_dir else self.root
+
+    def label_map(self) -> dict[str, str] | None:
+        """The label map named in the description, or ``None``."""
+        if not self.info.label_map:
+            return None
+        from .labelmap import read_label_map
+
+        lm = self.info.label_map
+        return read_label_map(lm if lm.lower() == "mocha" else self.root / lm)
+
     def utterance(self, utt_id: str) -> Utterance:
         """Load one utterance, with labels checked against the audio and markers against the info."""
-        return load_utterance(self.root, utt_id, self.info)
+        return load_utterance(self.data_root, utt_id, self.info, self.label_map())
 
     def utterances(self, split: str = "all") -> Iterator[Utterance]:
         """Iterate over ``train``, ``test`` or ``all`` utterances."""
@@ -151,47 +200,125 @@ class Corpus:
     def fingerprint(self) -> str:
         """A hash of every file of the corpus (names, sizes, contents), for caching models."""
         h = hashlib.sha256()
-        for p in sorted(self.root.iterdir()):
-            if p.is_file():
+        h.update(json.dumps(self.info.to_json(), sort_keys=True).encode())
+        for p in sorted(self.data_root.iterdir()):
+            if p.is_file() and p.name != "corpus.json":
                 h.update(p.name.encode())
                 h.update(p.read_bytes())
         return h.hexdigest()[:16]
 
 
 def load_corpus(root: str | os.PathLike[str]) -> Corpus:
-    """Open a corpus folder (reads only ``corpus.json``; utterances load on demand)."""
+    """Open a corpus folder, or a corpus description ``.json`` (utterances load on demand)."""
     root = Path(root)
+    if root.suffix.lower() == ".json" and root.is_file():
+        return Corpus(root.parent, load_corpus_info(root))
     if not root.is_dir():
         raise InputError(root, "not a folder")
     return Corpus(root, load_corpus_info(root))
 
 
-def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo) -> Utterance:
-    """Load ``<id>`` audio, TextGrid ``phones`` (and ``words`` if present) and C3D markers."""
+def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
+                   label_map: dict[str, str] | None = None) -> Utterance:
+    """Load ``<id>`` audio, labels (``phones`` and ``words`` tiers of a TextGrid, or a .lab /
+    .phn file) and markers (C3D, TSV/CSV or MOCHA EMA, resampled to the corpus rate).
+
+    Labels are mapped onto ARPAbet with ``label_map``. Markers shorter than the audio are padded
+    with NaN (a warning); longer ones are cut at the audio's end.
+    """
+    from .phones import normalise_label
+
     root = Path(root)
     apath = audio_path(root, utt_id)
     audio, rate = read_audio(apath)
-    tg_path = root / f"{utt_id}.TextGrid"
-    tiers = read_textgrid_tiers(tg_path) if tg_path.exists() else None
-    if tiers is None:
-        raise InputError(tg_path, "no TextGrid for this utterance")
-    phones = validate_phones(read_textgrid(tg_path, "phones"), len(audio) / rate, tg_path)
-    words = [w for w in tiers.get("words", []) if w.label]
-    mdata = read_c3d(root / f"{utt_id}.c3d")
+    lpath = label_path(root, utt_id)
+    words: list[PhoneSegment] = []
+    if lpath.suffix.lower() == ".textgrid":
+        tiers = read_textgrid_tiers(lpath)
+        raw = read_textgrid(lpath, "phones")
+        words = [w for w in tiers.get("words", []) if w.label]
+    else:
+        raw = read_labels(lpath, rate)
+    phones = validate_phones(raw, len(audio) / rate, lpath)
+    if label_map:
+        phones = [PhoneSegment(s.start, s.end,
+                               normalise_label(label_map.get(s.label, label_map.get(
+                                   normalise_label(s.label), s.label))))
+                  for s in phones]
+    mpath = marker_path(root, utt_id)
+    mdata = read_markers(mpath, info.marker_rate)
     if mdata.names != info.marker_names:
-        raise InputError(root / f"{utt_id}.c3d",
-                         f"marker set differs from corpus.json ({len(mdata.names)} markers, "
-                         f"{len(info.marker_names)} expected)")
-    if abs(mdata.rate - info.marker_rate) > 1e-6:
-        raise InputError(root / f"{utt_id}.c3d",
-                         f"marker rate {mdata.rate} Hz differs from corpus.json ({info.marker_rate})")
+        raise InputError(mpath, f"marker set differs from the corpus description "
+                                f"({len(mdata.names)} markers, {len(info.marker_names)} expected)")
+    markers = mdata.markers
+    n_audio = int(np.floor(len(audio) / rate * info.marker_rate + 1e-9)) + 1
+    if markers.shape[0] < n_audio - 1:
+        log.warning("%s: markers end at %.2f s but the audio at %.2f s; later frames are treated "
+                    "as unseen", mpath, (markers.shape[0] - 1) / info.marker_rate, len(audio) / rate)
+    if markers.shape[0] < n_audio:
+        pad = np.full((n_audio - markers.shape[0], *markers.shape[1:]), np.nan)
+        markers = np.concatenate([markers, pad])
+    markers = markers[:n_audio]
     text = ""
     txt = root / f"{utt_id}.txt"
     if txt.exists():
         text = txt.read_text(encoding="utf-8").strip()
     return Utterance(name=utt_id, audio=audio, sample_rate=rate, phones=phones,
-                     markers=mdata.markers, marker_rate=mdata.rate,
+                     markers=markers, marker_rate=info.marker_rate,
                      marker_names=list(mdata.names), words=words, text=text)
+
+
+def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str] | None = None,
+                fixed: list[str] | None = None, upper_lip: str = "", lower_lip: str = "",
+                lip_corners: list[str] | None = None, label_map: str = "",
+                marker_rate: float = 60.0, test: list[str] | None = None,
+                test_fraction: float = 1 / 3, name: str = "") -> tuple[Path, CorpusInfo]:
+    """Describe a folder of someone's own recordings as a corpus and write the description.
+
+    Utterances are the file stems that have audio, labels and markers. The marker roles (fixed
+    references, lip centres) are given by name; the test split is ``test`` or every
+    ``round(1 / test_fraction)``-th utterance. ``output`` defaults to ``data_dir/corpus.json``;
+    when it lies elsewhere (a read-only data folder), the description records ``data_dir``
+    relative to it.
+    """
+    data_dir = Path(data_dir).resolve()
+    if not data_dir.is_dir():
+        raise InputError(data_dir, "not a folder")
+    stems = sorted({p.stem for p in data_dir.iterdir() if p.suffix.lower() in (".wav", ".flac")})
+    ids = []
+    for stem in stems:
+        try:
+            label_path(data_dir, stem)
+            marker_path(data_dir, stem)
+        except InputError:
+            log.info("%s: no labels or markers; left out", data_dir / stem)
+            continue
+        ids.append(stem)
+    if not ids:
+        raise InputError(data_dir, "no utterance with audio, labels and markers")
+    first = read_markers(marker_path(data_dir, ids[0]))
+    names = first.names
+    planar = bool(np.nanmax(np.abs(first.markers[..., 0])) == 0.0)
+    for role in [*(fixed or []), upper_lip, lower_lip, *(lip_corners or [])]:
+        if role not in names:
+            raise InputError(marker_path(data_dir, ids[0]),
+                             f"no marker named {role!r}; markers: {' '.join(names)}")
+    if test is None:
+        step = max(2, round(1 / test_fraction)) if test_fraction > 0 else 0
+        test = [u for i, u in enumerate(ids) if step and i % step == step - 1]
+    train_ids = [u for u in ids if u not in test]
+    if not train_ids:
+        train_ids, test = ids, [u for u in test if u in ids]
+    out = Path(output) if output else data_dir / "corpus.json"
+    out = out if out.suffix.lower() == ".json" else out / "corpus.json"
+    rel = "" if out.parent.resolve() == data_dir else os.path.relpath(data_dir, out.parent.resolve())
+    info = CorpusInfo(marker_names=names, marker_rate=float(marker_rate), fixed_markers=list(fixed or []),
+                      upper_lip=upper_lip, lower_lip=lower_lip, train=train_ids, test=list(test),
+                      lip_corners=list(lip_corners or []), label_map=label_map, data_dir=rel,
+                      dimensions=2 if planar else 3, name=name or data_dir.name)
+    CorpusInfo.from_json(info.to_json(), out)  # the same checks as on loading
+    save_corpus_info(out, info)
+    return out, info
 
 
 def marker_coverage(markers: np.ndarray) -> float:

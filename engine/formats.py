@@ -8,6 +8,7 @@ where the user's file was.
 from __future__ import annotations
 
 import contextlib
+import io
 import logging
 import os
 import tempfile
@@ -16,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from scipy.signal import resample_poly
 
 from .data import PhoneSegment
 from .errors import InputError
@@ -379,3 +381,145 @@ def read_marker_table(path: str | os.PathLike[str], rate: float | None = None) -
     if rate is None:
         raise InputError(path, "no time column: give the marker rate")
     return MarkerData(markers, rate, names)
+
+
+# --------------------------------------------------------------------------- MOCHA-TIMIT EMA
+#: MOCHA-TIMIT coils and their (x, y) columns (1-based) in the ASCII conversion of MOCHAtools.
+MOCHA_COILS = {"UI": (3, 8), "LI": (4, 9), "UL": (5, 10), "LL": (6, 11), "TT": (7, 12),
+               "TB": (13, 18), "TD": (14, 19), "V": (15, 20), "BN": (17, 22)}
+MOCHA_RATE = 500.0
+
+
+def _midsagittal(x_ap: np.ndarray, y_up: np.ndarray) -> np.ndarray:
+    """MOCHA midsagittal (x toward the back, y up; 1/100 mm) to facetraj axes in mm: x = 0 (the
+    midsagittal plane), y up, z forward = -x."""
+    return np.stack([np.zeros_like(x_ap), y_up / 100.0, -x_ap / 100.0], axis=-1)
+
+
+def _read_est_track(path: Path, raw: bytes) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Edinburgh Speech Tools track file (ascii or binary): times, channel values, names."""
+    end = raw.find(b"EST_Header_End")
+    if end < 0:
+        raise InputError(path, "EST track file without EST_Header_End")
+    header = raw[:end].decode("ascii", errors="replace").splitlines()
+    body = raw[raw.index(b"\n", end) + 1:]
+    fields: dict[str, str] = {}
+    names: dict[int, str] = {}
+    for line in header[1:]:
+        parts = line.split(None, 1)
+        if len(parts) != 2:
+            continue
+        key, val = parts[0], parts[1].strip()
+        if key.startswith("Channel_"):
+            names[int(key.split("_")[1])] = val
+        fields[key] = val
+    try:
+        n_frames, n_chan = int(fields["NumFrames"]), int(fields["NumChannels"])
+    except (KeyError, ValueError) as exc:
+        raise InputError(path, "EST header lacks NumFrames/NumChannels") from exc
+    width = 2 + n_chan
+    if fields.get("DataType", "ascii") == "binary":
+        order = ">" if fields.get("ByteOrder", "10") == "10" else "<"
+        data = np.frombuffer(body, dtype=f"{order}f4")
+        if data.size < n_frames * width:
+            raise InputError(path, f"binary EST data holds {data.size} values, "
+                                   f"{n_frames * width} expected (truncated?)")
+        data = data[: n_frames * width].reshape(n_frames, width).astype(np.float64)
+    else:
+        rows = [ln.split() for ln in body.decode("ascii", errors="replace").splitlines() if ln.strip()]
+        try:
+            data = np.array([[float(v) for v in r[:width]] for r in rows])
+        except ValueError as exc:
+            raise InputError(path, f"EST data is not numeric ({exc})") from exc
+        if data.ndim != 2 or data.shape[1] != width:
+            raise InputError(path, f"EST rows have {data.shape[-1]} columns, {width} expected")
+    return data[:, 0], data[:, 2:], [names.get(i, f"ch{i}") for i in range(n_chan)]
+
+
+def read_mocha_ema(path: str | os.PathLike[str]) -> MarkerData:
+    """Read MOCHA-TIMIT EMA: the 22-column ASCII form of MOCHAtools or the EST track form.
+
+    Coils become 2-D (midsagittal) markers in mm: x = 0, y up, z forward (MOCHA's x points to
+    the back of the mouth). The rate is 500 Hz as recorded.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise InputError(path, "no such EMA file")
+    raw = path.read_bytes()
+    if not raw.strip():
+        raise InputError(path, "the EMA file is empty")
+    names = list(MOCHA_COILS)
+    if raw.startswith(b"EST_File"):
+        times, chans, chan_names = _read_est_track(path, raw)
+        lower = [c.lower() for c in chan_names]
+        cols = []
+        for coil, (cx, cy) in MOCHA_COILS.items():
+            key_x, key_y = f"{coil.lower()}_x", f"{coil.lower()}_y"
+            if key_x in lower and key_y in lower:
+                cols.append((lower.index(key_x), lower.index(key_y)))
+            else:  # unnamed channels: the MOCHAtools column order (channel = column - 3)
+                cols.append((cx - 3, cy - 3))
+        if max(max(c) for c in cols) >= chans.shape[1]:
+            raise InputError(path, f"EST track has {chans.shape[1]} channels; MOCHA EMA needs 20")
+    else:
+        try:
+            table = np.loadtxt(io.StringIO(raw.decode("ascii")), ndmin=2)
+        except (ValueError, UnicodeDecodeError) as exc:
+            raise InputError(path, f"not a MOCHA EMA text file ({exc})") from exc
+        if table.shape[1] != 22:
+            raise InputError(path, f"expected 22 columns (time, flag, 20 coil values), "
+                                   f"found {table.shape[1]}")
+        times, chans = table[:, 0], table[:, 2:]
+        cols = [(cx - 3, cy - 3) for cx, cy in MOCHA_COILS.values()]
+    markers = np.stack([_midsagittal(chans[:, cx], chans[:, cy]) for cx, cy in cols], axis=1)
+    rate = MOCHA_RATE
+    if len(times) > 1:
+        rate = float(round((len(times) - 1) / (times[-1] - times[0])))
+    return MarkerData(markers, rate, names)
+
+
+# --------------------------------------------------------------------------- any marker file
+MARKER_SUFFIXES = (".c3d", ".tsv", ".csv", ".ema")
+
+
+def resample_markers(markers: np.ndarray, rate: float, target: float) -> np.ndarray:
+    """Markers at another frame rate: polyphase filtering when complete, else linear
+    interpolation in which frames next to a gap stay NaN."""
+    if abs(rate - target) < 1e-9:
+        return markers
+    n_out = int(np.floor((markers.shape[0] - 1) / rate * target + 1e-9)) + 1
+    if np.isfinite(markers).all():
+        from fractions import Fraction
+
+        frac = Fraction(target / rate).limit_denominator(1000)
+        out = resample_poly(markers, frac.numerator, frac.denominator, axis=0, padtype="line")
+        if out.shape[0] >= n_out:
+            return out[:n_out]
+    t_in = np.arange(markers.shape[0]) / rate
+    t_out = np.arange(n_out) / target
+    flat = markers.reshape(markers.shape[0], -1)
+    out = np.empty((n_out, flat.shape[1]))
+    for c in range(flat.shape[1]):
+        ok = np.isfinite(flat[:, c])
+        out[:, c] = np.interp(t_out, t_in[ok], flat[ok, c]) if ok.sum() > 1 else np.nan
+        bad = np.interp(t_out, t_in, (~ok).astype(float)) > 0
+        out[bad, c] = np.nan
+    return out.reshape(n_out, *markers.shape[1:])
+
+
+def read_markers(path: str | os.PathLike[str], rate: float | None = None) -> MarkerData:
+    """Read markers from C3D, TSV/CSV or MOCHA EMA (by suffix); resample to ``rate`` if given."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".c3d":
+        data = read_c3d(path)
+    elif suffix in (".tsv", ".csv", ".txt"):
+        data = read_marker_table(path, rate)
+    elif suffix == ".ema":
+        data = read_mocha_ema(path)
+    else:
+        raise InputError(path, f"unknown marker format {suffix!r} (use .c3d, .tsv, .csv or .ema)")
+    if rate is not None and abs(data.rate - rate) > 1e-6:
+        log.info("%s: markers resampled from %g Hz to %g Hz", path, data.rate, rate)
+        data = MarkerData(resample_markers(data.markers, data.rate, rate), float(rate), data.names)
+    return data

@@ -54,7 +54,8 @@ def kabsch(source: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, np.ndarr
     """Rotation ``R`` and translation ``t`` minimising ``|| source @ R.T + t - target ||``.
 
     ``source`` and ``target`` are ``(..., n, 3)``; batched over leading axes. Reflections are
-    excluded.
+    excluded. Midsagittal (2-D) data, where every x is 0, gets the exact in-plane fit (a rotation
+    about x), which needs only two points.
 
     Examples
     --------
@@ -66,12 +67,28 @@ def kabsch(source: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, np.ndarr
     """
     src_c = source.mean(axis=-2, keepdims=True)
     tgt_c = target.mean(axis=-2, keepdims=True)
+    if not np.any(source[..., 0]) and not np.any(target[..., 0]):
+        return _kabsch_planar(source - src_c, target - tgt_c, src_c, tgt_c)
     h = np.swapaxes(source - src_c, -1, -2) @ (target - tgt_c)
     u, _, vt = np.linalg.svd(h)
     d = np.sign(np.linalg.det(np.swapaxes(vt, -1, -2) @ np.swapaxes(u, -1, -2)))
     diag = np.ones((*h.shape[:-2], 3))
     diag[..., 2] = np.where(d == 0, 1.0, d)
     rot = np.swapaxes(vt, -1, -2) @ (diag[..., :, None] * np.swapaxes(u, -1, -2))
+    trans = tgt_c[..., 0, :] - np.einsum("...ij,...j->...i", rot, src_c[..., 0, :])
+    return rot, trans
+
+
+def _kabsch_planar(src: np.ndarray, tgt: np.ndarray, src_c: np.ndarray, tgt_c: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """In-plane (y-z) rigid fit of centred points; the rotation is about the x axis."""
+    y, z = src[..., 1], src[..., 2]
+    ty, tz = tgt[..., 1], tgt[..., 2]
+    theta = np.arctan2((y * tz - z * ty).sum(-1), (y * ty + z * tz).sum(-1))
+    c, s = np.cos(theta), np.sin(theta)
+    rot = np.zeros((*theta.shape, 3, 3))
+    rot[..., 0, 0] = 1.0
+    rot[..., 1, 1], rot[..., 1, 2], rot[..., 2, 1], rot[..., 2, 2] = c, -s, s, c
     trans = tgt_c[..., 0, :] - np.einsum("...ij,...j->...i", rot, src_c[..., 0, :])
     return rot, trans
 

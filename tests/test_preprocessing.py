@@ -158,3 +158,20 @@ def test_spline_smooths_and_keeps_slow_signals():
     with pytest.raises(ValueError):
         smooth(slow, 60.0, "cubic")
     np.testing.assert_array_equal(smooth(slow, 60.0, "none"), slow)
+
+
+def test_planar_head_motion_with_two_fixed_points():
+    # midsagittal data (x = 0): two reference coils fix an in-plane rotation and translation
+    rng = np.random.default_rng(5)
+    neutral = np.zeros((4, 3))
+    neutral[:, 1:] = rng.standard_normal((4, 2)) * 30
+    faces = np.repeat(neutral[None], 20, axis=0)
+    faces[:, 3, 1] += np.linspace(0, 5, 20)            # a lip moving down-up, non-rigid
+    moved = faces.copy()
+    for t in range(20):
+        a = 0.05 * np.sin(t)
+        rot = np.array([[1, 0, 0], [0, np.cos(a), -np.sin(a)], [0, np.sin(a), np.cos(a)]])
+        moved[t] = faces[t] @ rot.T + np.array([0.0, t * 0.3, -t * 0.2])
+    out = remove_head_motion(moved, np.array([0, 1]), neutral[:2])
+    np.testing.assert_allclose(out, faces, atol=1e-9)
+    assert not out[..., 0].any()
