@@ -231,6 +231,45 @@ def cmd_corpus_show(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_video(args: argparse.Namespace) -> int:
+    from .model import Model, synthesize
+
+    try:
+        from app.video import VideoSettings, render_video
+    except ImportError as exc:
+        raise FacetrajError(f"video export needs the app's packages: {exc}") from exc
+    model = Model.load(args.model)
+    cfg = _synth_config(args)
+    original = None
+    title = ""
+    if args.corpus:
+        from .corpus import load_corpus
+
+        if not args.utterance:
+            raise FacetrajError("give --utterance ID with --corpus")
+        utt = load_corpus(args.corpus).utterance(args.utterance)
+        audio, rate, phones, n_frames = utt.audio, utt.sample_rate, utt.phones, utt.n_frames
+        original = model.normalise_markers(utt.markers) if utt.markers is not None else None
+        title, source = utt.text or utt.name, utt.name
+    elif args.audio:
+        from .formats import read_audio, read_labels
+
+        audio, rate = read_audio(args.audio)
+        phones = read_labels(args.labels, rate) if args.labels else None
+        n_frames, source, title = None, str(args.labels or args.audio), args.audio.name
+    else:
+        raise FacetrajError("give an AUDIO file, or --corpus and --utterance")
+    if phones is None and cfg.mode == "phonetic":
+        cfg = cfg.with_(mode="acoustic")
+    res = synthesize(model, audio, rate, phones, cfg, n_frames=n_frames, source=source)
+    w, h = (int(v) for v in args.size.lower().split("x"))
+    render_video(model, res, audio, rate, args.output, original=original,
+                 settings=VideoSettings(w, h, args.fps), overwrite=args.overwrite,
+                 progress=TerminalProgress("video"), title=title)
+    print(args.output)
+    return 0
+
+
 def cmd_gui(args: argparse.Namespace) -> int:
     try:
         from app.main import run_app
@@ -331,7 +370,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--csv", action="store_true", help="the full K x K matrix as CSV")
     p.set_defaults(func=cmd_similarity)
 
-    p = sub.add_parser("corpus", help="the default corpus generator")
+    p = sub.add_parser("video", help="an MP4 of the face points and lip panels with the sound")
+    p.add_argument("model", type=Path)
+    p.add_argument("audio", type=Path, nargs="?", help="WAV or FLAC (or use --corpus)")
+    p.add_argument("--labels", type=Path, help="phone labels for AUDIO")
+    p.add_argument("--corpus", type=Path, help="take the utterance (and its original) from a corpus")
+    p.add_argument("--utterance", help="utterance id in --corpus")
+    p.add_argument("-o", "--output", type=Path, required=True, help="an .mp4 file")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing file")
+    p.add_argument("--fps", type=float, default=30.0)
+    p.add_argument("--size", default="1280x544", help="WIDTHxHEIGHT")
+    _add_synth_options(p)
+    p.set_defaults(func=cmd_video)
+
+    p = sub.add_parser("corpus", help="the default corpus: build it; describe your own folder")
     csub = p.add_subparsers(dest="corpus_command", metavar="ACTION", required=True)
     b = csub.add_parser("build", help="synthesize the default corpus into a folder")
     b.add_argument("output", type=Path)

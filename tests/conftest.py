@@ -52,6 +52,7 @@ def default_corpus():
 
 @pytest.fixture(scope="session")
 def default_model(default_corpus):
-    from engine.model import train
+    """The default model, trained once per session into the (test) cache the app also reads."""
+    from app.cache import load_or_train
 
-    return train(default_corpus)
+    return load_or_train(default_corpus)
