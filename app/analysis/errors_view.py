@@ -1,0 +1,241 @@
+"""Error analysis: which phones synthesize worst, which utterances, which segments.
+
+The view runs :func:`engine.analysis.error_report` in a background worker and shows correlation
+and RMS lip error per phone, a sortable per-utterance list and the worst segments; a click on an
+utterance or a segment jumps there (utterance and time). :class:`LipErrorPanel` adds
+``|original - synthesized|`` of the lips to the time-aligned stack with the worst segments of
+the current utterance highlighted.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+from PyQt6.QtCore import pyqtSignal
+from PyQt6.QtWidgets import (
+    QComboBox,
+    QHBoxLayout,
+    QLabel,
+    QProgressBar,
+    QPushButton,
+    QSpinBox,
+    QTableWidget,
+    QTabWidget,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.style import ORIGINAL_COLOR, SYNTH_COLOR
+from engine.analysis import (
+    ErrorReport,
+    error_report,
+    lip_error,
+    segment_errors,
+    subset_corpus,
+    worst_segments,
+)
+from engine.corpus import Corpus
+from engine.model import Model
+
+from .common import (
+    NumberItem,
+    ask_save_path,
+    fill_table,
+    heat_item,
+    report_error,
+    run_background,
+    text_item,
+)
+
+log = logging.getLogger(__name__)
+
+SPLITS = {"test": ("test",), "train": ("train",), "train + test": ("train", "test")}
+
+
+class ErrorView(QWidget):
+    """Per-phone, per-utterance and worst-segment errors over a corpus."""
+
+    reportReady = pyqtSignal(object)
+    jumpRequested = pyqtSignal(str, float)       # utterance id, time (s)
+
+    def __init__(self, model: Model, corpus: Corpus, window=None, parent: QWidget | None = None):
+        super().__init__(parent)
+        self.model = model
+        self.corpus = corpus
+        self.window_ = window
+        self.report: ErrorReport | None = None
+        self._pending_seek: tuple[str, float] | None = None
+
+        self.splits = QComboBox()
+        self.splits.addItems(list(SPLITS))
+        self.per_split = QSpinBox()
+        self.per_split.setRange(0, 10000)
+        self.per_split.setSpecialValueText("all")
+        self.run_btn = QPushButton("Compute")
+        self.run_btn.clicked.connect(self.start)
+        self.progress = QProgressBar()
+        self.progress.setRange(0, 1000)
+        csv_btn = QPushButton("Export CSV…")
+        csv_btn.clicked.connect(self._export_csv)
+        top = QHBoxLayout()
+        top.addWidget(QLabel("split:"))
+        top.addWidget(self.splits)
+        top.addWidget(QLabel("utterances:"))
+        top.addWidget(self.per_split)
+        top.addWidget(self.run_btn)
+        top.addWidget(self.progress, 1)
+        top.addWidget(csv_btn)
+
+        self.phone_table = QTableWidget()
+        self.utt_table = QTableWidget()
+        self.worst_table = QTableWidget()
+        for t in (self.phone_table, self.utt_table, self.worst_table):
+            t.setSortingEnabled(True)
+            t.verticalHeader().setVisible(False)
+            t.setSelectionBehavior(QTableWidget.SelectionBehavior.SelectRows)
+        self.utt_table.cellClicked.connect(self._utt_clicked)
+        self.worst_table.cellClicked.connect(self._worst_clicked)
+        self.tabs = QTabWidget()
+        self.tabs.addTab(self.phone_table, "Per phone")
+        self.tabs.addTab(self.utt_table, "Per utterance")
+        self.tabs.addTab(self.worst_table, "Worst segments")
+        self.status = QLabel("Compute synthesizes every utterance of the split and compares it with "
+                             "the original (lip markers).")
+        self.status.setWordWrap(True)
+        lay = QVBoxLayout(self)
+        lay.addLayout(top)
+        lay.addWidget(self.status)
+        lay.addWidget(self.tabs, 1)
+        self.jumpRequested.connect(self._jump)
+        if window is not None:
+            window.synthesisChanged.connect(self._after_load)
+
+    # ------------------------------------------------------------------ work
+    def start(self) -> None:
+        model = self.model
+        corpus = subset_corpus(self.corpus, int(self.per_split.value()) or None)
+        splits = SPLITS[self.splits.currentText()]
+        config = getattr(self.window_, "synth_config", None)
+        self.run_btn.setEnabled(False)
+        run_background(self, lambda p: error_report(model, corpus, splits, config, progress=p),
+                       self._done, self._on_progress, self._failed, "Error analysis", self.window_)
+
+    def _on_progress(self, fraction: float, message: str) -> None:
+        self.progress.setValue(int(1000 * fraction))
+        self.status.setText(message)
+
+    def _failed(self, exc: BaseException) -> None:
+        self.run_btn.setEnabled(True)
+        report_error(self, "Error analysis", exc)
+
+    def _done(self, report: ErrorReport) -> None:
+        self.run_btn.setEnabled(True)
+        self.set_report(report)
+        self.reportReady.emit(report)
+
+    # ------------------------------------------------------------------ display
+    def set_report(self, report: ErrorReport) -> None:
+        self.report = report
+        rms_max = max((p.rms for p in report.phones), default=1.0)
+        rows = [[text_item(p.phone), heat_item(p.correlation, 0.0, 1.0, "{:.3f}", "RdYlGn"),
+                 heat_item(p.rms, 0.0, rms_max, "{:.2f}", "YlOrRd"), NumberItem(p.frames, "{:.0f}"),
+                 NumberItem(p.segments, "{:.0f}")] for p in report.phones]
+        fill_table(self.phone_table, ["phone", "correlation (lips y)", "RMS error (mm)", "frames",
+                                      "segments"], rows)
+        rms_u = max((u.rms for u in report.utterances), default=1.0)
+        rows = [[text_item(u.utterance), text_item(u.split),
+                 *(heat_item(getattr(u, m), 0.0, 1.0, "{:.3f}", "RdYlGn")
+                   for m in ("whole_face", "lower_lip", "upper_lip")),
+                 heat_item(u.rms, 0.0, rms_u, "{:.2f}"), text_item(u.worst_label),
+                 NumberItem(u.worst_time, "{:.2f}"), NumberItem(u.worst_error, "{:.2f}")]
+                for u in report.utterances]
+        fill_table(self.utt_table, ["utterance", "split", "whole face r", "lower lip r", "upper lip r",
+                                    "RMS (mm)", "worst phone", "at (s)", "its error (mm)"], rows)
+        rows = [[text_item(s.utterance), text_item(s.label), NumberItem(s.start, "{:.3f}"),
+                 NumberItem(s.end, "{:.3f}"), heat_item(s.error, 0.0, report.worst[0].error, "{:.2f}")]
+                for s in report.worst]
+        fill_table(self.worst_table, ["utterance", "phone", "start (s)", "end (s)", "mean lip error (mm)"],
+                   rows)
+        self.status.setText(f"{len(report.utterances)} utterances, {len(report.phones)} phones. "
+                            "Click an utterance or a segment to go there.")
+
+    def _utt_clicked(self, row: int, _col: int) -> None:
+        utt = self.utt_table.item(row, 0).text()
+        t = self.utt_table.item(row, 7)
+        self.jumpRequested.emit(utt, float(t.value) if isinstance(t, NumberItem) else 0.0)
+
+    def _worst_clicked(self, row: int, _col: int) -> None:
+        utt = self.worst_table.item(row, 0).text()
+        start = self.worst_table.item(row, 2)
+        self.jumpRequested.emit(utt, float(start.value) if isinstance(start, NumberItem) else 0.0)
+
+    # ------------------------------------------------------------------ navigation
+    def _jump(self, utt: str, t: float) -> None:
+        w = self.window_
+        if w is None:
+            return
+        view = getattr(w, "view", None)
+        if view is not None and view.utterance.name == utt:
+            w.seek(t)
+            return
+        self._pending_seek = (utt, t)
+        w.set_utterance(utt)
+
+    def _after_load(self) -> None:
+        if self._pending_seek is None:
+            return
+        view = getattr(self.window_, "view", None)
+        if view is not None and view.utterance.name == self._pending_seek[0]:
+            t = self._pending_seek[1]
+            self._pending_seek = None
+            self.window_.seek(t)
+
+    # ------------------------------------------------------------------ export
+    def export_csv(self, path: str | Path) -> Path:
+        from engine.analysis import write_error_csv
+
+        if self.report is None:
+            raise ValueError("compute the errors first")
+        return write_error_csv(path, self.report)
+
+    def _export_csv(self) -> None:
+        path = ask_save_path(self, "Export per-utterance errors", "errors.csv", "CSV (*.csv)")
+        if path:
+            try:
+                self.export_csv(path)
+            except (OSError, ValueError) as exc:
+                report_error(self, "Export failed", exc)
+
+
+class LipErrorPanel:
+    """Timeline panel: ``|original - synthesized|`` of the upper and lower lip (mm), the worst
+    segments of the utterance shaded and labelled."""
+
+    title = "lip error"
+    height = 1.0
+
+    def __init__(self, model: Model, worst: int = 3):
+        self.model = model
+        self.worst = worst
+        self.last_segments = []
+
+    def draw(self, ax, view) -> None:
+        ax.set_ylabel("|orig - synth|\n(mm)", fontsize=8)
+        if view.original is None:
+            ax.text(0.5, 0.5, "no original markers", transform=ax.transAxes, ha="center",
+                    va="center", color="#888888", fontsize=8)
+            return
+        err = lip_error(self.model, view.original, view.synthesis.markers)
+        t = view.times[: len(err)]
+        ax.plot(t, err[:, 0], color=ORIGINAL_COLOR, lw=1.1, label="upper lip")
+        ax.plot(t, err[:, 1], color=SYNTH_COLOR, lw=1.1, label="lower lip")
+        segs = worst_segments(segment_errors(view.utterance.phones, view.times, err,
+                                             view.utterance.name), self.worst)
+        self.last_segments = segs
+        for s in segs:
+            ax.axvspan(s.start, s.end, color="#e03131", alpha=0.15, lw=0)
+            ax.text(0.5 * (s.start + s.end), 0.95, f"{s.label} {s.error:.1f}",
+                    transform=ax.get_xaxis_transform(), ha="center", va="top", fontsize=7, color="#c92a2a", clip_on=True)
+        ax.set_ylim(bottom=0)
+        ax.legend(loc="upper right", fontsize=7, ncol=2, framealpha=0.8)

@@ -1,0 +1,279 @@
+"""Kinematics as phoneticians measure them, as panels of the time-aligned stack.
+
+Lip aperture (upper-to-lower lip distance), lip width (corner to corner), protrusion (forward
+displacement of the lips from the neutral face) and the tangential velocity of any marker, each for
+the original (dotted blue) and the synthesized (orange) trajectories. On the velocity panel the
+gesture landmarks (onset, peak velocity, maximum constriction, release peak velocity, offset) are
+found by the engine with an adjustable threshold (20 % of the peak by default), for original and
+synthesized alike; :class:`KinematicsControls` lists them with the timing error of each landmark
+and exports TSV and a TextGrid point tier.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+from PyQt6.QtCore import pyqtSignal
+from PyQt6.QtWidgets import (
+    QComboBox,
+    QDoubleSpinBox,
+    QFormLayout,
+    QHBoxLayout,
+    QLabel,
+    QLineEdit,
+    QPushButton,
+    QTableWidget,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.style import ORIGINAL_COLOR, SYNTH_COLOR
+from engine.kinematics import (
+    LABIAL_PHONES,
+    LANDMARKS,
+    GestureMeasurement,
+    mean_abs_timing_error,
+    measure_gestures,
+    model_lip_measures,
+    write_landmarks_textgrid,
+    write_landmarks_tsv,
+)
+from engine.model import Model
+
+from .common import NumberItem, ask_save_path, fill_table, report_error, text_item
+
+log = logging.getLogger(__name__)
+
+LANDMARK_MARKERS = {"onset": "^", "pvel": "o", "maxc": "v", "pvel2": "o", "offset": "s"}
+MEASURES = {
+    "aperture": ("lip aperture", "aperture\n(mm)"),
+    "width": ("lip width", "width\n(mm)"),
+    "protrusion": ("lip protrusion", "protrusion\n(mm)"),
+}
+
+
+class LipMeasurePanel:
+    """Timeline panel: one lip measure (``aperture``, ``width`` or ``protrusion``)."""
+
+    height = 0.9
+
+    def __init__(self, model: Model, measure: str):
+        if measure not in MEASURES:
+            raise ValueError(f"unknown lip measure {measure!r}")
+        self.model = model
+        self.measure = measure
+        self.title = MEASURES[measure][0]
+
+    def draw(self, ax, view) -> None:
+        syn = getattr(model_lip_measures(self.model, view.synthesis.markers), self.measure)
+        t = view.times[: len(syn)]
+        ax.plot(t, syn, color=SYNTH_COLOR, lw=1.3, label="synthesized")
+        if view.original is not None:
+            orig = getattr(model_lip_measures(self.model, view.original), self.measure)
+            ax.plot(view.times[: len(orig)], orig, color=ORIGINAL_COLOR, lw=1.3, ls=(0, (2, 1.5)),
+                    label="original")
+        ax.set_ylabel(MEASURES[self.measure][1], fontsize=8)
+
+
+class KinematicsControls(QWidget):
+    """The velocity panel's settings (marker, threshold, smoothing, gesture phones), the landmark
+    table with timing errors, and export."""
+
+    changed = pyqtSignal()
+    measured = pyqtSignal(object)           # the GestureMeasurement
+
+    def __init__(self, model: Model, window=None, parent: QWidget | None = None):
+        super().__init__(parent)
+        self.model = model
+        self.window_ = window
+        self.view = None
+        self.measurement: GestureMeasurement | None = None
+        self._key = None
+
+        self.marker = QComboBox()
+        self.marker.addItems(model.marker_names)
+        self.marker.setCurrentIndex(model.lower_lip)
+        self.threshold = QDoubleSpinBox()
+        self.threshold.setRange(1, 90)
+        self.threshold.setValue(20)
+        self.threshold.setSuffix(" % of peak")
+        self.smooth = QDoubleSpinBox()
+        self.smooth.setRange(0, 50)
+        self.smooth.setValue(0)
+        self.smooth.setSuffix(" ms")
+        self.smooth.setToolTip("light Gaussian smoothing of the positions before differencing (SD)")
+        self.phones = QLineEdit(" ".join(LABIAL_PHONES))
+        self.phones.setToolTip("gestures are searched around the segments of these phones")
+        for w in (self.marker,):
+            w.currentIndexChanged.connect(self._changed)
+        for w in (self.threshold, self.smooth):
+            w.valueChanged.connect(self._changed)
+        self.phones.editingFinished.connect(self._changed)
+        form = QFormLayout()
+        form.addRow("marker:", self.marker)
+        form.addRow("threshold:", self.threshold)
+        form.addRow("smoothing:", self.smooth)
+        form.addRow("gesture phones:", self.phones)
+
+        self.table = QTableWidget()
+        self.table.setSortingEnabled(True)
+        self.table.verticalHeader().setVisible(False)
+        self.summary = QLabel("")
+        self.summary.setWordWrap(True)
+        tsv = QPushButton("Export TSV…")
+        tsv.clicked.connect(self._export_tsv)
+        tg = QPushButton("Export TextGrid…")
+        tg.clicked.connect(self._export_textgrid)
+        buttons = QHBoxLayout()
+        buttons.addWidget(tsv)
+        buttons.addWidget(tg)
+        buttons.addStretch(1)
+        lay = QVBoxLayout(self)
+        lay.addLayout(form)
+        lay.addWidget(self.summary)
+        lay.addWidget(self.table, 1)
+        lay.addLayout(buttons)
+
+        self.panel = VelocityPanel(self)
+        if window is not None:
+            window.synthesisChanged.connect(lambda: self.set_view(window.view))
+            if window.view is not None:
+                self.set_view(window.view)
+
+    # ------------------------------------------------------------------ settings
+    @property
+    def marker_index(self) -> int:
+        return self.marker.currentIndex()
+
+    @property
+    def threshold_fraction(self) -> float:
+        return float(self.threshold.value()) / 100.0
+
+    @property
+    def smooth_s(self) -> float:
+        return float(self.smooth.value()) / 1000.0
+
+    @property
+    def gesture_labels(self) -> list[str]:
+        return self.phones.text().split()
+
+    def _changed(self) -> None:
+        if self.view is not None:
+            self.measure(self.view)
+        self.changed.emit()
+        tl = getattr(self.window_, "timeline", None)
+        if tl is not None and self.panel in tl.panels:
+            tl.relayout(tl.xlim())
+
+    # ------------------------------------------------------------------ measuring
+    def set_view(self, view) -> None:
+        self.view = view
+        if view is not None:
+            self.measure(view)
+
+    def measure(self, view) -> GestureMeasurement:
+        """The engine's gesture measurement for ``view`` with the current settings (cached)."""
+        key = (id(view), self.marker_index, self.threshold_fraction, self.smooth_s,
+               tuple(self.gesture_labels))
+        if key == self._key and self.measurement is not None:
+            return self.measurement
+        m = measure_gestures(view.synthesis.markers, view.original, self.marker_index, view.rate,
+                             view.utterance.phones, self.gesture_labels, self.threshold_fraction,
+                             self.smooth_s, t0=float(view.times[0]))
+        self._key = key
+        self.measurement = m
+        self._fill(m)
+        self.measured.emit(m)
+        return m
+
+    def _fill(self, m: GestureMeasurement) -> None:
+        pairs = m.pairs()
+        rows = []
+        if pairs:
+            for gi, p in enumerate(pairs):
+                o, s, e = p.original.times(), p.synthesized.times(), p.errors()
+                for k in LANDMARKS:
+                    rows.append([NumberItem(gi + 1, "{:.0f}"), text_item(p.original.label), text_item(k),
+                                 NumberItem(o[k], "{:.3f}"), NumberItem(s[k], "{:.3f}"),
+                                 NumberItem(1000 * e[k], "{:+.0f}")])
+            mae = mean_abs_timing_error(pairs)
+            self.summary.setText("mean |timing error| (ms): " + ", ".join(
+                f"{k} {1000 * v:.0f}" for k, v in mae.items()))
+        else:
+            for gi, g in enumerate(m.synthesized):
+                for k, t in g.times().items():
+                    rows.append([NumberItem(gi + 1, "{:.0f}"), text_item(g.label), text_item(k),
+                                 NumberItem(float("nan")), NumberItem(t, "{:.3f}"), NumberItem(float("nan"))])
+            self.summary.setText("no original markers: synthesized landmarks only")
+        fill_table(self.table, ["gesture", "phone", "landmark", "original (s)", "synthesized (s)",
+                                "error (ms)"], rows)
+
+    # ------------------------------------------------------------------ export
+    def _sources(self) -> dict:
+        m = self.measurement
+        if m is None:
+            raise ValueError("no utterance measured yet")
+        out = {}
+        if m.v_original is not None:
+            out["original"] = m.original
+        out["synthesized"] = m.synthesized
+        return out
+
+    def export_tsv(self, path: str | Path) -> Path:
+        return write_landmarks_tsv(path, self._sources(), self.model.marker_names[self.marker_index])
+
+    def export_textgrid(self, path: str | Path) -> Path:
+        return write_landmarks_textgrid(path, self._sources(), self.view.utterance.duration)
+
+    def _export(self, title: str, default: str, filters: str, fn) -> None:
+        name = self.view.utterance.name if self.view is not None else "landmarks"
+        path = ask_save_path(self, title, f"{name}_{default}", filters)
+        if path:
+            try:
+                fn(path)
+            except (OSError, ValueError) as exc:
+                report_error(self, "Export failed", exc)
+
+    def _export_tsv(self) -> None:
+        self._export("Export landmarks", "landmarks.tsv", "TSV (*.tsv)", self.export_tsv)
+
+    def _export_textgrid(self) -> None:
+        self._export("Export landmarks as TextGrid", "landmarks.TextGrid", "TextGrid (*.TextGrid)",
+                     self.export_textgrid)
+
+
+class VelocityPanel:
+    """Timeline panel: tangential velocity of the chosen marker with its gesture landmarks
+    (original above, synthesized below each gesture) and the threshold levels."""
+
+    height = 1.2
+
+    def __init__(self, controls: KinematicsControls):
+        self.controls = controls
+
+    @property
+    def title(self) -> str:
+        return f"tangential velocity {self.controls.model.marker_names[self.controls.marker_index]}"
+
+    def draw(self, ax, view) -> None:
+        m = self.controls.measure(view)
+        ax.plot(m.times, m.v_synthesized, color=SYNTH_COLOR, lw=1.2, label="synthesized")
+        sets = [(m.synthesized, SYNTH_COLOR, 0.08)]
+        if m.v_original is not None:
+            ax.plot(m.times, m.v_original, color=ORIGINAL_COLOR, lw=1.2, ls=(0, (2, 1.5)),
+                    label="original")
+            sets.insert(0, (m.original, ORIGINAL_COLOR, 0.92))
+        for gestures, color, y in sets:
+            for g in gestures:
+                for k, t in g.times().items():
+                    ax.plot([t], [y], LANDMARK_MARKERS[k], color=color, ms=4.5,
+                            transform=ax.get_xaxis_transform(), clip_on=True,
+                            mfc=color if k in ("pvel", "pvel2", "maxc") else "none")
+                ax.plot([g.onset, g.pvel], [self.controls.threshold_fraction * g.v_pvel] * 2, color=color,
+                        lw=0.6, alpha=0.6)
+                ax.plot([g.pvel2, g.offset], [self.controls.threshold_fraction * g.v_pvel2] * 2,
+                        color=color, lw=0.6, alpha=0.6)
+        ax.set_ylabel(f"{self.controls.model.marker_names[m.marker]}\nspeed (mm/s)", fontsize=8)
+        ax.set_ylim(bottom=0)
+        ax.legend(loc="upper right", fontsize=7, ncol=2, framealpha=0.8)

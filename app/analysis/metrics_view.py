@@ -1,0 +1,254 @@
+"""Metrics: the paper's Table 2 (train / test x triangular / spline; whole face, lower lip, upper
+lip) plus acoustic-only rows, and the N sweep (Figure 5), each computed by the engine in a
+background worker with progress. Export CSV (Table 2, sweep) and PNG (the two plots).
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import numpy as np
+from PyQt6.QtCore import Qt, pyqtSignal
+from PyQt6.QtWidgets import (
+    QCheckBox,
+    QGridLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QProgressBar,
+    QPushButton,
+    QSpinBox,
+    QSplitter,
+    QTableWidget,
+    QVBoxLayout,
+    QWidget,
+)
+
+from engine.analysis import (
+    SweepCurve,
+    Table2Row,
+    subset_corpus,
+    sweep_curves,
+    table2_rows,
+    write_sweep_csv,
+    write_table2_csv,
+)
+from engine.corpus import Corpus
+from engine.evaluation import METRICS, EvalResult, sweep_n, table2
+from engine.model import Model
+
+from .common import (
+    Canvas,
+    NumberItem,
+    ask_save_path,
+    fill_table,
+    heat_item,
+    report_error,
+    run_background,
+    text_item,
+)
+
+log = logging.getLogger(__name__)
+
+METRIC_NAMES = {"whole_face": "Whole Face", "lower_lip": "Lower Lip", "upper_lip": "Upper Lip"}
+
+
+def _short(row: Table2Row) -> str:
+    """A compact bar label: split, smoothing, acoustic-only."""
+    smooth = {"triangular": "triang.", "spline": "spline"}.get(row.smoothing, row.smoothing)
+    return f"{row.split}\n{smooth}" + ("\nacoustic" if row.mode != "phonetic" else "")
+
+
+class MetricsView(QWidget):
+    """Table 2 and the N sweep for a model and corpus."""
+
+    table2Done = pyqtSignal()
+    sweepDone = pyqtSignal()
+
+    def __init__(self, model: Model, corpus: Corpus, window=None, parent: QWidget | None = None):
+        super().__init__(parent)
+        self.model = model
+        self.corpus = corpus
+        self.window_ = window
+        self.table2_result: EvalResult | None = None
+        self.sweep_result: EvalResult | None = None
+        self.rows: list[Table2Row] = []
+        self.curves: list[SweepCurve] = []
+
+        self.per_split = QSpinBox()
+        self.per_split.setRange(0, 10000)
+        self.per_split.setSpecialValueText("all")
+        self.per_split.setToolTip("utterances per split (all: the whole corpus)")
+        self.acoustic = QCheckBox("acoustic-only rows")
+        self.acoustic.setChecked(True)
+        self.max_n = QSpinBox()
+        self.max_n.setRange(1, 30)
+        self.max_n.setValue(10)
+        self.run_table2 = QPushButton("Compute Table 2")
+        self.run_table2.clicked.connect(self.start_table2)
+        self.run_sweep = QPushButton("Run N sweep")
+        self.run_sweep.clicked.connect(self.start_sweep)
+        self.progress = QProgressBar()
+        self.progress.setRange(0, 1000)
+        self.status = QLabel("")
+        exp = [("Table 2 CSV…", self._export_table2), ("N sweep CSV…", self._export_sweep),
+               ("PNG…", self._export_png)]
+
+        opts = QGroupBox("Run")
+        g = QGridLayout(opts)
+        g.addWidget(QLabel("utterances per split:"), 0, 0)
+        g.addWidget(self.per_split, 0, 1)
+        g.addWidget(self.acoustic, 0, 2)
+        g.addWidget(self.run_table2, 0, 3)
+        g.addWidget(QLabel("N from 1 to:"), 1, 0)
+        g.addWidget(self.max_n, 1, 1)
+        g.addWidget(self.run_sweep, 1, 3)
+        g.addWidget(self.progress, 2, 0, 1, 3)
+        g.addWidget(self.status, 2, 3)
+        buttons = QHBoxLayout()
+        buttons.addWidget(QLabel("Export:"))
+        for text, slot in exp:
+            b = QPushButton(text)
+            b.clicked.connect(slot)
+            buttons.addWidget(b)
+        buttons.addStretch(1)
+
+        self.table = QTableWidget()
+        self.table.setSortingEnabled(True)
+        self.table.verticalHeader().setVisible(False)
+        self.canvas = Canvas(9, 3.6)
+        split = QSplitter(Qt.Orientation.Vertical)
+        split.addWidget(self.table)
+        split.addWidget(self.canvas)
+        lay = QVBoxLayout(self)
+        lay.addWidget(opts)
+        lay.addLayout(buttons)
+        lay.addWidget(split, 1)
+        self._draw()
+
+    # ------------------------------------------------------------------ work
+    def _subset(self) -> Corpus:
+        return subset_corpus(self.corpus, int(self.per_split.value()) or None)
+
+    def _busy(self, busy: bool) -> None:
+        self.run_table2.setEnabled(not busy)
+        self.run_sweep.setEnabled(not busy)
+
+    def _on_progress(self, fraction: float, message: str) -> None:
+        self.progress.setValue(int(1000 * fraction))
+        self.status.setText(message)
+
+    def _failed(self, exc: BaseException) -> None:
+        self._busy(False)
+        self.status.setText("failed")
+        report_error(self, "Metrics", exc)
+
+    def start_table2(self) -> None:
+        corpus, model, acoustic = self._subset(), self.model, self.acoustic.isChecked()
+        self._busy(True)
+        run_background(self, lambda p: table2(model, corpus, acoustic=acoustic, progress=p),
+                       self._table2_done, self._on_progress, self._failed, "Table 2", self.window_)
+
+    def start_sweep(self) -> None:
+        corpus, model = self._subset(), self.model
+        ns = tuple(range(1, int(self.max_n.value()) + 1))
+        self._busy(True)
+        run_background(self, lambda p: sweep_n(model, corpus, ns, progress=p),
+                       self._sweep_done, self._on_progress, self._failed, "N sweep", self.window_)
+
+    def _table2_done(self, result: EvalResult) -> None:
+        self._busy(False)
+        self.set_table2(result)
+        self.table2Done.emit()
+
+    def _sweep_done(self, result: EvalResult) -> None:
+        self._busy(False)
+        self.set_sweep(result)
+        self.sweepDone.emit()
+
+    # ------------------------------------------------------------------ display
+    def set_table2(self, result: EvalResult) -> None:
+        self.table2_result = result
+        self.rows = table2_rows(result)
+        head = ["Test condition", "Whole Face", "Lower Lip", "Upper Lip", "N", "utterances"]
+        rows = [[text_item(r.name), *(heat_item(getattr(r, m), 0.4, 1.0, "{:.4f}", "RdYlGn")
+                                      for m in METRICS),
+                 NumberItem(r.n_context_phones, "{:.0f}"), NumberItem(r.utterances, "{:.0f}")]
+                for r in self.rows]
+        fill_table(self.table, head, rows)
+        self.status.setText(f"Table 2: {len(self.rows)} conditions")
+        self._draw()
+
+    def set_sweep(self, result: EvalResult) -> None:
+        self.sweep_result = result
+        self.curves = sweep_curves(result)
+        self.status.setText("N sweep done")
+        self._draw()
+
+    def _draw(self) -> None:
+        fig = self.canvas.figure
+        fig.clear()
+        ax1, ax2 = fig.subplots(1, 2, gridspec_kw={"width_ratios": [3, 2]})
+        fig.subplots_adjust(left=0.07, right=0.98, bottom=0.3, top=0.9, wspace=0.25)
+        if self.rows:
+            x = np.arange(len(self.rows))
+            width = 0.27
+            for k, m in enumerate(METRICS):
+                ax1.bar(x + (k - 1) * width, [getattr(r, m) for r in self.rows], width,
+                        label=METRIC_NAMES[m])
+            ax1.set_xticks(x, [_short(r) for r in self.rows], fontsize=6.5)
+            ax1.set_ylim(0, 1.18)
+            ax1.set_yticks(np.linspace(0, 1, 6))
+            ax1.legend(fontsize=7, ncol=3, loc="upper center", frameon=False)
+        else:
+            ax1.text(0.5, 0.5, "Compute Table 2", ha="center", va="center", transform=ax1.transAxes,
+                     color="#888888")
+        ax1.set_title("Table 2: mean correlation, speech frames", fontsize=9)
+        ax1.set_ylabel("correlation", fontsize=8)
+        ax1.tick_params(labelsize=7)
+        if self.curves:
+            for c in self.curves:
+                style = "-o" if c.split == "test" else "--s"
+                ax2.plot(c.ns, c.whole_face, style, ms=4, label=f"{c.split} (whole face)")
+            ax2.set_xlabel("N (context-phones searched)", fontsize=8)
+            ax2.legend(fontsize=7)
+            ax2.set_xticks(self.curves[0].ns)
+        else:
+            ax2.text(0.5, 0.5, "Run N sweep", ha="center", va="center", transform=ax2.transAxes,
+                     color="#888888")
+        ax2.set_title("Figure 5: correlation against N (triangular)", fontsize=9)
+        ax2.tick_params(labelsize=7)
+        self.canvas.draw_idle()
+
+    # ------------------------------------------------------------------ export
+    def export_table2_csv(self, path: str | Path) -> Path:
+        if self.table2_result is None:
+            raise ValueError("compute Table 2 first")
+        return write_table2_csv(path, self.table2_result)
+
+    def export_sweep_csv(self, path: str | Path) -> Path:
+        if self.sweep_result is None:
+            raise ValueError("run the N sweep first")
+        return write_sweep_csv(path, self.sweep_result)
+
+    def export_png(self, path: str | Path) -> Path:
+        self.canvas.draw()
+        return self.canvas.save_png(path)
+
+    def _export(self, title: str, default: str, filters: str, fn) -> None:
+        path = ask_save_path(self, title, default, filters)
+        if path:
+            try:
+                fn(path)
+            except (OSError, ValueError) as exc:
+                report_error(self, "Export failed", exc)
+
+    def _export_table2(self) -> None:
+        self._export("Export Table 2", "table2.csv", "CSV (*.csv)", self.export_table2_csv)
+
+    def _export_sweep(self) -> None:
+        self._export("Export N sweep", "n_sweep.csv", "CSV (*.csv)", self.export_sweep_csv)
+
+    def _export_png(self) -> None:
+        self._export("Export plots", "metrics.png", "PNG image (*.png)", self.export_png)

@@ -1,0 +1,241 @@
+"""The principal component mode explorer (the paper's Figure 2).
+
+Pick a PC and drag its coefficient over +-3 standard deviations: the 3-D view shows the neutral
+face (grey), the displaced face (orange) and displacement arrows; beside it the front projection
+as in Figure 2 (circles: neutral, arrows: displacement) and the variance share of every PC.
+"Animate" sweeps the mode back and forth. All shapes come from ``model.mode_shape``.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import numpy as np
+import pyvista as pv
+from PyQt6.QtCore import Qt, QTimer, pyqtSignal
+from PyQt6.QtWidgets import (
+    QComboBox,
+    QHBoxLayout,
+    QLabel,
+    QPushButton,
+    QSlider,
+    QSplitter,
+    QVBoxLayout,
+    QWidget,
+)
+from pyvistaqt import QtInteractor
+
+from app.style import BACKGROUND, SYNTH_COLOR
+from engine.analysis import describe_mode, mode_displacement, mode_sd
+from engine.model import Model
+
+from .common import Canvas
+
+log = logging.getLogger(__name__)
+
+SLIDER_STEPS = 100          # slider units per standard deviation
+NEUTRAL_COLOR = "#8c8c8c"
+
+
+class PCModeExplorer(QWidget):
+    """Explore one PC at a time: slider over +-3 SD, 3-D view, Figure 2 projection, variance."""
+
+    valueChanged = pyqtSignal(int, float)     # component, coefficient value (mm units of the PC)
+
+    def __init__(self, model: Model, window=None, parent: QWidget | None = None):
+        super().__init__(parent)
+        self.model = model
+        self.window_ = window
+        self.sd = mode_sd(model)
+        self.neutral = model.neutral_face()
+        self.component = 0
+        self.value = 0.0
+        self._phase = 0.0
+
+        self.combo = QComboBox()
+        for k, share in enumerate(model.pca.explained_ratio):
+            self.combo.addItem(f"PC{k + 1}  ({100 * share:.1f} %)")
+        self.combo.currentIndexChanged.connect(self.set_component)
+        self.slider = QSlider(Qt.Orientation.Horizontal)
+        self.slider.setRange(-3 * SLIDER_STEPS, 3 * SLIDER_STEPS)
+        self.slider.setTickInterval(SLIDER_STEPS)
+        self.slider.setTickPosition(QSlider.TickPosition.TicksBelow)
+        self.slider.valueChanged.connect(self._slider_moved)
+        self.value_label = QLabel()
+        self.value_label.setMinimumWidth(170)
+        self.animate_btn = QPushButton("Animate")
+        self.animate_btn.setCheckable(True)
+        self.animate_btn.toggled.connect(self.set_animating)
+        reset = QPushButton("Reset")
+        reset.clicked.connect(lambda: self.slider.setValue(0))
+        self.description = QLabel()
+        self.description.setWordWrap(True)
+        controls = QHBoxLayout()
+        controls.addWidget(QLabel("component:"))
+        controls.addWidget(self.combo)
+        controls.addWidget(QLabel("-3 SD"))
+        controls.addWidget(self.slider, 1)
+        controls.addWidget(QLabel("+3 SD"))
+        controls.addWidget(self.value_label)
+        controls.addWidget(reset)
+        controls.addWidget(self.animate_btn)
+
+        self.plotter = QtInteractor(self, auto_update=False)
+        self.plotter.set_background(BACKGROUND)
+        self.canvas = Canvas(5, 6)
+        split = QSplitter(Qt.Orientation.Horizontal)
+        split.addWidget(self.plotter.interactor)
+        split.addWidget(self.canvas)
+        split.setSizes([600, 450])
+        lay = QVBoxLayout(self)
+        lay.addLayout(controls)
+        lay.addWidget(self.description)
+        lay.addWidget(split, 1)
+
+        self.timer = QTimer(self)
+        self.timer.setInterval(40)
+        self.timer.timeout.connect(self._tick)
+        self._build_scene()
+        self._build_plots()
+        self.set_component(0)
+
+    # ------------------------------------------------------------------ scene
+    def _build_scene(self) -> None:
+        n = len(self.neutral)
+        verts = np.column_stack([np.ones(n, int), np.arange(n)]).ravel()
+        self.neutral_poly = pv.PolyData(self.neutral.copy())
+        self.neutral_poly.verts = verts
+        self.displaced = pv.PolyData(self.neutral.copy())
+        self.displaced.verts = verts
+        both = np.vstack([self.neutral, self.neutral])
+        self.arrows = pv.PolyData(both)
+        self.arrows.lines = np.column_stack([np.full(n, 2), np.arange(n), np.arange(n) + n]).ravel()
+        p = self.plotter
+        p.add_mesh(self.neutral_poly, color=NEUTRAL_COLOR, render_points_as_spheres=True,
+                   point_size=11, style="points", name="neutral", pickable=False)
+        p.add_mesh(self.displaced, color=SYNTH_COLOR, render_points_as_spheres=True, point_size=11,
+                   style="points", name="displaced", pickable=False)
+        p.add_mesh(self.arrows, color="#222222", line_width=2.5, name="arrows", pickable=False)
+        self.heads = None
+        p.camera_position = "xy"
+        p.camera.azimuth = -25
+        p.camera.elevation = 10
+        p.reset_camera()
+
+    def _build_plots(self) -> None:
+        fig = self.canvas.figure
+        fig.clear()
+        self.ax_face, self.ax_var = fig.subplots(2, 1, gridspec_kw={"height_ratios": [3, 1.2]})
+        fig.subplots_adjust(left=0.12, right=0.97, top=0.95, bottom=0.08, hspace=0.35)
+        share = 100 * self.model.pca.explained_ratio
+        k = np.arange(1, len(share) + 1)
+        self.bars = self.ax_var.bar(k, share, color="#9fb7d9")
+        self.ax_var.plot(k, np.cumsum(share), color="#333333", lw=1, marker=".", ms=3,
+                         label="cumulative")
+        self.ax_var.set_xlabel("principal component", fontsize=8)
+        self.ax_var.set_ylabel("% variance", fontsize=8)
+        self.ax_var.set_ylim(0, 105)
+        self.ax_var.tick_params(labelsize=7)
+        self.ax_var.legend(fontsize=7, loc="center right")
+        ax = self.ax_face
+        ax.plot(self.neutral[:, 0], self.neutral[:, 1], "o", mfc="none", mec="#333333", ms=6)
+        self.quiver = ax.quiver(self.neutral[:, 0], self.neutral[:, 1], np.zeros(len(self.neutral)),
+                                np.zeros(len(self.neutral)), angles="xy", scale_units="xy", scale=1,
+                                color=SYNTH_COLOR, width=0.006)
+        ax.set_aspect("equal", adjustable="box")
+        ax.set_xlabel("x (mm)", fontsize=8)
+        ax.set_ylabel("y (mm)", fontsize=8)
+        ax.tick_params(labelsize=7)
+        span = np.ptp(self.neutral[:, :2], axis=0).max()
+        pad = 0.15 * span
+        ax.set_xlim(self.neutral[:, 0].min() - pad, self.neutral[:, 0].max() + pad)
+        ax.set_ylim(self.neutral[:, 1].min() - pad, self.neutral[:, 1].max() + pad)
+
+    # ------------------------------------------------------------------ state
+    def set_component(self, k: int) -> None:
+        self.component = int(k)
+        if self.combo.currentIndex() != k:
+            self.combo.setCurrentIndex(k)
+        for i, b in enumerate(self.bars):
+            b.set_color(SYNTH_COLOR if i == k else "#9fb7d9")
+        self.description.setText(describe_mode(self.model, k).text())
+        self.set_value(self.slider.value() / SLIDER_STEPS * self.sd[k], move_slider=False)
+
+    def set_sd_units(self, sds: float) -> None:
+        """Move the slider to ``sds`` standard deviations (clamped to +-3)."""
+        self.slider.setValue(int(round(np.clip(sds, -3, 3) * SLIDER_STEPS)))
+
+    def _slider_moved(self, pos: int) -> None:
+        self.set_value(pos / SLIDER_STEPS * self.sd[self.component], move_slider=False)
+
+    def set_value(self, value: float, move_slider: bool = True) -> None:
+        """Set the coefficient of the current PC (in the PC's units) and redraw."""
+        self.value = float(value)
+        if move_slider:
+            self.slider.blockSignals(True)
+            self.slider.setValue(int(round(value / self.sd[self.component] * SLIDER_STEPS)))
+            self.slider.blockSignals(False)
+        shape = self.model.mode_shape(self.component, self.value)
+        disp = mode_displacement(self.model, self.component, self.value)
+        self.displaced.points[:] = shape
+        self.displaced.GetPoints().Modified()
+        n = len(shape)
+        self.arrows.points[n:] = shape
+        self.arrows.GetPoints().Modified()
+        self._update_heads(shape, disp)
+        sd = self.sd[self.component]
+        self.value_label.setText(f"{self.value:+.2f} ({self.value / sd:+.2f} SD)")
+        self.plotter.render()
+        self.quiver.set_UVC(disp[:, 0], disp[:, 1])
+        self.ax_face.set_title(f"PC{self.component + 1} = {self.value:+.1f} "
+                               f"({self.value / sd:+.1f} SD)", fontsize=9)
+        self.canvas.draw_idle()
+        self.valueChanged.emit(self.component, self.value)
+
+    def _update_heads(self, shape: np.ndarray, disp: np.ndarray) -> None:
+        length = np.linalg.norm(disp, axis=1)
+        keep = length > max(1e-6, 0.05 * float(length.max(initial=0.0)))
+        if not keep.any():
+            if self.heads is not None:
+                self.plotter.remove_actor(self.heads, render=False)
+                self.heads = None
+            return
+        size = 0.02 * float(np.ptp(self.neutral, axis=0).max())
+        pts = pv.PolyData(shape[keep])
+        pts["v"] = disp[keep] / length[keep, None]
+        glyphs = pts.glyph(orient="v", scale=False, factor=size,
+                           geom=pv.Cone(center=(-0.5, 0, 0), direction=(1, 0, 0), radius=0.3,
+                                        height=1.0, resolution=10))
+        self.heads = self.plotter.add_mesh(glyphs, color="#222222", name="heads", pickable=False,
+                                           render=False)
+
+    def displaced_points(self) -> np.ndarray:
+        """The displaced face as shown in the 3-D view, ``(M, 3)``."""
+        return np.array(self.displaced.points)
+
+    # ------------------------------------------------------------------ animation
+    def set_animating(self, on: bool) -> None:
+        if self.animate_btn.isChecked() != on:
+            self.animate_btn.setChecked(on)
+            return
+        if on:
+            self._phase = math.asin(float(np.clip(self.slider.value() / (3 * SLIDER_STEPS), -1, 1)))
+            self.timer.start()
+        else:
+            self.timer.stop()
+
+    def _tick(self) -> None:
+        self._phase += 2 * math.pi / 50          # one sweep back and forth in 2 s
+        self.set_sd_units(3 * math.sin(self._phase))
+
+    def close_view(self) -> None:
+        self.timer.stop()
+        try:
+            self.plotter.close()
+        except Exception:
+            log.debug("plotter close failed", exc_info=True)
+
+    def closeEvent(self, event) -> None:
+        self.close_view()
+        super().closeEvent(event)
