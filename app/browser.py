@@ -1,0 +1,138 @@
+"""The utterance browser: train and test groups, each utterance with its lip correlations (filled
+in as the background evaluation delivers them) and a filter box."""
+
+from __future__ import annotations
+
+import logging
+import math
+import re
+
+from PyQt6.QtCore import Qt, pyqtSignal
+from PyQt6.QtWidgets import QHeaderView, QLineEdit, QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget
+
+log = logging.getLogger(__name__)
+
+ID_ROLE = Qt.ItemDataRole.UserRole
+
+
+def normalise_text(text: str) -> str:
+    """Lower case, letters and single spaces only (for matching sentences)."""
+    return " ".join(re.sub(r"[^a-z' ]+", " ", text.lower()).split())
+
+
+class UtteranceBrowser(QWidget):
+    """A filterable tree of the corpus utterances."""
+
+    utteranceSelected = pyqtSignal(str)
+
+    COLUMNS = ("utterance", "LL y r", "UL y r")
+
+    def __init__(self, parent: QWidget | None = None):
+        super().__init__(parent)
+        self.filter = QLineEdit(self)
+        self.filter.setPlaceholderText("filter: id or words")
+        self.filter.setClearButtonEnabled(True)
+        self.tree = QTreeWidget(self)
+        self.tree.setColumnCount(len(self.COLUMNS))
+        self.tree.setHeaderLabels(list(self.COLUMNS))
+        self.tree.setRootIsDecorated(True)
+        self.tree.setUniformRowHeights(True)
+        self.tree.setAlternatingRowColors(True)
+        header = self.tree.header()
+        header.setStretchLastSection(False)
+        header.setSectionResizeMode(0, QHeaderView.ResizeMode.Stretch)
+        for c in (1, 2):
+            header.setSectionResizeMode(c, QHeaderView.ResizeMode.Fixed)
+            self.tree.setColumnWidth(c, 74)
+        self.setMinimumWidth(360)
+        for c, what in ((1, "lower"), (2, "upper")):
+            self.tree.headerItem().setToolTip(
+                c, f"correlation of the {what} lip centre y, original vs synthesized, on speech frames "
+                   "(paper Table 2), with the current synthesis settings")
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(2, 2, 2, 2)
+        lay.addWidget(self.filter)
+        lay.addWidget(self.tree)
+        self.items: dict[str, QTreeWidgetItem] = {}
+        self.texts: dict[str, str] = {}
+        self.groups: dict[str, QTreeWidgetItem] = {}
+        self.filter.textChanged.connect(self.apply_filter)
+        self.tree.currentItemChanged.connect(self._on_current)
+
+    def populate(self, splits: dict[str, list[str]], texts: dict[str, str]) -> None:
+        """Fill the tree: ``splits`` maps group name (train, test) to utterance ids."""
+        self.tree.blockSignals(True)
+        self.tree.clear()
+        self.items.clear()
+        self.groups.clear()
+        self.texts = dict(texts)
+        for split, ids in splits.items():
+            group = QTreeWidgetItem([f"{split} ({len(ids)})", "", ""])
+            group.setFlags(Qt.ItemFlag.ItemIsEnabled)
+            font = group.font(0)
+            font.setBold(True)
+            group.setFont(0, font)
+            self.tree.addTopLevelItem(group)
+            self.groups[split] = group
+            for utt_id in ids:
+                text = texts.get(utt_id, "")
+                item = QTreeWidgetItem([f"{utt_id}  {text}" if text else utt_id, "…", "…"])
+                item.setData(0, ID_ROLE, utt_id)
+                item.setToolTip(0, f"{utt_id}: {text}" if text else utt_id)
+                for c in (1, 2):
+                    item.setTextAlignment(c, Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
+                group.addChild(item)
+                self.items[utt_id] = item
+            group.setExpanded(True)
+        self.tree.blockSignals(False)
+        self.apply_filter(self.filter.text())
+
+    def add_external(self, utt_id: str) -> None:
+        """Add an utterance opened from files (no original markers) to an "opened" group."""
+        group = self.groups.get("opened")
+        if group is None:
+            group = QTreeWidgetItem(["opened", "", ""])
+            group.setFlags(Qt.ItemFlag.ItemIsEnabled)
+            self.tree.addTopLevelItem(group)
+            self.groups["opened"] = group
+        if utt_id not in self.items:
+            item = QTreeWidgetItem([utt_id, "–", "–"])
+            item.setData(0, ID_ROLE, utt_id)
+            group.addChild(item)
+            self.items[utt_id] = item
+        group.setExpanded(True)
+
+    def set_current(self, utt_id: str) -> None:
+        item = self.items.get(utt_id)
+        if item is None:
+            return
+        self.tree.blockSignals(True)
+        self.tree.setCurrentItem(item)
+        self.tree.scrollToItem(item)
+        self.tree.blockSignals(False)
+
+    def set_scores(self, utt_id: str, lower: float, upper: float) -> None:
+        item = self.items.get(utt_id)
+        if item is None:
+            return
+        for col, v in ((1, lower), (2, upper)):
+            item.setText(col, "–" if v is None or not math.isfinite(v) else f"{v:.3f}")
+
+    def clear_scores(self) -> None:
+        for item in self.items.values():
+            if item.text(1) != "–":
+                item.setText(1, "…")
+                item.setText(2, "…")
+
+    def apply_filter(self, text: str) -> None:
+        words = normalise_text(text).split()
+        for utt_id, item in self.items.items():
+            hay = f"{utt_id.lower()} {normalise_text(self.texts.get(utt_id, ''))}"
+            item.setHidden(not all(w in hay for w in words))
+
+    def _on_current(self, current: QTreeWidgetItem | None, _previous) -> None:
+        if current is None:
+            return
+        utt_id = current.data(0, ID_ROLE)
+        if utt_id:
+            self.utteranceSelected.emit(str(utt_id))

@@ -1,0 +1,69 @@
+"""The trained-model cache: ``$FACETRAJ_CACHE_DIR`` or the user cache directory, one ``.npz`` per
+(corpus contents, training settings)."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import os
+from collections.abc import Callable
+from pathlib import Path
+
+from engine.config import TrainConfig
+from engine.corpus import Corpus
+from engine.errors import ModelFileError
+from engine.model import Model, train
+
+log = logging.getLogger(__name__)
+
+Progress = Callable[[float, str], None]
+
+
+def cache_dir() -> Path:
+    """Where trained models are kept (created on demand)."""
+    env = os.environ.get("FACETRAJ_CACHE_DIR")
+    if env:
+        return Path(env)
+    from platformdirs import user_cache_dir
+
+    return Path(user_cache_dir("facetraj"))
+
+
+def model_key(fingerprint: str, config: TrainConfig) -> str:
+    """A short hash of the corpus fingerprint and the training settings."""
+    blob = json.dumps({"corpus": fingerprint, "train": config.to_dict()}, sort_keys=True)
+    return hashlib.sha256(blob.encode()).hexdigest()[:20]
+
+
+def cached_model_path(corpus: Corpus, config: TrainConfig | None = None) -> Path:
+    """The cache file of ``corpus`` trained with ``config`` (hashes every corpus file)."""
+    config = config or TrainConfig()
+    return cache_dir() / f"model-{model_key(corpus.fingerprint(), config)}.npz"
+
+
+def load_or_train(corpus: Corpus, config: TrainConfig | None = None,
+                  progress: Progress | None = None) -> Model:
+    """The cached model of ``corpus``, training and caching it on the first call."""
+    config = config or TrainConfig()
+    progress = progress or (lambda f, m: None)
+    progress(0.0, "hashing the corpus")
+    path = cached_model_path(corpus, config)
+    if path.exists():
+        try:
+            progress(0.5, f"loading cached model {path.name}")
+            model = Model.load(path)
+            log.info("loaded cached model %s", path)
+            progress(1.0, "model loaded")
+            return model
+        except ModelFileError as exc:
+            log.warning("ignoring unreadable cached model: %s", exc)
+    log.info("training the model on %s (first run; cached in %s)", corpus.root, path.parent)
+    model = train(corpus, config=config, progress=lambda f, m: progress(0.02 + 0.96 * f, f"training: {m}"))
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        model.save(path)
+    except OSError as exc:
+        log.warning("could not cache the model in %s: %s", path, exc)
+    progress(1.0, "model trained")
+    return model

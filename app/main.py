@@ -1,0 +1,95 @@
+"""``run_app``: the entry point of ``facetraj`` (no arguments), ``facetraj gui`` and
+``facetraj --screenshot OUT.png``."""
+
+from __future__ import annotations
+
+import logging
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+log = logging.getLogger(__name__)
+
+WINDOW_SIZE = (1600, 1000)
+
+
+def _ensure_display() -> subprocess.Popen | None:
+    """For a screenshot on a machine without a display: start a private Xvfb (None if not needed)."""
+    if os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
+        return None
+    xvfb = shutil.which("Xvfb")
+    if xvfb is None:
+        log.warning("no display and no Xvfb: the 3-D view needs an X display")
+        return None
+    read, write = os.pipe()
+    proc = subprocess.Popen([xvfb, "-displayfd", str(write), "-screen", "0", "1600x1200x24", "-nolisten",
+                             "tcp"], pass_fds=(write,), stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    os.close(write)
+    with os.fdopen(read) as fh:
+        number = fh.readline().strip()
+    os.environ["DISPLAY"] = f":{number}"
+    log.info("started Xvfb on display :%s for the screenshot", number)
+    return proc
+
+
+def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | None = None,
+            time: float | None = None, model: Path | None = None) -> int:
+    """Open the main window on ``corpus``; with ``screenshot``, render it to that PNG and exit.
+
+    Returns the process exit status (2 when the corpus, model or utterance cannot be used in
+    screenshot mode).
+    """
+    xvfb = _ensure_display() if screenshot else None
+    os.environ.setdefault("QT_LOGGING_RULES", "qt.multimedia.*=false;qt.multimedia.ffmpeg=false")
+    from PyQt6.QtCore import QTimer
+    from PyQt6.QtWidgets import QApplication
+
+    from .main_window import MainWindow
+
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    app.setApplicationName("facetraj")
+    window = MainWindow(Path(corpus), model_path=model, utterance=utterance, start_time=time)
+    window.resize(*WINDOW_SIZE)
+    try:
+        from . import analysis
+
+        analysis.install(window)
+    except Exception:
+        log.exception("the analysis views could not be installed")
+    status = {"code": 0}
+    if screenshot:
+        out = Path(screenshot)
+
+        def fail(message: str) -> None:
+            print(f"facetraj: error: {message}", file=sys.stderr)
+            status["code"] = 2
+            app.quit()
+
+        window.show_error = fail           # no dialogs in screenshot mode
+
+        def shoot() -> None:
+            if window.view is None:
+                return
+            try:
+                window.seek(time or 0.0)
+                app.processEvents()
+                window.save_screenshot(out)
+                log.info("screenshot written to %s", out)
+                print(out)
+            except Exception as exc:
+                fail(str(exc))
+                return
+            app.quit()
+
+        window.synthesisChanged.connect(lambda: QTimer.singleShot(300, shoot))
+    window.show()
+    try:
+        rc = app.exec()
+    finally:
+        window.close()
+        if xvfb is not None:
+            xvfb.terminate()
+    return status["code"] or rc

@@ -1,0 +1,129 @@
+"""The synthesis settings side panel (paper section 2.3): N, C, xi, nu, phonetic or acoustic-only
+search, smoothing. A change is announced once the user pauses (debounced)."""
+
+from __future__ import annotations
+
+from PyQt6.QtCore import QTimer, pyqtSignal
+from PyQt6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QDoubleSpinBox,
+    QFormLayout,
+    QHBoxLayout,
+    QLabel,
+    QPushButton,
+    QSpinBox,
+    QVBoxLayout,
+    QWidget,
+)
+
+from engine.config import SynthConfig
+
+
+class SynthSettingsPanel(QWidget):
+    """Edits a :class:`SynthConfig`; emits ``configChanged`` after a short pause in editing."""
+
+    configChanged = pyqtSignal(object)
+
+    def __init__(self, config: SynthConfig | None = None, parent: QWidget | None = None,
+                 debounce_ms: int = 300):
+        super().__init__(parent)
+        self._timer = QTimer(self)
+        self._timer.setSingleShot(True)
+        self._timer.setInterval(debounce_ms)
+        self._timer.timeout.connect(lambda: self.configChanged.emit(self.config()))
+        self._base = config or SynthConfig()
+
+        self.n = QSpinBox()
+        self.n.setRange(1, 50)
+        self.n.setToolTip("N: the number of visually most similar context-phones searched (eq 4-5)")
+        self.c = QSpinBox()
+        self.c.setRange(0, 10)
+        self.c.setToolTip("C: phones of context on each side used in eq 4 (at most the trained C)")
+        self.xi = QDoubleSpinBox()
+        self.xi.setRange(0.0, 1000.0)
+        self.xi.setDecimals(1)
+        self.xi.setSingleStep(1.0)
+        self.xi.setToolTip("ξ: eq 4 constant weighting the centre phone (> 10 lets it dominate)")
+        self.nu_default = QCheckBox("model's")
+        self.nu = QDoubleSpinBox()
+        self.nu.setRange(0.01, 1000.0)
+        self.nu.setDecimals(2)
+        self.nu.setToolTip("ν: eq 3 constant of the visual phoneme similarity")
+        self.mode = QComboBox()
+        self.mode.addItem("phonetic (labels restrict the search)", "phonetic")
+        self.mode.addItem("acoustic only (whole codebook)", "acoustic")
+        self.smoothing = QComboBox()
+        for label, value in (("triangular, 100 ms", "triangular"), ("spline", "spline"),
+                             ("none", "none")):
+            self.smoothing.addItem(label, value)
+        self.smoothing.setToolTip("smoothing of the synthesized markers shown in 3-D")
+        self.reset = QPushButton("Paper defaults")
+        self.status = QLabel("")
+        self.status.setWordWrap(True)
+
+        form = QFormLayout()
+        form.addRow("N (context-phones)", self.n)
+        form.addRow("C (context)", self.c)
+        form.addRow("ξ (eq 4)", self.xi)
+        nu_row = QHBoxLayout()
+        nu_row.addWidget(self.nu, 1)
+        nu_row.addWidget(self.nu_default)
+        form.addRow("ν (eq 3)", nu_row)
+        form.addRow("search", self.mode)
+        form.addRow("smoothing", self.smoothing)
+        lay = QVBoxLayout(self)
+        lay.addLayout(form)
+        lay.addWidget(self.reset)
+        lay.addWidget(self.status)
+        lay.addStretch(1)
+
+        self.set_config(self._base)
+        for w in (self.n, self.c):
+            w.valueChanged.connect(self._changed)
+        self.xi.valueChanged.connect(self._changed)
+        self.nu.valueChanged.connect(self._changed)
+        self.nu_default.toggled.connect(self._on_nu_default)
+        self.mode.currentIndexChanged.connect(self._changed)
+        self.smoothing.currentIndexChanged.connect(self._changed)
+        self.reset.clicked.connect(lambda: (self.set_config(SynthConfig()), self._changed()))
+
+    def set_limits(self, max_context: int, default_nu: float) -> None:
+        """Fit the controls to a model: C up to its trained context, ν's default."""
+        self.c.setMaximum(max_context)
+        self._model_nu = default_nu
+        if self.nu_default.isChecked():
+            self.nu.blockSignals(True)
+            self.nu.setValue(default_nu)
+            self.nu.blockSignals(False)
+
+    def set_config(self, cfg: SynthConfig) -> None:
+        """Show ``cfg`` without emitting a change."""
+        self._base = cfg
+        widgets = (self.n, self.c, self.xi, self.nu, self.nu_default, self.mode, self.smoothing)
+        for w in widgets:
+            w.blockSignals(True)
+        self.n.setValue(cfg.n_context_phones)
+        self.c.setValue(cfg.context)
+        self.xi.setValue(cfg.xi)
+        self.nu_default.setChecked(cfg.nu is None)
+        self.nu.setEnabled(cfg.nu is not None)
+        if cfg.nu is not None:
+            self.nu.setValue(cfg.nu)
+        self.mode.setCurrentIndex(max(0, self.mode.findData(cfg.mode)))
+        self.smoothing.setCurrentIndex(max(0, self.smoothing.findData(cfg.smoothing)))
+        for w in widgets:
+            w.blockSignals(False)
+
+    def config(self) -> SynthConfig:
+        return self._base.with_(
+            n_context_phones=self.n.value(), context=self.c.value(), xi=self.xi.value(),
+            nu=None if self.nu_default.isChecked() else self.nu.value(),
+            mode=self.mode.currentData(), smoothing=self.smoothing.currentData())
+
+    def _on_nu_default(self, checked: bool) -> None:
+        self.nu.setEnabled(not checked)
+        self._changed()
+
+    def _changed(self, *_args) -> None:
+        self._timer.start()

@@ -1,0 +1,73 @@
+"""What the window shows for one utterance: the utterance, its synthesis and derived tracks.
+
+:func:`build_view` does all the work (synthesis, both smoothings, the speech mask) and is meant to
+run in a background worker; the result is an immutable snapshot that every view reads.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from engine.config import SynthConfig
+from engine.data import Utterance
+from engine.evaluation import speech_mask
+from engine.model import Model, Synthesis, resmooth, synthesize
+
+
+@dataclass
+class UtteranceView:
+    """The current utterance and everything derived from it.
+
+    Attributes
+    ----------
+    utterance : the utterance (audio, phones, markers or ``None``).
+    split : ``train``, ``test`` or ``external`` (opened from files, not in the corpus).
+    synthesis : the engine's synthesis result (``synthesis.markers`` uses the chosen smoothing).
+    original : ``(T, M, 3)`` original markers in the model's head frame, ``None`` without markers.
+    triangular, spline : ``(T, M, 3)`` the synthesis smoothed each way (paper Figure 4).
+    speech : ``(T,)`` bool, speech frames (112 ms median-filtered energy, paper section 3).
+    times : ``(T,)`` frame times in seconds.
+    """
+
+    utterance: Utterance
+    split: str
+    synthesis: Synthesis
+    original: np.ndarray | None
+    triangular: np.ndarray
+    spline: np.ndarray
+    speech: np.ndarray
+    times: np.ndarray
+
+    @property
+    def shown(self) -> np.ndarray:
+        """The synthesized markers the 3-D view shows (the configured smoothing)."""
+        return self.synthesis.markers
+
+    @property
+    def n_frames(self) -> int:
+        return len(self.times)
+
+    @property
+    def duration(self) -> float:
+        return self.utterance.duration
+
+    @property
+    def rate(self) -> float:
+        """Marker frames per second."""
+        return float(1.0 / (self.times[1] - self.times[0])) if len(self.times) > 1 else 60.0
+
+
+def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig) -> UtteranceView:
+    """Synthesize ``utt`` with ``config`` and derive every track the window shows (slow: run in a
+    worker). Raises the engine's :class:`~engine.errors.FacetrajError` on bad input."""
+    n_frames = utt.n_frames or None
+    res = synthesize(model, utt.audio, utt.sample_rate, utt.phones if utt.phones else None, config,
+                     n_frames=n_frames, source=utt.name)
+    original = model.normalise_markers(utt.markers) if utt.markers is not None else None
+    triangular = res.markers if config.smoothing == "triangular" else resmooth(model, res, "triangular")
+    spline = res.markers if config.smoothing == "spline" else resmooth(model, res, "spline")
+    speech = speech_mask(utt.audio, utt.sample_rate, res.times)
+    return UtteranceView(utterance=utt, split=split, synthesis=res, original=original,
+                         triangular=triangular, spline=spline, speech=speech, times=res.times)

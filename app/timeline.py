@@ -1,0 +1,356 @@
+"""The time-aligned panels under the 3-D view: one matplotlib figure, one shared time axis.
+
+A panel is any object with ``title: str``, ``height: float`` (relative) and
+``draw(ax, view) -> None``. The timeline lays the panels out, redraws them when the view changes,
+and draws the moving cursor by blitting (a full redraw happens only on layout, zoom or pan).
+
+Mouse: click to seek, drag to select a loop range, wheel to zoom the time axis around the pointer,
+right or middle drag to pan, double-click to show the whole utterance.
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import Protocol
+
+import numpy as np
+from matplotlib.backends.backend_qtagg import FigureCanvasQTAgg
+from matplotlib.figure import Figure
+from PyQt6.QtCore import pyqtSignal
+from PyQt6.QtWidgets import QSizePolicy, QVBoxLayout, QWidget
+from scipy.signal import spectrogram
+
+from .state import UtteranceView
+from .style import (
+    CURSOR_COLOR,
+    LOOP_COLOR,
+    ORIGINAL_COLOR,
+    SPEECH_DOT_COLOR,
+    SPLINE_COLOR,
+    TRIANGULAR_COLOR,
+)
+
+log = logging.getLogger(__name__)
+
+
+class Panel(Protocol):
+    title: str
+    height: float
+
+    def draw(self, ax, view: UtteranceView) -> None: ...
+
+
+# ---------------------------------------------------------------------- built-in panels
+class WaveformPanel:
+    """The speech signal (min/max envelope per pixel column)."""
+
+    title = "waveform"
+    height = 0.8
+
+    def draw(self, ax, view: UtteranceView) -> None:
+        x = view.utterance.audio
+        rate = view.utterance.sample_rate
+        bins = min(len(x), 6000)
+        step = max(1, len(x) // bins)
+        n = (len(x) // step) * step
+        blocks = x[:n].reshape(-1, step)
+        t = (np.arange(blocks.shape[0]) + 0.5) * step / rate
+        ax.fill_between(t, blocks.min(axis=1), blocks.max(axis=1), color="#333333", lw=0.4,
+                        step="mid")
+        peak = float(np.abs(x).max()) or 1.0
+        ax.set_ylim(-1.05 * peak, 1.05 * peak)
+        ax.set_yticks([])
+        ax.set_ylabel("speech", fontsize=8)
+
+
+class SpectrogramPanel:
+    """A wide-band spectrogram (grey scale, 0 to 8 kHz)."""
+
+    title = "spectrogram"
+    height = 1.3
+    max_freq = 8000.0
+
+    def draw(self, ax, view: UtteranceView) -> None:
+        x = view.utterance.audio
+        rate = view.utterance.sample_rate
+        nper = max(16, int(0.006 * rate))
+        hop = max(1, int(0.002 * rate))
+        f, t, s = spectrogram(x, rate, window="hamming", nperseg=nper, noverlap=nper - hop,
+                              nfft=max(256, 2 ** int(np.ceil(np.log2(nper)))), mode="psd")
+        keep = f <= self.max_freq
+        db = 10 * np.log10(s[keep] + 1e-14)
+        top = float(db.max())
+        ax.imshow(db, origin="lower", aspect="auto", cmap="gray_r", vmin=top - 65, vmax=top,
+                  extent=(float(t[0]), float(t[-1]), 0.0, float(f[keep][-1]) / 1000.0),
+                  interpolation="bilinear", rasterized=True)
+        ax.set_ylabel("kHz", fontsize=8)
+
+
+class PhoneTierPanel:
+    """Word and phone labels with their boundaries."""
+
+    title = "phones"
+    height = 0.55
+
+    def draw(self, ax, view: UtteranceView) -> None:
+        utt = view.utterance
+        ax.set_ylim(0, 2 if utt.words else 1)
+        ax.set_yticks([])
+        ax.set_ylabel("words\nphones" if utt.words else "phones", fontsize=8)
+        for seg in utt.phones:
+            silent = seg.label in ("sil", "", "sp", "pau", "h#")
+            if silent:
+                ax.axvspan(seg.start, seg.end, 0, 1 / ax.get_ylim()[1], color="#eeeeee", lw=0)
+            ax.axvline(seg.start, 0, 1 / ax.get_ylim()[1], color="#888888", lw=0.6)
+            ax.text((seg.start + seg.end) / 2, 0.5, seg.label, ha="center", va="center",
+                    fontsize=8, color="#999999" if silent else "black", clip_on=True)
+        for w in utt.words:
+            ax.axvline(w.start, 0.5, 1, color="#888888", lw=0.6)
+            ax.axvline(w.end, 0.5, 1, color="#888888", lw=0.6)
+            ax.text((w.start + w.end) / 2, 1.5, w.label, ha="center", va="center", fontsize=8,
+                    style="italic", clip_on=True)
+        if utt.words:
+            ax.axhline(1, color="#bbbbbb", lw=0.5)
+
+
+class LipPanel:
+    """Upper- or lower-lip centre y: original (dotted), spline (dark) and triangular (light)
+    synthesis, and the speech/silence dots on a line through the middle (paper Figure 4)."""
+
+    height = 1.2
+
+    def __init__(self, window, which: str):
+        self.window = window
+        self.which = which
+        self.title = f"{which} lip y"
+
+    def marker(self) -> int:
+        model = self.window.model
+        return model.upper_lip if self.which == "upper" else model.lower_lip
+
+    def draw(self, ax, view: UtteranceView) -> None:
+        k = self.marker()
+        t = view.times
+        tri = view.triangular[:, k, 1]
+        spl = view.spline[:, k, 1]
+        ax.plot(t, tri, color=TRIANGULAR_COLOR, lw=1.6, label="synthesized, triangular")
+        ax.plot(t, spl, color=SPLINE_COLOR, lw=1.3, label="synthesized, spline")
+        ys = [tri, spl]
+        if view.original is not None:
+            orig = view.original[:, k, 1]
+            ax.plot(t, orig, color=ORIGINAL_COLOR, lw=1.5, ls=(0, (2, 1.5)), label="original")
+            ys.append(orig)
+        allv = np.concatenate([y[np.isfinite(y)] for y in ys])
+        lo, hi = float(allv.min()), float(allv.max())
+        pad = 0.12 * max(hi - lo, 0.5)
+        top = 0.45 * max(hi - lo, 0.5) if self.which == "upper" else pad   # room for the legend
+        ax.set_ylim(lo - pad, hi + top)
+        mid = (lo + hi) / 2
+        sp = view.speech
+        ax.plot(t[sp], np.full(int(sp.sum()), mid), ls="none", marker=".", ms=2.2,
+                color=SPEECH_DOT_COLOR, label="speech frames")
+        ax.set_ylabel(f"{self.which} lip\ny (mm)", fontsize=8)
+        if self.which == "upper":
+            ax.legend(loc="upper right", fontsize=7, ncol=4, frameon=True, framealpha=0.85,
+                      handlelength=2.2, borderpad=0.3)
+
+
+# ---------------------------------------------------------------------- the timeline
+class Timeline(QWidget):
+    """The stack of time-aligned panels with a blitted cursor."""
+
+    seekRequested = pyqtSignal(float)
+    loopSelected = pyqtSignal(float, float)
+    loopCleared = pyqtSignal()
+
+    def __init__(self, parent: QWidget | None = None):
+        super().__init__(parent)
+        self.figure = Figure(figsize=(10, 5), dpi=100)
+        self.figure.set_facecolor("white")
+        self.canvas = FigureCanvasQTAgg(self.figure)
+        self.canvas.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(0, 0, 0, 0)
+        lay.addWidget(self.canvas)
+        self.panels: list[Panel] = []
+        self.axes: list = []
+        self.view: UtteranceView | None = None
+        self.cursor_time = 0.0
+        self.loop: tuple[float, float] | None = None
+        self._cursors: list = []
+        self._spans: list = []
+        self._bg = None
+        self._press: tuple[float, float, int] | None = None   # (xdata, xpixel, button)
+        self._drag_span: tuple[float, float] | None = None
+        self.canvas.mpl_connect("draw_event", self._on_draw)
+        self.canvas.mpl_connect("button_press_event", self._on_press)
+        self.canvas.mpl_connect("motion_notify_event", self._on_motion)
+        self.canvas.mpl_connect("button_release_event", self._on_release)
+        self.canvas.mpl_connect("scroll_event", self._on_scroll)
+
+    # ------------------------------------------------------------------ panels
+    def add_panel(self, panel: Panel) -> None:
+        self.panels.append(panel)
+        self.relayout()
+
+    def remove_panel(self, panel: Panel) -> None:
+        if panel in self.panels:
+            self.panels.remove(panel)
+            self.relayout()
+
+    def set_view(self, view: UtteranceView | None, keep_zoom: bool = False) -> None:
+        xlim = self.axes[0].get_xlim() if (keep_zoom and self.axes) else None
+        self.view = view
+        self.relayout(xlim)
+
+    def axes_of(self, panel: Panel):
+        """The matplotlib axes a panel was drawn in (None before the first layout)."""
+        try:
+            return self.axes[self.panels.index(panel)]
+        except (ValueError, IndexError):
+            return None
+
+    def relayout(self, xlim: tuple[float, float] | None = None) -> None:
+        """Rebuild the figure: one axes per panel, shared time axis, then a full draw."""
+        fig = self.figure
+        fig.clear()
+        self.axes, self._cursors, self._spans = [], [], []
+        self._bg = None
+        if not self.panels or self.view is None:
+            self.canvas.draw_idle()
+            return
+        grid = fig.add_gridspec(len(self.panels), 1, height_ratios=[p.height for p in self.panels],
+                                left=0.075, right=0.99, top=0.985, bottom=0.075, hspace=0.09)
+        first = None
+        for i, panel in enumerate(self.panels):
+            ax = fig.add_subplot(grid[i, 0], sharex=first)
+            first = first or ax
+            try:
+                panel.draw(ax, self.view)
+            except Exception:  # a broken panel must not take the window down
+                log.exception("panel %r failed to draw", getattr(panel, "title", panel))
+                ax.text(0.5, 0.5, f"{getattr(panel, 'title', 'panel')}: drawing failed",
+                        transform=ax.transAxes, ha="center", va="center", color="red")
+            ax.tick_params(labelsize=7, length=2)
+            if i < len(self.panels) - 1:
+                ax.tick_params(labelbottom=False)
+            ax.grid(axis="x", color="#dddddd", lw=0.5)
+            self.axes.append(ax)
+        self.axes[-1].set_xlabel("time (s)", fontsize=8)
+        for ax in self.axes:
+            cur = ax.axvline(self.cursor_time, color=CURSOR_COLOR, lw=1.2, animated=True)
+            self._cursors.append(cur)
+        self._draw_loop_spans()
+        first.set_xlim(*(xlim or (0.0, self.view.duration)))
+        fig.align_ylabels(self.axes)
+        self.canvas.draw()
+
+    def _draw_loop_spans(self) -> None:
+        for s in self._spans:
+            s.remove()
+        self._spans = []
+        span = self._drag_span or self.loop
+        if span is None:
+            return
+        for ax in self.axes:
+            self._spans.append(ax.axvspan(span[0], span[1], color=LOOP_COLOR, alpha=0.18, lw=0))
+
+    # ------------------------------------------------------------------ cursor (blitting)
+    def _on_draw(self, event) -> None:
+        self._bg = self.canvas.copy_from_bbox(self.figure.bbox)
+        for ax, cur in zip(self.axes, self._cursors, strict=True):
+            ax.draw_artist(cur)
+
+    def set_cursor(self, t: float, follow: bool = False) -> None:
+        """Move the cursor to ``t`` seconds by blitting; with ``follow`` the visible range pages
+        along when the cursor leaves it (a zoomed view during playback)."""
+        self.cursor_time = float(t)
+        if not self.axes:
+            return
+        if follow:
+            lo, hi = self.axes[0].get_xlim()
+            if not lo <= t <= hi and self.view is not None:
+                width = hi - lo
+                lo = min(max(0.0, t - 0.1 * width), max(0.0, self.view.duration - width))
+                self.axes[0].set_xlim(lo, lo + width)
+                self.canvas.draw()
+                return
+        for cur in self._cursors:
+            cur.set_xdata([t, t])
+        if self._bg is None:
+            self.canvas.draw_idle()
+            return
+        self.canvas.restore_region(self._bg)
+        for ax, cur in zip(self.axes, self._cursors, strict=True):
+            ax.draw_artist(cur)
+        self.canvas.blit(self.figure.bbox)
+
+    def set_loop(self, loop: tuple[float, float] | None) -> None:
+        self.loop = loop
+        self._draw_loop_spans()
+        self.canvas.draw_idle()
+
+    def xlim(self) -> tuple[float, float]:
+        return tuple(self.axes[0].get_xlim()) if self.axes else (0.0, 0.0)
+
+    def set_xlim(self, lo: float, hi: float) -> None:
+        if self.axes and self.view is not None:
+            dur = self.view.duration
+            width = min(max(hi - lo, 0.02), dur)
+            lo = min(max(0.0, lo), dur - width)
+            self.axes[0].set_xlim(lo, lo + width)
+            self.canvas.draw_idle()
+
+    def reset_zoom(self) -> None:
+        if self.view is not None:
+            self.set_xlim(0.0, self.view.duration)
+
+    # ------------------------------------------------------------------ mouse
+    def _on_press(self, event) -> None:
+        if event.inaxes is None or event.xdata is None:
+            return
+        if event.dblclick:
+            self.reset_zoom()
+            return
+        self._press = (float(event.xdata), float(event.x), int(event.button))
+
+    def _on_motion(self, event) -> None:
+        if self._press is None or event.x is None:
+            return
+        x0, px0, button = self._press
+        if button == 1 and event.xdata is not None and event.inaxes is not None:
+            if abs(event.x - px0) >= 4:
+                self._drag_span = (min(x0, event.xdata), max(x0, event.xdata))
+                self._draw_loop_spans()
+                self.canvas.draw_idle()
+        elif button in (2, 3) and self.axes:
+            ax = self.axes[0]
+            inv = ax.transData.inverted()
+            dx = inv.transform((event.x, 0))[0] - inv.transform((px0, 0))[0]
+            lo, hi = ax.get_xlim()
+            self.set_xlim(lo - dx, hi - dx)
+            self._press = (x0, float(event.x), button)
+
+    def _on_release(self, event) -> None:
+        if self._press is None:
+            return
+        x0, _px0, button = self._press
+        self._press = None
+        if button != 1:
+            return
+        span, self._drag_span = self._drag_span, None
+        if span is not None and span[1] - span[0] > 1e-3:
+            self.loop = span
+            self._draw_loop_spans()
+            self.canvas.draw_idle()
+            self.loopSelected.emit(span[0], span[1])
+        else:
+            self.seekRequested.emit(x0)
+
+    def _on_scroll(self, event) -> None:
+        if event.xdata is None or not self.axes:
+            return
+        factor = 0.8 if event.button == "up" else 1.25
+        lo, hi = self.axes[0].get_xlim()
+        x = float(event.xdata)
+        self.set_xlim(x - (x - lo) * factor, x + (hi - x) * factor)

@@ -1,0 +1,308 @@
+"""The 3-D view: original and synthesized face markers, lip contours and an optional face surface.
+
+The two marker sets share one scene, overlaid or side by side. Each set is one ``vtkPoints``
+shared by its markers, its lip contour lines and (for the synthesized set) the face surface, so a
+frame update is one copy into two arrays and one render. Hovering a marker shows its name.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pyvista as pv
+from PyQt6.QtCore import QPoint
+from PyQt6.QtGui import QCursor
+from PyQt6.QtWidgets import QToolTip, QVBoxLayout, QWidget
+from pyvistaqt import QtInteractor
+from scipy.spatial import Delaunay
+
+from engine.model import Model
+
+from .state import UtteranceView
+from .style import BACKGROUND, ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
+
+log = logging.getLogger(__name__)
+
+CAMERA_PRESETS: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] = {
+    # direction from the face to the camera (x to the talker's left, y up, z forward), view up
+    "front": ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0)),
+    "profile": ((-1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
+    "three-quarter": ((-0.75, 0.18, 1.0), (0.0, 1.0, 0.0)),
+}
+
+
+def lip_contours(neutral: np.ndarray, upper: int, lower: int, corners: list[int]) -> list[list[int]]:
+    """Upper and lower lip contour polylines (marker indices, corner to corner), found from the
+    neutral face: the markers between the corners that lie close to each lip centre's height."""
+    if len(corners) != 2:
+        return [[upper, lower]]
+    xs = neutral[corners, 0]
+    x_lo, x_hi = float(xs.min()), float(xs.max())
+    y_c = float(neutral[corners, 1].mean())
+    lines = []
+    for centre, sign in ((upper, 1.0), (lower, -1.0)):
+        yc = float(neutral[centre, 1])
+        reach = abs(yc - y_c) * 1.5 + 1e-6
+        picked = []
+        for i, (x, y, _z) in enumerate(neutral):
+            if i in corners or not x_lo < x < x_hi:
+                continue
+            dy = (y - y_c) * sign
+            if -0.25 * reach <= dy <= reach and abs(y - yc) <= 0.5 * abs(yc - y_c) + 1e-6:
+                picked.append(i)
+        if centre not in picked:
+            picked.append(centre)
+        left, right = sorted(corners, key=lambda i: neutral[i, 0])
+        lines.append([left, *sorted(picked, key=lambda i: neutral[i, 0]), right])
+    return lines
+
+
+def face_triangles(neutral: np.ndarray, contours: list[list[int]]) -> np.ndarray:
+    """Triangles ``(n, 3)`` of a face surface: 2-D Delaunay on the neutral x-y, without the mouth
+    opening and without long edges across the face's outline."""
+    tri = Delaunay(neutral[:, :2]).simplices
+    edges = np.concatenate([neutral[tri[:, a], :2] - neutral[tri[:, b], :2]
+                            for a, b in ((0, 1), (1, 2), (2, 0))])
+    lengths = np.linalg.norm(edges, axis=1).reshape(3, -1).T
+    keep = lengths.max(axis=1) <= 2.5 * np.median(lengths)
+    if len(contours) == 2:
+        up, lo = set(contours[0]), set(contours[1])
+        lips = up | lo
+        mouth = np.array([set(t) <= lips and bool(set(t) & (up - lo)) and bool(set(t) & (lo - up))
+                          for t in tri.tolist()])
+        keep &= ~mouth
+    return tri[keep]
+
+
+def _fill_nan(markers: np.ndarray, fallback: np.ndarray) -> np.ndarray:
+    """For display: a marker not seen keeps its last seen position (else the fallback)."""
+    out = np.array(markers, dtype=np.float64)
+    bad = ~np.isfinite(out).all(axis=2)
+    if not bad.any():
+        return out
+    for m in np.flatnonzero(bad.any(axis=0)):
+        ok = ~bad[:, m]
+        if not ok.any():
+            out[:, m] = fallback[m]
+            continue
+        idx = np.where(ok, np.arange(len(ok)), 0)
+        np.maximum.accumulate(idx, out=idx)
+        first = int(np.argmax(ok))
+        idx[:first] = first
+        out[:, m] = out[idx, m]
+    return out
+
+
+class MarkerSet:
+    """One marker set in the scene: points, lip lines, optionally a surface, all sharing points."""
+
+    def __init__(self, plotter: QtInteractor, name: str, color: str, neutral: np.ndarray,
+                 contours: list[list[int]], triangles: np.ndarray | None):
+        self.name = name
+        self.points = pv.PolyData(neutral.copy())
+        self.points.verts = np.column_stack([np.ones(len(neutral), int), np.arange(len(neutral))]).ravel()
+        self.actor = plotter.add_mesh(self.points, color=color, render_points_as_spheres=True,
+                                      point_size=13, style="points", name=f"{name}-points",
+                                      reset_camera=False, lighting=True, pickable=False)
+        self.lines = pv.PolyData()
+        self.lines.SetPoints(self.points.GetPoints())
+        self.lines.lines = np.concatenate([[len(c), *c] for c in contours])
+        self.line_actor = plotter.add_mesh(self.lines, color=color, line_width=3, name=f"{name}-lips",
+                                           reset_camera=False, pickable=False)
+        self.surface_actor = None
+        if triangles is not None and len(triangles):
+            self.surface = pv.PolyData()
+            self.surface.SetPoints(self.points.GetPoints())
+            self.surface.faces = np.column_stack([np.full(len(triangles), 3), triangles]).ravel()
+            self.surface_actor = plotter.add_mesh(self.surface, color=SURFACE_COLOR, opacity=0.45,
+                                                  smooth_shading=False, name=f"{name}-surface",
+                                                  reset_camera=False, pickable=False,
+                                                  specular=0.1, ambient=0.25)
+        self.current = neutral.copy()
+
+    def set_points(self, pts: np.ndarray) -> None:
+        self.current = pts
+        arr = self.points.points
+        arr[:] = pts
+        self.points.GetPoints().Modified()
+
+    def set_visible(self, visible: bool, surface: bool) -> None:
+        self.actor.SetVisibility(visible)
+        self.line_actor.SetVisibility(visible)
+        if self.surface_actor is not None:
+            self.surface_actor.SetVisibility(visible and surface)
+
+
+class FaceView(QWidget):
+    """The 3-D marker view (pyvistaqt). ``show_frame(k)`` displays frame ``k`` of the view."""
+
+    def __init__(self, parent: QWidget | None = None):
+        super().__init__(parent)
+        self.plotter = QtInteractor(self, auto_update=False, multi_samples=4)
+        self.plotter.set_background(BACKGROUND)
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(0, 0, 0, 0)
+        lay.addWidget(self.plotter.interactor)
+        self.model: Model | None = None
+        self.view: UtteranceView | None = None
+        self.original: MarkerSet | None = None
+        self.synth: MarkerSet | None = None
+        self.side_by_side = False
+        self.show_surface = True
+        self.show_original = True
+        self.show_synth = True
+        self.frame = -1
+        self.preset = "three-quarter"
+        self._orig = self._syn = None
+        self._offset = np.zeros(3)
+        self._caption = None
+        self._hover_name = ""
+        self.plotter.iren.add_observer("MouseMoveEvent", self._on_mouse_move)
+
+    # ------------------------------------------------------------------ scene
+    def set_model(self, model: Model) -> None:
+        """Build the scene for ``model``'s marker set."""
+        self.model = model
+        self.plotter.clear()
+        neutral = model.neutral_face()
+        self.neutral = neutral
+        self.contours = lip_contours(neutral, model.upper_lip, model.lower_lip, list(model.lip_corners))
+        tri = face_triangles(neutral, self.contours)
+        self.synth = MarkerSet(self.plotter, "synthesized", SYNTH_COLOR, neutral, self.contours, tri)
+        self.original = MarkerSet(self.plotter, "original", ORIGINAL_COLOR, neutral, self.contours, None)
+        width = float(np.ptp(neutral[:, 0]))
+        self._half_gap = np.array([0.55 * width + 10.0, 0.0, 0.0])
+        self.plotter.add_legend(labels=[["original", ORIGINAL_COLOR], ["synthesized", SYNTH_COLOR]],
+                                bcolor="white", face="circle", size=(0.26, 0.09), loc="upper right",
+                                background_opacity=0.8)
+        self._caption = self.plotter.add_text("", position="lower_left", font_size=9, color="black",
+                                              name="caption", render=False)
+        self._update_visibility()
+        self.set_camera(self.preset, render=False)
+
+    def set_view(self, view: UtteranceView) -> None:
+        self.view = view
+        self._syn = _fill_nan(view.shown, self.neutral)
+        self._orig = None if view.original is None else _fill_nan(view.original, self.neutral)
+        self._update_visibility()
+        self.frame = -1
+
+    def _update_visibility(self) -> None:
+        if self.synth is None:
+            return
+        has_orig = self._orig is not None or self.view is None
+        self.original.set_visible(self.show_original and has_orig, False)
+        self.synth.set_visible(self.show_synth, self.show_surface)
+        self._offset = self._half_gap if (self.side_by_side and has_orig) else np.zeros(3)
+
+    def show_frame(self, k: int, caption: str = "", render: bool = True) -> None:
+        """Put frame ``k`` of the current view on screen."""
+        if self._syn is None:
+            return
+        k = int(np.clip(k, 0, len(self._syn) - 1))
+        self.synth.set_points(self._syn[k] + self._offset)
+        if self._orig is not None:
+            self.original.set_points(self._orig[min(k, len(self._orig) - 1)] - self._offset)
+        if self._caption is not None:
+            self._caption.SetText(0, caption) if hasattr(self._caption, "SetText") else \
+                self._caption.SetInput(caption)
+        self.frame = k
+        if render:
+            self.plotter.render()
+
+    def rerender(self) -> None:
+        if self.frame >= 0:
+            self.show_frame(self.frame, self._caption_text())
+        else:
+            self.plotter.render()
+
+    def _caption_text(self) -> str:
+        if self._caption is None:
+            return ""
+        try:
+            return self._caption.GetText(0)
+        except AttributeError:
+            return self._caption.GetInput() or ""
+
+    # ------------------------------------------------------------------ options
+    def set_side_by_side(self, on: bool) -> None:
+        self.side_by_side = bool(on)
+        self._update_visibility()
+        self.rerender()
+        self.set_camera(self.preset)
+
+    def set_surface(self, on: bool) -> None:
+        self.show_surface = bool(on)
+        self._update_visibility()
+        self.plotter.render()
+
+    def set_sets_visible(self, original: bool, synth: bool) -> None:
+        self.show_original, self.show_synth = bool(original), bool(synth)
+        self._update_visibility()
+        self.plotter.render()
+
+    def set_camera(self, preset: str, render: bool = True) -> None:
+        """Front, profile or three-quarter view of the face, fitted to the markers."""
+        if self.model is None:
+            return
+        self.preset = preset
+        direction, up = CAMERA_PRESETS[preset]
+        d = np.asarray(direction, float)
+        d /= np.linalg.norm(d)
+        pts = [self.neutral + self._offset, self.neutral - self._offset]
+        allp = np.concatenate(pts)
+        centre = (allp.min(axis=0) + allp.max(axis=0)) / 2
+        self.plotter.camera_position = [tuple(centre + 400 * d), tuple(centre), up]
+        lo, hi = allp.min(axis=0) - 5, allp.max(axis=0) + 5
+        self.plotter.renderer.ResetCamera(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
+        self.plotter.camera.zoom(1.15)
+        if render:
+            self.plotter.render()
+
+    # ------------------------------------------------------------------ hover
+    def _project(self, pts: np.ndarray) -> np.ndarray:
+        """Display coordinates (pixels, origin bottom left) of world points."""
+        ren = self.plotter.renderer
+        cam = ren.GetActiveCamera()
+        m = cam.GetCompositeProjectionTransformMatrix(ren.GetTiledAspectRatio(), -1, 1)
+        mat = np.array([[m.GetElement(i, j) for j in range(4)] for i in range(4)])
+        h = np.c_[pts, np.ones(len(pts))] @ mat.T
+        ndc = h[:, :2] / h[:, 3:4]
+        w, hgt = ren.GetSize()
+        ox, oy = ren.GetOrigin()
+        return np.c_[ox + (ndc[:, 0] + 1) * w / 2, oy + (ndc[:, 1] + 1) * hgt / 2]
+
+    def marker_at(self, x: float, y: float, radius: float = 9.0) -> str | None:
+        """The marker under display position ``(x, y)`` (VTK pixels), as "NAME (set)"."""
+        if self.model is None:
+            return None
+        best, label = radius, None
+        for mset, visible in ((self.synth, self.show_synth), (self.original, self.show_original)):
+            if mset is None or not visible or not mset.actor.GetVisibility():
+                continue
+            d = np.linalg.norm(self._project(mset.current) - np.array([x, y]), axis=1)
+            i = int(np.nanargmin(d))
+            if d[i] < best:
+                best, label = float(d[i]), f"{self.model.marker_names[i]} ({mset.name})"
+        return label
+
+    def _on_mouse_move(self, obj, event) -> None:
+        try:
+            x, y = self.plotter.iren.interactor.GetEventPosition()
+            label = self.marker_at(x, y)
+        except Exception:  # never let a hover raise inside VTK's callback
+            log.debug("hover failed", exc_info=True)
+            return
+        if label != self._hover_name:
+            self._hover_name = label or ""
+            if label:
+                QToolTip.showText(QCursor.pos() + QPoint(12, 8), label, self)
+            else:
+                QToolTip.hideText()
+
+    def close_view(self) -> None:
+        try:
+            self.plotter.close()
+        except Exception:
+            log.debug("plotter close failed", exc_info=True)

@@ -1,0 +1,241 @@
+"""The main window in a real X display (run under Xvfb): opening, playback, seeking, changing the
+utterance and the settings, the screenshot (checked on its pixels), and a corrupt file."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pytestqt")
+pytest.importorskip("pyvistaqt")
+
+if not os.environ.get("DISPLAY"):
+    pytest.skip("the app tests need an X display (run under xvfb-run)", allow_module_level=True)
+
+from PyQt6.QtCore import QPoint, Qt
+from PyQt6.QtGui import QImage
+from PyQt6.QtWidgets import QFileDialog, QMessageBox
+
+from app import style
+from app.browser import normalise_text
+from app.main_window import DEFAULT_SENTENCE, MainWindow
+from engine.cli import default_corpus
+
+pytestmark = pytest.mark.gui
+
+ROOT = Path(__file__).resolve().parent.parent
+WAIT_MS = 60_000
+
+
+@pytest.fixture(scope="session")
+def trained_cache(tmp_path_factory):
+    """One model of the default corpus, trained once into a private cache for every test."""
+    from app.cache import load_or_train
+    from engine.corpus import load_corpus
+
+    corpus_dir = default_corpus()
+    if not (corpus_dir / "corpus.json").exists():
+        pytest.skip(f"the default corpus is not built ({corpus_dir}); run `make corpus`")
+    cache = tmp_path_factory.mktemp("facetraj-cache")
+    old = os.environ.get("FACETRAJ_CACHE_DIR")
+    os.environ["FACETRAJ_CACHE_DIR"] = str(cache)
+    load_or_train(load_corpus(corpus_dir))
+    yield cache
+    if old is None:
+        os.environ.pop("FACETRAJ_CACHE_DIR", None)
+    else:
+        os.environ["FACETRAJ_CACHE_DIR"] = old
+
+
+@pytest.fixture
+def window(qtbot, trained_cache):
+    """The main window on the default corpus, shown, with its first utterance synthesized."""
+    win = MainWindow(default_corpus(), use_audio=False)
+    qtbot.addWidget(win)
+    win.resize(1600, 1000)
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        win.show()
+    qtbot.waitExposed(win)
+    win.activateWindow()
+    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    yield win
+    win.close()
+
+
+def _canvas_point(win: MainWindow, ax, t: float) -> QPoint:
+    """The canvas widget position of time ``t`` in the middle of ``ax``."""
+    canvas = win.timeline.canvas
+    y_mid = sum(ax.get_ylim()) / 2
+    x, y = ax.transData.transform((t, y_mid))
+    dpr = canvas.devicePixelRatioF()
+    return QPoint(int(round(x / dpr)), int(round((canvas.figure.bbox.height - y) / dpr)))
+
+
+def test_window_opens_on_default_corpus(window):
+    win = window
+    assert win.corpus is not None and win.corpus.root.resolve() == default_corpus().resolve()
+    assert win.model is not None and win.model.n_markers == len(win.corpus.info.marker_names)
+    view = win.view
+    assert view is not None
+    assert view.split == "test"
+    assert normalise_text(view.utterance.text) == normalise_text(DEFAULT_SENTENCE)
+    assert view.original is not None and view.original.shape == view.shown.shape
+    assert view.speech.any() and not view.speech.all()
+    assert set(win.browser.groups) == {"train", "test"}
+    assert len(win.browser.items) == len(win.corpus.info.ids)
+    assert len(win.timeline.axes) == len(win.timeline.panels) >= 5
+    assert win.analysis_menu.title().replace("&", "") == "Analysis"
+
+
+def test_play_moves_cursor_and_3d_frame(window, qtbot):
+    win = window
+    win.seek(0.0)
+    start_points = win.face.synth.current.copy()
+    moved: list[float] = []
+    win.cursorMoved.connect(moved.append)
+    win.play()
+    qtbot.waitUntil(lambda: win.displayed_frame >= 20, timeout=10_000)
+    win.pause()
+    assert win.timeline.cursor_time > 0.2
+    assert moved and moved[-1] == pytest.approx(win.timeline.cursor_time)
+    assert not np.allclose(win.face.synth.current, start_points)
+    k = win.displayed_frame
+    np.testing.assert_allclose(win.face.synth.current, win.face._syn[k] + win.face._offset)
+    # the frame shown is the one at the clock, within a frame
+    assert abs(win.current_time() * win.view.rate - k) <= 1.0
+
+
+def test_click_on_lip_panel_seeks(window, qtbot):
+    win = window
+    lower = next(p for p in win.timeline.panels if getattr(p, "title", "") == "lower lip y")
+    ax = win.timeline.axes_of(lower)
+    target = 0.4 * win.view.duration
+    with qtbot.waitSignal(win.cursorMoved, timeout=5000):
+        qtbot.mouseClick(win.timeline.canvas, Qt.MouseButton.LeftButton,
+                         pos=_canvas_point(win, ax, target))
+    assert win.current_time() == pytest.approx(target, abs=0.02)
+    assert win.timeline.cursor_time == pytest.approx(target, abs=0.02)
+    assert win.displayed_frame == pytest.approx(target * win.view.rate, abs=1.5)
+    # keys: one frame forward, then back to the start
+    k = win.displayed_frame
+    qtbot.waitActive(win)
+    qtbot.keyClick(win, Qt.Key.Key_Right)
+    assert win.displayed_frame == k + 1
+    qtbot.keyClick(win, Qt.Key.Key_Home)
+    assert win.displayed_frame == 0
+
+
+def test_changing_utterance_updates_every_view(window, qtbot):
+    win = window
+    other = next(u for u in win.corpus.info.test if u != win.view.utterance.name)
+    item = win.browser.items[other]
+    with qtbot.waitSignals([win.utteranceChanged, win.synthesisChanged], timeout=WAIT_MS):
+        win.browser.tree.setCurrentItem(item)     # as a click in the browser does
+    view = win.view
+    assert view.utterance.name == other
+    assert win.face.view is view and win.timeline.view is view
+    np.testing.assert_allclose(win.face.synth.current, view.shown[win.displayed_frame])
+    assert win.clock.duration == pytest.approx(view.utterance.duration)
+    assert win.slider.maximum() == view.n_frames - 1
+    assert other in win.title.text()
+    assert win.timeline.xlim()[1] == pytest.approx(view.duration)
+    assert win.browser.tree.currentItem() is item
+
+
+def test_changing_n_resynthesizes(window, qtbot):
+    win = window
+    before = win.view
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        win.settings.n.setValue(1)
+    after = win.view
+    assert after is not before
+    assert after.utterance.name == before.utterance.name
+    assert win.synth_config.n_context_phones == 1
+    assert after.synthesis.config.n_context_phones == 1
+    assert not np.allclose(after.shown, before.shown)
+    assert win.timeline.view is after and win.face.view is after
+
+
+def _colour_count(img: np.ndarray, hex_colour: str, tol: float = 60.0) -> int:
+    rgb = np.array([int(hex_colour[i:i + 2], 16) for i in (1, 3, 5)], float)
+    return int((np.linalg.norm(img[..., :3].astype(float) - rgb, axis=-1) < tol).sum())
+
+
+def _read_png(path: Path) -> np.ndarray:
+    img = QImage(str(path)).convertToFormat(QImage.Format.Format_RGB888)
+    assert not img.isNull(), path
+    h, w = img.height(), img.width()
+    ptr = img.constBits()
+    ptr.setsize(img.sizeInBytes())
+    return np.frombuffer(ptr, np.uint8).reshape(h, img.bytesPerLine())[:, :3 * w].reshape(h, w, 3).copy()
+
+
+def test_screenshot_shows_both_point_sets_and_lip_panels(window, tmp_path):
+    win = window
+    win.seek(0.5 * win.view.duration)
+    out = win.save_screenshot(tmp_path / "app.png")
+    img = _read_png(out)
+    assert img.shape[:2] == (win.height(), win.width())
+    # the 3-D area: both marker colours are there
+    p = win.face.mapTo(win, QPoint(0, 0))
+    area = img[p.y():p.y() + win.face.height(), p.x():p.x() + win.face.width()]
+    assert _colour_count(area, style.ORIGINAL_COLOR) > 150
+    assert _colour_count(area, style.SYNTH_COLOR) > 150
+    # the lip panels: curves drawn (non-white pixels, the spline and original colours)
+    canvas = win.timeline.canvas
+    c = canvas.mapTo(win, QPoint(0, 0))
+    fig_h = canvas.figure.bbox.height
+    for title in ("upper lip y", "lower lip y"):
+        panel = next(pp for pp in win.timeline.panels if getattr(pp, "title", "") == title)
+        bb = win.timeline.axes_of(panel).bbox
+        y0 = c.y() + int(fig_h - bb.y1) + 2
+        y1 = c.y() + int(fig_h - bb.y0) - 2
+        x0, x1 = c.x() + int(bb.x0) + 2, c.x() + int(bb.x1) - 2
+        lip = img[y0:y1, x0:x1]
+        non_white = (lip.astype(int).sum(axis=2) < 720).mean()
+        assert non_white > 0.01, title
+        assert _colour_count(lip, style.SPLINE_COLOR, 50) > 100, title
+        assert _colour_count(lip, style.ORIGINAL_COLOR, 50) > 100, title
+
+
+def test_screenshot_command_line(trained_cache, tmp_path):
+    out = tmp_path / "cli.png"
+    env = {**os.environ, "FACETRAJ_CACHE_DIR": str(trained_cache)}
+    proc = subprocess.run([sys.executable, "-m", "engine.cli", "--screenshot", str(out), "--time", "1.0"],
+                          cwd=ROOT, env=env, capture_output=True, text=True, timeout=180)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    img = _read_png(out)
+    assert img.shape[0] >= 800 and img.shape[1] >= 1200
+    assert _colour_count(img, style.ORIGINAL_COLOR) > 300
+    assert _colour_count(img, style.SYNTH_COLOR) > 150
+
+
+def test_corrupt_file_shows_error_and_app_keeps_working(window, qtbot, tmp_path, monkeypatch):
+    win = window
+    bad = tmp_path / "broken.wav"
+    bad.write_bytes(b"RIFF\x10\x00\x00\x00WAVEfmt garbage, not audio")
+    answers = iter([(str(bad), ""), ("", "")])
+    monkeypatch.setattr(QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: next(answers)))
+    shown: list[str] = []
+    monkeypatch.setattr(QMessageBox, "critical", staticmethod(lambda parent, title, text, *a, **k:
+                                                              shown.append(text)))
+    name = win.view.utterance.name
+    win.action_open_audio.trigger()
+    assert len(shown) == 1 and "broken.wav" in shown[0]
+    assert win.view.utterance.name == name
+    # still working: play moves the frame
+    win.seek(0.0)
+    win.play()
+    qtbot.waitUntil(lambda: win.displayed_frame >= 5, timeout=10_000)
+    win.pause()
+    # a corrupt corpus folder too
+    (tmp_path / "corpus.json").write_text("{not json")
+    monkeypatch.setattr(QFileDialog, "getExistingDirectory", staticmethod(lambda *a, **k: str(tmp_path)))
+    win.action_open_corpus.trigger()
+    assert len(shown) == 2 and "corpus.json" in shown[1]
+    assert win.corpus.root.resolve() == default_corpus().resolve()
