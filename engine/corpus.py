@@ -259,6 +259,10 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
         pad = np.full((n_audio - markers.shape[0], *markers.shape[1:]), np.nan)
         markers = np.concatenate([markers, pad])
     markers = markers[:n_audio]
+    seen = marker_coverage(markers)
+    if seen < 0.5:
+        log.warning("%s: only %.0f %% of the marker samples are seen; frames with gaps over "
+                    "%.0f ms are left out of training and evaluation", mpath, 100 * seen, 100)
     text = ""
     txt = root / f"{utt_id}.txt"
     if txt.exists():

@@ -107,12 +107,12 @@ def _read_text(path: Path) -> str:
     if not path.exists():
         raise InputError(path, "no such label file")
     raw = path.read_bytes()
-    for enc in ("utf-8", "utf-16"):
-        try:
-            return raw.decode(enc)
-        except UnicodeDecodeError:
-            continue
-    raise InputError(path, "the file is not UTF-8 (or UTF-16) text")
+    try:
+        if raw.startswith((b"\xff\xfe", b"\xfe\xff")):  # UTF-16 (Praat writes it) only with a BOM
+            return raw.decode("utf-16")
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise InputError(path, "the file is not UTF-8 (or UTF-16) text") from None
 
 
 def read_textgrid_tiers(path: str | os.PathLike[str]) -> dict[str, list[PhoneSegment]]:
@@ -227,7 +227,7 @@ def validate_phones(phones: Sequence[PhoneSegment], duration: float,
         raise InputError(path, "the label file holds no segments")
     out: list[PhoneSegment] = []
     for i, seg in enumerate(phones):
-        if out and seg.end - seg.start < 1e-3 and seg.start >= out[-1].end - 1e-6:
+        if out and 0 <= seg.end - seg.start < 1e-3 and seg.start >= out[-1].end - 1e-6:
             out[-1] = PhoneSegment(out[-1].start, seg.end, out[-1].label)
             continue
         if not seg.end > seg.start:

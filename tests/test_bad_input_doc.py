@@ -1,0 +1,150 @@
+"""Every row of docs/bad-input.md, produced for real: the documented message is the one given."""
+
+import json
+import logging
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+import soundfile as sf
+
+from engine.config import SynthConfig
+from engine.corpus import CorpusInfo, load_corpus, save_corpus_info
+from engine.data import PhoneSegment, Utterance
+from engine.errors import FacetrajError
+from engine.formats import (
+    atomic_write,
+    read_audio,
+    read_c3d,
+    read_lab,
+    read_labels,
+    read_markers,
+    read_mocha_ema,
+    validate_phones,
+    write_c3d,
+)
+from engine.labelmap import read_label_map
+from engine.model import MarkerSetup, Model, synthesize, train
+
+DOC = Path(__file__).resolve().parent.parent / "docs" / "bad-input.md"
+
+
+def _rows():
+    rows = []
+    for line in DOC.read_text().splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) == 3 and cells[0] not in ("case", "---") and not cells[0].startswith("-"):
+            rows.append((cells[0], re.findall(r'"([^"]+)"', cells[2])))
+    return rows
+
+
+def _copy_utt(src: Path, dst: Path, stem: str, utt_id: str = "u"):
+    for ext in ("wav", "TextGrid", "c3d"):
+        (dst / f"{utt_id}.{ext}").write_bytes((src / f"{stem}.{ext}").read_bytes())
+
+
+def produce(case: str, tmp: Path, toy_dir: Path, model: Model, caplog) -> str:
+    """Make the bad input of ``case`` happen; return the message (error or log)."""
+    wav = toy_dir / "toy030.wav"
+    audio, rate = read_audio(wav)
+    phones = read_labels(toy_dir / "toy030.TextGrid")
+    info = load_corpus(toy_dir).info
+
+    def corpus_with(markers=None, names=None):
+        _copy_utt(toy_dir, tmp, "toy030")
+        if markers is not None:
+            write_c3d(tmp / "u.c3d", markers, 60.0, names or info.marker_names)
+        save_corpus_info(tmp, CorpusInfo(**{**info.__dict__, "train": ["u"], "test": []}))
+        return load_corpus(tmp).utterance("u")
+
+    toy_markers = read_c3d(toy_dir / "toy030.c3d").markers
+    setup = MarkerSetup(info.fixed_markers, info.upper_lip, info.lower_lip)
+    names = info.marker_names
+
+    def write(name: str, data: bytes | str) -> Path:
+        path = tmp / name
+        path.write_bytes(data if isinstance(data, bytes) else data.encode())
+        return path
+
+    def with_phone(label: str):
+        return [PhoneSegment(s.start, s.end, label if i == 1 else s.label) for i, s in enumerate(phones)]
+
+    gappy = toy_markers.copy()
+    gappy[20:40] = np.nan
+    sparse = np.where(np.arange(len(toy_markers))[:, None, None] % 3 == 0, toy_markers, np.nan)
+    newer = {"format": "facetraj-model", "version": 9}
+    cases = {
+        "audio file missing": lambda: read_audio(tmp / "none.wav"),
+        "audio file of 0 bytes": lambda: read_audio(write("e.wav", b"")),
+        "corrupt or unreadable audio": lambda: read_audio(write("c.wav", b"RIFF....WAVEjunk" * 9)),
+        "audio with no samples": lambda: (sf.write(tmp / "n.wav", np.zeros(0), 16000),
+                                          read_audio(tmp / "n.wav")),
+        "sample rate below 8 kHz": lambda: (sf.write(tmp / "r.wav", np.zeros(100), 6000),
+                                            read_audio(tmp / "r.wav")),
+        "stereo or multi-channel audio": lambda: (sf.write(tmp / "s.wav", np.zeros((100, 2)), 16000),
+                                                  read_audio(tmp / "s.wav")),
+        "labels that end before or after the audio": lambda: validate_phones(
+            [PhoneSegment(0, 1, "a")], 2.0, "l.lab"),
+        "labels that start late": lambda: validate_phones([PhoneSegment(0.5, 2, "a")], 2.0, "l.lab"),
+        "overlapping or unsorted labels": lambda: validate_phones(
+            [PhoneSegment(0, 1.2, "a"), PhoneSegment(1, 2, "b")], 2.0, "l.lab"),
+        "a segment that ends before it starts": lambda: validate_phones(
+            [PhoneSegment(0, 1, "a"), PhoneSegment(1, 0.5, "b")], 2.0, "l.lab"),
+        "an empty label file": lambda: validate_phones([], 2.0, "l.lab"),
+        "unknown label format": lambda: read_labels(tmp / "x.seg"),
+        "a phone the model does not know": lambda: (synthesize(model, audio, rate, with_phone("ux")),
+                                                    synthesize(model, audio, rate, with_phone("zz"))),
+        "label text that is not UTF-8": lambda: read_lab(write("b.lab", b"0 1 \xe9\xff\xfe\xfa")),
+        "a C3D whose marker set differs from the corpus": lambda: corpus_with(
+            toy_markers[:, :11], names[:11]),
+        "a marker file that is not C3D": lambda: read_c3d(write("m.c3d", b"x" * 600)),
+        "markers shorter than the audio": lambda: corpus_with(toy_markers[:40]),
+        "markers mostly missing (NaN)": lambda: corpus_with(sparse),
+        "marker gaps longer than 100 ms": lambda: train(
+            [Utterance("g", audio, rate, phones, gappy, 60.0, names)], setup),
+        "training utterances with different marker sets": lambda: train(
+            [Utterance("a", audio, rate, phones, toy_markers, 60.0, names),
+             Utterance("b", audio, rate, phones, toy_markers[:, :11], 60.0, names[:11])], setup),
+        "a one-frame marker file": lambda: train(
+            [Utterance("a", audio, rate, phones, toy_markers[:1], 60.0, names)], setup),
+        "audio too short to synthesize (under two marker frames)": lambda: synthesize(
+            model, audio[:200], rate, None, SynthConfig(mode="acoustic")),
+        "phonetic synthesis without labels": lambda: synthesize(model, audio, rate, None),
+        "a model file that is not ours": lambda: (np.savez(tmp / "o.npz", a=np.zeros(2)),
+                                                  Model.load(tmp / "o.npz")),
+        "a truncated model file": lambda: Model.load(
+            write("t.npz", model.save(tmp / "full.npz").read_bytes()[:500])),
+        "a model file from a newer facetraj": lambda: (
+            np.savez(tmp / "n.npz", meta=np.array(json.dumps(newer))), Model.load(tmp / "n.npz")),
+        "a corpus folder without corpus.json": lambda: load_corpus(tmp),
+        "a corpus.json that is not JSON": lambda: (write("corpus.json", "{"), load_corpus(tmp)),
+        "a corpus.json naming an unknown marker": lambda: (
+            save_corpus_info(tmp, CorpusInfo(**{**info.__dict__, "lower_lip": "NOSE"})),
+            load_corpus(tmp)),
+        "an output file that exists": lambda: (write("o.tsv", "x"),
+                                               atomic_write(tmp / "o.tsv", overwrite=False).__enter__()),
+        "an unknown marker format": lambda: read_markers(tmp / "m.trc"),
+        "a MOCHA EMA file with the wrong column count": lambda: read_mocha_ema(
+            write("x.ema", "0 1 2 3\n1 1 2 3\n")),
+        "a label map line that is not a pair": lambda: read_label_map(write("map.txt", "a b c\n")),
+    }
+    caplog.clear()
+    try:
+        with caplog.at_level(logging.INFO):
+            cases[case]()
+    except (FacetrajError, FileExistsError) as exc:
+        return str(exc) + "\n" + caplog.text
+    return caplog.text
+
+
+@pytest.mark.parametrize("case, phrases", _rows(), ids=[r[0] for r in _rows()])
+def test_documented_message(case, phrases, tmp_path, toy_corpus_dir, toy_model, caplog):
+    assert phrases, f"no quoted message in the row {case!r}"
+    message = produce(case, tmp_path, toy_corpus_dir, toy_model, caplog)
+    for phrase in phrases:
+        assert phrase in message, f"{case}: {phrase!r} not in {message!r}"
+
+
+def test_every_row_is_checked():
+    assert len(_rows()) >= 30
