@@ -236,6 +236,7 @@ class LipErrorPanel:
         for s in segs:
             ax.axvspan(s.start, s.end, color="#e03131", alpha=0.15, lw=0)
             ax.text(0.5 * (s.start + s.end), 0.95, f"{s.label} {s.error:.1f}",
-                    transform=ax.get_xaxis_transform(), ha="center", va="top", fontsize=7, color="#c92a2a", clip_on=True)
+                    transform=ax.get_xaxis_transform(), ha="center", va="top", fontsize=7,
+                    color="#c92a2a", clip_on=True)
         ax.set_ylim(bottom=0)
         ax.legend(loc="upper right", fontsize=7, ncol=2, framealpha=0.8)

