@@ -173,6 +173,21 @@ def _local_minima(v: np.ndarray, lo: int, hi: int) -> np.ndarray:
     return idx[ok]
 
 
+def _nearest_peak(v: np.ndarray, lo: int, hi: int, before: bool, strong: float = 0.5) -> int:
+    """The local velocity maximum in ``[lo, hi]`` nearest ``hi`` (``before``) or ``lo`` among those
+    at least ``strong`` times the largest; the plain maximum when there is no local maximum."""
+    seg = v[lo:hi + 1]
+    if seg.size < 3:
+        return lo + int(np.argmax(seg))
+    inner = np.arange(1, seg.size - 1)
+    peaks = inner[(seg[inner] >= seg[inner - 1]) & (seg[inner] >= seg[inner + 1])
+                  & ((seg[inner] > seg[inner - 1]) | (seg[inner] > seg[inner + 1]))]
+    peaks = peaks[seg[peaks] >= strong * seg.max()]
+    if peaks.size == 0:
+        return lo + int(np.argmax(seg))
+    return lo + int(peaks[-1] if before else peaks[0])
+
+
 def find_gesture(velocity: np.ndarray, rate: float, anchor: float, threshold: float = 0.2,
                  window_s: float = 0.25, search: tuple[float, float] | None = None,
                  label: str = "", t0: float = 0.0) -> Gesture:
@@ -180,8 +195,10 @@ def find_gesture(velocity: np.ndarray, rate: float, anchor: float, threshold: fl
 
     Maximum constriction is the velocity minimum in ``search`` (seconds; default ``anchor`` +-
     ``window_s / 2``) nearest ``anchor``; the closing and release peaks are the velocity maxima
-    within ``window_s`` before and after it; onset and offset are where the velocity crosses
-    ``threshold`` times the closing and the release peak. ``t0`` is the time of frame 0.
+    within ``window_s`` before and after it (the nearest local maxima reaching half the largest
+    one); onset and offset are where the velocity crosses ``threshold`` times the closing and the
+    release peak, searched back (forward) no further than the velocity minimum before (after) the
+    peak, which stands in when the speed never falls that low. ``t0`` is the time of frame 0.
 
     Examples
     --------
@@ -218,12 +235,16 @@ def find_gesture(velocity: np.ndarray, rate: float, anchor: float, threshold: fl
         m = lo + int(np.argmin(v[lo:hi + 1]))
     b0 = max(0, m - win)
     b1 = min(n - 1, m + win)
-    p1 = b0 + int(np.argmax(v[b0:m + 1]))
-    p2 = m + int(np.argmax(v[m:b1 + 1]))
+    p1 = _nearest_peak(v, b0, m, before=True)
+    p2 = _nearest_peak(v, m, b1, before=False)
     if v[p1] <= 0 or v[p2] <= 0:
         return none
-    onset = _crossing(v, p1, threshold * v[p1], -1, b0) if p1 > b0 else float(b0)
-    offset = _crossing(v, p2, threshold * v[p2], 1, b1) if p2 < b1 else float(b1)
+    # onset/offset: the threshold crossing, searched no further than the velocity minimum between
+    # the peak and the window edge (in running speech the speed rarely falls to 20 % between moves)
+    lo_bound = b0 + int(np.argmin(v[b0:p1 + 1]))
+    hi_bound = p2 + int(np.argmin(v[p2:b1 + 1]))
+    onset = _crossing(v, p1, threshold * v[p1], -1, lo_bound) if p1 > lo_bound else float(lo_bound)
+    offset = _crossing(v, p2, threshold * v[p2], 1, hi_bound) if p2 < hi_bound else float(hi_bound)
     to_t = lambda f: t0 + f / rate  # noqa: E731
     return Gesture(label, anchor, to_t(onset), to_t(_parabolic(v, p1)), to_t(_parabolic(v, m)),
                    to_t(_parabolic(v, p2)), to_t(offset), float(v[p1]), float(v[p2]))

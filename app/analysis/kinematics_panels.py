@@ -266,6 +266,8 @@ class VelocityPanel:
             sets.insert(0, (m.original, ORIGINAL_COLOR, 0.92))
         for gestures, color, y in sets:
             for g in gestures:
+                ax.plot([g.onset, g.offset], [y, y], color=color, lw=0.8, alpha=0.7,
+                        transform=ax.get_xaxis_transform(), clip_on=True)
                 for k, t in g.times().items():
                     ax.plot([t], [y], LANDMARK_MARKERS[k], color=color, ms=4.5,
                             transform=ax.get_xaxis_transform(), clip_on=True,

@@ -1,0 +1,133 @@
+"""Screenshots of the analysis views for ``docs/analysis.md`` (run under a display, e.g. Xvfb):
+
+    xvfb-run -a -s "-screen 0 1600x1200x24" python -m app.analysis.figures data_samples docs/figures
+
+Writes ``analysis_<view>.png`` for every view and ``analysis_window.png`` (the main window with the
+kinematics and lip error panels in the time-aligned stack).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+from PyQt6.QtCore import QEventLoop, QTimer
+from PyQt6.QtWidgets import QApplication, QWidget
+
+log = logging.getLogger(__name__)
+
+
+def wait_until(cond: Callable[[], bool], timeout_s: float = 300.0, step_ms: int = 50) -> bool:
+    """Run the event loop until ``cond()`` holds (or the timeout)."""
+    loop = QEventLoop()
+    timer = QTimer()
+    timer.setInterval(step_ms)
+    elapsed = {"ms": 0}
+
+    def check() -> None:
+        elapsed["ms"] += step_ms
+        if cond() or elapsed["ms"] > timeout_s * 1000:
+            loop.quit()
+
+    timer.timeout.connect(check)
+    timer.start()
+    if not cond():
+        loop.exec()
+    timer.stop()
+    return cond()
+
+
+def settle(ms: int = 300) -> None:
+    loop = QEventLoop()
+    QTimer.singleShot(ms, loop.quit)
+    loop.exec()
+
+
+def shoot(widget: QWidget, path: Path) -> Path:
+    settle()
+    widget.grab().save(str(path))
+    log.info("wrote %s", path)
+    return path
+
+
+def make_figures(corpus_dir: Path, out: Path, per_split: int = 6) -> list[Path]:
+    """Open the main window on ``corpus_dir`` with the analysis views and save their screenshots."""
+    from app.main_window import MainWindow
+    from engine.corpus import load_corpus
+
+    from . import install
+
+    out.mkdir(parents=True, exist_ok=True)
+    win = MainWindow(corpus_dir, use_audio=False)
+    views = install(win)
+    win.resize(1600, 1000)
+    win.show()
+    if not wait_until(lambda: win.view is not None and not win.busy):
+        raise RuntimeError("the window did not load the corpus")
+    written = []
+    info = load_corpus(corpus_dir).info
+    standalone = {"similarity": (1000, 900), "metrics": (1100, 850), "pc_modes": (1300, 750),
+                  "inspector": (900, 950), "errors": (1000, 750), "kinematics": (600, 700)}
+    for key, size in standalone.items():
+        w = views.open_view(key)
+        dock = views.docks[key]
+        dock.setFloating(True)
+        dock.resize(*size)
+        if key == "similarity":
+            w.tabs.setCurrentIndex(2)
+        if key == "metrics":
+            w.per_split.setValue(per_split)
+            w.max_n.setValue(6)
+            w.start_table2()
+            wait_until(lambda w=w: w.table2_result is not None)
+            w.start_sweep()
+            wait_until(lambda w=w: w.sweep_result is not None)
+        if key == "pc_modes":
+            w.set_sd_units(2.5)
+        if key == "errors":
+            w.per_split.setValue(per_split)
+            w.start()
+            wait_until(lambda w=w: w.report is not None)
+            w.tabs.setCurrentIndex(0)
+        if key == "inspector":
+            win.seek(min(1.0, win.view.duration / 2))
+        written.append(shoot(dock, out / f"analysis_{key}.png"))
+        if key == "similarity":
+            w.tabs.setCurrentIndex(0)
+            written.append(shoot(dock, out / "analysis_similarity_table.png"))
+            w.tabs.setCurrentIndex(1)
+            written.append(shoot(dock, out / "analysis_similarity_table1.png"))
+        if key == "errors":
+            w.tabs.setCurrentIndex(1)
+            written.append(shoot(dock, out / "analysis_errors_utterances.png"))
+        dock.hide()
+    for key in ("aperture", "width", "protrusion", "velocity", "lip_error"):
+        views.panel_actions[key].setChecked(True)
+    win.resize(1600, 1400)
+    win.splitter.setSizes([300, 1100])
+    if info.test:
+        win.seek(0.0)
+    written.append(shoot(win, out / "analysis_window.png"))
+    views.close()
+    win.close()
+    return written
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("corpus", type=Path)
+    p.add_argument("out", type=Path)
+    p.add_argument("--per-split", type=int, default=6, help="utterances per split for the metrics")
+    args = p.parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    make_figures(args.corpus, args.out, args.per_split)
+    app.quit()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
