@@ -14,7 +14,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 
-from PyQt6.QtCore import Qt
+from PyQt6.QtCore import QEvent, QObject, Qt
 from PyQt6.QtGui import QAction
 from PyQt6.QtWidgets import QDockWidget, QWidget
 
@@ -32,6 +32,7 @@ class AnalysisViews:
         self.widgets: dict[str, QWidget] = {}
         self.panels: dict[str, object] = {}
         self.controls = None        # KinematicsControls (owns the velocity panel)
+        self._batch = False
         menu = window.analysis_menu
         self.view_actions: dict[str, QAction] = {}
         for key, text in VIEWS.items():
@@ -48,6 +49,7 @@ class AnalysisViews:
             menu.addAction(act)
             self.panel_actions[key] = act
         window.modelReady.connect(self._model_changed)
+        window.installEventFilter(_CloseWatcher(self, window))
 
     # ------------------------------------------------------------------ views
     def _factories(self) -> dict[str, Callable[[], QWidget]]:
@@ -82,10 +84,9 @@ class AnalysisViews:
         dock.show()
         dock.raise_()
         if key == "kinematics":
-            for k in ("aperture", "velocity"):
-                self.panel_actions[k].setChecked(True)
+            self.show_panels(["aperture", "velocity"])
         if key == "errors":
-            self.panel_actions["lip_error"].setChecked(True)
+            self.show_panels(["lip_error"])
         return self.widgets[key]
 
     def _kinematics_controls(self):
@@ -109,6 +110,18 @@ class AnalysisViews:
             return LipErrorPanel(model)
         raise KeyError(key)
 
+    def show_panels(self, keys: list[str]) -> None:
+        """Check several panels at once with a single timeline redraw."""
+        tl = self.window.timeline
+        self._batch = True
+        try:
+            for k in keys:
+                self.panel_actions[k].setChecked(True)
+        finally:
+            self._batch = False
+        if self.window.model is not None:
+            tl.relayout(tl.xlim() if tl.axes else None)
+
     def set_panel(self, key: str, on: bool) -> None:
         """Add or remove timeline panel ``key`` (kept checked and added once a model exists)."""
         tl = self.window.timeline
@@ -121,7 +134,10 @@ class AnalysisViews:
             return
         panel = self._make_panel(key)
         self.panels[key] = panel
-        tl.add_panel(panel)
+        if self._batch:
+            tl.panels.append(panel)
+        else:
+            tl.add_panel(panel)
 
     # ------------------------------------------------------------------ model changes
     def _model_changed(self) -> None:
@@ -145,10 +161,24 @@ class AnalysisViews:
                 self.set_panel(key, True)
 
     def close(self) -> None:
+        """Stop timers and close the 3-D views of the open analysis views."""
         for widget in self.widgets.values():
             close = getattr(widget, "close_view", None)
             if close is not None:
                 close()
+
+
+class _CloseWatcher(QObject):
+    """Stops the analysis views (animation timers, 3-D views) when the window closes."""
+
+    def __init__(self, views: AnalysisViews, parent: QObject):
+        super().__init__(parent)
+        self.views = views
+
+    def eventFilter(self, obj, event) -> bool:
+        if event.type() == QEvent.Type.Close:
+            self.views.close()
+        return False
 
 
 VIEWS = {

@@ -45,6 +45,7 @@ from .common import (
     heat_item,
     report_error,
     run_background,
+    stop_tasks,
     text_item,
 )
 
@@ -190,6 +191,10 @@ class ErrorView(QWidget):
             t = self._pending_seek[1]
             self._pending_seek = None
             self.window_.seek(t)
+
+    def closeEvent(self, event) -> None:
+        stop_tasks(self)
+        super().closeEvent(event)
 
     # ------------------------------------------------------------------ export
     def export_csv(self, path: str | Path) -> Path:

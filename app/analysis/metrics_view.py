@@ -46,6 +46,7 @@ from .common import (
     heat_item,
     report_error,
     run_background,
+    stop_tasks,
     text_item,
 )
 
@@ -220,6 +221,10 @@ class MetricsView(QWidget):
         ax2.set_title("Figure 5: correlation against N (triangular)", fontsize=9)
         ax2.tick_params(labelsize=7)
         self.canvas.draw_idle()
+
+    def closeEvent(self, event) -> None:
+        stop_tasks(self)
+        super().closeEvent(event)
 
     # ------------------------------------------------------------------ export
     def export_table2_csv(self, path: str | Path) -> Path:
