@@ -11,7 +11,7 @@ from __future__ import annotations
 import logging
 
 import numpy as np
-from PyQt6.QtCore import Qt, pyqtSignal
+from PyQt6.QtCore import Qt, QTimer, pyqtSignal
 from PyQt6.QtWidgets import (
     QFormLayout,
     QLabel,
@@ -29,6 +29,8 @@ from .common import Canvas, NumberItem, fill_table, heat_item, text_item
 
 log = logging.getLogger(__name__)
 
+UPDATE_MS = 120
+
 
 class CodebookInspector(QWidget):
     """Eqs 4-8 at one frame of a synthesis."""
@@ -41,6 +43,12 @@ class CodebookInspector(QWidget):
         self.window_ = window
         self.synthesis: Synthesis | None = None
         self.current: FrameInspection | None = None
+        self._shown: Synthesis | None = None
+        self._pending: int | None = None
+        self._timer = QTimer(self)
+        self._timer.setSingleShot(True)
+        self._timer.setInterval(UPDATE_MS)
+        self._timer.timeout.connect(self._flush)
 
         self.frame_label = QLabel("-")
         self.phone_label = QLabel("-")
@@ -102,16 +110,34 @@ class CodebookInspector(QWidget):
             self.set_time(time)
 
     def set_time(self, t: float) -> None:
+        """Inspect the frame at ``t`` seconds; updates are coalesced (at most one per
+        ``UPDATE_MS``) and wait while the inspector is hidden, so playback is not slowed down."""
         if self.synthesis is None or len(self.synthesis.times) == 0:
             return
-        self.set_frame(int(round(float(t) * self.model.marker_rate)))
+        self._pending = int(round(float(t) * self.model.marker_rate))
+        if not self._timer.isActive():
+            self._timer.start()
+
+    def _flush(self) -> None:
+        if self._pending is None:
+            return
+        if not self.isVisible() and self.current is not None:
+            return                       # showEvent flushes
+        frame, self._pending = self._pending, None
+        self.set_frame(frame)
+
+    def showEvent(self, event) -> None:
+        super().showEvent(event)
+        self._flush()
 
     def set_frame(self, frame: int) -> None:
         if self.synthesis is None:
             return
         frame = int(np.clip(frame, 0, len(self.synthesis.times) - 1))
-        if self.current is not None and self.current.frame == frame and self.isVisible():
+        if self.current is not None and self.current.frame == frame and \
+                self.current.time == float(self.synthesis.times[frame]) and self._shown is self.synthesis:
             return
+        self._shown = self.synthesis
         self.show_inspection(inspect_frame(self.model, self.synthesis, frame))
 
     # ------------------------------------------------------------------ display
