@@ -78,11 +78,12 @@ def figure4(data: ReportData, path: Path) -> Path | None:
     t_audio = np.arange(len(f4.audio)) / f4.sample_rate
     axes[0].plot(t_audio, f4.audio, color="0.3", lw=0.4)
     axes[0].set_ylabel("speech")
-    top = float(np.abs(f4.audio).max() or 1.0)
+    peak = float(np.abs(f4.audio).max() or 1.0)
+    axes[0].set_ylim(-1.1 * peak, 1.35 * peak)
     for seg in f4.phones:
         if seg.label and seg.label not in ("sil", "sp", ""):
-            axes[0].text((seg.start + seg.end) / 2, 0.92 * top, seg.label, ha="center", va="top",
-                         fontsize=6, color="0.25")
+            axes[0].text((seg.start + seg.end) / 2, 0.97, seg.label, ha="center", va="top",
+                         fontsize=6, color="0.25", transform=axes[0].get_xaxis_transform())
     where = f"{f4.utterance}, {f4.split} split, N = 3"
     axes[0].set_title(f"\"{f4.text}\" ({where})" if f4.text else where, fontsize=9)
     for ax, name, traces in ((axes[1], "upper lip y (mm)", f4.upper_lip),
@@ -91,7 +92,9 @@ def figure4(data: ReportData, path: Path) -> Path | None:
         ax.plot(f4.times, traces["spline"], color=DARK, lw=1.4, label="spline")
         ax.plot(f4.times, traces["original"], ":", color=ORIGINAL, lw=1.6, label="original")
         vals = np.concatenate([v[np.isfinite(v)] for v in traces.values()])
-        mid = float((vals.min() + vals.max()) / 2) if vals.size else 0.0
+        lo, hi = (float(vals.min()), float(vals.max())) if vals.size else (0.0, 1.0)
+        mid = (lo + hi) / 2
+        ax.set_ylim(lo - 0.05 * (hi - lo), hi + 0.3 * (hi - lo))   # headroom for the legend
         ax.plot(f4.times[f4.speech], np.full(int(f4.speech.sum()), mid), ".", color="0.4", ms=2,
                 label="speech frames")
         ax.set_ylabel(name)
@@ -99,7 +102,7 @@ def figure4(data: ReportData, path: Path) -> Path | None:
     for ax, key in ((axes[1], "upper_lip"), (axes[2], "lower_lip")):
         txt = ", ".join(f"{sm} r = {c[key]:.2f}" for sm, c in f4.correlations.items())
         ax.text(0.01, 0.03, txt, transform=ax.transAxes, fontsize=7, color="0.2")
-    axes[1].legend(fontsize=7, ncol=4, loc="upper right")
+    axes[1].legend(fontsize=7, ncol=4, loc="upper left")
     axes[2].set_xlabel("time (s)")
     fig.tight_layout()
     return _save(fig, path)
