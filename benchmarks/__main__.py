@@ -76,9 +76,10 @@ def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS) -> list[BenchRow]:
     return rows
 
 
-def write_markdown(path: Path, rows: Sequence[BenchRow], ctx: BenchContext, elapsed_s: float) -> Path:
+def write_markdown(path: Path, rows: Sequence[BenchRow], ctx: BenchContext, elapsed_s: float,
+                   info: dict[str, str] | None = None) -> Path:
     """``docs/benchmarks.md``: the machine, the corpus, the table, and how to read it."""
-    info = machine_info()
+    info = info or machine_info()
     size = (f"{len(ctx.train_utts)} training utterances ({ctx.train_audio_s / 60:.1f} min of speech), "
             f"{len(ctx.test_utts)} test utterances")
     lines = [
@@ -128,12 +129,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not logging.getLogger().handlers:
         logging.basicConfig(level=logging.INFO, format="%(name)s: %(message)s", stream=sys.stderr)
     t0 = time.perf_counter()
+    info = machine_info()
     ctx = load_context(args.corpus, args.smoke)
     rows = run_all(ctx, args.only)
     print(format_table(rows))
     out = args.out if args.out is not None else (None if args.smoke else DEFAULT_OUT)
     if out is not None:
-        write_markdown(out, rows, ctx, time.perf_counter() - t0)
+        write_markdown(out, rows, ctx, time.perf_counter() - t0, info)
         print(f"written {out}")
     return 0
 

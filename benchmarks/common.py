@@ -132,6 +132,10 @@ def machine_info() -> dict[str, str]:
         "Python": platform.python_version(),
         "numpy": np.__version__,
         "scipy": scipy.__version__,
+        "BLAS threads": ", ".join(f"{k}={os.environ[k]}" for k in
+                                  ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+                                  if k in os.environ) or "library default",
+        "load average at start": " ".join(f"{x:.1f}" for x in os.getloadavg()),
     }
 
 

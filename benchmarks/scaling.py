@@ -12,6 +12,7 @@ markers on test utterances, scored as in Table 2.
 
 from __future__ import annotations
 
+import inspect
 import logging
 import math
 import time
@@ -24,6 +25,7 @@ from engine.codebook import Codebook
 from engine.config import SynthConfig
 from engine.evaluation import speech_mask, trajectory_correlations
 from engine.model import Model, synthesize
+from engine.synthesis import nearest_codewords
 
 from .common import BenchContext, BenchRow, concatenate_input
 
@@ -39,6 +41,18 @@ LSF_JITTER = 0.01
 PC_JITTER = 0.05
 #: test utterances scored against the original markers (full search vs prefilter, x1 codebook)
 N_TEST_UTTS = 8
+#: prefilter runs whose distance temporaries would exceed this are skipped (shared machine)
+MAX_TEMP_BYTES = 1.5 * 1024**3
+
+
+def prefilter_temp_bytes(n_frames: int, n_codewords: int, order: int) -> float:
+    """Peak temporaries of ``engine.synthesis.nearest_codewords`` as written when this benchmark
+    was: a float32 ``(chunk, 5L, P)`` difference and its absolute value per chunk of frames.
+    An implementation without a fixed integer ``chunk`` default is assumed to bound its memory."""
+    chunk = inspect.signature(nearest_codewords).parameters.get("chunk")
+    if chunk is None or not isinstance(chunk.default, int):
+        return 0.0
+    return 2.0 * min(chunk.default, n_frames) * n_codewords * order * 4
 
 
 def replicate_codebook(cb: Codebook, factor: int, rng: np.random.Generator) -> Codebook:
@@ -110,6 +124,13 @@ def run(ctx: BenchContext, factors: Sequence[int] | None = None,
                              note=f"{size} codewords; {t_full * 1000 / full.times.size:.2f} ms/frame"))
         for k in prefilters:
             if k >= size:
+                continue
+            temp = prefilter_temp_bytes(full.times.size, size, base.config.lpc_order)
+            if temp > MAX_TEMP_BYTES:
+                rows.append(BenchRow("scaling", f"acoustic, prefilter K={k}, codebook x{factor}",
+                                     float("nan"), "x RT",
+                                     note=f"skipped: nearest_codewords would allocate "
+                                          f"{temp / 1024**3:.1f} GiB of temporaries"))
                 continue
             t_pre, pre = _timed(model, audio, rate, SynthConfig(mode="acoustic", acoustic_prefilter=k))
             pre_times[(factor, k)] = t_pre
