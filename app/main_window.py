@@ -44,7 +44,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from PyQt6.QtCore import QPoint, Qt, QTimer, pyqtSignal
+from PyQt6.QtCore import QEvent, QPoint, Qt, QTimer, pyqtSignal
 from PyQt6.QtGui import QAction, QImage, QKeySequence, QPainter, QShortcut
 from PyQt6.QtWidgets import (
     QCheckBox,
@@ -78,6 +78,7 @@ from .browser import UtteranceBrowser, normalise_text
 from .cache import load_or_train
 from .settings_panel import SynthSettingsPanel
 from .state import UtteranceView, build_view
+from .style import ORIGINAL_COLOR, SYNTH_COLOR
 from .timeline import LipPanel, PhoneTierPanel, SpectrogramPanel, Timeline, WaveformPanel
 from .transport import PlaybackClock
 from .view3d import CAMERA_PRESETS, FaceView
@@ -127,6 +128,7 @@ class MainWindow(QMainWindow):
         self._latency = 0.0          # running estimate of one frame update (s)
         self.stats: list[tuple[float, int, float, float]] | None = None   # benchmark hook
         self.displayed_frame = -1
+        self._frame_pending: tuple[float, int] | None = None   # (tick time, frame) until flushed
         self.clock = PlaybackClock(self, use_audio=use_audio)
         self.clock.playingChanged.connect(self._on_playing_changed)
 
@@ -213,11 +215,17 @@ class MainWindow(QMainWindow):
             self.camera_buttons[name] = b
         self.camera_buttons[self.face.preset].setChecked(True)
         lay.addSpacing(16)
+        legend = QLabel(f'<span style="color:{ORIGINAL_COLOR}; font-size:16px">●</span> original &nbsp; '
+                        f'<span style="color:{SYNTH_COLOR}; font-size:16px">●</span> synthesized')
+        legend.setToolTip("marker colours in the 3-D view (lines: lip contours; surface: the "
+                          "synthesized face)")
+        lay.addWidget(legend)
+        lay.addSpacing(16)
         self.side_by_side = QCheckBox("side by side")
         self.side_by_side.toggled.connect(self.face.set_side_by_side)
-        self.show_original = QCheckBox("original")
+        self.show_original = QCheckBox("show original")
         self.show_original.setChecked(True)
-        self.show_synth = QCheckBox("synthesized")
+        self.show_synth = QCheckBox("show synthesized")
         self.show_synth.setChecked(True)
         for cb in (self.show_original, self.show_synth):
             cb.toggled.connect(lambda _c: self.face.set_sets_visible(self.show_original.isChecked(),
@@ -256,7 +264,7 @@ class MainWindow(QMainWindow):
         self.slider.valueChanged.connect(self._on_slider)
         lay.addWidget(self.slider, 1)
         self.time_label = QLabel("0.000 s")
-        self.time_label.setMinimumWidth(210)
+        self.time_label.setMinimumWidth(300)
         self.time_label.setStyleSheet("font-family: monospace;")
         lay.addWidget(self.time_label)
         self.speed = QComboBox()
@@ -637,14 +645,23 @@ class MainWindow(QMainWindow):
         # aim at the clock time when this update reaches the screen
         target = min(t + self._latency * self.clock.speed, self.clock.duration)
         k = int(np.clip(round(target * self.view.rate), 0, self.view.n_frames - 1))
-        if k == self.displayed_frame:
+        if k == self.displayed_frame or self._frame_pending is not None:
             return
-        start = time.perf_counter()
+        self._frame_pending = (time.perf_counter(), k)
         self._show_time(target, force=True)
+
+    def event(self, e: QEvent) -> bool:
+        """The window's flush (UpdateRequest) is when a frame reaches the screen: time it."""
+        if e.type() != QEvent.Type.UpdateRequest or self._frame_pending is None:
+            return super().event(e)
+        result = super().event(e)
+        start, k = self._frame_pending
+        self._frame_pending = None
         spent = time.perf_counter() - start
-        self._latency = min(0.9 * self._latency + 0.1 * spent, 0.06) if self._latency else spent
+        self._latency = min(0.8 * self._latency + 0.2 * spent, 0.08) if self._latency else spent
         if self.stats is not None:
             self.stats.append((start, k, spent, self.clock.time()))
+        return result
 
     def _show_time(self, t: float, force: bool = False) -> None:
         """Put frame round(t * rate) in the 3-D view and the cursor at ``t`` (blitted)."""
@@ -656,14 +673,16 @@ class MainWindow(QMainWindow):
         if not force and k == self.displayed_frame:
             return
         phone = _phone_at(view, t)
-        caption = f"t = {t:6.3f} s   frame {k}   /{phone}/" if phone else f"t = {t:6.3f} s   frame {k}"
-        self.face.show_frame(k, caption)
-        self.timeline.set_cursor(t, follow=self.clock.playing)
+        # everything is only marked dirty here: the window's next flush puts the 3-D frame, the
+        # cursor and the widgets on screen together (one composition per frame)
+        self.face.show_frame(k)
         self.displayed_frame = k
         self.slider.blockSignals(True)
         self.slider.setValue(k)
         self.slider.blockSignals(False)
-        self.time_label.setText(f"{t:6.3f} / {view.duration:.3f} s  {('/' + phone + '/') if phone else ''}")
+        self.time_label.setText(f"{t:6.3f} / {view.duration:.3f} s  frame {k:4d}  "
+                                f"{('/' + phone + '/') if phone else ''}")
+        self.timeline.set_cursor(t, follow=self.clock.playing)
         self.cursorMoved.emit(float(t))
 
     # ================================================================== files

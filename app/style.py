@@ -7,5 +7,5 @@ TRIANGULAR_COLOR = "#f7b27a"    # synthesized, triangular smoothing: light orang
 SPEECH_DOT_COLOR = "#222222"    # speech/silence dots
 CURSOR_COLOR = "#d6336c"        # the play cursor
 LOOP_COLOR = "#2b8a3e"          # the loop range
-SURFACE_COLOR = "#f1d3bd"       # the face surface
+SURFACE_COLOR = "#ecc9ae"       # the face surface
 BACKGROUND = "#ffffff"

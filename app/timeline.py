@@ -16,6 +16,7 @@ from typing import Protocol
 import numpy as np
 from matplotlib.backends.backend_qtagg import FigureCanvasQTAgg
 from matplotlib.figure import Figure
+from matplotlib.transforms import Bbox
 from PyQt6.QtCore import pyqtSignal
 from PyQt6.QtWidgets import QSizePolicy, QVBoxLayout, QWidget
 from scipy.signal import spectrogram
@@ -31,6 +32,18 @@ from .style import (
 )
 
 log = logging.getLogger(__name__)
+
+
+class _Canvas(FigureCanvasQTAgg):
+    """A canvas whose ``blit`` schedules the repaint instead of forcing it: the window then puts
+    the cursor, the 3-D frame and the widgets on screen in one flush per frame (each flush composes
+    the whole window through OpenGL once a GL widget is in it)."""
+
+    def blit(self, bbox=None) -> None:
+        if bbox is None:
+            bbox = self.figure.bbox
+        left, bottom, w, h = (int(pt / self.device_pixel_ratio) for pt in bbox.bounds)
+        self.update(left, self.rect().height() - (bottom + h), w + 1, h + 1)
 
 
 class Panel(Protocol):
@@ -167,7 +180,7 @@ class Timeline(QWidget):
         super().__init__(parent)
         self.figure = Figure(figsize=(10, 5), dpi=100)
         self.figure.set_facecolor("white")
-        self.canvas = FigureCanvasQTAgg(self.figure)
+        self.canvas = _Canvas(self.figure)
         self.canvas.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
         lay = QVBoxLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
@@ -180,6 +193,7 @@ class Timeline(QWidget):
         self._cursors: list = []
         self._spans: list = []
         self._bg = None
+        self._cursor_x: float | None = None
         self._press: tuple[float, float, int] | None = None   # (xdata, xpixel, button)
         self._drag_span: tuple[float, float] | None = None
         self.canvas.mpl_connect("draw_event", self._on_draw)
@@ -258,6 +272,7 @@ class Timeline(QWidget):
     # ------------------------------------------------------------------ cursor (blitting)
     def _on_draw(self, event) -> None:
         self._bg = self.canvas.copy_from_bbox(self.figure.bbox)
+        self._cursor_x = self._cursor_px(self.cursor_time) if self.axes else None
         for ax, cur in zip(self.axes, self._cursors, strict=True):
             ax.draw_artist(cur)
 
@@ -275,15 +290,26 @@ class Timeline(QWidget):
                 self.axes[0].set_xlim(lo, lo + width)
                 self.canvas.draw()
                 return
+        x_new = self._cursor_px(t)
         for cur in self._cursors:
             cur.set_xdata([t, t])
         if self._bg is None:
             self.canvas.draw_idle()
             return
-        self.canvas.restore_region(self._bg)
+        # restore and repaint only the strip between the old and the new cursor position
+        fig_box = self.figure.bbox
+        x_old = self._cursor_x if self._cursor_x is not None else x_new
+        lo = max(fig_box.x0, min(x_old, x_new) - 3)
+        hi = min(fig_box.x1, max(x_old, x_new) + 3)
+        self._cursor_x = x_new
+        strip = Bbox([[np.floor(lo), fig_box.y0], [np.ceil(hi), fig_box.y1]])
+        self.canvas.restore_region(self._bg, bbox=strip, xy=(strip.x0, strip.y0))
         for ax, cur in zip(self.axes, self._cursors, strict=True):
             ax.draw_artist(cur)
-        self.canvas.blit(self.figure.bbox)
+        self.canvas.blit(strip)
+
+    def _cursor_px(self, t: float) -> float:
+        return float(self.axes[0].transData.transform((t, 0))[0])
 
     def set_loop(self, loop: tuple[float, float] | None) -> None:
         self.loop = loop

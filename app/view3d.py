@@ -115,10 +115,16 @@ class MarkerSet:
             self.surface = pv.PolyData()
             self.surface.SetPoints(self.points.GetPoints())
             self.surface.faces = np.column_stack([np.full(len(triangles), 3), triangles]).ravel()
-            self.surface_actor = plotter.add_mesh(self.surface, color=SURFACE_COLOR, opacity=0.45,
+            # opaque (a translucent surface costs an order-independent transparency pass, several
+            # times the whole frame on a software renderer), pushed back in depth so the markers
+            # on it stay whole
+            self.surface_actor = plotter.add_mesh(self.surface, color=SURFACE_COLOR, opacity=1.0,
                                                   smooth_shading=False, name=f"{name}-surface",
                                                   reset_camera=False, pickable=False,
-                                                  specular=0.1, ambient=0.25)
+                                                  specular=0.05, ambient=0.3, diffuse=0.7)
+            mapper = self.surface_actor.GetMapper()
+            mapper.SetResolveCoincidentTopologyToPolygonOffset()
+            mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(2.0, 2000.0)
         self.current = neutral.copy()
 
     def set_points(self, pts: np.ndarray) -> None:
@@ -137,9 +143,9 @@ class MarkerSet:
 class FaceView(QWidget):
     """The 3-D marker view (pyvistaqt). ``show_frame(k)`` displays frame ``k`` of the view."""
 
-    def __init__(self, parent: QWidget | None = None):
+    def __init__(self, parent: QWidget | None = None, multi_samples: int = 0):
         super().__init__(parent)
-        self.plotter = QtInteractor(self, auto_update=False, multi_samples=4)
+        self.plotter = QtInteractor(self, auto_update=False, multi_samples=multi_samples)
         self.plotter.set_background(BACKGROUND)
         lay = QVBoxLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
@@ -156,7 +162,6 @@ class FaceView(QWidget):
         self.preset = "three-quarter"
         self._orig = self._syn = None
         self._offset = np.zeros(3)
-        self._caption = None
         self._hover_name = ""
         self.plotter.iren.add_observer("MouseMoveEvent", self._on_mouse_move)
 
@@ -173,11 +178,8 @@ class FaceView(QWidget):
         self.original = MarkerSet(self.plotter, "original", ORIGINAL_COLOR, neutral, self.contours, None)
         width = float(np.ptp(neutral[:, 0]))
         self._half_gap = np.array([0.55 * width + 10.0, 0.0, 0.0])
-        self.plotter.add_legend(labels=[["original", ORIGINAL_COLOR], ["synthesized", SYNTH_COLOR]],
-                                bcolor="white", face="circle", size=(0.26, 0.09), loc="upper right",
-                                background_opacity=0.8)
-        self._caption = self.plotter.add_text("", position="lower_left", font_size=9, color="black",
-                                              name="caption", render=False)
+        # no VTK text (legend, caption): re-rasterizing text costs more than the whole scene on a
+        # software renderer; the window shows the legend and the time in Qt widgets instead
         self._update_visibility()
         self.set_camera(self.preset, render=False)
 
@@ -196,34 +198,25 @@ class FaceView(QWidget):
         self.synth.set_visible(self.show_synth, self.show_surface)
         self._offset = self._half_gap if (self.side_by_side and has_orig) else np.zeros(3)
 
-    def show_frame(self, k: int, caption: str = "", render: bool = True) -> None:
-        """Put frame ``k`` of the current view on screen."""
+    def show_frame(self, k: int, render: bool = True) -> None:
+        """Put frame ``k`` of the current view in the scene and ask for a repaint (the render
+        happens in the widget's paint, together with the rest of the window's; ``render()`` on
+        the plotter would render twice)."""
         if self._syn is None:
             return
         k = int(np.clip(k, 0, len(self._syn) - 1))
         self.synth.set_points(self._syn[k] + self._offset)
         if self._orig is not None:
             self.original.set_points(self._orig[min(k, len(self._orig) - 1)] - self._offset)
-        if self._caption is not None:
-            self._caption.SetText(0, caption) if hasattr(self._caption, "SetText") else \
-                self._caption.SetInput(caption)
         self.frame = k
         if render:
-            self.plotter.render()
+            self.plotter.update()
 
     def rerender(self) -> None:
+        """Render now (synchronously), e.g. before a screenshot."""
         if self.frame >= 0:
-            self.show_frame(self.frame, self._caption_text())
-        else:
-            self.plotter.render()
-
-    def _caption_text(self) -> str:
-        if self._caption is None:
-            return ""
-        try:
-            return self._caption.GetText(0)
-        except AttributeError:
-            return self._caption.GetInput() or ""
+            self.show_frame(self.frame, render=False)
+        self.plotter.render()
 
     # ------------------------------------------------------------------ options
     def set_side_by_side(self, on: bool) -> None:
