@@ -100,7 +100,7 @@ class KinematicsControls(QWidget):
         self.threshold.setSuffix(" % of peak")
         self.smooth = QDoubleSpinBox()
         self.smooth.setRange(0, 50)
-        self.smooth.setValue(0)
+        self.smooth.setValue(15)
         self.smooth.setSuffix(" ms")
         self.smooth.setToolTip("light Gaussian smoothing of the positions before differencing (SD)")
         self.phones = QLineEdit(" ".join(LABIAL_PHONES))
