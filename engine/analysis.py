@@ -523,6 +523,20 @@ def mode_sd(model: Model) -> np.ndarray:
     return np.sqrt(np.asarray(model.pca.variances, dtype=np.float64))
 
 
+def variance_shares(model: Model) -> tuple[np.ndarray, np.ndarray]:
+    """Share of the total variance of each PC and the cumulative share, both ``(K,)`` in %.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> m = SimpleNamespace(pca=SimpleNamespace(explained_ratio=np.array([0.5, 0.3, 0.1])))
+    >>> [a.round(1).tolist() for a in variance_shares(m)]
+    [[50.0, 30.0, 10.0], [50.0, 80.0, 90.0]]
+    """
+    share = 100.0 * np.asarray(model.pca.explained_ratio, dtype=np.float64)
+    return share, np.cumsum(share)
+
+
 def mode_displacement(model: Model, component: int, value: float) -> np.ndarray:
     """Displacement of every marker from the neutral face when PC ``component`` is ``value``:
     ``value`` times the eigenvector, ``(M, 3)`` mm."""

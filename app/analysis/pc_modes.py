@@ -20,14 +20,16 @@ from PyQt6.QtWidgets import (
     QLabel,
     QPushButton,
     QSlider,
+    QSpinBox,
     QSplitter,
     QVBoxLayout,
     QWidget,
 )
 from pyvistaqt import QtInteractor
 
-from app.style import BACKGROUND, SYNTH_COLOR
-from engine.analysis import describe_mode, mode_displacement, mode_sd
+from app.style import BACKGROUND, SURFACE_COLOR, SYNTH_COLOR
+from app.view3d import face_triangles, lip_contours
+from engine.analysis import describe_mode, mode_displacement, mode_sd, variance_shares
 from engine.model import Model
 
 from .common import Canvas
@@ -35,6 +37,14 @@ from .common import Canvas
 log = logging.getLogger(__name__)
 
 SLIDER_STEPS = 100          # slider units per standard deviation
+#: 3-D camera presets: direction from the face to the camera, view up (x right, y up, z forward)
+CAMERAS = {
+    "front": ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0)),
+    "profile": ((-1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
+    "three-quarter": ((-0.75, 0.18, 1.0), (0.0, 1.0, 0.0)),
+}
+#: 2-D projections (Figure 2): horizontal and vertical coordinate
+PROJECTIONS = {"front (x-y)": (0, 1), "profile (z-y)": (2, 1)}
 NEUTRAL_COLOR = "#8c8c8c"
 
 
@@ -71,6 +81,25 @@ class PCModeExplorer(QWidget):
         reset.clicked.connect(lambda: self.slider.setValue(0))
         self.description = QLabel()
         self.description.setWordWrap(True)
+        self.projection = QComboBox()
+        self.projection.addItems(list(PROJECTIONS))
+        self.projection.currentIndexChanged.connect(self._projection_changed)
+        self.arrow_scale = QSpinBox()
+        self.arrow_scale.setRange(1, 20)
+        self.arrow_scale.setValue(3)
+        self.arrow_scale.setPrefix("arrows x")
+        self.arrow_scale.setToolTip("lengthen the 2-D arrows for legibility (the 3-D view is true to scale)")
+        self.arrow_scale.valueChanged.connect(lambda _v: self.set_value(self.value, move_slider=False))
+        view_bar = QHBoxLayout()
+        view_bar.addWidget(QLabel("3-D camera:"))
+        for name in CAMERAS:
+            b = QPushButton(name)
+            b.clicked.connect(lambda _c=False, n=name: self.set_camera(n))
+            view_bar.addWidget(b)
+        view_bar.addStretch(1)
+        view_bar.addWidget(QLabel("2-D projection:"))
+        view_bar.addWidget(self.projection)
+        view_bar.addWidget(self.arrow_scale)
         controls = QHBoxLayout()
         controls.addWidget(QLabel("component:"))
         controls.addWidget(self.combo)
@@ -91,6 +120,7 @@ class PCModeExplorer(QWidget):
         lay = QVBoxLayout(self)
         lay.addLayout(controls)
         lay.addWidget(self.description)
+        lay.addLayout(view_bar)
         lay.addWidget(split, 1)
 
         self.timer = QTimer(self)
@@ -117,40 +147,74 @@ class PCModeExplorer(QWidget):
         p.add_mesh(self.displaced, color=SYNTH_COLOR, render_points_as_spheres=True, point_size=11,
                    style="points", name="displaced", pickable=False)
         p.add_mesh(self.arrows, color="#222222", line_width=2.5, name="arrows", pickable=False)
+        try:   # the displaced face as a translucent surface with its lip contours (as the main view)
+            contours = lip_contours(self.neutral, self.model.upper_lip, self.model.lower_lip,
+                                    list(self.model.lip_corners))
+            tri = face_triangles(self.neutral, contours)
+            surf = pv.PolyData()
+            surf.SetPoints(self.displaced.GetPoints())
+            surf.faces = np.column_stack([np.full(len(tri), 3), tri]).ravel()
+            p.add_mesh(surf, color=SURFACE_COLOR, opacity=0.35, name="surface", pickable=False)
+            lips = pv.PolyData()
+            lips.SetPoints(self.displaced.GetPoints())
+            lips.lines = np.concatenate([[len(c), *c] for c in contours])
+            p.add_mesh(lips, color=SYNTH_COLOR, line_width=3, name="lips", pickable=False)
+        except Exception:   # a degenerate marker layout: points and arrows only
+            log.debug("no face surface for the PC explorer", exc_info=True)
         self.heads = None
-        p.camera_position = "xy"
-        p.camera.azimuth = -25
-        p.camera.elevation = 10
-        p.reset_camera()
+        self.set_camera("three-quarter", render=False)
+
+    def set_camera(self, name: str, render: bool = True) -> None:
+        """Look at the face from the ``front``, in ``profile`` or at ``three-quarter``."""
+        direction, up = CAMERAS[name]
+        centre = self.neutral.mean(axis=0)
+        dist = 3.0 * float(np.ptp(self.neutral, axis=0).max())
+        d = np.asarray(direction, dtype=float)
+        d /= np.linalg.norm(d)
+        self.plotter.camera_position = [tuple(centre + dist * d), tuple(centre), up]
+        self.plotter.reset_camera()
+        if render:
+            self.plotter.render()
 
     def _build_plots(self) -> None:
         fig = self.canvas.figure
         fig.clear()
         self.ax_face, self.ax_var = fig.subplots(2, 1, gridspec_kw={"height_ratios": [3, 1.2]})
         fig.subplots_adjust(left=0.12, right=0.97, top=0.95, bottom=0.08, hspace=0.35)
-        share = 100 * self.model.pca.explained_ratio
+        share, cumulative = variance_shares(self.model)
         k = np.arange(1, len(share) + 1)
         self.bars = self.ax_var.bar(k, share, color="#9fb7d9")
-        self.ax_var.plot(k, np.cumsum(share), color="#333333", lw=1, marker=".", ms=3,
+        self.ax_var.plot(k, cumulative, color="#333333", lw=1, marker=".", ms=3,
                          label="cumulative")
         self.ax_var.set_xlabel("principal component", fontsize=8)
         self.ax_var.set_ylabel("% variance", fontsize=8)
         self.ax_var.set_ylim(0, 105)
         self.ax_var.tick_params(labelsize=7)
         self.ax_var.legend(fontsize=7, loc="center right")
+        self._draw_projection_base()
+
+    def _axes2d(self) -> tuple[int, int]:
+        return PROJECTIONS[self.projection.currentText()]
+
+    def _draw_projection_base(self) -> None:
         ax = self.ax_face
-        ax.plot(self.neutral[:, 0], self.neutral[:, 1], "o", mfc="none", mec="#333333", ms=6)
-        self.quiver = ax.quiver(self.neutral[:, 0], self.neutral[:, 1], np.zeros(len(self.neutral)),
+        ax.clear()
+        h, v = self._axes2d()
+        ax.plot(self.neutral[:, h], self.neutral[:, v], "o", mfc="none", mec="#333333", ms=6)
+        self.quiver = ax.quiver(self.neutral[:, h], self.neutral[:, v], np.zeros(len(self.neutral)),
                                 np.zeros(len(self.neutral)), angles="xy", scale_units="xy", scale=1,
                                 color=SYNTH_COLOR, width=0.006)
         ax.set_aspect("equal", adjustable="box")
-        ax.set_xlabel("x (mm)", fontsize=8)
-        ax.set_ylabel("y (mm)", fontsize=8)
+        ax.set_xlabel(f"{'xyz'[h]} (mm)", fontsize=8)
+        ax.set_ylabel(f"{'xyz'[v]} (mm)", fontsize=8)
         ax.tick_params(labelsize=7)
-        span = np.ptp(self.neutral[:, :2], axis=0).max()
-        pad = 0.15 * span
-        ax.set_xlim(self.neutral[:, 0].min() - pad, self.neutral[:, 0].max() + pad)
-        ax.set_ylim(self.neutral[:, 1].min() - pad, self.neutral[:, 1].max() + pad)
+        pad = 0.15 * np.ptp(self.neutral[:, [h, v]], axis=0).max()
+        ax.set_xlim(self.neutral[:, h].min() - pad, self.neutral[:, h].max() + pad)
+        ax.set_ylim(self.neutral[:, v].min() - pad, self.neutral[:, v].max() + pad)
+
+    def _projection_changed(self) -> None:
+        self._draw_projection_base()
+        self.set_value(self.value, move_slider=False)
 
     # ------------------------------------------------------------------ state
     def set_component(self, k: int) -> None:
@@ -187,9 +251,11 @@ class PCModeExplorer(QWidget):
         sd = self.sd[self.component]
         self.value_label.setText(f"{self.value:+.2f} ({self.value / sd:+.2f} SD)")
         self.plotter.render()
-        self.quiver.set_UVC(disp[:, 0], disp[:, 1])
-        self.ax_face.set_title(f"PC{self.component + 1} = {self.value:+.1f} "
-                               f"({self.value / sd:+.1f} SD)", fontsize=9)
+        h, v = self._axes2d()
+        scale = int(self.arrow_scale.value())
+        self.quiver.set_UVC(scale * disp[:, h], scale * disp[:, v])
+        self.ax_face.set_title(f"PC{self.component + 1} = {self.value:+.1f} ({self.value / sd:+.1f} SD)"
+                               + (f", arrows x{scale}" if scale != 1 else ""), fontsize=9)
         self.canvas.draw_idle()
         self.valueChanged.emit(self.component, self.value)
 
