@@ -37,6 +37,7 @@ from engine.analysis import (
 from engine.corpus import Corpus
 from engine.evaluation import METRICS, EvalResult, sweep_n, table2
 from engine.model import Model
+from engine.report import PAPER_TABLE2
 
 from .common import (
     Canvas,
@@ -53,6 +54,13 @@ from .common import (
 log = logging.getLogger(__name__)
 
 METRIC_NAMES = {"whole_face": "Whole Face", "lower_lip": "Lower Lip", "upper_lip": "Upper Lip"}
+
+
+def _paper(row: Table2Row) -> tuple[float, float, float]:
+    """The paper's Table 2 value of this condition (phonetic, N = 3), else NaN."""
+    if row.mode != "phonetic" or row.n_context_phones != 3:
+        return (float("nan"),) * 3
+    return PAPER_TABLE2.get((row.split, row.smoothing), (float("nan"),) * 3)
 
 
 def _short(row: Table2Row) -> str:
@@ -172,10 +180,12 @@ class MetricsView(QWidget):
     def set_table2(self, result: EvalResult) -> None:
         self.table2_result = result
         self.rows = table2_rows(result)
-        head = ["Test condition", "Whole Face", "Lower Lip", "Upper Lip", "N", "utterances"]
+        head = ["Test condition", "Whole Face", "Lower Lip", "Upper Lip", "N", "utterances",
+                "paper: Whole Face", "Lower Lip", "Upper Lip"]
         rows = [[text_item(r.name), *(heat_item(getattr(r, m), 0.4, 1.0, "{:.4f}", "RdYlGn")
                                       for m in METRICS),
-                 NumberItem(r.n_context_phones, "{:.0f}"), NumberItem(r.utterances, "{:.0f}")]
+                 NumberItem(r.n_context_phones, "{:.0f}"), NumberItem(r.utterances, "{:.0f}"),
+                 *(NumberItem(v, "{:.4f}") for v in _paper(r))]
                 for r in self.rows]
         fill_table(self.table, head, rows)
         self.status.setText(f"Table 2: {len(self.rows)} conditions")

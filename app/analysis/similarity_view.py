@@ -25,6 +25,7 @@ from PyQt6.QtWidgets import (
 
 from engine.analysis import cluster_phones, dendrogram, similarity_in_order, write_similarity_csv
 from engine.model import Model
+from engine.report import paper_table1
 from engine.similarity import top_similar
 
 from .common import Canvas, ask_save_path, fill_table, heat_item, report_error, text_item
@@ -99,12 +100,15 @@ class SimilarityView(QWidget):
         self.table.verticalHeader().setVisible(False)
 
     def _fill_table1(self) -> None:
-        heads = ["Phoneme", "Closest", "S", "2nd", "S", "3rd", "S"]
+        heads = ["Phoneme", "Closest", "S", "2nd", "S", "3rd", "S", "paper's top 3 (nu = 10)"]
+        paper = paper_table1()
         rows = []
         for r in self.table1:
             row = [text_item(r.phone)]
             for p, v in r.neighbours:
                 row += [text_item(p), heat_item(v, 0.0, 1.0)]
+            ref = paper.get(r.phone)
+            row.append(text_item("  ".join(f"{p} {v:.2f}" for p, v in ref) if ref else "-"))
             rows.append(row)
         fill_table(self.table1_table, heads, rows)
         self.table1_table.verticalHeader().setVisible(False)
