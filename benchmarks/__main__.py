@@ -40,7 +40,7 @@ def display_available() -> tuple[bool, str]:
     return False, "no DISPLAY (run under xvfb-run, as make bench does)"
 
 
-def run_playback(smoke: bool) -> list[BenchRow]:
+def run_playback(smoke: bool, corpus: Path | None = None) -> list[BenchRow]:
     """Call ``benchmarks.playback.main(argv)`` when it exists and a display is available."""
     if importlib.util.find_spec("benchmarks.playback") is None:
         reason = "benchmarks/playback.py does not exist yet"
@@ -52,7 +52,8 @@ def run_playback(smoke: bool) -> list[BenchRow]:
         return [BenchRow("playback", "app playback", float("nan"), "", note=f"skipped: {reason}")]
     module = importlib.import_module("benchmarks.playback")
     try:
-        out = module.main(["--smoke"] if smoke else [])
+        argv = (["--corpus", str(corpus)] if corpus is not None else []) + (["--smoke"] if smoke else [])
+        out = module.main(argv)
     except Exception as exc:  # the app benchmark is another module; report, do not crash ours
         log.exception("playback benchmark failed")
         return [BenchRow("playback", "app playback", float("nan"), "", note=f"failed: {exc}")]
@@ -72,7 +73,7 @@ def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS) -> list[BenchRow]:
     if "scaling" in only:
         rows += scaling.run(ctx)
     if "playback" in only:
-        rows += run_playback(ctx.smoke)
+        rows += run_playback(ctx.smoke, ctx.corpus.root)
     return rows
 
 

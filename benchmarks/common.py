@@ -44,8 +44,11 @@ class BenchRow:
     value : the number (NaN when it could not be measured).
     unit : ``s``, ``MiB``, ``x RT`` (times faster than real time), ``corr``, ``ms``...
     aim : the issue's aim for this number, as text (empty when there is none).
-    ok : whether the aim is met (``None`` when there is no aim).
+    ok : whether the aim is met (``None`` when there is no aim); judged on wall time.
     note : anything needed to read the number.
+    cpu : the same number computed from this process's CPU time instead of wall time (NaN when
+        not applicable). On a shared machine wall time includes waiting for a core; with
+        multi-threaded BLAS CPU time can exceed wall time.
     """
 
     group: str
@@ -55,9 +58,10 @@ class BenchRow:
     aim: str = ""
     ok: bool | None = None
     note: str = ""
+    cpu: float = float("nan")
 
-    def cell(self) -> str:
-        v = self.value
+    def cell(self, v: float | None = None) -> str:
+        v = self.value if v is None else v
         if not math.isfinite(v):
             return "n/a"
         if self.unit == "corr":
@@ -74,25 +78,27 @@ class BenchRow:
 
 def format_table(rows: Sequence[BenchRow]) -> str:
     """The rows as a fixed-width text table (printed by ``python -m benchmarks``)."""
-    heads = ("group", "benchmark", "value", "unit", "aim", "", "note")
-    cells = [(r.group, r.name, r.cell(), r.unit, r.aim, r.verdict(), r.note) for r in rows]
+    heads = ("group", "benchmark", "value", "by CPU", "unit", "aim", "", "note")
+    cells = [(r.group, r.name, r.cell(), r.cell(r.cpu) if math.isfinite(r.cpu) else "", r.unit, r.aim,
+              r.verdict(), r.note) for r in rows]
     widths = [max(len(h), *(len(c[i]) for c in cells)) if cells else len(h)
               for i, h in enumerate(heads)]
     widths[-1] = len(heads[-1])
     line = "  ".join(h.ljust(w) for h, w in zip(heads, widths, strict=True)).rstrip()
     out = [line, "-" * len(line)]
     for c in cells:
-        out.append("  ".join(x.rjust(w) if i == 2 else x.ljust(w)
+        out.append("  ".join(x.rjust(w) if i in (2, 3) else x.ljust(w)
                              for i, (x, w) in enumerate(zip(c, widths, strict=True))).rstrip())
     return "\n".join(out)
 
 
 def markdown_table(rows: Sequence[BenchRow]) -> str:
     """The rows as a Markdown table."""
-    out = ["| group | benchmark | value | unit | aim | | note |",
-           "|---|---|---:|---|---|---|---|"]
+    out = ["| group | benchmark | value (wall) | value (CPU time) | unit | aim | | note |",
+           "|---|---|---:|---:|---|---|---|---|"]
     for r in rows:
-        out.append(f"| {r.group} | {r.name} | {r.cell()} | {r.unit} | {r.aim} | {r.verdict()} "
+        cpu = r.cell(r.cpu) if math.isfinite(r.cpu) else ""
+        out.append(f"| {r.group} | {r.name} | {r.cell()} | {cpu} | {r.unit} | {r.aim} | {r.verdict()} "
                    f"| {r.note} |")
     return "\n".join(out)
 
@@ -146,17 +152,31 @@ def peak_rss_mib() -> float:
 
 
 # ---------------------------------------------------------------------- timing
-def best_time(fn: Callable[[], object], repeat: int = 3, min_total_s: float = 0.0) -> float:
-    """Smallest wall time of ``repeat`` calls of ``fn`` (more calls while under ``min_total_s``)."""
-    best = float("inf")
+@dataclass(frozen=True)
+class Timing:
+    """Wall and CPU seconds of one call."""
+
+    wall: float
+    cpu: float
+
+
+def timed(fn: Callable[[], object]) -> tuple[Timing, object]:
+    """Call ``fn`` once; its wall and process CPU time, and its result."""
+    c0, t0 = time.process_time(), time.perf_counter()
+    out = fn()
+    return Timing(time.perf_counter() - t0, time.process_time() - c0), out
+
+
+def best_time(fn: Callable[[], object], repeat: int = 3, min_total_s: float = 0.0) -> Timing:
+    """The fastest (by wall time) of ``repeat`` calls of ``fn`` (more while under ``min_total_s``)."""
+    best = Timing(float("inf"), float("inf"))
     total = 0.0
     count = 0
     while count < repeat or total < min_total_s:
-        t0 = time.perf_counter()
-        fn()
-        dt = time.perf_counter() - t0
-        best = min(best, dt)
-        total += dt
+        t, _ = timed(fn)
+        if t.wall < best.wall:
+            best = t
+        total += t.wall
         count += 1
         if count >= 50:
             break

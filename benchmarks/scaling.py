@@ -15,7 +15,6 @@ from __future__ import annotations
 import inspect
 import logging
 import math
-import time
 from collections.abc import Sequence
 from dataclasses import replace
 
@@ -24,10 +23,10 @@ import numpy as np
 from engine.codebook import Codebook
 from engine.config import SynthConfig
 from engine.evaluation import speech_mask, trajectory_correlations
-from engine.model import Model, synthesize
+from engine.model import Model, Synthesis, synthesize
 from engine.synthesis import nearest_codewords
 
-from .common import BenchContext, BenchRow, concatenate_input
+from .common import BenchContext, BenchRow, Timing, concatenate_input, timed
 
 log = logging.getLogger(__name__)
 
@@ -80,10 +79,9 @@ def agreement(model: Model, a: np.ndarray, b: np.ndarray) -> float:
     return trajectory_correlations(a, b, mask, model)["whole_face"]
 
 
-def _timed(model: Model, audio: np.ndarray, rate: int, cfg: SynthConfig):
-    t0 = time.perf_counter()
-    res = synthesize(model, audio, rate, None, cfg)
-    return time.perf_counter() - t0, res
+def _timed(model: Model, audio: np.ndarray, rate: int, cfg: SynthConfig) -> tuple[Timing, Synthesis]:
+    tm, res = timed(lambda: synthesize(model, audio, rate, None, cfg))
+    return tm, res  # type: ignore[return-value]
 
 
 def original_correlation(model: Model, ctx: BenchContext, prefilter: int | None) -> float:
@@ -111,17 +109,22 @@ def run(ctx: BenchContext, factors: Sequence[int] | None = None,
     rows: list[BenchRow] = []
     full_times: dict[int, float] = {}
     pre_times: dict[tuple[int, int], float] = {}
+    full_cpu: dict[int, float] = {}
+    pre_cpu: dict[tuple[int, int], float] = {}
     synthesize(base, audio[: rate // 2], rate, None, SynthConfig(mode="acoustic"))  # warm-up
     for factor in factors:
         model = replace(base, codebook=replicate_codebook(base.codebook, factor, rng))
         size = model.codebook.lsf.shape[0]
-        t_full, full = _timed(model, audio, rate, SynthConfig(mode="acoustic"))
+        tm_full, full = _timed(model, audio, rate, SynthConfig(mode="acoustic"))
+        t_full = tm_full.wall
         full_times[factor] = t_full
+        full_cpu[factor] = tm_full.cpu
         rows.append(BenchRow("scaling", f"acoustic, full search, codebook x{factor}",
                              seconds / t_full, "x RT",
                              aim=">= 50x" if factor == 1 else "",
                              ok=None if ctx.smoke or factor != 1 else seconds / t_full >= 50,
-                             note=f"{size} codewords; {t_full * 1000 / full.times.size:.2f} ms/frame"))
+                             note=f"{size} codewords; {t_full * 1000 / full.times.size:.2f} ms/frame",
+                             cpu=seconds / tm_full.cpu))
         for k in prefilters:
             if k >= size:
                 continue
@@ -132,13 +135,16 @@ def run(ctx: BenchContext, factors: Sequence[int] | None = None,
                                      note=f"skipped: nearest_codewords would allocate "
                                           f"{temp / 1024**3:.1f} GiB of temporaries"))
                 continue
-            t_pre, pre = _timed(model, audio, rate, SynthConfig(mode="acoustic", acoustic_prefilter=k))
+            tm_pre, pre = _timed(model, audio, rate, SynthConfig(mode="acoustic", acoustic_prefilter=k))
+            t_pre = tm_pre.wall
             pre_times[(factor, k)] = t_pre
+            pre_cpu[(factor, k)] = tm_pre.cpu
             agree = agreement(model, full.markers, pre.markers)
             rows.append(BenchRow("scaling", f"acoustic, prefilter K={k}, codebook x{factor}",
                                  seconds / t_pre, "x RT",
                                  note=f"{t_full / t_pre:.1f}x faster than full search; "
-                                      f"correlation with full search {agree:.4f}"))
+                                      f"correlation with full search {agree:.4f}",
+                                 cpu=seconds / tm_pre.cpu))
         log.info("scaling x%d (%d codewords): full %.2f s", factor, size, t_full)
     lo, hi = min(factors), max(factors)
     if hi > lo:
@@ -147,12 +153,14 @@ def run(ctx: BenchContext, factors: Sequence[int] | None = None,
 
         e_full = exponent(full_times[lo], full_times[hi])
         rows.append(BenchRow("scaling", f"growth exponent, full search (time ~ size^e, x{lo}..x{hi})",
-                             e_full, "e", aim="< 1", ok=None if ctx.smoke else e_full < 1))
+                             e_full, "e", aim="< 1", ok=None if ctx.smoke else e_full < 1,
+                             cpu=exponent(full_cpu[lo], full_cpu[hi])))
         for k in prefilters:
             if (lo, k) in pre_times and (hi, k) in pre_times:
                 e = exponent(pre_times[(lo, k)], pre_times[(hi, k)])
                 rows.append(BenchRow("scaling", f"growth exponent, prefilter K={k}", e, "e",
-                                     aim="< 1", ok=None if ctx.smoke else e < 1))
+                                     aim="< 1", ok=None if ctx.smoke else e < 1,
+                                     cpu=exponent(pre_cpu[(lo, k)], pre_cpu[(hi, k)])))
     # accuracy against the original markers (x1 codebook)
     if ctx.test_utts:
         n = min(len(ctx.test_utts), N_TEST_UTTS)
