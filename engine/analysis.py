@@ -466,6 +466,17 @@ class FrameInspection:
     lsf: np.ndarray          # w (P,)
     lsf_hat: np.ndarray      # w-hat (P,)
     error: float             # sum_k h_k |w_k - w-hat_k|
+    audio_rate: float = 16000.0
+
+    @property
+    def lsf_hz(self) -> np.ndarray:
+        """w in Hz (LSFs are angles in radians at the analysis rate)."""
+        return self.lsf * self.audio_rate / (2 * np.pi)
+
+    @property
+    def lsf_hat_hz(self) -> np.ndarray:
+        """w-hat in Hz."""
+        return self.lsf_hat * self.audio_rate / (2 * np.pi)
 
     @property
     def weight_sum(self) -> float:
@@ -514,7 +525,7 @@ def inspect_frame(model: Model, synthesis: Synthesis, frame: int, top: int | Non
                                 start + (pos + 0.5) * (end - start) / n, float(d[i]), float(v[i])))
     return FrameInspection(frame, float(synthesis.times[frame]), phone, ctx_txt, chosen, rows,
                            float(fw.gamma[frame]), np.asarray(w), np.asarray(fw.lsf_hat[frame]),
-                           float(fw.error[frame]))
+                           float(fw.error[frame]), float(model.config.audio_rate))
 
 
 # ---------------------------------------------------------------------- PC modes (Figure 2)

@@ -283,6 +283,10 @@ class GestureMeasurement:
     original: list[Gesture]
     synthesized: list[Gesture]
 
+    def levels(self, g: Gesture) -> tuple[float, float]:
+        """The onset and offset threshold levels (mm/s) of gesture ``g``."""
+        return self.threshold * g.v_pvel, self.threshold * g.v_pvel2
+
     def pairs(self) -> list[LandmarkTiming]:
         """Original and synthesized gestures paired by anchor (empty without the original)."""
         return compare_landmarks(self.original, self.synthesized) if self.v_original is not None else []

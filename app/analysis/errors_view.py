@@ -34,6 +34,7 @@ from engine.analysis import (
     segment_errors,
     subset_corpus,
     worst_segments,
+    write_error_csv,
 )
 from engine.corpus import Corpus
 from engine.model import Model
@@ -198,8 +199,6 @@ class ErrorView(QWidget):
 
     # ------------------------------------------------------------------ export
     def export_csv(self, path: str | Path) -> Path:
-        from engine.analysis import write_error_csv
-
         if self.report is None:
             raise ValueError("compute the errors first")
         return write_error_csv(path, self.report)

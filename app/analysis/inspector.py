@@ -167,10 +167,9 @@ class CodebookInspector(QWidget):
         fig.clear()
         ax, axw = fig.subplots(1, 2, gridspec_kw={"width_ratios": [3, 2]})
         fig.subplots_adjust(left=0.14, right=0.98, bottom=0.2, top=0.86, wspace=0.3)
-        hz = self.model.config.audio_rate / (2 * np.pi)
         # LSFs as a barcode on a frequency axis: closely spaced pairs mark the formants
-        ax.vlines(ins.lsf * hz, 0.52, 0.98, color=ORIGINAL_COLOR, lw=1.6)
-        ax.vlines(ins.lsf_hat * hz, 0.02, 0.48, color=SYNTH_COLOR, lw=1.6)
+        ax.vlines(ins.lsf_hz, 0.52, 0.98, color=ORIGINAL_COLOR, lw=1.6)
+        ax.vlines(ins.lsf_hat_hz, 0.02, 0.48, color=SYNTH_COLOR, lw=1.6)
         ax.set_yticks([0.25, 0.75], ["w-hat (eq 7)", "w (input)"], fontsize=7)
         ax.set_ylim(0, 1)
         ax.set_xlim(0, self.model.config.audio_rate / 2)

@@ -272,10 +272,9 @@ class VelocityPanel:
                     ax.plot([t], [y], LANDMARK_MARKERS[k], color=color, ms=4.5,
                             transform=ax.get_xaxis_transform(), clip_on=True,
                             mfc=color if k in ("pvel", "pvel2", "maxc") else "none")
-                ax.plot([g.onset, g.pvel], [self.controls.threshold_fraction * g.v_pvel] * 2, color=color,
-                        lw=0.6, alpha=0.6)
-                ax.plot([g.pvel2, g.offset], [self.controls.threshold_fraction * g.v_pvel2] * 2,
-                        color=color, lw=0.6, alpha=0.6)
+                on, off = m.levels(g)
+                ax.plot([g.onset, g.pvel], [on, on], color=color, lw=0.6, alpha=0.6)
+                ax.plot([g.pvel2, g.offset], [off, off], color=color, lw=0.6, alpha=0.6)
         ax.set_ylabel(f"{self.controls.model.marker_names[m.marker]}\nspeed (mm/s)", fontsize=8)
         ax.set_ylim(bottom=0)
         ax.legend(loc="upper right", fontsize=7, ncol=2, framealpha=0.8)
