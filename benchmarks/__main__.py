@@ -63,7 +63,8 @@ def run_playback(smoke: bool, corpus: Path | None = None) -> list[BenchRow]:
                      note=f"benchmarks.playback.main returned {out!r}")]
 
 
-def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS) -> list[BenchRow]:
+def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS, factors: Sequence[int] | None = None,
+            prefilters: Sequence[int] | None = None) -> list[BenchRow]:
     """Run the selected benchmark groups on ``ctx``; return all rows in order."""
     rows: list[BenchRow] = []
     if "train" in only:
@@ -71,7 +72,7 @@ def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS) -> list[BenchRow]:
     if "synth" in only:
         rows += synth.run(ctx)
     if "scaling" in only:
-        rows += scaling.run(ctx)
+        rows += scaling.run(ctx, factors, prefilters)
     if "playback" in only:
         rows += run_playback(ctx.smoke, ctx.corpus.root)
     return rows
@@ -126,13 +127,17 @@ def main(argv: Sequence[str] | None = None) -> int:
                         help=f"Markdown output (default {DEFAULT_OUT.relative_to(REPO)}; "
                              f"none in smoke mode)")
     parser.add_argument("--only", nargs="+", choices=GROUPS, default=list(GROUPS))
+    parser.add_argument("--factors", nargs="+", type=int, default=None,
+                        help="codebook growth factors of the scaling benchmark (default 1 4 16)")
+    parser.add_argument("--prefilters", nargs="+", type=int, default=None,
+                        help="prefilter sizes K of the scaling benchmark (default 32 128 512)")
     args = parser.parse_args(argv)
     if not logging.getLogger().handlers:
         logging.basicConfig(level=logging.INFO, format="%(name)s: %(message)s", stream=sys.stderr)
     t0 = time.perf_counter()
     info = machine_info()
     ctx = load_context(args.corpus, args.smoke)
-    rows = run_all(ctx, args.only)
+    rows = run_all(ctx, args.only, args.factors, args.prefilters)
     print(format_table(rows))
     out = args.out if args.out is not None else (None if args.smoke else DEFAULT_OUT)
     if out is not None:
