@@ -60,7 +60,10 @@ def lip_contours(neutral: np.ndarray, upper: int, lower: int, corners: list[int]
 
 def face_triangles(neutral: np.ndarray, contours: list[list[int]]) -> np.ndarray:
     """Triangles ``(n, 3)`` of a face surface: 2-D Delaunay on the neutral x-y, without the mouth
-    opening and without long edges across the face's outline."""
+    opening and without long edges across the face's outline. Midsagittal (2-D) data, or fewer
+    than four markers spanning the x-y plane, has no surface: no triangles."""
+    if len(neutral) < 4 or np.ptp(neutral[:, 0]) == 0 or np.ptp(neutral[:, 1]) == 0:
+        return np.zeros((0, 3), dtype=int)
     tri = Delaunay(neutral[:, :2]).simplices
     edges = np.concatenate([neutral[tri[:, a], :2] - neutral[tri[:, b], :2]
                             for a, b in ((0, 1), (1, 2), (2, 0))])

@@ -272,6 +272,50 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
                      marker_names=list(mdata.names), words=words, text=text)
 
 
+@dataclass
+class FolderScan:
+    """What a folder of recordings holds: usable utterances, the marker set, the labels used."""
+
+    ids: list[str]
+    marker_names: list[str]
+    marker_rate: float
+    dimensions: int
+    labels: list[str]
+    first_marker_file: Path
+    left_out: list[str] = field(default_factory=list)
+
+
+def scan_folder(data_dir: str | os.PathLike[str], read_labels_of: int = 50) -> FolderScan:
+    """List the utterances (stems with audio, labels and markers) of a folder, its marker set
+    (from the first marker file) and the distinct labels of the first ``read_labels_of`` label
+    files (for building a label map)."""
+    data_dir = Path(data_dir)
+    if not data_dir.is_dir():
+        raise InputError(data_dir, "not a folder")
+    stems = sorted({p.stem for p in data_dir.iterdir() if p.suffix.lower() in (".wav", ".flac")})
+    ids, left_out = [], []
+    for stem in stems:
+        try:
+            label_path(data_dir, stem)
+            marker_path(data_dir, stem)
+        except InputError:
+            left_out.append(stem)
+            continue
+        ids.append(stem)
+    if not ids:
+        raise InputError(data_dir, "no utterance with audio, labels and markers")
+    mfile = marker_path(data_dir, ids[0])
+    first = read_markers(mfile)
+    labels: set[str] = set()
+    for utt_id in ids[:read_labels_of]:
+        lpath = label_path(data_dir, utt_id)
+        segs = read_textgrid(lpath) if lpath.suffix.lower() == ".textgrid" else read_labels(lpath)
+        labels.update(s.label for s in segs)
+    planar = not np.any(first.markers[..., 0][np.isfinite(first.markers[..., 0])])
+    return FolderScan(ids, first.names, first.rate, 2 if planar else 3, sorted(labels), mfile,
+                      left_out)
+
+
 def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str] | None = None,
                 fixed: list[str] | None = None, upper_lip: str = "", lower_lip: str = "",
                 lip_corners: list[str] | None = None, label_map: str = "",
@@ -286,26 +330,11 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
     relative to it.
     """
     data_dir = Path(data_dir).resolve()
-    if not data_dir.is_dir():
-        raise InputError(data_dir, "not a folder")
-    stems = sorted({p.stem for p in data_dir.iterdir() if p.suffix.lower() in (".wav", ".flac")})
-    ids = []
-    for stem in stems:
-        try:
-            label_path(data_dir, stem)
-            marker_path(data_dir, stem)
-        except InputError:
-            log.info("%s: no labels or markers; left out", data_dir / stem)
-            continue
-        ids.append(stem)
-    if not ids:
-        raise InputError(data_dir, "no utterance with audio, labels and markers")
-    first = read_markers(marker_path(data_dir, ids[0]))
-    names = first.names
-    planar = bool(np.nanmax(np.abs(first.markers[..., 0])) == 0.0)
+    scan = scan_folder(data_dir)
+    ids, names, planar = scan.ids, scan.marker_names, scan.dimensions == 2
     for role in [*(fixed or []), upper_lip, lower_lip, *(lip_corners or [])]:
         if role not in names:
-            raise InputError(marker_path(data_dir, ids[0]),
+            raise InputError(scan.first_marker_file,
                              f"no marker named {role!r}; markers: {' '.join(names)}")
     if test is None:
         step = max(2, round(1 / test_fraction)) if test_fraction > 0 else 0

@@ -1,0 +1,440 @@
+"""Bringing one's own data in and getting results out (File menu).
+
+In: a dialog that describes a folder of recordings (audio + labels + markers) as a corpus: which
+markers are the fixed head references and which are the lip centres, and an editable table that
+maps the folder's labels onto ARPAbet (a MOCHA-TIMIT preset is provided). The description is
+written by the engine (:func:`engine.corpus.init_corpus`) and opened like any corpus.
+
+Out: the current synthesized or original trajectories (C3D, TSV, NPZ), the time-aligned panels as
+a figure (PNG, SVG, PDF), the model file, and a video (MP4) with a progress bar. Every file is
+written under a temporary name and renamed into place; an existing file is replaced only after the
+user confirms.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+from pathlib import Path
+
+import numpy as np
+from PyQt6.QtCore import Qt
+from PyQt6.QtGui import QAction
+from PyQt6.QtWidgets import (
+    QAbstractItemView,
+    QComboBox,
+    QDialog,
+    QDialogButtonBox,
+    QDoubleSpinBox,
+    QFileDialog,
+    QFormLayout,
+    QHBoxLayout,
+    QHeaderView,
+    QLabel,
+    QLineEdit,
+    QListWidget,
+    QListWidgetItem,
+    QMessageBox,
+    QPushButton,
+    QTableWidget,
+    QTableWidgetItem,
+    QVBoxLayout,
+    QWidget,
+)
+
+from engine.corpus import FolderScan, init_corpus, scan_folder
+from engine.errors import FacetrajError
+from engine.formats import atomic_write, write_c3d, write_marker_tsv
+from engine.labelmap import MOCHA_TO_ARPABET, read_label_map, write_label_map
+from engine.phones import ARPABET, SILENCE, SILENCE_LABELS, normalise_label
+
+log = logging.getLogger(__name__)
+
+FIXED_HINTS = ("FH", "FOREHEAD", "NB", "NOSE_BRIDGE", "BN", "UI", "HEAD", "REF")
+UPPER_HINTS = ("UL_C", "UL", "ULC", "UPPER_LIP")
+LOWER_HINTS = ("LL_C", "LL", "LLC", "LOWER_LIP")
+
+
+def guess_roles(names: list[str]) -> tuple[list[str], str, str]:
+    """Likely fixed markers and lip centres from the names (the user confirms in the dialog)."""
+    upper_names = [n.upper() for n in names]
+    fixed = [n for n, u in zip(names, upper_names, strict=True) if u.startswith(FIXED_HINTS)]
+
+    def first(hints: tuple[str, ...]) -> str:
+        for h in hints:
+            for n, u in zip(names, upper_names, strict=True):
+                if u == h:
+                    return n
+        for h in hints:
+            for n, u in zip(names, upper_names, strict=True):
+                if u.startswith(h):
+                    return n
+        return names[0]
+
+    return fixed, first(UPPER_HINTS), first(LOWER_HINTS)
+
+
+def default_label_map(labels: list[str], preset: str = "") -> dict[str, str]:
+    """A starting label map: the preset's entry, or the label itself when it is ARPAbet."""
+    table = MOCHA_TO_ARPABET if preset == "mocha" else {}
+    out = {}
+    for lab in labels:
+        norm = normalise_label(lab)
+        if lab in table:
+            out[lab] = table[lab]
+        elif lab.lower() in SILENCE_LABELS or norm == SILENCE:
+            out[lab] = SILENCE
+        elif norm in ARPABET:
+            out[lab] = norm
+        else:
+            out[lab] = ""
+    return out
+
+
+class ImportDialog(QDialog):
+    """Describe a folder of one's own recordings as a corpus."""
+
+    def __init__(self, parent: QWidget | None = None, folder: Path | None = None):
+        super().__init__(parent)
+        self.setWindowTitle("Import your own recordings")
+        self.resize(720, 640)
+        self.scan: FolderScan | None = None
+        self.result_path: Path | None = None
+        lay = QVBoxLayout(self)
+        intro = QLabel("A folder with one audio file (WAV/FLAC), one label file (TextGrid, .lab, "
+                       ".phn) and one marker file (C3D, TSV/CSV, MOCHA .ema) per utterance, sharing "
+                       "the file name.")
+        intro.setWordWrap(True)
+        lay.addWidget(intro)
+        form = QFormLayout()
+        row = QHBoxLayout()
+        self.folder_edit = QLineEdit()
+        browse = QPushButton("Browse…")
+        browse.clicked.connect(self._browse)
+        row.addWidget(self.folder_edit)
+        row.addWidget(browse)
+        form.addRow("Folder", row)
+        self.summary = QLabel("")
+        form.addRow("", self.summary)
+        self.fixed_list = QListWidget()
+        self.fixed_list.setSelectionMode(QAbstractItemView.SelectionMode.NoSelection)
+        self.fixed_list.setMaximumHeight(130)
+        form.addRow("Fixed (head) markers", self.fixed_list)
+        self.upper = QComboBox()
+        self.lower = QComboBox()
+        form.addRow("Upper lip centre", self.upper)
+        form.addRow("Lower lip centre", self.lower)
+        self.rate = QDoubleSpinBox()
+        self.rate.setRange(10, 1000)
+        self.rate.setValue(60)
+        self.rate.setSuffix(" Hz")
+        form.addRow("Marker rate (resampled to)", self.rate)
+        self.test_fraction = QDoubleSpinBox()
+        self.test_fraction.setRange(0, 0.9)
+        self.test_fraction.setSingleStep(0.05)
+        self.test_fraction.setValue(1 / 3)
+        form.addRow("Test fraction", self.test_fraction)
+        self.output_edit = QLineEdit()
+        form.addRow("Description file", self.output_edit)
+        lay.addLayout(form)
+        map_row = QHBoxLayout()
+        map_row.addWidget(QLabel("Label map onto ARPAbet (empty cells: the label is unknown)"))
+        self.preset = QComboBox()
+        self.preset.addItems(["labels as they are", "MOCHA-TIMIT"])
+        self.preset.currentIndexChanged.connect(self._fill_map)
+        map_row.addWidget(self.preset)
+        load = QPushButton("Load…")
+        load.clicked.connect(self._load_map)
+        save = QPushButton("Save…")
+        save.clicked.connect(self._save_map)
+        map_row.addWidget(load)
+        map_row.addWidget(save)
+        lay.addLayout(map_row)
+        self.map_table = QTableWidget(0, 2)
+        self.map_table.setHorizontalHeaderLabels(["label", "ARPAbet"])
+        self.map_table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.Stretch)
+        lay.addWidget(self.map_table, 1)
+        buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Ok
+                                   | QDialogButtonBox.StandardButton.Cancel)
+        buttons.accepted.connect(self._accept)
+        buttons.rejected.connect(self.reject)
+        self.ok_button = buttons.button(QDialogButtonBox.StandardButton.Ok)
+        self.ok_button.setEnabled(False)
+        lay.addWidget(buttons)
+        self.folder_edit.editingFinished.connect(lambda: self.set_folder(Path(self.folder_edit.text())))
+        if folder is not None:
+            self.set_folder(folder)
+
+    # ------------------------------------------------------------------ folder
+    def _browse(self) -> None:
+        path = QFileDialog.getExistingDirectory(self, "A folder of recordings")
+        if path:
+            self.set_folder(Path(path))
+
+    def set_folder(self, folder: Path) -> None:
+        """Scan ``folder`` and fill the marker roles and the label map."""
+        self.folder_edit.setText(str(folder))
+        try:
+            scan = scan_folder(folder)
+        except FacetrajError as exc:
+            self.scan = None
+            self.summary.setText(str(exc))
+            self.ok_button.setEnabled(False)
+            return
+        self.scan = scan
+        dims = "midsagittal (2-D)" if scan.dimensions == 2 else "3-D"
+        self.summary.setText(f"{len(scan.ids)} utterances, {len(scan.marker_names)} {dims} markers at "
+                             f"{scan.marker_rate:g} Hz, {len(scan.labels)} distinct labels"
+                             + (f"; {len(scan.left_out)} files without labels or markers left out"
+                                if scan.left_out else ""))
+        fixed, upper, lower = guess_roles(scan.marker_names)
+        self.fixed_list.clear()
+        for name in scan.marker_names:
+            item = QListWidgetItem(name)
+            item.setFlags(item.flags() | Qt.ItemFlag.ItemIsUserCheckable)
+            item.setCheckState(Qt.CheckState.Checked if name in fixed else Qt.CheckState.Unchecked)
+            self.fixed_list.addItem(item)
+        for combo, pick in ((self.upper, upper), (self.lower, lower)):
+            combo.clear()
+            combo.addItems(scan.marker_names)
+            combo.setCurrentText(pick)
+        mocha = any(lab in ("@", "ii", "uu", "@@", "breath") for lab in scan.labels)
+        self.preset.blockSignals(True)
+        self.preset.setCurrentIndex(1 if mocha else 0)
+        self.preset.blockSignals(False)
+        self._fill_map()
+        out = folder / "corpus.json"
+        if not os.access(folder, os.W_OK):
+            from platformdirs import user_data_dir
+
+            out = Path(user_data_dir("facetraj")) / "corpora" / f"{folder.name}.json"
+        self.output_edit.setText(str(out))
+        self.ok_button.setEnabled(True)
+
+    # ------------------------------------------------------------------ label map
+    def _fill_map(self) -> None:
+        if self.scan is None:
+            return
+        preset = "mocha" if self.preset.currentIndex() == 1 else ""
+        self.set_label_map(default_label_map(self.scan.labels, preset))
+
+    def set_label_map(self, table: dict[str, str]) -> None:
+        self.map_table.setRowCount(0)
+        for lab, arpa in table.items():
+            r = self.map_table.rowCount()
+            self.map_table.insertRow(r)
+            item = QTableWidgetItem(lab)
+            item.setFlags(item.flags() & ~Qt.ItemFlag.ItemIsEditable)
+            self.map_table.setItem(r, 0, item)
+            self.map_table.setItem(r, 1, QTableWidgetItem(arpa))
+
+    def label_map(self) -> dict[str, str]:
+        """The table as a dict (rows with an empty ARPAbet cell left out)."""
+        out = {}
+        for r in range(self.map_table.rowCount()):
+            lab = self.map_table.item(r, 0).text()
+            cell = self.map_table.item(r, 1)
+            arpa = cell.text().strip() if cell else ""
+            if arpa:
+                out[lab] = arpa
+        return out
+
+    def _load_map(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self, "Load a label map", "", "Label map (*.tsv *.txt)")
+        if not path:
+            return
+        try:
+            loaded = read_label_map(path)
+        except FacetrajError as exc:
+            QMessageBox.critical(self, "facetraj", str(exc))
+            return
+        current = {self.map_table.item(r, 0).text(): "" for r in range(self.map_table.rowCount())}
+        self.set_label_map({**current, **loaded})
+
+    def _save_map(self) -> None:
+        path, _ = QFileDialog.getSaveFileName(self, "Save the label map", "labels.tsv", "TSV (*.tsv)")
+        if path:
+            write_label_map(path, self.label_map())
+
+    # ------------------------------------------------------------------ accept
+    def fixed_markers(self) -> list[str]:
+        return [self.fixed_list.item(i).text() for i in range(self.fixed_list.count())
+                if self.fixed_list.item(i).checkState() == Qt.CheckState.Checked]
+
+    def write_description(self) -> Path:
+        """Write the label map and the corpus description; return the description's path."""
+        if self.scan is None:
+            raise FacetrajError("choose a folder of recordings first")
+        folder = Path(self.folder_edit.text())
+        out = Path(self.output_edit.text())
+        out.parent.mkdir(parents=True, exist_ok=True)
+        table = self.label_map()
+        unknown = [r for r in self.scan.labels if r not in table]
+        if unknown:
+            raise FacetrajError(f"{folder}: labels without an ARPAbet entry: {' '.join(unknown)}")
+        identity = all(normalise_label(k) == normalise_label(v) for k, v in table.items())
+        label_map = ""
+        if not identity:
+            map_path = out.with_name(out.stem + ".labelmap.tsv")
+            write_label_map(map_path, table)
+            label_map = map_path.name
+        path, _ = init_corpus(folder, out, self.fixed_markers(), self.upper.currentText(),
+                              self.lower.currentText(), label_map=label_map,
+                              marker_rate=self.rate.value(), test_fraction=self.test_fraction.value(),
+                              name=folder.name)
+        return path
+
+    def _accept(self) -> None:
+        try:
+            self.result_path = self.write_description()
+        except FacetrajError as exc:
+            QMessageBox.critical(self, "facetraj", str(exc))
+            return
+        self.accept()
+
+
+# ---------------------------------------------------------------------- exports
+def _confirm_overwrite(window, path: Path) -> bool:
+    if not path.exists():
+        return True
+    answer = QMessageBox.question(window, "facetraj", f"{path} exists. Replace it?")
+    return answer == QMessageBox.StandardButton.Yes
+
+
+def export_trajectories(window, path: Path, which: str = "synthesized") -> Path:
+    """Write the current utterance's ``synthesized`` or ``original`` markers (C3D, TSV or NPZ)."""
+    view, model = window.view, window.model
+    if view is None:
+        raise FacetrajError("no utterance is shown")
+    markers = view.shown if which == "synthesized" else view.original
+    if markers is None:
+        raise FacetrajError(f"{view.utterance.name} has no original markers")
+    suffix = path.suffix.lower()
+    if suffix == ".c3d":
+        write_c3d(path, markers, model.marker_rate, model.marker_names)
+    elif suffix in (".tsv", ".txt", ".csv"):
+        write_marker_tsv(path, markers, model.marker_rate, model.marker_names)
+    elif suffix == ".npz":
+        syn = view.synthesis
+        with atomic_write(path) as tmp, open(tmp, "wb") as fh:
+            np.savez_compressed(fh, times=view.times, markers=markers, pcs=syn.pcs, raw_pcs=syn.raw_pcs,
+                                gamma=syn.frames.gamma, marker_names=np.array(model.marker_names),
+                                config=np.array(json.dumps(syn.config.to_dict())), which=np.array(which))
+    else:
+        raise FacetrajError(f"{path}: unknown format (use .c3d, .tsv or .npz)")
+    return path
+
+
+def export_figure(window, path: Path) -> Path:
+    """Save the time-aligned panels as PNG, SVG or PDF (by the suffix)."""
+    suffix = path.suffix.lower().lstrip(".")
+    if suffix not in ("png", "svg", "pdf"):
+        raise FacetrajError(f"{path}: unknown figure format (use .png, .svg or .pdf)")
+    with atomic_write(path) as tmp:
+        window.timeline.figure.savefig(tmp, format=suffix, dpi=150, facecolor="white")
+    return path
+
+
+def export_video(window, path: Path) -> None:
+    """Render the current utterance to an MP4 in the background, with a progress bar."""
+    from .video import render_video
+
+    view, model = window.view, window.model
+    if view is None:
+        raise FacetrajError("no utterance is shown")
+    utt = view.utterance
+
+    def work(progress):
+        return render_video(model, view.synthesis, utt.audio, utt.sample_rate, path,
+                            original=view.original, overwrite=True, progress=progress,
+                            title=utt.text or utt.name)
+
+    window.run_in_background(work, lambda p: window.status_label.setText(f"wrote {p}"),
+                             f"rendering {path.name}")
+
+
+def install(window) -> None:
+    """Add import and export entries to the window's File menu."""
+    file_menu = window.menuBar().actions()[0].menu()
+    first = file_menu.actions()[2] if len(file_menu.actions()) > 2 else None
+
+    def guarded(fn):
+        def run(*_):
+            try:
+                fn()
+            except (FacetrajError, OSError) as exc:
+                window._report_error(exc if isinstance(exc, FacetrajError) else FacetrajError(str(exc)))
+        return run
+
+    def do_import():
+        dlg = ImportDialog(window)
+        if dlg.exec() == QDialog.DialogCode.Accepted and dlg.result_path:
+            window.open_corpus(dlg.result_path)
+
+    def ask_save(title: str, default: str, filters: str) -> Path | None:
+        path, _ = QFileDialog.getSaveFileName(window, title, default, filters)
+        if not path:
+            return None
+        p = Path(path)
+        return p if _confirm_overwrite(window, p) else None
+
+    def do_traj(which: str):
+        name = window.view.utterance.name if window.view else "trajectories"
+        p = ask_save(f"Export {which} trajectories", f"{name}_{which}.c3d",
+                     "C3D (*.c3d);;TSV (*.tsv);;NumPy (*.npz)")
+        if p:
+            export_trajectories(window, p, which)
+            window.status_label.setText(f"wrote {p}")
+
+    def do_figure():
+        p = ask_save("Export the panels as a figure", "panels.png", "PNG (*.png);;SVG (*.svg);;PDF (*.pdf)")
+        if p:
+            export_figure(window, p)
+            window.status_label.setText(f"wrote {p}")
+
+    def do_model():
+        if window.model is None:
+            raise FacetrajError("no model yet")
+        p = ask_save("Save the model", "model.npz", "facetraj model (*.npz)")
+        if p:
+            window.model.save(p)
+            window.status_label.setText(f"wrote {p}")
+
+    def do_video():
+        name = window.view.utterance.name if window.view else "facetraj"
+        p = ask_save("Export a video", f"{name}.mp4", "MP4 (*.mp4)")
+        if p:
+            export_video(window, p)
+
+    entries = [
+        ("&Import your own recordings…", do_import),
+        ("Export &synthesized trajectories…", lambda: do_traj("synthesized")),
+        ("Export &original trajectories…", lambda: do_traj("original")),
+        ("Export the panels as a &figure…", do_figure),
+        ("Save the &model…", do_model),
+        ("Export a &video…", do_video),
+    ]
+    window.own_data_actions = {}
+    for text, fn in entries:
+        action = QAction(text, window)
+        action.triggered.connect(guarded(fn))
+        if first is not None:
+            file_menu.insertAction(first, action)
+        else:
+            file_menu.addAction(action)
+        window.own_data_actions[text.replace("&", "").rstrip("…")] = action
+
+    def on_model():
+        model = window.model
+        plotter = window.face.plotter
+        plotter.remove_actor("facetraj-dimensions")
+        if model is not None and not model.neutral_face()[:, 0].any():
+            window.face.set_camera("profile")          # midsagittal data: shown as such
+            if "profile" in getattr(window, "camera_buttons", {}):
+                window.camera_buttons["profile"].setChecked(True)
+            plotter.add_text("midsagittal (2-D) data: profile view, y up, z forward",
+                             position="lower_left", font_size=9, color="black",
+                             name="facetraj-dimensions")
+
+    window.modelReady.connect(on_model)
