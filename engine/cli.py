@@ -270,6 +270,20 @@ def cmd_video(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_report(args: argparse.Namespace) -> int:
+    from .model import Model
+
+    try:
+        from app.report_figures import make_report
+    except ImportError as exc:
+        raise FacetrajError(f"the report's figures need matplotlib: {exc}") from exc
+    model = Model.load(args.model) if args.model else None
+    out = make_report(args.corpus, args.output, model=model, progress=TerminalProgress("report"),
+                      ns=range(1, args.max_n + 1))
+    print(out)
+    return 0
+
+
 def cmd_gui(args: argparse.Namespace) -> int:
     try:
         from app.main import run_app
@@ -370,6 +384,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--csv", action="store_true", help="the full K x K matrix as CSV")
     p.set_defaults(func=cmd_similarity)
 
+    p = sub.add_parser("report", help="results report: Tables 1-2, Figures 4-5, baselines")
+    p.add_argument("corpus", type=Path, nargs="?", default=None, help="corpus (default data_samples)")
+    p.add_argument("-o", "--output", type=Path, default=Path("docs"),
+                   help="folder of results.md, results.json and figures/ (default docs)")
+    p.add_argument("--model", type=Path, help="a trained model (default: train on the corpus)")
+    p.add_argument("--max-n", type=int, default=10, help="the N sweep runs 1..MAX_N")
+    p.set_defaults(func=cmd_report)
+
     p = sub.add_parser("video", help="an MP4 of the face points and lip panels with the sound")
     p.add_argument("model", type=Path)
     p.add_argument("audio", type=Path, nargs="?", help="WAV or FLAC (or use --corpus)")
@@ -419,7 +441,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command is None:
         args.corpus = default_corpus()
         args.func = cmd_gui
-    elif args.command == "gui" and args.corpus is None:
+    elif args.command in ("gui", "report") and args.corpus is None:
         args.corpus = default_corpus()
     try:
         return args.func(args)

@@ -76,3 +76,11 @@ def test_bad_input_exit_2(args, message, model_file, toy_corpus_dir, tmp_path, c
     assert code == 2
     assert message in err and "Traceback" not in err
     assert (tmp_path / "exists.c3d").read_text() == "keep me"
+
+
+def test_report_command(model_file, toy_corpus_dir, tmp_path):
+    assert main(["-q", "report", str(toy_corpus_dir), "-o", str(tmp_path), "--model", str(model_file),
+                 "--max-n", "2"]) == 0
+    text = (tmp_path / "results.md").read_text()
+    assert "Table 1" in text and "Table 2" in text
+    assert (tmp_path / "results.json").exists()
