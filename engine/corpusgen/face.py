@@ -7,7 +7,8 @@ talker's right side (x < 0) and ``_L`` for the talker's left side (x > 0).
 The rig (all displacements from the rest face):
 
 * jaw: rotation about the condyle axis (the line through both condyles, parallel to x) by the
-  VTL jaw angle ``JA`` (relative to the rest posture), plus the small forward shift ``JX``. Chin,
+  VTL jaw angle ``JA`` (relative to the rest posture, times ``jaw_gain``), with a small forward
+  glide of the condyles as the jaw opens, plus VTL's forward shift ``JX``. Chin,
   jaw line and labiomental markers move rigidly with it, the cheeks in part (weights by height);
 * upper lip: the VTL EMA point ``UL`` (vertical and forward motion);
 * lower lip: its centre sits ``LD`` (VTL's lip distance) below the upper lip; it is the jaw-carried
@@ -97,7 +98,8 @@ class FaceConfig:
     rate: float = 60.0
     condyle_y: float = 22.0          # condyle axis height (mm, relative to the lips at rest)
     condyle_z: float = -85.0         # and depth
-    jaw_gain: float = 1.8            # face jaw degrees per VTL JA degree
+    jaw_gain: float = 2.0            # face jaw degrees per VTL JA degree (JD3 moves little)
+    condyle_glide: float = 0.3       # forward glide of the jaw (mm) per face jaw degree
     jx_gain: float = 10.0            # mm per cm of JX
     lip_gain: float = 10.0           # mm per cm of UL motion, LD and LP
     protrusion_gain: float = 0.5     # share of VTL's lip protrusion shown on the outer lips
@@ -214,7 +216,7 @@ def articulate(d: Drivers, cfg: FaceConfig) -> np.ndarray:
 
     # jaw rotation about the condyle axis (opening = JA more negative than at rest)
     theta = np.deg2rad(cfg.jaw_gain * (cfg.rest_ja - d.ja))
-    jx = cfg.jx_gain * (d.jx - cfg.rest_jx)
+    jx = cfg.jx_gain * (d.jx - cfg.rest_jx) + cfg.condyle_glide * np.rad2deg(theta)
 
     def jaw_disp(i: int) -> np.ndarray:
         dy0, dz0 = r[i, 1] - cfg.condyle_y, r[i, 2] - cfg.condyle_z
