@@ -730,6 +730,7 @@ class MainWindow(QMainWindow):
     def save_screenshot(self, path: Path) -> Path:
         """Render the whole window (with the 3-D view) to a PNG."""
         self.face.rerender()
+        self.timeline.canvas.draw()
         pix = self.grab()
         img = self.plotter.screenshot(return_img=True)
         if img is not None and img.size:

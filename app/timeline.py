@@ -194,9 +194,11 @@ class Timeline(QWidget):
         self._spans: list = []
         self._bg = None
         self._cursor_x: float | None = None
+        self._bg_bounds: tuple[float, ...] = ()
         self._press: tuple[float, float, int] | None = None   # (xdata, xpixel, button)
         self._drag_span: tuple[float, float] | None = None
         self.canvas.mpl_connect("draw_event", self._on_draw)
+        self.canvas.mpl_connect("resize_event", self._on_resize)
         self.canvas.mpl_connect("button_press_event", self._on_press)
         self.canvas.mpl_connect("motion_notify_event", self._on_motion)
         self.canvas.mpl_connect("button_release_event", self._on_release)
@@ -272,9 +274,13 @@ class Timeline(QWidget):
     # ------------------------------------------------------------------ cursor (blitting)
     def _on_draw(self, event) -> None:
         self._bg = self.canvas.copy_from_bbox(self.figure.bbox)
+        self._bg_bounds = tuple(self.figure.bbox.bounds)
         self._cursor_x = self._cursor_px(self.cursor_time) if self.axes else None
         for ax, cur in zip(self.axes, self._cursors, strict=True):
             ax.draw_artist(cur)
+
+    def _on_resize(self, event) -> None:
+        self._bg = None
 
     def set_cursor(self, t: float, follow: bool = False) -> None:
         """Move the cursor to ``t`` seconds by blitting; with ``follow`` the visible range pages
@@ -293,8 +299,9 @@ class Timeline(QWidget):
         x_new = self._cursor_px(t)
         for cur in self._cursors:
             cur.set_xdata([t, t])
-        if self._bg is None:
-            self.canvas.draw_idle()
+        if self._bg is None or getattr(self.canvas, "_draw_pending", False) \
+                or tuple(self.figure.bbox.bounds) != self._bg_bounds:
+            self.canvas.draw_idle()     # a full draw is due anyway (layout, resize, zoom)
             return
         # restore and repaint only the strip between the old and the new cursor position
         fig_box = self.figure.bbox

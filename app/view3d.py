@@ -28,7 +28,7 @@ CAMERA_PRESETS: dict[str, tuple[tuple[float, float, float], tuple[float, float, 
     # direction from the face to the camera (x to the talker's left, y up, z forward), view up
     "front": ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0)),
     "profile": ((-1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
-    "three-quarter": ((-0.75, 0.18, 1.0), (0.0, 1.0, 0.0)),
+    "three-quarter": ((-0.6, 0.12, 1.0), (0.0, 1.0, 0.0)),
 }
 
 
@@ -42,14 +42,12 @@ def lip_contours(neutral: np.ndarray, upper: int, lower: int, corners: list[int]
     y_c = float(neutral[corners, 1].mean())
     lines = []
     for centre, sign in ((upper, 1.0), (lower, -1.0)):
-        yc = float(neutral[centre, 1])
-        reach = abs(yc - y_c) * 1.5 + 1e-6
+        height = abs(float(neutral[centre, 1]) - y_c) + 1e-6
         picked = []
         for i, (x, y, _z) in enumerate(neutral):
-            if i in corners or not x_lo < x < x_hi:
+            if i in corners or not x_lo + 1.0 < x < x_hi - 1.0:
                 continue
-            dy = (y - y_c) * sign
-            if -0.25 * reach <= dy <= reach and abs(y - yc) <= 0.5 * abs(yc - y_c) + 1e-6:
+            if 0.15 * height <= (y - y_c) * sign <= 1.5 * height:
                 picked.append(i)
         if centre not in picked:
             picked.append(centre)
@@ -58,17 +56,14 @@ def lip_contours(neutral: np.ndarray, upper: int, lower: int, corners: list[int]
     return lines
 
 
-def face_triangles(neutral: np.ndarray, contours: list[list[int]]) -> np.ndarray:
+def face_triangles(neutral: np.ndarray, contours: list[list[int]], max_edge: float = 2.6) -> np.ndarray:
     """Triangles ``(n, 3)`` of a face surface: 2-D Delaunay on the neutral x-y, without the mouth
-    opening and without long edges across the face's outline. Midsagittal (2-D) data, or fewer
-    than four markers spanning the x-y plane, has no surface: no triangles."""
-    if len(neutral) < 4 or np.ptp(neutral[:, 0]) == 0 or np.ptp(neutral[:, 1]) == 0:
-        return np.zeros((0, 3), dtype=int)
+    opening and without triangles with a 3-D edge longer than ``max_edge`` times the median edge
+    (those bridge across the face's outline or reach back along the jaw)."""
     tri = Delaunay(neutral[:, :2]).simplices
-    edges = np.concatenate([neutral[tri[:, a], :2] - neutral[tri[:, b], :2]
-                            for a, b in ((0, 1), (1, 2), (2, 0))])
-    lengths = np.linalg.norm(edges, axis=1).reshape(3, -1).T
-    keep = lengths.max(axis=1) <= 2.5 * np.median(lengths)
+    edges = np.stack([np.linalg.norm(neutral[tri[:, a]] - neutral[tri[:, b]], axis=1)
+                      for a, b in ((0, 1), (1, 2), (2, 0))], axis=1)
+    keep = edges.max(axis=1) <= max_edge * np.median(edges)
     if len(contours) == 2:
         up, lo = set(contours[0]), set(contours[1])
         lips = up | lo
@@ -106,7 +101,7 @@ class MarkerSet:
         self.points = pv.PolyData(neutral.copy())
         self.points.verts = np.column_stack([np.ones(len(neutral), int), np.arange(len(neutral))]).ravel()
         self.actor = plotter.add_mesh(self.points, color=color, render_points_as_spheres=True,
-                                      point_size=13, style="points", name=f"{name}-points",
+                                      point_size=11, style="points", name=f"{name}-points",
                                       reset_camera=False, lighting=True, pickable=False)
         self.lines = pv.PolyData()
         self.lines.SetPoints(self.points.GetPoints())
@@ -124,7 +119,7 @@ class MarkerSet:
             self.surface_actor = plotter.add_mesh(self.surface, color=SURFACE_COLOR, opacity=1.0,
                                                   smooth_shading=False, name=f"{name}-surface",
                                                   reset_camera=False, pickable=False,
-                                                  specular=0.05, ambient=0.3, diffuse=0.7)
+                                                  specular=0.0, ambient=0.45, diffuse=0.6)
             mapper = self.surface_actor.GetMapper()
             mapper.SetResolveCoincidentTopologyToPolygonOffset()
             mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(2.0, 2000.0)
@@ -252,7 +247,7 @@ class FaceView(QWidget):
         self.plotter.camera_position = [tuple(centre + 400 * d), tuple(centre), up]
         lo, hi = allp.min(axis=0) - 5, allp.max(axis=0) + 5
         self.plotter.renderer.ResetCamera(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
-        self.plotter.camera.zoom(1.15)
+        self.plotter.camera.zoom(1.45)
         if render:
             self.plotter.render()
 
