@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -128,6 +129,38 @@ def test_click_on_lip_panel_seeks(window, qtbot):
     assert win.displayed_frame == k + 1
     qtbot.keyClick(win, Qt.Key.Key_Home)
     assert win.displayed_frame == 0
+
+
+def test_drag_selects_a_loop_and_playback_wraps_in_it(window, qtbot):
+    win = window
+    lower = next(p for p in win.timeline.panels if getattr(p, "title", "") == "lower lip y")
+    ax = win.timeline.axes_of(lower)
+    dur = win.view.duration
+    a, b = 0.3 * dur, 0.45 * dur
+    canvas = win.timeline.canvas
+    qtbot.mousePress(canvas, Qt.MouseButton.LeftButton, pos=_canvas_point(win, ax, a))
+    qtbot.mouseMove(canvas, pos=_canvas_point(win, ax, (a + b) / 2))
+    qtbot.mouseMove(canvas, pos=_canvas_point(win, ax, b))
+    qtbot.mouseRelease(canvas, Qt.MouseButton.LeftButton, pos=_canvas_point(win, ax, b))
+    assert win.loop_box.isChecked()
+    assert win.clock.loop == pytest.approx((a, b), abs=0.02)
+    times: list[float] = []
+    win.cursorMoved.connect(times.append)
+    win.play()
+    qtbot.waitUntil(lambda: any(t1 < t0 for t0, t1 in pairwise(times)),
+                    timeout=10_000)
+    win.pause()
+    lo, hi = win.clock.loop
+    assert all(lo - 0.05 <= t <= hi + 0.05 for t in times)
+
+
+def test_marker_name_on_hover(window):
+    win = window
+    face = win.face
+    k = win.model.upper_lip
+    x, y = face._project(face.synth.current)[k]
+    label = face.marker_at(x, y)
+    assert label is not None and label.startswith(win.model.marker_names[k])
 
 
 def test_changing_utterance_updates_every_view(window, qtbot):
