@@ -23,7 +23,17 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from . import scaling, synth, train
-from .common import REPO, BenchContext, BenchRow, format_table, load_context, machine_info, markdown_table
+from .common import (
+    REPO,
+    BenchContext,
+    BenchRow,
+    concatenate_input,
+    format_table,
+    load_context,
+    machine_info,
+    markdown_table,
+    profile_top,
+)
 
 log = logging.getLogger("benchmarks")
 
@@ -78,8 +88,26 @@ def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS, factors: Sequence[i
     return rows
 
 
+def profiles(ctx: BenchContext) -> dict[str, list[tuple[str, float, float]]]:
+    """Where synthesis spends its time: cProfile of 10 s phonetic and 2 s acoustic-only input."""
+    from engine.config import SynthConfig
+    from engine.model import synthesize
+
+    source = ctx.test_utts or ctx.train_utts
+    model = ctx.model
+    out = {}
+    for mode, seconds in (("phonetic", 10.0), ("acoustic", 2.0)):
+        audio, rate, phones = concatenate_input(source, seconds)
+        labels = phones if mode == "phonetic" else None
+        out[f"{mode}, {seconds:g} s input"] = profile_top(
+            lambda audio=audio, rate=rate, labels=labels, mode=mode: synthesize(
+                model, audio, rate, labels, SynthConfig(mode=mode)))
+    return out
+
+
 def write_markdown(path: Path, rows: Sequence[BenchRow], ctx: BenchContext, elapsed_s: float,
-                   info: dict[str, str] | None = None) -> Path:
+                   info: dict[str, str] | None = None,
+                   prof: dict[str, list[tuple[str, float, float]]] | None = None) -> Path:
     """``docs/benchmarks.md``: the machine, the corpus, the table, and how to read it."""
     info = info or machine_info()
     size = (f"{len(ctx.train_utts)} training utterances ({ctx.train_audio_s / 60:.1f} min of speech), "
@@ -100,8 +128,20 @@ def write_markdown(path: Path, rows: Sequence[BenchRow], ctx: BenchContext, elap
         "",
         markdown_table(rows),
         "",
+        "## Aims",
+        "",
+        *([f"- {r.name}: {r.cell()} {r.unit} (aim {r.aim}): **{r.verdict()}**"
+           for r in rows if r.ok is not None] or ["- not judged (smoke size)"]),
+        "",
+        *(["## Where synthesis spends its time (cProfile, own time)", ""] if prof else []),
+        *[line for name, top in (prof or {}).items() for line in (
+            f"{name}:", "", "| function | s | share |", "|---|---:|---:|",
+            *[f"| `{f}` | {t:.3f} | {100 * sh:.0f} % |" for f, t, sh in top], "")],
         "## How to read it",
         "",
+        "- `value (CPU time)` is the same figure computed from this process's CPU time: on a shared "
+        "machine wall time includes waiting for a core (it is the one judged against the aims); "
+        "multi-threaded BLAS can make CPU time exceed wall time.",
         "- `x RT` is the real-time factor, input duration / wall time (200 = 200 times faster than "
         "real time). Every synthesis call includes the LSF analysis of the input, eqs 4-8, "
         "smoothing and the rebuild of the markers from the PCs.",
@@ -138,10 +178,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     info = machine_info()
     ctx = load_context(args.corpus, args.smoke)
     rows = run_all(ctx, args.only, args.factors, args.prefilters)
+    prof = profiles(ctx) if "synth" in args.only else None
     print(format_table(rows))
     out = args.out if args.out is not None else (None if args.smoke else DEFAULT_OUT)
     if out is not None:
-        write_markdown(out, rows, ctx, time.perf_counter() - t0, info)
+        write_markdown(out, rows, ctx, time.perf_counter() - t0, info, prof)
         print(f"written {out}")
     return 0
 

@@ -183,6 +183,28 @@ def best_time(fn: Callable[[], object], repeat: int = 3, min_total_s: float = 0.
     return best
 
 
+def profile_top(fn: Callable[[], object], n: int = 6) -> list[tuple[str, float, float]]:
+    """cProfile ``fn``: the ``n`` functions with the most own time, as ``(name, seconds, share)``."""
+    import cProfile
+    import pstats
+
+    prof = cProfile.Profile()
+    prof.enable()
+    fn()
+    prof.disable()
+    stats = pstats.Stats(prof).stats  # type: ignore[attr-defined]
+    total = sum(v[2] for v in stats.values()) or 1.0
+    top = sorted(stats.items(), key=lambda kv: -kv[1][2])[:n]
+    out = []
+    for (path, line, func), v in top:
+        if path == "~":  # a builtin: "<built-in method numpy...c_einsum>" -> "c_einsum (numpy C)"
+            name = func.strip("<>").split()[-1].split(".")[-1].strip("'") + " (C)"
+        else:
+            name = f"{Path(path).parent.name}/{Path(path).name}:{line}({func})"
+        out.append((name, float(v[2]), float(v[2] / total)))
+    return out
+
+
 # ---------------------------------------------------------------------- the context
 @dataclass
 class BenchContext:
