@@ -8,6 +8,7 @@ import logging
 import math
 import os
 import platform
+import re
 import resource
 import sys
 import tempfile
@@ -198,7 +199,8 @@ def profile_top(fn: Callable[[], object], n: int = 6) -> list[tuple[str, float, 
     out = []
     for (path, line, func), v in top:
         if path == "~":  # a builtin: "<built-in method numpy...c_einsum>" -> "c_einsum (numpy C)"
-            name = func.strip("<>").split()[-1].split(".")[-1].strip("'") + " (C)"
+            quoted = re.search(r"'([^']+)'", func)
+            name = (quoted.group(1) if quoted else func.strip("<>").split()[-1].split(".")[-1]) + " (C)"
         else:
             name = f"{Path(path).parent.name}/{Path(path).name}:{line}({func})"
         out.append((name, float(v[2]), float(v[2] / total)))
