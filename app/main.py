@@ -24,9 +24,10 @@ def _ensure_display() -> subprocess.Popen | None:
         log.warning("no display and no Xvfb: the 3-D view needs an X display")
         return None
     read, write = os.pipe()
+    # -terminate: the server exits by itself when its last client (this process) disconnects
     proc = subprocess.Popen([xvfb, "-displayfd", str(write), "-screen", "0", "1600x1200x24", "-nolisten",
-                             "tcp"], pass_fds=(write,), stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+                             "tcp", "-terminate"], pass_fds=(write,), stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, start_new_session=True)
     os.close(write)
     with os.fdopen(read) as fh:
         number = fh.readline().strip()
@@ -90,6 +91,5 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
         rc = app.exec()
     finally:
         window.close()
-        if xvfb is not None:
-            xvfb.terminate()
+    del xvfb   # it ends when this process disconnects
     return status["code"] or rc

@@ -128,6 +128,7 @@ class MainWindow(QMainWindow):
         self._latency = 0.0          # running estimate of one frame update (s)
         self.stats: list[tuple[float, int, float, float]] | None = None   # benchmark hook
         self.displayed_frame = -1
+        self._closing = False
         self._frame_pending: tuple[float, int] | None = None   # (tick time, frame) until flushed
         self.clock = PlaybackClock(self, use_audio=use_audio)
         self.clock.playingChanged.connect(self._on_playing_changed)
@@ -356,6 +357,8 @@ class MainWindow(QMainWindow):
                           on_partial: Callable[[Any], None] | None = None) -> Task:
         """Run ``fn(progress)`` in a worker thread; ``on_done(result)`` on the GUI thread."""
         task = Task(fn, progress_label, self)
+        if self._closing:            # never start work once the window is closing
+            return task
         task.progress.connect(lambda f, m: self._on_task_progress(task, f, m))
         task.succeeded.connect(lambda r: self._safe(on_done, r))
         task.failed.connect(lambda e: self._safe(on_error, e) if on_error else self._report_error(e))
@@ -804,6 +807,7 @@ class MainWindow(QMainWindow):
         return any(t is not self._corr_task for t in self._tasks)
 
     def closeEvent(self, event) -> None:
+        self._closing = True
         self._timer.stop()
         self.clock.close()
         for task in list(self._tasks):
