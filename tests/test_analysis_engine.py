@@ -174,3 +174,15 @@ def test_pc_modes(toy_model):
     assert s.axis == "vertical"                               # the toy jaw moves vertically
     assert s.markers[0][0] in {"CHIN", "LL_C"}
     assert "PC1" in s.text()
+
+
+def test_inspect_frame_acoustic_only(toy_model, toy_corpus):
+    from engine.config import SynthConfig
+
+    utt = toy_corpus.utterance(toy_corpus.info.test[0])
+    res = synthesize(toy_model, utt.audio, utt.sample_rate, None, SynthConfig(mode="acoustic"),
+                     n_frames=utt.n_frames)
+    ins = inspect_frame(toy_model, res, 30, top=10)
+    assert ins.phone == "" and ins.chosen == [] and len(ins.codewords) == 10
+    assert sum(res.frames.weights[30]) == pytest.approx(1.0)
+    assert ins.lsf_hz == pytest.approx(ins.lsf * toy_model.config.audio_rate / (2 * np.pi))
