@@ -272,3 +272,14 @@ def test_corrupt_file_shows_error_and_app_keeps_working(window, qtbot, tmp_path,
     win.action_open_corpus.trigger()
     assert len(shown) == 2 and "corpus.json" in shown[1]
     assert win.corpus.root.resolve() == default_corpus().resolve()
+    # a good audio file without labels: acoustic-only synthesis, no original markers
+    from engine.corpus import audio_path
+
+    good = audio_path(win.corpus.root, win.corpus.info.test[-1])
+    answers = iter([(str(good), ""), ("", "")])
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        win.action_open_audio.trigger()
+    assert len(shown) == 2
+    assert win.view.split == "external" and win.view.original is None
+    assert win.view.synthesis.config.mode == "acoustic"
+    assert win.browser.tree.currentItem() is win.browser.items[win.view.utterance.name]
