@@ -154,13 +154,16 @@ def test_drag_selects_a_loop_and_playback_wraps_in_it(window, qtbot):
     assert all(lo - 0.05 <= t <= hi + 0.05 for t in times)
 
 
-def test_marker_name_on_hover(window):
+def test_marker_name_on_hover(window, qtbot):
     win = window
     face = win.face
     k = win.model.upper_lip
-    x, y = face._project(face.synth.current)[k]
-    label = face.marker_at(x, y)
-    assert label is not None and label.startswith(win.model.marker_names[k])
+    x, y = face._project(face.synth.current)[k]          # VTK display pixels, origin bottom left
+    widget = face.plotter
+    dpr = widget.devicePixelRatioF()
+    qtbot.mouseMove(widget, pos=QPoint(int(x / dpr), int(widget.height() - y / dpr)))
+    qtbot.waitUntil(lambda: bool(face._hover_name), timeout=5000)
+    assert face._hover_name.startswith(win.model.marker_names[k])
 
 
 def test_changing_utterance_updates_every_view(window, qtbot):
