@@ -102,7 +102,8 @@ class MarkerSet:
         self.points.verts = np.column_stack([np.ones(len(neutral), int), np.arange(len(neutral))]).ravel()
         self.actor = plotter.add_mesh(self.points, color=color, render_points_as_spheres=True,
                                       point_size=11, style="points", name=f"{name}-points",
-                                      reset_camera=False, lighting=True, pickable=False)
+                                      reset_camera=False, lighting=True, pickable=False,
+                                      ambient=0.3, diffuse=0.8)
         self.lines = pv.PolyData()
         self.lines.SetPoints(self.points.GetPoints())
         self.lines.lines = np.concatenate([[len(c), *c] for c in contours])
@@ -113,13 +114,21 @@ class MarkerSet:
             self.surface = pv.PolyData()
             self.surface.SetPoints(self.points.GetPoints())
             self.surface.faces = np.column_stack([np.full(len(triangles), 3), triangles]).ravel()
+            # normals of the neutral face, kept (the face moves little): smooth, cheap shading
+            shape = pv.PolyData(neutral, faces=self.surface.faces).compute_normals(
+                cell_normals=False, auto_orient_normals=True, consistent_normals=True)
+            normals = np.asarray(shape.point_data["Normals"])
+            if normals[:, 2].mean() < 0:       # z is forward: normals face the viewer
+                normals = -normals
+            self.surface.point_data.active_normals = normals
             # opaque (a translucent surface costs an order-independent transparency pass, several
             # times the whole frame on a software renderer), pushed back in depth so the markers
             # on it stay whole
             self.surface_actor = plotter.add_mesh(self.surface, color=SURFACE_COLOR, opacity=1.0,
                                                   smooth_shading=False, name=f"{name}-surface",
                                                   reset_camera=False, pickable=False,
-                                                  specular=0.0, ambient=0.45, diffuse=0.6)
+                                                  specular=0.1, ambient=0.3, diffuse=0.75)
+            self.surface_actor.GetProperty().SetInterpolationToGouraud()
             mapper = self.surface_actor.GetMapper()
             mapper.SetResolveCoincidentTopologyToPolygonOffset()
             mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(2.0, 2000.0)
@@ -168,6 +177,12 @@ class FaceView(QWidget):
         """Build the scene for ``model``'s marker set."""
         self.model = model
         self.plotter.clear()
+        # one light that follows the camera plus a key light from above: shading that shows
+        # the face's shape at little cost (each light is per-fragment work on a software renderer)
+        self.plotter.remove_all_lights()
+        self.plotter.add_light(pv.Light(light_type="headlight", intensity=0.75))
+        self.plotter.add_light(pv.Light(position=(0.4, 1.0, 0.6), light_type="camera light",
+                                        intensity=0.35))
         neutral = model.neutral_face()
         self.neutral = neutral
         self.contours = lip_contours(neutral, model.upper_lip, model.lower_lip, list(model.lip_corners))

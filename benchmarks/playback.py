@@ -145,13 +145,15 @@ def main(argv: Sequence[str] | None = None) -> list:
     p.add_argument("--speed", type=float, default=1.0, choices=[0.25, 0.5, 1.0])
     p.add_argument("--during-correlations", action="store_true",
                    help="measure while the browser's lip correlations are still computed")
+    p.add_argument("--size", default="1600x1000", help="window size WxH (default 1600x1000)")
     p.add_argument("--smoke", action="store_true", help="a tiny run (1.5 s of playback)")
     p.add_argument("--json", type=Path, help="also write the statistics as JSON")
     args = p.parse_args(list(argv) if argv is not None else None)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s: %(message)s")
     seconds = 1.5 if args.smoke else args.seconds
     result = measure(args.corpus or default_corpus(), seconds, args.utterance,
-                     during_correlations=args.during_correlations or args.smoke, speed=args.speed)
+                     during_correlations=args.during_correlations or args.smoke, speed=args.speed,
+                     size=tuple(int(v) for v in args.size.lower().split("x")))
     print(format_result(result))
     if args.json:
         args.json.write_text(json.dumps(result, indent=2) + "\n")
