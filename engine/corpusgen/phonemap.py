@@ -27,7 +27,7 @@ VOWELS: frozenset[str] = frozenset(
 PHONE_MAP: dict[str, tuple[tuple[str, float], ...]] = {
     # monophthongs
     "aa": (("a", 1.0),),            # father, lot: open /a/
-    "ae": (("E:", 1.0),),           # cat: the most open front vowel of JD3
+    "ae": (("E:", 1.0),),           # cat: long open-mid front (JD3 has no [æ])
     "ah": (("6", 1.0),),            # strut (stressed): near-open central (VTL's 6_low)
     "ao": (("O", 1.0),),            # thought: open-mid back rounded
     "eh": (("E", 1.0),),            # dress
