@@ -646,7 +646,8 @@ class MainWindow(QMainWindow):
             self._show_time(t, force=True)
             return
         # aim at the clock time when this update reaches the screen
-        target = min(t + self._latency * self.clock.speed, self.clock.duration)
+        end = self.clock.loop[1] if (self.clock.looping and self.clock.loop) else self.clock.duration
+        target = min(t + self._latency * self.clock.speed, end)
         k = int(np.clip(round(target * self.view.rate), 0, self.view.n_frames - 1))
         if k == self.displayed_frame or self._frame_pending is not None:
             return

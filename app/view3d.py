@@ -1,8 +1,8 @@
 """The 3-D view: original and synthesized face markers, lip contours and an optional face surface.
 
 The two marker sets share one scene, overlaid or side by side. Each set is one ``vtkPoints``
-shared by its markers, its lip contour lines and (for the synthesized set) the face surface, so a
-frame update is one copy into two arrays and one render. Hovering a marker shows its name.
+shared by its markers and its lip contour lines (the synthesized set's face surface follows a few
+mm beneath), so a frame update is a few small array copies and one render. Hovering a marker shows its name.
 """
 
 from __future__ import annotations
@@ -23,6 +23,8 @@ from .state import UtteranceView
 from .style import BACKGROUND, ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
 
 log = logging.getLogger(__name__)
+
+SURFACE_INSET_MM = 4.0
 
 CAMERA_PRESETS: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] = {
     # direction from the face to the camera (x to the talker's left, y up, z forward), view up
@@ -110,28 +112,27 @@ class MarkerSet:
         self.line_actor = plotter.add_mesh(self.lines, color=color, line_width=3, name=f"{name}-lips",
                                            reset_camera=False, pickable=False)
         self.surface_actor = None
+        self._inset: np.ndarray | None = None
         if triangles is not None and len(triangles):
-            self.surface = pv.PolyData()
-            self.surface.SetPoints(self.points.GetPoints())
-            self.surface.faces = np.column_stack([np.full(len(triangles), 3), triangles]).ravel()
+            faces = np.column_stack([np.full(len(triangles), 3), triangles]).ravel()
             # normals of the neutral face, kept (the face moves little): smooth, cheap shading
-            shape = pv.PolyData(neutral, faces=self.surface.faces).compute_normals(
+            shape = pv.PolyData(neutral, faces=faces).compute_normals(
                 cell_normals=False, auto_orient_normals=True, consistent_normals=True)
             normals = np.asarray(shape.point_data["Normals"])
             if normals[:, 2].mean() < 0:       # z is forward: normals face the viewer
                 normals = -normals
+            # the surface lies SURFACE_INSET_MM under the markers, so that it hides neither its
+            # own markers nor original markers a little behind them; opaque, because a
+            # translucent surface costs an order-independent transparency pass (several times
+            # the whole frame on a software renderer)
+            self._inset = SURFACE_INSET_MM * normals
+            self.surface = pv.PolyData(neutral - self._inset, faces=faces)
             self.surface.point_data.active_normals = normals
-            # opaque (a translucent surface costs an order-independent transparency pass, several
-            # times the whole frame on a software renderer), pushed back in depth so the markers
-            # on it stay whole
             self.surface_actor = plotter.add_mesh(self.surface, color=SURFACE_COLOR, opacity=1.0,
                                                   smooth_shading=False, name=f"{name}-surface",
                                                   reset_camera=False, pickable=False,
                                                   specular=0.1, ambient=0.3, diffuse=0.75)
             self.surface_actor.GetProperty().SetInterpolationToGouraud()
-            mapper = self.surface_actor.GetMapper()
-            mapper.SetResolveCoincidentTopologyToPolygonOffset()
-            mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(2.0, 2000.0)
         self.current = neutral.copy()
 
     def set_points(self, pts: np.ndarray) -> None:
@@ -139,6 +140,9 @@ class MarkerSet:
         arr = self.points.points
         arr[:] = pts
         self.points.GetPoints().Modified()
+        if self._inset is not None:
+            self.surface.points[:] = pts - self._inset
+            self.surface.GetPoints().Modified()
 
     def set_visible(self, visible: bool, surface: bool) -> None:
         self.actor.SetVisibility(visible)
