@@ -108,7 +108,7 @@ class UtteranceBrowser(QWidget):
             return
         self.tree.blockSignals(True)
         self.tree.setCurrentItem(item)
-        self.tree.scrollToItem(item)
+        self.tree.scrollToItem(item, QTreeWidget.ScrollHint.PositionAtCenter)
         self.tree.blockSignals(False)
 
     def set_scores(self, utt_id: str, lower: float, upper: float) -> None:

@@ -435,7 +435,7 @@ class MainWindow(QMainWindow):
         self.face.set_model(model)
         self.settings.set_limits(model.config.context, model.config.nu)
         info = corpus.info
-        self.browser.populate({"train": list(info.train), "test": list(info.test)}, texts)
+        self.browser.populate({"test": list(info.test), "train": list(info.train)}, texts)
         self.status_label.setText(f"{corpus.root}: {len(info.train)} training and {len(info.test)} test "
                                   f"utterances, {model.n_markers} markers, {model.pca.n_components} PCs")
         self.modelReady.emit()
