@@ -329,8 +329,8 @@ def test_installed_in_main_window(qtbot, corpus_dir, model):
     titles = [p.title for p in win.timeline.panels]
     assert "lip aperture" in titles and "lip error" in titles
     assert any(t.startswith("tangential velocity") for t in titles)
-    for key in PANELS:
-        views.panel_actions[key].setChecked(True)
+    views.show_panels(list(PANELS))
+    assert all(views.panel_actions[k].isChecked() for k in PANELS)
     assert len(win.timeline.axes) == len(win.timeline.panels)
     # the inspector follows the cursor
     ins = views.widgets["inspector"]

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -43,12 +44,17 @@ class Canvas(FigureCanvasQTAgg):
         return path
 
 
+@lru_cache(maxsize=16)
+def _cmap(name: str):
+    return colormaps[name]          # a copy per lookup: cache it (initialising one is slow)
+
+
 def heat_color(value: float, lo: float = 0.0, hi: float = 1.0, cmap: str = "YlOrRd") -> QColor:
     """A background colour for ``value`` on ``[lo, hi]`` (NaN: light grey)."""
     if not np.isfinite(value):
         return QColor("#eeeeee")
     x = 0.0 if hi <= lo else float(np.clip((value - lo) / (hi - lo), 0, 1))
-    r, g, b, _ = colormaps[cmap](x)
+    r, g, b, _ = _cmap(cmap)(x)
     return QColor.fromRgbF(r, g, b)
 
 

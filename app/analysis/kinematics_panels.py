@@ -14,6 +14,7 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
+import numpy as np
 from PyQt6.QtCore import pyqtSignal
 from PyQt6.QtWidgets import (
     QComboBox,
@@ -264,17 +265,24 @@ class VelocityPanel:
             ax.plot(m.times, m.v_original, color=ORIGINAL_COLOR, lw=1.2, ls=(0, (2, 1.5)),
                     label="original")
             sets.insert(0, (m.original, ORIGINAL_COLOR, 0.92))
+        xt = ax.get_xaxis_transform()
         for gestures, color, y in sets:
+            if not gestures:
+                continue
+            # one artist per landmark kind and per line kind (NaN separates the gestures)
+            spans = [x for g in gestures for x in (g.onset, g.offset, np.nan)]
+            ax.plot(spans, [y if np.isfinite(x) else np.nan for x in spans], color=color, lw=0.8,
+                    alpha=0.7, transform=xt, clip_on=True)
+            for k in LANDMARKS:
+                times = [getattr(g, k) for g in gestures]
+                ax.plot(times, [y] * len(times), LANDMARK_MARKERS[k], color=color, ms=4.5, transform=xt,
+                        clip_on=True, mfc=color if k in ("pvel", "pvel2", "maxc") else "none", ls="none")
+            lx, ly = [], []
             for g in gestures:
-                ax.plot([g.onset, g.offset], [y, y], color=color, lw=0.8, alpha=0.7,
-                        transform=ax.get_xaxis_transform(), clip_on=True)
-                for k, t in g.times().items():
-                    ax.plot([t], [y], LANDMARK_MARKERS[k], color=color, ms=4.5,
-                            transform=ax.get_xaxis_transform(), clip_on=True,
-                            mfc=color if k in ("pvel", "pvel2", "maxc") else "none")
                 on, off = m.levels(g)
-                ax.plot([g.onset, g.pvel], [on, on], color=color, lw=0.6, alpha=0.6)
-                ax.plot([g.pvel2, g.offset], [off, off], color=color, lw=0.6, alpha=0.6)
+                lx += [g.onset, g.pvel, np.nan, g.pvel2, g.offset, np.nan]
+                ly += [on, on, np.nan, off, off, np.nan]
+            ax.plot(lx, ly, color=color, lw=0.6, alpha=0.6)
         ax.set_ylabel(f"{self.controls.model.marker_names[m.marker]}\nspeed (mm/s)", fontsize=8)
         ax.set_ylim(bottom=0)
         ax.legend(loc="upper right", fontsize=7, ncol=2, framealpha=0.8)
