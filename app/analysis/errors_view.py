@@ -139,23 +139,26 @@ class ErrorView(QWidget):
     # ------------------------------------------------------------------ display
     def set_report(self, report: ErrorReport) -> None:
         self.report = report
-        rms_max = max((p.rms for p in report.phones), default=1.0)
+        finite = [p.rms for p in report.phones if p.rms == p.rms]
+        rms_lo, rms_max = (min(finite), max(finite)) if finite else (0.0, 1.0)
         rows = [[text_item(p.phone), heat_item(p.correlation, 0.0, 1.0, "{:.3f}", "RdYlGn"),
-                 heat_item(p.rms, 0.0, rms_max, "{:.2f}", "YlOrRd"), NumberItem(p.frames, "{:.0f}"),
+                 heat_item(p.rms, rms_lo, rms_max, "{:.2f}", "YlOrRd"), NumberItem(p.frames, "{:.0f}"),
                  NumberItem(p.segments, "{:.0f}")] for p in report.phones]
         fill_table(self.phone_table, ["phone", "correlation (lips y)", "RMS error (mm)", "frames",
                                       "segments"], rows)
-        rms_u = max((u.rms for u in report.utterances), default=1.0)
+        finite = [u.rms for u in report.utterances if u.rms == u.rms]
+        rms_ulo, rms_u = (min(finite), max(finite)) if finite else (0.0, 1.0)
         rows = [[text_item(u.utterance), text_item(u.split),
                  *(heat_item(getattr(u, m), 0.0, 1.0, "{:.3f}", "RdYlGn")
                    for m in ("whole_face", "lower_lip", "upper_lip")),
-                 heat_item(u.rms, 0.0, rms_u, "{:.2f}"), text_item(u.worst_label),
+                 heat_item(u.rms, rms_ulo, rms_u, "{:.2f}"), text_item(u.worst_label),
                  NumberItem(u.worst_time, "{:.2f}"), NumberItem(u.worst_error, "{:.2f}")]
                 for u in report.utterances]
         fill_table(self.utt_table, ["utterance", "split", "whole face r", "lower lip r", "upper lip r",
                                     "RMS (mm)", "worst phone", "at (s)", "its error (mm)"], rows)
         rows = [[text_item(s.utterance), text_item(s.label), NumberItem(s.start, "{:.3f}"),
-                 NumberItem(s.end, "{:.3f}"), heat_item(s.error, 0.0, report.worst[0].error, "{:.2f}")]
+                 NumberItem(s.end, "{:.3f}"),
+                 heat_item(s.error, report.worst[-1].error, report.worst[0].error, "{:.2f}")]
                 for s in report.worst]
         fill_table(self.worst_table, ["utterance", "phone", "start (s)", "end (s)", "mean lip error (mm)"],
                    rows)
