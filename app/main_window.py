@@ -542,8 +542,12 @@ class MainWindow(QMainWindow):
         ids = [(s, u) for s in ("test", "train") for u in getattr(corpus.info, s)]
         smoothing = cfg.smoothing
 
+        clock = self.clock
+
         def work(progress: Progress) -> None:
             for k, (split, utt_id) in enumerate(ids):
+                while clock.playing and not progress.cancelled:
+                    time.sleep(0.05)    # playback first: resume when the sound stops
                 progress(k / max(len(ids), 1), f"lip correlations: {utt_id}")
                 try:
                     utt = corpus.utterance(utt_id)
