@@ -14,9 +14,10 @@ $(VENV)/.installed-run: pyproject.toml | $(BIN)/python
 	$(BIN)/pip install -q -e .
 	touch $@
 
+# the tests include the corpus generator's bit-for-bit reproduction check, hence the corpus extra
 $(VENV)/.installed-test: pyproject.toml | $(BIN)/python
-	$(BIN)/pip install -q -e ".[test]"
-	touch $@ $(VENV)/.installed-run
+	$(BIN)/pip install -q -e ".[test,corpus]"
+	touch $@ $(VENV)/.installed-run $(VENV)/.installed-corpus
 
 $(VENV)/.installed-corpus: pyproject.toml | $(BIN)/python
 	$(BIN)/pip install -q -e ".[test,corpus]"

@@ -425,16 +425,18 @@ def install(window) -> None:
             file_menu.addAction(action)
         window.own_data_actions[text.replace("&", "").rstrip("…")] = action
 
+    window.dimensions_label = QLabel("midsagittal (2-D) data: profile view, y up, z forward")
+    window.dimensions_label.setStyleSheet("font-weight: 600; padding: 0 8px;")
+    window.statusBar().addPermanentWidget(window.dimensions_label)
+    window.dimensions_label.hide()
+
     def on_model():
         model = window.model
-        plotter = window.face.plotter
-        plotter.remove_actor("facetraj-dimensions")
-        if model is not None and not model.neutral_face()[:, 0].any():
+        planar = model is not None and not model.neutral_face()[:, 0].any()
+        window.dimensions_label.setVisible(planar)
+        if planar:
             window.face.set_camera("profile")          # midsagittal data: shown as such
             if "profile" in getattr(window, "camera_buttons", {}):
                 window.camera_buttons["profile"].setChecked(True)
-            plotter.add_text("midsagittal (2-D) data: profile view, y up, z forward",
-                             position="lower_left", font_size=9, color="black",
-                             name="facetraj-dimensions")
 
     window.modelReady.connect(on_model)

@@ -61,7 +61,10 @@ def lip_contours(neutral: np.ndarray, upper: int, lower: int, corners: list[int]
 def face_triangles(neutral: np.ndarray, contours: list[list[int]], max_edge: float = 2.6) -> np.ndarray:
     """Triangles ``(n, 3)`` of a face surface: 2-D Delaunay on the neutral x-y, without the mouth
     opening and without triangles with a 3-D edge longer than ``max_edge`` times the median edge
-    (those bridge across the face's outline or reach back along the jaw)."""
+    (those bridge across the face's outline or reach back along the jaw). Midsagittal (2-D) data,
+    or markers not spanning the x-y plane, have no surface: no triangles."""
+    if len(neutral) < 4 or np.ptp(neutral[:, 0]) == 0 or np.ptp(neutral[:, 1]) == 0:
+        return np.zeros((0, 3), dtype=int)
     tri = Delaunay(neutral[:, :2]).simplices
     edges = np.stack([np.linalg.norm(neutral[tri[:, a]] - neutral[tri[:, b]], axis=1)
                       for a, b in ((0, 1), (1, 2), (2, 0))], axis=1)
