@@ -421,7 +421,10 @@ def discussion(data: ReportData) -> list[str]:
               f"(paper 0.7230)"
             + ("; as in the paper, the lower lip, carried by the jaw, is predicted better than the "
                "upper lip." if te["lower_lip"] > te["upper_lip"] else
-               "; unlike the paper, the upper lip is predicted at least as well as the lower lip.")
+               "; unlike the paper, the upper lip is predicted at least as well as the lower lip. "
+               "A likely reason is the synthetic rig: its upper lip follows one articulatory track, "
+               "while its lower lip adds the jaw rotation and the lip opening, two sources the "
+               "codebook must get right together.")
             + " The ± values are standard deviations over utterances: single sentences vary a lot, "
               "and short sentences with few speech frames give noisy correlations.")
     if tr and te and trs and tes:
@@ -452,7 +455,12 @@ def discussion(data: ReportData) -> list[str]:
                "follows the phone sequence almost deterministically, so such tokens carry nearly the "
                "same face as the exact training token; diluting it costs little (the acoustic "
                "weights of eqs 5-6 also keep favouring the exact token, whose LSFs match the input). ")
-            + "With few test sentences the curve is noisy at the 0.005 level.")
+            + (f"With only {c['n_test']} test sentences the curve is noisy at the 0.005 level."
+               if c["n_test"] < 30 else
+               "Our held-out curve keeps rising slowly beyond N = 3: the acoustic weights (eq 6) "
+               "pick the best-matching codewords among the 5N candidates, so more candidates rarely "
+               "hurt on this corpus, whose tokens of a phone vary little from one sentence to "
+               "another."))
     ac = data.row("acoustic-only", "test", "triangular")
     vis = next((r for r in data.comparisons if r["mode"] == "viseme" and r["split"] == "test"
                 and r["smoothing"] == "triangular"), None)
@@ -488,14 +496,29 @@ def discussion(data: ReportData) -> list[str]:
                "absolute correlation as evidence for the codebook design on this corpus. ")
             + "The viseme lookup has no coarticulation and steps at phone boundaries (smoothed by the "
               "same 100 ms window); the ridge regression sees ±83 ms of acoustics but no labels.")
+    agree = table1_agreement(data.table1, data.paper_table1)
+    same = [r.phone + "-" + r.neighbours[0][0] for r in data.table1
+            if r.neighbours and r.phone in data.paper_table1
+            and r.neighbours[0][0] == data.paper_table1[r.phone][0][0]]
+    out.append(
+        f"**Table 1.** Only {agree['same_closest']} of {agree['phones_compared']} phones have the "
+        f"paper's closest phone ({', '.join(same) or 'none'}); on average "
+        f"{_f(agree['mean_top3_overlap'], 2)} of the three neighbours agree. The visual similarity "
+        "is computed from face PCs, and the synthetic face moves only with the jaw and lips: "
+        "phones that differ in the tongue (invisible in both the paper's data and ours) or in "
+        "cheek and lip shape details of a real talker cannot be told apart the same way, and our "
+        "similarities are lower overall because the largest distance sets the scale (eq 3). "
+        "The lip-driven groups that the paper highlights (b, p, m; f, v; s, z, sh, zh; ch, jh) are "
+        "the ones to compare.")
     out.append(
         "**Choices the paper leaves open** also move the numbers: which coordinates make up the "
         "\"whole face\" average (here the "
         f"{data.model['moving_coordinates']} head-normalised coordinates whose training standard "
-        "deviation is at least 10 % of the largest), the energy threshold of the speech/silence "
-        "detector, the LSF analysis (order 18, 25 ms Hamming window, pre-emphasis 0.97), and the "
-        "scale of the distance before eq 3 (normalised by the largest distance, so nu = 10 gives "
-        "similarities comparable to the paper's Table 1). See `docs/algorithm.md`.")
+        "deviation is at least 10 % of the largest; cheek, chin and nose points move little against "
+        "the marker noise and pull the whole-face average down), the energy threshold of the "
+        "speech/silence detector, the LSF analysis (order 18, 25 ms Hamming window, pre-emphasis "
+        "0.97), and the scale of the distance before eq 3 (normalised by the largest distance; the "
+        "paper does not say what its distances were measured in). See `docs/algorithm.md`.")
     return out
 
 
