@@ -124,6 +124,8 @@ class MainWindow(QMainWindow):
         self._pending_time = start_time
         self._tasks: list[Task] = []
         self._synth_generation = 0
+        # the latest utterance asked for: (loader, split, is it a new utterance not shown yet)
+        self._request: tuple[Callable[[], Utterance], str, bool] | None = None
         self._corr_task: Task | None = None
         self._latency = 0.0          # running estimate of one frame update (s)
         self.stats: list[tuple[float, int, float, float]] | None = None   # benchmark hook
@@ -432,6 +434,7 @@ class MainWindow(QMainWindow):
         self.corpus, self.model, self.texts = corpus, model, texts
         self.external.clear()
         self.view = None
+        self._request = None
         self.face.set_model(model)
         self.settings.set_limits(model.config.context, model.config.nu)
         info = corpus.info
@@ -464,14 +467,16 @@ class MainWindow(QMainWindow):
             return
         self.synth_config = cfg
         self.settings.set_config(cfg)
-        if self.view is not None:
-            utt, split = self.view.utterance, self.view.split
-            self._synthesize(lambda: utt, split, new_utterance=False)
+        if self._request is not None:
+            # the utterance asked for last (it may still be on its way)
+            get_utterance, split, new_utterance = self._request
+            self._synthesize(get_utterance, split, new_utterance)
         self._start_correlations()
 
     def _synthesize(self, get_utterance: Callable[[], Utterance], split: str, new_utterance: bool) -> None:
         model = self.model
         cfg = self.synth_config
+        self._request = (get_utterance, split, new_utterance)
         self._synth_generation += 1
         gen = self._synth_generation
 
@@ -488,6 +493,8 @@ class MainWindow(QMainWindow):
         self.run_in_background(work, done, "synthesizing")
 
     def _apply_view(self, view: UtteranceView, new_utterance: bool) -> None:
+        utt_now = view.utterance
+        self._request = (lambda: utt_now, view.split, False)
         t = 0.0 if new_utterance else self.clock.time()
         was_playing = self.clock.playing and not new_utterance
         if new_utterance:
@@ -653,7 +660,11 @@ class MainWindow(QMainWindow):
         end = self.clock.loop[1] if (self.clock.looping and self.clock.loop) else self.clock.duration
         target = min(t + self._latency * self.clock.speed, end)
         k = int(np.clip(round(target * self.view.rate), 0, self.view.n_frames - 1))
-        if k == self.displayed_frame or self._frame_pending is not None:
+        if self._frame_pending is not None:
+            if time.perf_counter() - self._frame_pending[0] < 0.25:
+                return
+            self._frame_pending = None    # no flush came (window hidden?): do not stall
+        if k == self.displayed_frame:
             return
         self._frame_pending = (time.perf_counter(), k)
         self._show_time(target, force=True)

@@ -195,6 +195,14 @@ def test_changing_n_resynthesizes(window, qtbot):
     assert after.synthesis.config.n_context_phones == 1
     assert not np.allclose(after.shown, before.shown)
     assert win.timeline.view is after and win.face.view is after
+    # a new utterance asked for, then N changed before it arrived: both apply
+    other = next(u for u in win.corpus.info.test if u != after.utterance.name)
+    win.set_utterance(other)
+    win.set_synth_config(win.synth_config.with_(n_context_phones=2))
+    qtbot.waitUntil(lambda: win.view.utterance.name == other
+                    and win.view.synthesis.config.n_context_phones == 2, timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    assert win.view.utterance.name == other and win.settings.n.value() == 2
 
 
 def _colour_count(img: np.ndarray, hex_colour: str, tol: float = 60.0) -> int:
