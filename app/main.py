@@ -36,6 +36,25 @@ def _ensure_display() -> subprocess.Popen | None:
     return proc
 
 
+def build_window(corpus: Path | str | None, model: Path | None = None, utterance: str | None = None,
+                 time: float | None = None, use_audio: bool | None = None):
+    """The main window as users get it: with the analysis views and the import/export entries.
+
+    A view set that fails to install is logged and left out; the window still opens.
+    """
+    from . import analysis, own_data
+    from .main_window import MainWindow
+
+    window = MainWindow(None if corpus is None else Path(corpus), model_path=model, utterance=utterance,
+                        start_time=time, use_audio=use_audio)
+    for extension in (own_data, analysis):
+        try:
+            extension.install(window)
+        except Exception:
+            log.exception("%s could not be installed", extension.__name__)
+    return window
+
+
 def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | None = None,
             time: float | None = None, model: Path | None = None) -> int:
     """Open the main window on ``corpus``; with ``screenshot``, render it to that PNG and exit.
@@ -48,18 +67,10 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
     from PyQt6.QtCore import QTimer
     from PyQt6.QtWidgets import QApplication
 
-    from .main_window import MainWindow
-
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("facetraj")
-    window = MainWindow(Path(corpus), model_path=model, utterance=utterance, start_time=time)
+    window = build_window(corpus, model=model, utterance=utterance, time=time)
     window.resize(*WINDOW_SIZE)
-    try:
-        from . import analysis
-
-        analysis.install(window)
-    except Exception:
-        log.exception("the analysis views could not be installed")
     status = {"code": 0}
     if screenshot:
         out = Path(screenshot)

@@ -412,7 +412,7 @@ class MainWindow(QMainWindow):
         def work(progress: Progress) -> tuple[Model, dict[str, str]]:
             texts = {}
             for utt_id in corpus.info.ids:
-                p = corpus.root / f"{utt_id}.txt"
+                p = corpus.data_root / f"{utt_id}.txt"
                 if p.exists():
                     texts[utt_id] = p.read_text(encoding="utf-8", errors="replace").strip()
             if model_path is not None:

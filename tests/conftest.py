@@ -17,8 +17,8 @@ MOCHA = ROOT.parent / "shared" / "data" / "mocha_fsew0_001"
 
 @pytest.fixture(scope="session", autouse=True)
 def _isolated_cache(tmp_path_factory):
-    """Keep the app's model cache out of the user's home during tests."""
-    os.environ.setdefault("FACETRAJ_CACHE_DIR", str(tmp_path_factory.mktemp("cache")))
+    """One private model cache for the whole session, never the user's."""
+    os.environ["FACETRAJ_CACHE_DIR"] = str(tmp_path_factory.mktemp("cache"))
 
 
 @pytest.fixture(scope="session")
@@ -56,3 +56,9 @@ def default_model(default_corpus):
     from app.cache import load_or_train
 
     return load_or_train(default_corpus)
+
+
+@pytest.fixture(scope="session")
+def trained_cache(default_model) -> Path:
+    """The session cache, holding the default model (trained once for every test that needs it)."""
+    return Path(os.environ["FACETRAJ_CACHE_DIR"])

@@ -24,6 +24,7 @@ from PyQt6.QtWidgets import QFileDialog, QMessageBox
 
 from app import style
 from app.browser import normalise_text
+from app.main import build_window
 from app.main_window import DEFAULT_SENTENCE, MainWindow
 from engine.cli import default_corpus
 
@@ -33,30 +34,10 @@ ROOT = Path(__file__).resolve().parent.parent
 WAIT_MS = 60_000
 
 
-@pytest.fixture(scope="session")
-def trained_cache(tmp_path_factory):
-    """One model of the default corpus, trained once into a private cache for every test."""
-    from app.cache import load_or_train
-    from engine.corpus import load_corpus
-
-    corpus_dir = default_corpus()
-    if not (corpus_dir / "corpus.json").exists():
-        pytest.skip(f"the default corpus is not built ({corpus_dir}); run `make corpus`")
-    cache = tmp_path_factory.mktemp("facetraj-cache")
-    old = os.environ.get("FACETRAJ_CACHE_DIR")
-    os.environ["FACETRAJ_CACHE_DIR"] = str(cache)
-    load_or_train(load_corpus(corpus_dir))
-    yield cache
-    if old is None:
-        os.environ.pop("FACETRAJ_CACHE_DIR", None)
-    else:
-        os.environ["FACETRAJ_CACHE_DIR"] = old
-
-
 @pytest.fixture
 def window(qtbot, trained_cache):
     """The main window on the default corpus, shown, with its first utterance synthesized."""
-    win = MainWindow(default_corpus(), use_audio=False)
+    win = build_window(default_corpus(), use_audio=False)
     qtbot.addWidget(win)
     win.resize(1600, 1000)
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):

@@ -17,14 +17,13 @@ if not (MOCHA / "fsew0_001.ema").exists():
 
 from PyQt6.QtWidgets import QMessageBox
 
-from app.main_window import MainWindow
+from app.main import build_window
 from app.own_data import (
     ImportDialog,
     default_label_map,
     export_figure,
     export_trajectories,
     guess_roles,
-    install,
 )
 from engine.corpus import load_corpus
 from engine.formats import read_c3d, read_marker_table
@@ -75,8 +74,7 @@ def mocha_window(qtbot, tmp_path, monkeypatch):
     path = dlg.write_description()
     errors: list[str] = []
     monkeypatch.setattr(QMessageBox, "critical", lambda *a, **k: errors.append(a[2]))
-    win = MainWindow(path, use_audio=False)
-    install(win)
+    win = build_window(path, use_audio=False)
     qtbot.addWidget(win)
     win.resize(1400, 900)
     win.show()
