@@ -55,7 +55,7 @@ def lpc(frames: np.ndarray, order: int) -> np.ndarray:
     return a
 
 
-def poly2lsf(a: np.ndarray) -> np.ndarray:
+def _poly2lsf_companion(a: np.ndarray) -> np.ndarray:
     """LSF in radians, ascending in (0, pi), of LPC polynomials ``a`` (``(..., P+1)``, ``a0 = 1``).
 
     ``P(z) = A(z) + z^-(P+1) A(1/z)`` and ``Q(z) = A(z) - z^-(P+1) A(1/z)``; their roots lie on
@@ -91,6 +91,64 @@ def poly2lsf(a: np.ndarray) -> np.ndarray:
     both = np.where((both > eps) & (both < np.pi - eps), both, np.inf)
     both.sort(axis=1)
     out[:] = both[:, :order]
+    if not np.all(np.isfinite(out)):
+        raise ValueError("LPC polynomial has roots off the unit circle pairs; is it minimum phase?")
+    return out.reshape(*lead, order)
+
+
+def _cheb_colleague_eigs(c: np.ndarray) -> np.ndarray:
+    """Roots (complex) of Chebyshev series rows ``c`` (``(B, m+1)``, highest last) by batched
+    colleague-matrix eigenvalues (numpy's ``chebcompanion``, vectorised over rows)."""
+    m = c.shape[1] - 1
+    if m == 1:
+        return (-c[:, :1] / c[:, 1:]).astype(complex)
+    base = np.zeros((m, m))
+    idx = np.arange(m - 1)
+    base[idx, idx + 1] = 0.5
+    base[idx + 1, idx] = 0.5
+    base[0, 1] = base[1, 0] = np.sqrt(0.5)
+    scl = np.r_[1.0, np.full(m - 1, np.sqrt(0.5))]
+    mat = np.broadcast_to(base, (c.shape[0], m, m)).copy()
+    mat[:, :, -1] -= (c[:, :-1] / c[:, -1:]) * (scl / scl[-1]) * 0.5
+    return np.linalg.eigvals(mat)
+
+
+def poly2lsf(a: np.ndarray) -> np.ndarray:
+    """LSF in radians, ascending in (0, pi), of LPC polynomials ``a`` (``(..., P+1)``, ``a0 = 1``).
+
+    ``P(z) = A(z) + z^-(P+1) A(1/z)`` and ``Q(z) = A(z) - z^-(P+1) A(1/z)``; their roots lie on
+    the unit circle and interlace; the LSF are their angles. The trivial roots (z = -1 of P,
+    z = +1 of Q for even order) are divided out, which leaves two symmetric polynomials of degree
+    P; on the unit circle each is ``e^(-j w P/2)`` times a cosine series of order P/2, i.e. a
+    Chebyshev series in ``x = cos w``, whose P/2 real roots in [-1, 1] are found as the
+    eigenvalues of batched (P/2 x P/2) colleague matrices (instead of (P+1 x P+1) companions).
+
+    Examples
+    --------
+    >>> np.round(poly2lsf(np.array([1.0, 0.0, 0.0])), 4)   # A(z) = 1: uniformly spaced LSF
+    array([1.0472, 2.0944])
+    """
+    a = np.asarray(a, dtype=np.float64)
+    lead = a.shape[:-1]
+    a2 = a.reshape(-1, a.shape[-1])
+    order = a2.shape[1] - 1
+    if order % 2 or order < 2:
+        return _poly2lsf_companion(a)
+    ext = np.concatenate([a2, np.zeros((a2.shape[0], 1))], axis=1)
+    rev = ext[:, ::-1]
+    half = order // 2
+    angles = []
+    for poly, sign in ((ext + rev, -1.0), (ext - rev, 1.0)):
+        # divide by (1 - sign z^-1): g_k = p_k + sign g_(k-1); degree P, symmetric
+        g = np.empty((poly.shape[0], order + 1))
+        g[:, 0] = poly[:, 0]
+        for k in range(1, order + 1):
+            g[:, k] = poly[:, k] + sign * g[:, k - 1]
+        # cosine series: g_half + 2 sum_k g_(half-k) cos(k w) -> Chebyshev coefficients
+        cheb = np.concatenate([g[:, half:half + 1], 2.0 * g[:, half - 1::-1]], axis=1)
+        x = _cheb_colleague_eigs(cheb).real
+        angles.append(np.arccos(np.clip(x, -1.0, 1.0)))
+    out = np.sort(np.concatenate(angles, axis=1), axis=1)
     if not np.all(np.isfinite(out)):
         raise ValueError("LPC polynomial has roots off the unit circle pairs; is it minimum phase?")
     return out.reshape(*lead, order)

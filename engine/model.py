@@ -26,12 +26,11 @@ from .markers import fill_gaps, reference_pose, remove_head_motion
 from .pca import PCA, fit_pca
 from .phones import SILENCE, context_ids, map_labels, segment_index
 from .similarity import (
-    context_similarity,
     distance_scale,
     phone_distances,
     phone_means,
     similarity_matrix,
-    top_contexts,
+    top_context_phones,
 )
 from .smoothing import smooth
 from .synthesis import FrameWeights, gamma_grid, nearest_codewords, weight_frames
@@ -408,9 +407,8 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         pid = {p: i for i, p in enumerate(model.phones)}
         ctx = context_ids([pid[s.label] for s in segs], mc.context, pid[SILENCE])
         s = model.similarity(config.nu)
-        n = context_similarity(ctx, cb.contexts, s, config.xi, min(config.context, mc.context))
-        top = top_contexts(n, config.n_context_phones)
-        scores = np.take_along_axis(n, top, axis=1)
+        top, scores = top_context_phones(ctx, cb.contexts, s, config.xi,
+                                         min(config.context, mc.context), config.n_context_phones)
         segments = [SegmentChoice(seg, ctx[i], top[i], scores[i]) for i, seg in enumerate(segs)]
         frame_seg = segment_index(segs, times)
         candidates = cb.codewords_of(top)[frame_seg]

@@ -139,3 +139,38 @@ def top_contexts(n: np.ndarray, count: int) -> np.ndarray:
     count = min(count, n.shape[1])
     order = np.argsort(-n, axis=1, kind="stable")
     return order[:, :count]
+
+
+def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, xi: float,
+                       context: int | None, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Eq 4 then :func:`top_contexts`, without scoring every codebook context for every query.
+
+    The context terms of eq 4 add at most ``B = 2 sum_i xi^-i`` (similarities are <= 1), so a
+    codebook context whose centre similarity is below ``S_max - B`` (``S_max`` the query centre's
+    best centre similarity in the codebook) can never outrank one whose centre reaches ``S_max``.
+    Queries are grouped by centre phone and scored only against the contexts that can win; the
+    result (including the lower-index-first tie order) is that of the full computation. Groups
+    with fewer than ``count`` contexts reaching ``S_max`` fall back to the full scoring.
+
+    Returns ``(top, scores)``, both ``(Q, count)``.
+    """
+    q = np.atleast_2d(np.asarray(query))
+    full = (q.shape[1] - 1) // 2
+    c = full if context is None else min(context, full)
+    bound = 2.0 * sum(xi ** (-i) for i in range(1, c + 1))
+    centres = codebook[:, full]
+    count = min(count, codebook.shape[0])
+    top = np.empty((q.shape[0], count), dtype=np.int64)
+    scores = np.empty((q.shape[0], count))
+    for centre in np.unique(q[:, full]):
+        rows = np.flatnonzero(q[:, full] == centre)
+        sim = s[centre, centres]
+        best = sim.max()
+        cand = np.flatnonzero(sim >= best - bound - 1e-12)
+        if (sim >= best).sum() < count:
+            cand = np.arange(codebook.shape[0])
+        n = context_similarity(q[rows], codebook[cand], s, xi, c)
+        order = top_contexts(n, count)
+        top[rows] = cand[order]
+        scores[rows] = np.take_along_axis(n, order, axis=1)
+    return top, scores

@@ -99,10 +99,13 @@ def weight_frames(w: np.ndarray, candidates: np.ndarray, cb_lsf: np.ndarray, cb_
 
     ``w`` is ``(T, P)`` input LSFs, ``candidates`` ``(T, I)`` codebook indices per frame,
     ``cb_lsf`` ``(5L, P)`` the codebook LSFs L_i and ``cb_pcs`` ``(5L, K)`` its PC vectors F_i.
-    Work is chunked over frames to bound memory (about 4 million values per chunk).
+    Work is chunked over frames to bound memory (about 4 million values per chunk). When every
+    frame has the same candidates (acoustic-only full search) the codebook is not gathered per
+    frame and eqs 7-8 are plain matrix products.
     """
     n_frames = w.shape[0]
     n_cand = candidates.shape[1]
+    shared = n_frames > 0 and candidates.strides[0] == 0          # a broadcast row: same for all
     chunk = max(1, min(chunk, int(4e6 // max(1, n_cand * max(w.shape[1], len(gammas))))))
     pcs = np.empty((n_frames, cb_pcs.shape[1]))
     gam = np.empty(n_frames)
@@ -110,15 +113,18 @@ def weight_frames(w: np.ndarray, candidates: np.ndarray, cb_lsf: np.ndarray, cb_
     lsf_hat = np.empty_like(w, dtype=np.float64)
     err = np.empty(n_frames)
     gammas = np.asarray(gammas, dtype=np.float64)
+    if shared:
+        lsf_all = cb_lsf[candidates[0]]
+        pcs_all = cb_pcs[candidates[0]]
     for a in range(0, n_frames, chunk):
         b = min(a + chunk, n_frames)
         wc = w[a:b]
         h = perceptual_weights(wc)                               # (t, P)   eq 5
-        cand_lsf = cb_lsf[candidates[a:b]]                       # (t, I, P)
-        d = lsf_distances(wc, cand_lsf, h)                       # (t, I)   eq 5
+        cand_lsf = lsf_all[None] if shared else cb_lsf[candidates[a:b]]   # (t|1, I, P)
+        d = np.matmul(np.abs(wc[:, None, :] - cand_lsf), h[:, :, None])[..., 0]   # (t, I) eq 5
         v = codebook_weights(d[:, None, :], gammas[None, :])     # (t, G, I) eq 6
-        what = np.einsum("tgi,tik->tgk", v, cand_lsf)            # (t, G, P) eq 7
-        e = np.einsum("tgk,tk->tg", np.abs(what - wc[:, None, :]), h)
+        what = np.matmul(v, cand_lsf)                            # (t, G, P) eq 7
+        e = np.matmul(np.abs(what - wc[:, None, :]), h[:, :, None])[..., 0]
         best = e.argmin(axis=1)
         rows = np.arange(b - a)
         vb = v[rows, best]
@@ -126,25 +132,40 @@ def weight_frames(w: np.ndarray, candidates: np.ndarray, cb_lsf: np.ndarray, cb_
         weights[a:b] = vb
         lsf_hat[a:b] = what[rows, best]
         err[a:b] = e[rows, best]
-        pcs[a:b] = np.einsum("ti,tik->tk", vb, cb_pcs[candidates[a:b]])  # eq 8
+        if shared:
+            pcs[a:b] = vb @ pcs_all                              # eq 8
+        else:
+            pcs[a:b] = np.matmul(vb[:, None, :], cb_pcs[candidates[a:b]])[:, 0]
     return FrameWeights(pcs, gam, weights, np.asarray(candidates), lsf_hat, err)
 
 
 def nearest_codewords(w: np.ndarray, cb_lsf: np.ndarray, count: int | None,
-                      chunk: int = 128) -> np.ndarray:
+                      chunk: int | None = None, shortlist: int = 4) -> np.ndarray:
     """Acoustic-only candidates: all ``5L`` codewords, or the ``count`` nearest by eq 5's distance.
+
+    The nearest are found in two steps: a shortlist of ``shortlist * count`` codewords by the
+    perceptually weighted *squared* distance ``sum_k h_k (w_k - L_ik)^2``, which expands into one
+    matrix product ``[-2 h w, h] . [L_i, L_i^2]`` (BLAS, float32), then eq 5's weighted absolute
+    distance on the shortlist only, keeping ``count``.
 
     Returns ``(T, I)`` codebook indices.
     """
     n_frames, n_cb = w.shape[0], cb_lsf.shape[0]
     if count is None or count >= n_cb:
         return np.broadcast_to(np.arange(n_cb), (n_frames, n_cb))
+    m = min(n_cb, max(count, shortlist * count))
+    chunk = chunk or max(1, min(256, int(4e6 // n_cb)))          # about 4 million distances per chunk
     out = np.empty((n_frames, count), dtype=np.int64)
-    cb32 = cb_lsf.astype(np.float32)
+    feats = np.concatenate([cb_lsf, cb_lsf**2], axis=1).astype(np.float32).T   # (2P, 5L)
     for a in range(0, n_frames, chunk):
         b = min(a + chunk, n_frames)
-        wc = w[a:b].astype(np.float32)
-        h = perceptual_weights(wc).astype(np.float32)
-        d = np.einsum("tik,tk->ti", np.abs(wc[:, None, :] - cb32[None]), h)
-        out[a:b] = np.argpartition(d, count - 1, axis=1)[:, :count]
+        wc = w[a:b]
+        h = perceptual_weights(wc)
+        q = np.concatenate([-2.0 * h * wc, h], axis=1).astype(np.float32)      # (t, 2P)
+        d2 = q @ feats                                                          # (t, 5L)
+        short = np.argpartition(d2, m - 1, axis=1)[:, :m] if m < n_cb else \
+            np.broadcast_to(np.arange(n_cb), (b - a, n_cb))
+        d = np.matmul(np.abs(wc[:, None, :] - cb_lsf[short]), h[:, :, None])[..., 0]   # eq 5
+        keep = np.argpartition(d, count - 1, axis=1)[:, :count]
+        out[a:b] = np.take_along_axis(short, keep, axis=1)
     return out
