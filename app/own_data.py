@@ -294,6 +294,72 @@ class ImportDialog(QDialog):
         self.accept()
 
 
+# ---------------------------------------------------------------------- marker panels
+JAW_NAMES = ("LI", "JAW", "JAW_C", "CN_C", "CHIN", "CN")
+
+
+class MarkerPanel:
+    """A time-aligned panel of one marker coordinate: original (dashed) and the triangular and
+    spline syntheses, like the lip panels (e.g. the jaw of MOCHA-TIMIT's lower incisor coil)."""
+
+    height = 1.0
+
+    def __init__(self, marker: str, axis: str = "y"):
+        self.marker = marker
+        self.axis = axis
+        self.title = f"{marker} {axis}"
+
+    def draw(self, ax, view) -> None:
+        from .style import ORIGINAL_COLOR, SPLINE_COLOR, TRIANGULAR_COLOR
+
+        names = view.utterance.marker_names or []
+        if self.marker not in names:
+            ax.text(0.5, 0.5, f"no marker {self.marker}", transform=ax.transAxes, ha="center")
+            return
+        k, a = names.index(self.marker), "xyz".index(self.axis)
+        t = view.times
+        ax.plot(t, view.triangular[:, k, a], color=TRIANGULAR_COLOR, lw=1.6)
+        ax.plot(t, view.spline[:, k, a], color=SPLINE_COLOR, lw=1.3)
+        if view.original is not None:
+            ax.plot(t, view.original[:, k, a], color=ORIGINAL_COLOR, lw=1.5, ls=(0, (2, 1.5)))
+        ax.set_ylabel(f"{self.marker}\n{self.axis} (mm)", fontsize=8)
+
+
+def jaw_marker(names: list[str]) -> str | None:
+    """The jaw marker among ``names`` (MOCHA's lower incisor LI, or a chin/jaw marker), if any."""
+    upper = [n.upper() for n in names]
+    for cand in JAW_NAMES:
+        if cand in upper:
+            return names[upper.index(cand)]
+    return None
+
+
+class MarkerPanelDialog(QDialog):
+    """Choose a marker and an axis for a new time-aligned panel."""
+
+    def __init__(self, names: list[str], parent: QWidget | None = None):
+        super().__init__(parent)
+        self.setWindowTitle("Add a marker trajectory panel")
+        form = QFormLayout(self)
+        self.marker = QComboBox()
+        self.marker.addItems(names)
+        jaw = jaw_marker(names)
+        if jaw:
+            self.marker.setCurrentText(jaw)
+        self.axis = QComboBox()
+        self.axis.addItems(["y (up)", "z (forward)", "x (right)"])
+        form.addRow("Marker", self.marker)
+        form.addRow("Coordinate", self.axis)
+        buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Ok
+                                   | QDialogButtonBox.StandardButton.Cancel)
+        buttons.accepted.connect(self.accept)
+        buttons.rejected.connect(self.reject)
+        form.addRow(buttons)
+
+    def panel(self) -> MarkerPanel:
+        return MarkerPanel(self.marker.currentText(), self.axis.currentText()[0])
+
+
 # ---------------------------------------------------------------------- exports
 def _confirm_overwrite(window, path: Path) -> bool:
     if not path.exists():
@@ -373,7 +439,8 @@ def install(window) -> None:
             window.open_corpus(dlg.result_path)
 
     def ask_save(title: str, default: str, filters: str) -> Path | None:
-        path, _ = QFileDialog.getSaveFileName(window, title, default, filters)
+        path, _ = QFileDialog.getSaveFileName(window, title, default, filters,
+                                              options=QFileDialog.Option.DontConfirmOverwrite)
         if not path:
             return None
         p = Path(path)
@@ -439,4 +506,40 @@ def install(window) -> None:
             if "profile" in getattr(window, "camera_buttons", {}):
                 window.camera_buttons["profile"].setChecked(True)
 
+    window.marker_panels = []
+
+    def add_marker_panel(panel: MarkerPanel) -> None:
+        window.marker_panels.append(panel)
+        window.timeline.add_panel(panel)
+
+    def ask_marker_panel():
+        if window.model is None:
+            raise FacetrajError("no model yet")
+        dlg = MarkerPanelDialog(list(window.model.marker_names), window)
+        if dlg.exec() == QDialog.DialogCode.Accepted:
+            add_marker_panel(dlg.panel())
+
+    def remove_marker_panels():
+        for panel in window.marker_panels:
+            window.timeline.remove_panel(panel)
+        window.marker_panels.clear()
+
+    add = QAction("Add a marker trajectory panel…", window)
+    add.triggered.connect(guarded(ask_marker_panel))
+    remove = QAction("Remove the marker trajectory panels", window)
+    remove.triggered.connect(guarded(remove_marker_panels))
+    window.view_menu.addSeparator()
+    window.view_menu.addAction(add)
+    window.view_menu.addAction(remove)
+    window.own_data_actions["Add a marker trajectory panel"] = add
+
+    def on_model_panels():
+        remove_marker_panels()
+        model = window.model
+        if model is not None and not model.neutral_face()[:, 0].any():
+            jaw = jaw_marker(list(model.marker_names))     # midsagittal EMA: the jaw beside the lips
+            if jaw:
+                add_marker_panel(MarkerPanel(jaw, "y"))
+
     window.modelReady.connect(on_model)
+    window.modelReady.connect(on_model_panels)

@@ -90,7 +90,13 @@ def test_midsagittal_corpus_shown_and_exported(mocha_window, tmp_path, qtbot):
     assert win.view.utterance.name == "fsew0_001" and win.model.n_markers == 9
     assert win.face.preset == "profile" and win.camera_buttons["profile"].isChecked()
     assert win.dimensions_label.isVisible() and "midsagittal" in win.dimensions_label.text()
-    # lips in the time-aligned panels: the real upper and lower lip y against the speech
+    # lips and jaw in the time-aligned panels: the real trajectories against the speech
+    jaw = win.marker_panels[0]
+    assert jaw.marker == "LI" and win.timeline.axes_of(jaw) is not None
+    ax = win.timeline.axes_of(jaw)
+    li = win.model.marker_names.index("LI")
+    dashed = [ln for ln in ax.get_lines() if ln.get_linestyle() not in ("-", "None")]
+    np.testing.assert_allclose(dashed[0].get_ydata()[:50], win.view.original[:50, li, 1])
     orig = win.view.original
     assert np.isfinite(orig[:100]).all() and np.isnan(orig[-10:]).all()
     for which, suffix in (("synthesized", ".c3d"), ("original", ".tsv"), ("synthesized", ".npz")):
