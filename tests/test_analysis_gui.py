@@ -9,7 +9,6 @@ tests run on the toy corpus instead, so that the views are still exercised.
 
 from __future__ import annotations
 
-import logging
 import math
 import os
 from types import SimpleNamespace
@@ -37,33 +36,17 @@ from engine.evaluation import sweep_n, table2
 from engine.similarity import top_similar
 
 pytestmark = pytest.mark.gui
-log = logging.getLogger(__name__)
 WAIT_MS = 90_000
 
 
 @pytest.fixture(scope="module")
-def corpus_dir(request):
-    from engine.cli import default_corpus
-
-    d = default_corpus()
-    if (d / "corpus.json").exists():
-        return d
-    log.warning("default corpus %s not built: analysis GUI tests run on the toy corpus", d)
-    return request.getfixturevalue("toy_corpus_dir")
+def corpus(default_corpus):
+    return default_corpus
 
 
 @pytest.fixture(scope="module")
-def corpus(corpus_dir):
-    from engine.corpus import load_corpus
-
-    return load_corpus(corpus_dir)
-
-
-@pytest.fixture(scope="module")
-def model(corpus):
-    from app.cache import load_or_train
-
-    return load_or_train(corpus)
+def model(default_model):
+    return default_model
 
 
 @pytest.fixture(scope="module")
@@ -307,11 +290,11 @@ def test_kinematics_landmarks_within_one_frame(qtbot, tmp_path):
 
 
 # ---------------------------------------------------------------------- in the main window
-def test_installed_in_main_window(qtbot, corpus_dir, model):
+def test_installed_in_main_window(qtbot, corpus, model):
     from app.analysis import PANELS, VIEWS, install
     from app.main_window import MainWindow
 
-    win = MainWindow(corpus_dir, use_audio=False)
+    win = MainWindow(corpus.root, use_audio=False)
     qtbot.addWidget(win)
     views = install(win)
     win.resize(1600, 1000)
