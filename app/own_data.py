@@ -7,18 +7,16 @@ written by the engine (:func:`engine.corpus.init_corpus`) and opened like any co
 
 Out: the current synthesized or original trajectories (C3D, TSV, NPZ), the time-aligned panels as
 a figure (PNG, SVG, PDF), the model file, and a video (MP4) with a progress bar. Every file is
-written under a temporary name and renamed into place; an existing file is replaced only after the
-user confirms.
+written under a temporary name and renamed into place; Qt's save dialog asks before an existing
+file is replaced.
 """
 
 from __future__ import annotations
 
-import json
 import logging
 import os
 from pathlib import Path
 
-import numpy as np
 from PyQt6.QtCore import Qt
 from PyQt6.QtGui import QAction
 from PyQt6.QtWidgets import (
@@ -43,10 +41,12 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
+from app.analysis.common import ask_save_path
 from engine.corpus import FolderScan, init_corpus, scan_folder
 from engine.errors import FacetrajError
-from engine.formats import atomic_write, write_c3d, write_marker_tsv
+from engine.formats import atomic_write
 from engine.labelmap import MOCHA_TO_ARPABET, read_label_map, write_label_map
+from engine.model import write_trajectories
 from engine.phones import ARPABET, SILENCE, SILENCE_LABELS, normalise_label
 
 log = logging.getLogger(__name__)
@@ -361,13 +361,6 @@ class MarkerPanelDialog(QDialog):
 
 
 # ---------------------------------------------------------------------- exports
-def _confirm_overwrite(window, path: Path) -> bool:
-    if not path.exists():
-        return True
-    answer = QMessageBox.question(window, "facetraj", f"{path} exists. Replace it?")
-    return answer == QMessageBox.StandardButton.Yes
-
-
 def export_trajectories(window, path: Path, which: str = "synthesized") -> Path:
     """Write the current utterance's ``synthesized`` or ``original`` markers (C3D, TSV or NPZ)."""
     view, model = window.view, window.model
@@ -376,20 +369,7 @@ def export_trajectories(window, path: Path, which: str = "synthesized") -> Path:
     markers = view.shown if which == "synthesized" else view.original
     if markers is None:
         raise FacetrajError(f"{view.utterance.name} has no original markers")
-    suffix = path.suffix.lower()
-    if suffix == ".c3d":
-        write_c3d(path, markers, model.marker_rate, model.marker_names)
-    elif suffix in (".tsv", ".txt", ".csv"):
-        write_marker_tsv(path, markers, model.marker_rate, model.marker_names)
-    elif suffix == ".npz":
-        syn = view.synthesis
-        with atomic_write(path) as tmp, open(tmp, "wb") as fh:
-            np.savez_compressed(fh, times=view.times, markers=markers, pcs=syn.pcs, raw_pcs=syn.raw_pcs,
-                                gamma=syn.frames.gamma, marker_names=np.array(model.marker_names),
-                                config=np.array(json.dumps(syn.config.to_dict())), which=np.array(which))
-    else:
-        raise FacetrajError(f"{path}: unknown format (use .c3d, .tsv or .npz)")
-    return path
+    return write_trajectories(path, markers, model, view.synthesis, which=which)
 
 
 def export_figure(window, path: Path) -> Path:
@@ -438,24 +418,17 @@ def install(window) -> None:
         if dlg.exec() == QDialog.DialogCode.Accepted and dlg.result_path:
             window.open_corpus(dlg.result_path)
 
-    def ask_save(title: str, default: str, filters: str) -> Path | None:
-        path, _ = QFileDialog.getSaveFileName(window, title, default, filters,
-                                              options=QFileDialog.Option.DontConfirmOverwrite)
-        if not path:
-            return None
-        p = Path(path)
-        return p if _confirm_overwrite(window, p) else None
-
     def do_traj(which: str):
         name = window.view.utterance.name if window.view else "trajectories"
-        p = ask_save(f"Export {which} trajectories", f"{name}_{which}.c3d",
+        p = ask_save_path(window, f"Export {which} trajectories", f"{name}_{which}.c3d",
                      "C3D (*.c3d);;TSV (*.tsv);;NumPy (*.npz)")
         if p:
             export_trajectories(window, p, which)
             window.status_label.setText(f"wrote {p}")
 
     def do_figure():
-        p = ask_save("Export the panels as a figure", "panels.png", "PNG (*.png);;SVG (*.svg);;PDF (*.pdf)")
+        p = ask_save_path(window, "Export the panels as a figure", "panels.png",
+                          "PNG (*.png);;SVG (*.svg);;PDF (*.pdf)")
         if p:
             export_figure(window, p)
             window.status_label.setText(f"wrote {p}")
@@ -463,14 +436,14 @@ def install(window) -> None:
     def do_model():
         if window.model is None:
             raise FacetrajError("no model yet")
-        p = ask_save("Save the model", "model.npz", "facetraj model (*.npz)")
+        p = ask_save_path(window, "Save the model", "model.npz", "facetraj model (*.npz)")
         if p:
             window.model.save(p)
             window.status_label.setText(f"wrote {p}")
 
     def do_video():
         name = window.view.utterance.name if window.view else "facetraj"
-        p = ask_save("Export a video", f"{name}.mp4", "MP4 (*.mp4)")
+        p = ask_save_path(window, "Export a video", f"{name}.mp4", "MP4 (*.mp4)")
         if p:
             export_video(window, p)
 

@@ -15,8 +15,6 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-import numpy as np
-
 from .config import SynthConfig, TrainConfig
 from .errors import FacetrajError
 
@@ -94,8 +92,8 @@ def cmd_train(args: argparse.Namespace) -> int:
 
 
 def cmd_synth(args: argparse.Namespace) -> int:
-    from .formats import atomic_write, read_audio, read_labels, write_c3d, write_marker_tsv
-    from .model import Model, synthesize
+    from .formats import read_audio, read_labels
+    from .model import Model, synthesize, write_trajectories
 
     model = Model.load(args.model)
     audio, rate = read_audio(args.audio)
@@ -109,20 +107,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
     label_map = _read_label_map(args.label_map) if args.label_map else None
     res = synthesize(model, audio, rate, phones, cfg, label_map=label_map,
                      source=str(args.labels or args.audio))
-    out = Path(args.output)
-    suffix = out.suffix.lower()
-    if suffix == ".c3d":
-        write_c3d(out, res.markers, model.marker_rate, model.marker_names, args.overwrite)
-    elif suffix in (".tsv", ".txt"):
-        write_marker_tsv(out, res.markers, model.marker_rate, model.marker_names, args.overwrite)
-    elif suffix == ".npz":
-        with atomic_write(out, args.overwrite) as tmp, open(tmp, "wb") as fh:
-            np.savez_compressed(fh, times=res.times, markers=res.markers, pcs=res.pcs,
-                                raw_pcs=res.raw_pcs, gamma=res.frames.gamma, lsf=res.lsf,
-                                marker_names=np.array(model.marker_names),
-                                config=np.array(json.dumps(cfg.to_dict())))
-    else:
-        raise FacetrajError(f"{out}: unknown output format (use .c3d, .tsv or .npz)")
+    out = write_trajectories(args.output, res.markers, model, res, args.overwrite)
     log.info("%d frames (%.2f s) synthesized, %s mode, %s smoothing", len(res.times),
              res.times[-1], cfg.mode, cfg.smoothing)
     print(out)
@@ -355,7 +340,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("audio", type=Path, help="WAV or FLAC")
     p.add_argument("--labels", type=Path, help="phone labels: .TextGrid, .lab or .phn")
     p.add_argument("--label-map", help="a label map (TSV: label<TAB>arpabet)")
-    p.add_argument("-o", "--output", type=Path, required=True, help=".c3d, .tsv or .npz")
+    p.add_argument("-o", "--output", type=Path, required=True, help=".c3d, .tsv, .csv or .npz")
     p.add_argument("--overwrite", action="store_true", help="replace an existing file")
     _add_synth_options(p)
     p.set_defaults(func=cmd_synth)

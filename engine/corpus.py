@@ -173,19 +173,22 @@ class Corpus:
 
     root: Path
     info: CorpusInfo
+    _memo: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @property
     def data_root(self) -> Path:
         return (self.root / self.info.data_dir).resolve() if self.info.data_dir else self.root
 
     def label_map(self) -> dict[str, str] | None:
-        """The label map named in the description, or ``None``."""
+        """The label map named in the description, or ``None`` (read once per corpus)."""
         if not self.info.label_map:
             return None
-        from .labelmap import read_label_map
+        if "label_map" not in self._memo:
+            from .labelmap import read_label_map
 
-        lm = self.info.label_map
-        return read_label_map(lm if lm.lower() == "mocha" else self.root / lm)
+            lm = self.info.label_map
+            self._memo["label_map"] = read_label_map(lm if lm.lower() == "mocha" else self.root / lm)
+        return self._memo["label_map"]
 
     def utterance(self, utt_id: str) -> Utterance:
         """Load one utterance, with labels checked against the audio and markers against the info."""
@@ -198,14 +201,17 @@ class Corpus:
             yield self.utterance(utt_id)
 
     def fingerprint(self) -> str:
-        """A hash of every file of the corpus (names, sizes, contents), for caching models."""
-        h = hashlib.sha256()
-        h.update(json.dumps(self.info.to_json(), sort_keys=True).encode())
-        for p in sorted(self.data_root.iterdir()):
-            if p.is_file() and p.name != "corpus.json":
-                h.update(p.name.encode())
-                h.update(p.read_bytes())
-        return h.hexdigest()[:16]
+        """A hash of the description and every data file (names and contents), for caching
+        models; computed once per corpus object."""
+        if "fingerprint" not in self._memo:
+            h = hashlib.sha256()
+            h.update(json.dumps(self.info.to_json(), sort_keys=True).encode())
+            for p in sorted(self.data_root.iterdir()):
+                if p.is_file() and p.name != "corpus.json":
+                    h.update(p.name.encode())
+                    h.update(p.read_bytes())
+            self._memo["fingerprint"] = h.hexdigest()[:16]
+        return self._memo["fingerprint"]
 
 
 def load_corpus(root: str | os.PathLike[str]) -> Corpus:
@@ -226,7 +232,7 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
     Labels are mapped onto ARPAbet with ``label_map``. Markers shorter than the audio are padded
     with NaN (a warning); longer ones are cut at the audio's end.
     """
-    from .phones import normalise_label
+    from .phones import apply_label_map
 
     root = Path(root)
     apath = audio_path(root, utt_id)
@@ -241,10 +247,7 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
         raw = read_labels(lpath, rate)
     phones = validate_phones(raw, len(audio) / rate, lpath)
     if label_map:
-        phones = [PhoneSegment(s.start, s.end,
-                               normalise_label(label_map.get(s.label, label_map.get(
-                                   normalise_label(s.label), s.label))))
-                  for s in phones]
+        phones = [PhoneSegment(s.start, s.end, apply_label_map(s.label, label_map)) for s in phones]
     mpath = marker_path(root, utt_id)
     mdata = read_markers(mpath, info.marker_rate)
     if mdata.names != info.marker_names:

@@ -172,15 +172,22 @@ def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
                        config: SynthConfig | None = None,
                        smoothings: Sequence[str] = ("triangular", "spline"),
                        eval_config: EvalConfig | None = None,
-                       synthesis: Synthesis | None = None) -> list[UtteranceScore]:
-    """Synthesize one utterance and score each smoothing against its original markers."""
+                       synthesis: Synthesis | None = None, original: np.ndarray | None = None,
+                       speech: np.ndarray | None = None) -> list[UtteranceScore]:
+    """Synthesize one utterance and score each smoothing against its original markers.
+
+    ``original`` (head-normalised markers) and ``speech`` (the speech-frame mask) may be passed
+    when already computed, e.g. when one utterance is scored under several configs.
+    """
     config = config or SynthConfig()
     if utt.markers is None:
         raise ValueError(f"{utt.name}: no original markers to compare with")
-    original = model.normalise_markers(utt.markers)
+    if original is None:
+        original = model.normalise_markers(utt.markers)
     res = synthesis or synthesize(model, utt.audio, utt.sample_rate, utt.phones, config,
                                   n_frames=utt.n_frames, source=utt.name)
-    mask = speech_mask(utt.audio, utt.sample_rate, res.times, eval_config)
+    mask = speech if speech is not None else speech_mask(utt.audio, utt.sample_rate, res.times,
+                                                         eval_config)
     out = []
     for sm in smoothings:
         markers = resmooth(model, res, sm)
@@ -204,8 +211,11 @@ def evaluate(model: Model, corpus: Corpus, splits: Iterable[str] = ("train", "te
         if progress:
             progress(k / max(len(ids), 1), f"{sp}: {utt_id}")
         utt = corpus.utterance(utt_id)
+        original = model.normalise_markers(utt.markers)
+        speech = speech_mask(utt.audio, utt.sample_rate, utt.frame_times(), eval_config)
         for cfg in configs:
-            result.scores.extend(evaluate_utterance(model, utt, sp, cfg, smoothings, eval_config))
+            result.scores.extend(evaluate_utterance(model, utt, sp, cfg, smoothings, eval_config,
+                                                    original=original, speech=speech))
     if progress:
         progress(1.0, "done")
     return result

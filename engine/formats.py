@@ -332,12 +332,14 @@ def write_c3d(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
 
 def write_marker_tsv(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
                      names: Sequence[str], overwrite: bool = True) -> None:
-    """Write trajectories as TSV: a ``time`` column then ``<name>_x <name>_y <name>_z``."""
+    """Write trajectories as a table: a ``time`` column then ``<name>_x <name>_y <name>_z``;
+    tab separated, or comma separated for a ``.csv`` path."""
     t = np.arange(markers.shape[0]) / rate
     header = ["time"] + [f"{n}_{a}" for n in names for a in "xyz"]
     table = np.column_stack([t, markers.reshape(markers.shape[0], -1)])
+    sep = "," if Path(path).suffix.lower() == ".csv" else "\t"
     with atomic_write(path, overwrite) as tmp:
-        np.savetxt(tmp, table, delimiter="\t", header="\t".join(header), comments="",
+        np.savetxt(tmp, table, delimiter=sep, header=sep.join(header), comments="",
                    fmt=["%.6f"] + ["%.4f"] * (table.shape[1] - 1))
 
 

@@ -55,27 +55,22 @@ def lpc(frames: np.ndarray, order: int) -> np.ndarray:
     return a
 
 
-def _poly2lsf_companion(a: np.ndarray) -> np.ndarray:
-    """LSF in radians, ascending in (0, pi), of LPC polynomials ``a`` (``(..., P+1)``, ``a0 = 1``).
-
-    ``P(z) = A(z) + z^-(P+1) A(1/z)`` and ``Q(z) = A(z) - z^-(P+1) A(1/z)``; their roots lie on
-    the unit circle and interlace; the LSF are their angles, the trivial roots at z = +-1 dropped.
-    Vectorised over leading axes through batched companion-matrix eigenvalues.
-
-    Examples
-    --------
-    >>> np.round(poly2lsf(np.array([1.0, 0.0, 0.0])), 4)   # A(z) = 1: uniformly spaced LSF
-    array([1.0472, 2.0944])
-    """
+def _sum_difference(a: np.ndarray) -> tuple[tuple[int, ...], int, np.ndarray, np.ndarray]:
+    """Leading shape, order P and the rows of P(z) = A(z) + z^-(P+1) A(1/z) and
+    Q(z) = A(z) - z^-(P+1) A(1/z) (``(B, P+2)`` coefficients in powers of z^-1)."""
     a = np.asarray(a, dtype=np.float64)
-    lead = a.shape[:-1]
     a2 = a.reshape(-1, a.shape[-1])
-    order = a2.shape[1] - 1
     ext = np.concatenate([a2, np.zeros((a2.shape[0], 1))], axis=1)
     rev = ext[:, ::-1]
-    out = np.empty((a2.shape[0], order))
+    return a.shape[:-1], a2.shape[1] - 1, ext + rev, ext - rev
+
+
+def _poly2lsf_companion(a: np.ndarray) -> np.ndarray:
+    """:func:`poly2lsf` for any order, through batched (P+1 x P+1) companion-matrix eigenvalues
+    of P(z) and Q(z); the trivial roots at z = +-1 are dropped. Used for odd orders."""
+    lead, order, p_rows, q_rows = _sum_difference(a)
     angles = []
-    for poly in (ext + rev, ext - rev):
+    for poly in (p_rows, q_rows):
         # companion matrix of the monic polynomial (highest power first is z^0 of A(z^-1) form;
         # the coefficient sequences are palindromic up to sign, so the order does not matter)
         deg = poly.shape[1] - 1
@@ -90,7 +85,7 @@ def _poly2lsf_companion(a: np.ndarray) -> np.ndarray:
     eps = 1e-9
     both = np.where((both > eps) & (both < np.pi - eps), both, np.inf)
     both.sort(axis=1)
-    out[:] = both[:, :order]
+    out = both[:, :order]
     if not np.all(np.isfinite(out)):
         raise ValueError("LPC polynomial has roots off the unit circle pairs; is it minimum phase?")
     return out.reshape(*lead, order)
@@ -128,17 +123,12 @@ def poly2lsf(a: np.ndarray) -> np.ndarray:
     >>> np.round(poly2lsf(np.array([1.0, 0.0, 0.0])), 4)   # A(z) = 1: uniformly spaced LSF
     array([1.0472, 2.0944])
     """
-    a = np.asarray(a, dtype=np.float64)
-    lead = a.shape[:-1]
-    a2 = a.reshape(-1, a.shape[-1])
-    order = a2.shape[1] - 1
+    lead, order, p_rows, q_rows = _sum_difference(a)
     if order % 2 or order < 2:
         return _poly2lsf_companion(a)
-    ext = np.concatenate([a2, np.zeros((a2.shape[0], 1))], axis=1)
-    rev = ext[:, ::-1]
     half = order // 2
     angles = []
-    for poly, sign in ((ext + rev, -1.0), (ext - rev, 1.0)):
+    for poly, sign in ((p_rows, -1.0), (q_rows, 1.0)):
         # divide by (1 - sign z^-1): g_k = p_k + sign g_(k-1); degree P, symmetric
         g = np.empty((poly.shape[0], order + 1))
         g[:, 0] = poly[:, 0]

@@ -24,7 +24,7 @@ from .formats import atomic_write, validate_phones
 from .lsf import lsf_at
 from .markers import fill_gaps, reference_pose, remove_head_motion
 from .pca import PCA, fit_pca
-from .phones import SILENCE, context_ids, map_labels, segment_index
+from .phones import SILENCE, apply_label_map, context_ids, map_labels, segment_index
 from .similarity import (
     distance_scale,
     phone_distances,
@@ -289,13 +289,14 @@ def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = 
              100 * pca.explained_ratio.sum())
 
     # 3. phone set and codebook
-    phone_set = sorted({SILENCE} | {_norm(s.label, label_map) for utt in loaded for s in utt.phones})
+    phone_set = sorted({SILENCE} | {apply_label_map(s.label, label_map)
+                                    for utt in loaded for s in utt.phones})
     pid = {p: i for i, p in enumerate(phone_set)}
     parts = []
     for k, (utt, nm) in enumerate(zip(loaded, normed, strict=True)):
         progress(0.45 + 0.5 * k / len(loaded), f"codebook: {utt.name}")
         phones = validate_phones(utt.phones, utt.duration, utt.name)
-        ids_ = [pid[_norm(s.label, label_map)] for s in phones]
+        ids_ = [pid[apply_label_map(s.label, label_map)] for s in phones]
         ctx = context_ids(ids_, config.context, pid[SILENCE])
         starts = np.array([s.start for s in phones])
         ends = np.array([s.end for s in phones])
@@ -325,15 +326,6 @@ def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = 
                  codebook=cb, means=means, distances=dist, scale=scale, coord_std=coord_std,
                  lip_corners=corners, train_utterances=[u.name for u in loaded],
                  corpus_fingerprint=fingerprint)
-
-
-def _norm(label: str, label_map: Mapping[str, str] | None) -> str:
-    from .phones import normalise_label
-
-    lab = normalise_label(label)
-    if label_map:
-        lab = normalise_label(label_map.get(label, label_map.get(lab, lab)))
-    return lab
 
 
 # ---------------------------------------------------------------------- synthesis
@@ -421,6 +413,34 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     pcs = smooth(fw.pcs, rate, config.smoothing, config.triangle_s, config.spline_knot_s)
     return Synthesis(times=times, lsf=w, raw_pcs=fw.pcs, pcs=pcs, markers=model.to_markers(pcs),
                      frames=fw, config=config, segments=segments, frame_segment=frame_seg)
+
+
+def write_trajectories(path: str | os.PathLike[str], markers: np.ndarray, model: Model,
+                       synthesis: Synthesis | None = None, overwrite: bool = True,
+                       which: str = "synthesized") -> Path:
+    """Write ``(T, M, 3)`` trajectories in the model's head frame as C3D, TSV/CSV or NPZ (by the
+    suffix). The NPZ also holds ``synthesis``'s times, smoothed and raw PCs, gamma, input LSF and
+    settings, and says ``which`` trajectories it holds (synthesized or original)."""
+    from .formats import write_c3d, write_marker_tsv
+
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".c3d":
+        write_c3d(path, markers, model.marker_rate, model.marker_names, overwrite)
+    elif suffix in (".tsv", ".txt", ".csv"):
+        write_marker_tsv(path, markers, model.marker_rate, model.marker_names, overwrite)
+    elif suffix == ".npz":
+        arrays = {"markers": markers, "marker_names": np.array(model.marker_names),
+                  "which": np.array(which)}
+        if synthesis is not None:
+            arrays.update(times=synthesis.times, pcs=synthesis.pcs, raw_pcs=synthesis.raw_pcs,
+                          gamma=synthesis.frames.gamma, lsf=synthesis.lsf,
+                          config=np.array(json.dumps(synthesis.config.to_dict())))
+        with atomic_write(path, overwrite) as tmp, open(tmp, "wb") as handle:
+            np.savez_compressed(handle, **arrays)
+    else:
+        raise InputError(path, "unknown format (use .c3d, .tsv, .csv or .npz)")
+    return path
 
 
 def resmooth(model: Model, result: Synthesis, method: str) -> np.ndarray:

@@ -44,6 +44,20 @@ def normalise_label(label: str) -> str:
     return SILENCE if lab in SILENCE_LABELS else lab
 
 
+def apply_label_map(label: str, table: Mapping[str, str] | None = None) -> str:
+    """A label normalised and mapped through ``table`` (looked up as written, then normalised).
+
+    Examples
+    --------
+    >>> apply_label_map("@", {"@": "AH0"}), apply_label_map("IY1", {"@": "ah"}), apply_label_map("T")
+    ('ah', 'iy', 't')
+    """
+    lab = normalise_label(label)
+    if table:
+        lab = normalise_label(table.get(label, table.get(lab, lab)))
+    return lab
+
+
 def map_labels(phones: Sequence[PhoneSegment], known: Sequence[str],
                table: Mapping[str, str] | None = None, path: str | None = None,
                strict: bool = False) -> list[PhoneSegment]:
@@ -58,9 +72,7 @@ def map_labels(phones: Sequence[PhoneSegment], known: Sequence[str],
     warned: set[str] = set()
     for seg in phones:
         raw = seg.label
-        lab = normalise_label(raw)
-        if table:
-            lab = normalise_label(table.get(raw, table.get(lab, lab)))
+        lab = apply_label_map(raw, table)
         if lab not in known_set:
             alt = FALLBACK.get(lab)
             if alt in known_set and not strict:

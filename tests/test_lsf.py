@@ -15,10 +15,12 @@ def _stable_poly(rng, order):
     for _ in range(order // 2):
         r, th = rng.uniform(0.5, 0.97), rng.uniform(0.05, np.pi - 0.05)
         poles += [r * np.exp(1j * th), r * np.exp(-1j * th)]
+    if order % 2:
+        poles.append(rng.uniform(-0.9, 0.9))
     return np.real(np.poly(poles))
 
 
-@pytest.mark.parametrize("order", [2, 10, 18])
+@pytest.mark.parametrize("order", [2, 9, 10, 18])
 def test_poly2lsf_matches_spectrum(order):
     spectrum = pytest.importorskip("spectrum", reason="the test extra provides spectrum")
     rng = np.random.default_rng(order)
