@@ -52,7 +52,13 @@ class SynthSettingsPanel(QWidget):
         self.nu.setToolTip("ν: eq 3 constant of the visual phoneme similarity")
         self.mode = QComboBox()
         self.mode.addItem("phonetic (labels restrict the search)", "phonetic")
-        self.mode.addItem("acoustic only (whole codebook)", "acoustic")
+        self.mode.addItem("acoustic only, indexed (fast)", "acoustic")
+        self.mode.addItem("acoustic only, whole codebook (paper, slow)", "acoustic-full")
+        self.mode.setToolTip(
+            "phonetic: eq 4 picks N context-phones from the labels, eqs 5-8 weight their codewords.\n"
+            "acoustic only, indexed: no labels; eqs 6-8 weight the codewords nearest to each frame by\n"
+            "eq 5, found in the model's LSF index (docs/algorithm.md gives the accuracy cost).\n"
+            "acoustic only, whole codebook: eqs 5-8 over every codeword, as the paper does.")
         self.smoothing = QComboBox()
         for label, value in (("triangular, 100 ms", "triangular"), ("spline", "spline"),
                              ("none", "none")):
@@ -110,16 +116,24 @@ class SynthSettingsPanel(QWidget):
         self.nu.setEnabled(cfg.nu is not None)
         if cfg.nu is not None:
             self.nu.setValue(cfg.nu)
-        self.mode.setCurrentIndex(max(0, self.mode.findData(cfg.mode)))
+        key = "acoustic-full" if cfg.mode == "acoustic" and cfg.acoustic_prefilter is None else cfg.mode
+        self.mode.setCurrentIndex(max(0, self.mode.findData(key)))
         self.smoothing.setCurrentIndex(max(0, self.smoothing.findData(cfg.smoothing)))
         for w in widgets:
             w.blockSignals(False)
 
     def config(self) -> SynthConfig:
+        key = self.mode.currentData()
+        search = {}
+        if key == "acoustic-full":
+            search = {"acoustic_prefilter": None}
+        elif self._base.acoustic_prefilter is None:      # back from the whole codebook: the default K
+            search = {"acoustic_prefilter": SynthConfig().acoustic_prefilter}
         return self._base.with_(
             n_context_phones=self.n.value(), context=self.c.value(), xi=self.xi.value(),
             nu=None if self.nu_default.isChecked() else self.nu.value(),
-            mode=self.mode.currentData(), smoothing=self.smoothing.currentData())
+            mode="acoustic" if key == "acoustic-full" else key,
+            smoothing=self.smoothing.currentData(), **search)
 
     def _on_nu_default(self, checked: bool) -> None:
         self.nu.setEnabled(not checked)

@@ -1,13 +1,18 @@
-"""Codebook scaling benchmark: acoustic-only synthesis (paper section 2.3, eq 5 over the whole
-codebook 5L) as the codebook grows x1, x4, x16, and what the nearest-neighbour prefilter
-(``SynthConfig(acoustic_prefilter=K)``) buys, with its accuracy cost.
+"""Codebook scaling benchmark: acoustic-only synthesis (paper section 2.3, no labels) as the
+codebook grows x1, x4, x16, with three ways of choosing the codewords each frame weights:
+
+* full search: eq 5 over the whole codebook 5L, as the paper defines the mode (time linear in 5L);
+* exact prefilter: the K codewords nearest by eq 5, found by comparing every codeword
+  (``SynthConfig(acoustic_probe=None)``), then eqs 6-8 over those K;
+* indexed (the default): the same K nearest looked up in the model's coarse k-means LSF index,
+  opening ``acoustic_probe`` cells (``engine.lsf_index``; time about sqrt(5L)).
 
 The larger codebooks replicate the trained one with jitter (LSFs + N(0, 0.01 rad), re-sorted;
-PCs + 5 % of each PC's standard deviation), which keeps the codeword density realistic. The
-accuracy cost of the prefilter is the correlation between its synthesized trajectories and the
-full search's on the same input (1 = identical), averaged over the moving coordinates as in the
-"whole face" figure, and, for the x1 codebook, the whole-face correlation with the original
-markers on test utterances, scored as in Table 2.
+PCs + 5 % of each PC's standard deviation), which keeps the codeword density realistic; their
+index is rebuilt (timed on its own row). The accuracy cost of a search is the correlation between
+its synthesized trajectories and the full search's on the same input (1 = identical), averaged over
+the moving coordinates as in the "whole face" figure, and, for the x1 codebook, the whole-face
+correlation with the original markers on test utterances, scored as in Table 2.
 """
 
 from __future__ import annotations
@@ -32,16 +37,18 @@ log = logging.getLogger(__name__)
 
 FACTORS = (1, 4, 16)
 SMOKE_FACTORS = (1, 4)
+#: K of the indexed search; the default K (SynthConfig) is the one judged against the aims
 PREFILTERS = (32, 128, 512)
 SMOKE_PREFILTERS = (32,)
 INPUT_S = 5.0
 SMOKE_INPUT_S = 1.0
 LSF_JITTER = 0.01
 PC_JITTER = 0.05
-#: test utterances scored against the original markers (full search vs prefilter, x1 codebook)
+#: test utterances scored against the original markers (x1 codebook)
 N_TEST_UTTS = 8
-#: prefilter runs whose distance temporaries would exceed this are skipped (shared machine)
+#: exact-prefilter runs whose distance temporaries would exceed this are skipped (shared machine)
 MAX_TEMP_BYTES = 2.5 * 1024**3
+FULL = SynthConfig(mode="acoustic", acoustic_prefilter=None)
 
 
 def prefilter_temp_bytes(n_frames: int, n_codewords: int, order: int) -> float:
@@ -84,97 +91,102 @@ def _timed(model: Model, audio: np.ndarray, rate: int, cfg: SynthConfig) -> tupl
     return tm, res  # type: ignore[return-value]
 
 
-def original_correlation(model: Model, ctx: BenchContext, prefilter: int | None) -> float:
+def original_correlation(model: Model, ctx: BenchContext, cfg: SynthConfig) -> float:
     """Mean whole-face correlation with the original markers, acoustic-only, on test utterances."""
     scores = []
     for utt in ctx.test_utts[:N_TEST_UTTS]:
-        res = synthesize(model, utt.audio, utt.sample_rate, None,
-                         SynthConfig(mode="acoustic", acoustic_prefilter=prefilter),
-                         n_frames=utt.n_frames)
+        res = synthesize(model, utt.audio, utt.sample_rate, None, cfg, n_frames=utt.n_frames)
         mask = speech_mask(utt.audio, utt.sample_rate, res.times)
         orig = model.normalise_markers(utt.markers)
         scores.append(trajectory_correlations(orig, res.markers, mask, model)["whole_face"])
     return float(np.nanmean(scores)) if scores else float("nan")
 
 
+def _exponent(t: dict, key_lo: object, key_hi: object, lo: int, hi: int) -> float:
+    """``e`` in time ~ size^e between the codebooks x``lo`` and x``hi``."""
+    return math.log(t[key_hi] / t[key_lo]) / math.log(hi / lo)
+
+
 def run(ctx: BenchContext, factors: Sequence[int] | None = None,
         prefilters: Sequence[int] | None = None, seconds: float | None = None) -> list[BenchRow]:
-    """Acoustic-only synthesis time per codebook size, full search and prefiltered."""
+    """Acoustic-only synthesis time per codebook size: full search, exact prefilter, indexed."""
     factors = tuple(factors or (SMOKE_FACTORS if ctx.smoke else FACTORS))
     prefilters = tuple(prefilters or (SMOKE_PREFILTERS if ctx.smoke else PREFILTERS))
     seconds = seconds or (SMOKE_INPUT_S if ctx.smoke else INPUT_S)
+    default = SynthConfig(mode="acoustic")
+    k_default, probe = default.acoustic_prefilter, default.acoustic_probe
+    k_exact = k_default if k_default in prefilters else prefilters[len(prefilters) // 2]
     base = ctx.model
     audio, rate, _ = concatenate_input(ctx.test_utts or ctx.train_utts, seconds)
     rng = np.random.default_rng(0)
     rows: list[BenchRow] = []
-    full_times: dict[int, float] = {}
-    pre_times: dict[tuple[int, int], float] = {}
-    full_cpu: dict[int, float] = {}
-    pre_cpu: dict[tuple[int, int], float] = {}
-    synthesize(base, audio[: rate // 2], rate, None, SynthConfig(mode="acoustic"))  # warm-up
+    wall: dict[tuple, float] = {}
+    cpu: dict[tuple, float] = {}
+    synthesize(base, audio[: rate // 2], rate, None, FULL)  # warm-up
+    judged = not ctx.smoke
+
+    def add(key: tuple, name: str, tm: Timing, note: str, aim: str = "", ok: bool | None = None) -> None:
+        wall[key], cpu[key] = tm.wall, tm.cpu
+        rows.append(BenchRow("scaling", name, seconds / tm.wall, "x RT", aim=aim, ok=ok, note=note,
+                             cpu=seconds / tm.cpu))
+
     for factor in factors:
-        model = replace(base, codebook=replicate_codebook(base.codebook, factor, rng))
+        model = replace(base, codebook=replicate_codebook(base.codebook, factor, rng), index=None)
         size = model.codebook.lsf.shape[0]
-        tm_full, full = _timed(model, audio, rate, SynthConfig(mode="acoustic"))
-        t_full = tm_full.wall
-        full_times[factor] = t_full
-        full_cpu[factor] = tm_full.cpu
-        rows.append(BenchRow("scaling", f"acoustic, full search, codebook x{factor}",
-                             seconds / t_full, "x RT",
-                             aim=">= 50x" if factor == 1 else "",
-                             ok=None if ctx.smoke or factor != 1 else seconds / t_full >= 50,
-                             note=f"{size} codewords; {t_full * 1000 / full.times.size:.2f} ms/frame",
-                             cpu=seconds / tm_full.cpu))
+        tm_ix, _ = timed(model.lsf_index)
+        rows.append(BenchRow("scaling", f"LSF index build (k-means), codebook x{factor}", tm_ix.wall,
+                             "s", note=f"{model.lsf_index().n_cells} cells for {size} codewords "
+                                       f"(at training: part of train())", cpu=tm_ix.cpu))
+        tm_full, full = _timed(model, audio, rate, FULL)
+        add(("full", factor), f"acoustic, full search (paper), codebook x{factor}", tm_full,
+            f"{size} codewords; {tm_full.wall * 1000 / full.times.size:.2f} ms/frame")
+        temp = prefilter_temp_bytes(full.times.size, size, base.config.lpc_order)
+        if k_exact < size and temp <= MAX_TEMP_BYTES:
+            cfg = default.with_(acoustic_prefilter=k_exact, acoustic_probe=None)
+            tm, res = _timed(model, audio, rate, cfg)
+            add(("exact", factor), f"acoustic, exact prefilter K={k_exact}, codebook x{factor}", tm,
+                f"{tm_full.wall / tm.wall:.1f}x faster than full search; correlation with full "
+                f"search {agreement(model, full.markers, res.markers):.4f}")
         for k in prefilters:
             if k >= size:
                 continue
-            temp = prefilter_temp_bytes(full.times.size, size, base.config.lpc_order)
-            if temp > MAX_TEMP_BYTES:
-                rows.append(BenchRow("scaling", f"acoustic, prefilter K={k}, codebook x{factor}",
-                                     float("nan"), "x RT",
-                                     note=f"skipped: nearest_codewords would allocate "
-                                          f"{temp / 1024**3:.1f} GiB of temporaries"))
-                continue
-            tm_pre, pre = _timed(model, audio, rate, SynthConfig(mode="acoustic", acoustic_prefilter=k))
-            t_pre = tm_pre.wall
-            pre_times[(factor, k)] = t_pre
-            pre_cpu[(factor, k)] = tm_pre.cpu
-            agree = agreement(model, full.markers, pre.markers)
-            rows.append(BenchRow("scaling", f"acoustic, prefilter K={k}, codebook x{factor}",
-                                 seconds / t_pre, "x RT",
-                                 note=f"{t_full / t_pre:.1f}x faster than full search; "
-                                      f"correlation with full search {agree:.4f}",
-                                 cpu=seconds / tm_pre.cpu))
-        log.info("scaling x%d (%d codewords): full %.2f s", factor, size, t_full)
+            cfg = default.with_(acoustic_prefilter=k)
+            tm, res = _timed(model, audio, rate, cfg)
+            is_default = k == k_default
+            add(("index", k, factor),
+                f"acoustic, indexed K={k}, probe {probe}{' (default)' if is_default else ''}, "
+                f"codebook x{factor}", tm,
+                f"{tm_full.wall / tm.wall:.1f}x faster than full search; correlation with full "
+                f"search {agreement(model, full.markers, res.markers):.4f}",
+                aim=">= 50x" if is_default and factor == 1 else "",
+                ok=judged and seconds / tm.wall >= 50 if is_default and factor == 1 else None)
+        log.info("scaling x%d (%d codewords): full %.2f s", factor, size, tm_full.wall)
     lo, hi = min(factors), max(factors)
     if hi > lo:
-        def exponent(t_lo: float, t_hi: float) -> float:
-            return math.log(t_hi / t_lo) / math.log(hi / lo)
-
-        e_full = exponent(full_times[lo], full_times[hi])
-        rows.append(BenchRow("scaling", f"growth exponent, full search (time ~ size^e, x{lo}..x{hi})",
-                             e_full, "e", aim="< 1", ok=None if ctx.smoke else e_full < 1,
-                             cpu=exponent(full_cpu[lo], full_cpu[hi])))
-        for k in prefilters:
-            have = sorted(f for f in factors if (f, k) in pre_times)
-            if len(have) < 2:
+        span = f"x{lo}..x{hi}"
+        series = [("full", "full search (paper)", ("full",)),
+                  ("exact", f"exact prefilter K={k_exact}", ("exact",)),
+                  *[(f"index{k}", f"indexed K={k}" + (" (default)" if k == k_default else ""),
+                     ("index", k)) for k in prefilters]]
+        for tag, label, key in series:
+            if (*key, lo) not in wall or (*key, hi) not in wall:
                 continue
-            a, b = have[0], have[-1]
-
-            def exp_k(t: dict[tuple[int, int], float], a: int = a, b: int = b, k: int = k) -> float:
-                return math.log(t[(b, k)] / t[(a, k)]) / math.log(b / a)
-
-            e = exp_k(pre_times)
-            rows.append(BenchRow("scaling", f"growth exponent, prefilter K={k} (x{a}..x{b})", e, "e",
-                                 aim="< 1", ok=None if ctx.smoke else e < 1, cpu=exp_k(pre_cpu)))
+            e = _exponent(wall, (*key, lo), (*key, hi), lo, hi)
+            is_default = tag == f"index{k_default}"
+            rows.append(BenchRow("scaling", f"growth exponent, {label} (time ~ size^e, {span})", e, "e",
+                                 aim="< 1" if is_default else "",
+                                 ok=(judged and e < 1) if is_default else None,
+                                 cpu=_exponent(cpu, (*key, lo), (*key, hi), lo, hi)))
     # accuracy against the original markers (x1 codebook)
     if ctx.test_utts:
         n = min(len(ctx.test_utts), N_TEST_UTTS)
-        c_full = original_correlation(base, ctx, None)
-        rows.append(BenchRow("scaling", "test whole-face correlation, acoustic full search", c_full,
-                             "corr", note=f"first {n} test utterances, triangular"))
-        k = prefilters[len(prefilters) // 2]
-        c_pre = original_correlation(base, ctx, k)
-        rows.append(BenchRow("scaling", f"test whole-face correlation, acoustic prefilter K={k}",
-                             c_pre, "corr", note=f"change {c_pre - c_full:+.4f} vs full search"))
+        c_full = original_correlation(base, ctx, FULL)
+        rows.append(BenchRow("scaling", "test whole-face correlation, acoustic full search (paper)",
+                             c_full, "corr", note=f"first {n} test utterances, triangular"))
+        for label, cfg in ((f"exact prefilter K={k_exact}",
+                            default.with_(acoustic_prefilter=k_exact, acoustic_probe=None)),
+                           (f"indexed K={k_default} (default)", default)):
+            c = original_correlation(base, ctx, cfg)
+            rows.append(BenchRow("scaling", f"test whole-face correlation, acoustic {label}", c,
+                                 "corr", note=f"change {c - c_full:+.4f} vs full search"))
     return rows

@@ -56,7 +56,7 @@ class TerminalProgress:
 def _train_config(args: argparse.Namespace) -> TrainConfig:
     kw = {}
     for name in ("lpc_order", "context", "nu", "codewords_per_phone", "placement",
-                 "distance_scale", "max_gap_s", "variance_target"):
+                 "distance_scale", "max_gap_s", "variance_target", "index_cells"):
         val = getattr(args, name, None)
         if val is not None:
             kw[name] = val
@@ -67,10 +67,14 @@ def _train_config(args: argparse.Namespace) -> TrainConfig:
 
 def _synth_config(args: argparse.Namespace) -> SynthConfig:
     kw = {}
-    for name in ("n_context_phones", "xi", "nu", "mode", "smoothing", "acoustic_prefilter"):
+    for name in ("n_context_phones", "xi", "nu", "mode", "smoothing"):
         val = getattr(args, name, None)
         if val is not None:
             kw[name] = val
+    for name in ("acoustic_prefilter", "acoustic_probe"):       # "all" is stored as ALL -> None
+        val = getattr(args, name, None)
+        if val is not None:
+            kw[name] = None if val == ALL else val
     if getattr(args, "synth_context", None) is not None:
         kw["context"] = args.synth_context
     return SynthConfig(**kw)
@@ -102,7 +106,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
     if args.labels:
         phones = read_labels(args.labels, rate)
     elif cfg.mode == "phonetic":
-        log.info("no labels given: acoustic-only synthesis over the whole codebook")
+        log.info("no labels given: acoustic-only synthesis")
         cfg = cfg.with_(mode="acoustic")
     label_map = _read_label_map(args.label_map) if args.label_map else None
     res = synthesize(model, audio, rate, phones, cfg, label_map=label_map,
@@ -292,6 +296,8 @@ def _add_train_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--distance-scale", choices=["max", "median", "none"],
                    help="normalisation of D before eq 3 (default max)")
     g.add_argument("--max-gap-s", type=float, help="longest marker gap filled (default 0.1 s)")
+    g.add_argument("--index-cells", type=int,
+                   help="cells of the LSF index for acoustic-only synthesis (default sqrt(5L))")
 
 
 def _add_synth_options(p: argparse.ArgumentParser, nu: bool = True) -> None:
@@ -303,8 +309,28 @@ def _add_synth_options(p: argparse.ArgumentParser, nu: bool = True) -> None:
     g.add_argument("--synth-context", type=int, help="context C used in eq 4 (default 3)")
     g.add_argument("--mode", choices=["phonetic", "acoustic"], help="default phonetic")
     g.add_argument("--smoothing", choices=["triangular", "spline", "none"])
-    g.add_argument("--acoustic-prefilter", type=int,
-                   help="acoustic mode: keep only this many nearest codewords per frame")
+    g.add_argument("--acoustic-prefilter", type=_count_or_all, metavar="K|all",
+                   help="acoustic mode: weight the K codewords nearest to each frame (default "
+                        "128); 'all' weights the whole codebook, as the paper does (slow)")
+    g.add_argument("--acoustic-probe", type=_count_or_all, metavar="P|all",
+                   help="acoustic mode: find the K nearest in P cells of the model's LSF index "
+                        "(default 8); 'all' compares every codeword (exact, slower)")
+
+
+ALL = -1
+
+
+def _count_or_all(text: str) -> int:
+    """A positive count, or ``all`` (returned as :data:`ALL`)."""
+    if text.strip().lower() == "all":
+        return ALL
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive whole number or 'all', got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive whole number or 'all', got {text!r}")
+    return value
 
 
 def build_parser() -> argparse.ArgumentParser:

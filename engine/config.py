@@ -34,6 +34,8 @@ class TrainConfig:
     nu : the constant of eq 3.
     distance_scale : how D (eq 2) is normalised before eq 3: ``max`` divides by the largest
         distance, ``median`` by the median off-diagonal distance, ``none`` leaves it in PC units.
+    index_cells : cells of the coarse k-means index over the codebook LSFs used by acoustic-only
+        synthesis (``engine.lsf_index``); ``None`` takes ``round(sqrt(5L))``.
     """
 
     audio_rate: int = 16000
@@ -48,6 +50,7 @@ class TrainConfig:
     placement: Placement = "centres"
     nu: float = 10.0
     distance_scale: DistanceScale = "max"
+    index_cells: int | None = None
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -73,8 +76,11 @@ class SynthConfig:
     smoothing : ``triangular`` (100 ms zero-phase window), ``spline`` or ``none``.
     triangle_s : the triangular window's total duration.
     spline_knot_s : knot spacing of the spline smoother.
-    acoustic_prefilter : in acoustic mode, keep only this many nearest codewords per frame
-        before eqs 6-8 (``None`` searches all 5L).
+    acoustic_prefilter : in acoustic mode, keep only the K codewords nearest to each frame by
+        eq 5 before eqs 6-8; ``None`` weights all 5L codewords, as the paper does (slow).
+    acoustic_probe : how the K nearest are found: among the members of this many cells of the
+        model's coarse LSF index (``engine.lsf_index``, fast, growth about sqrt(5L)); ``None``
+        compares every codeword (exact, linear in 5L).
     """
 
     n_context_phones: int = 3
@@ -88,7 +94,8 @@ class SynthConfig:
     smoothing: Smoothing = "triangular"
     triangle_s: float = 0.1
     spline_knot_s: float = 0.1
-    acoustic_prefilter: int | None = None
+    acoustic_prefilter: int | None = 128
+    acoustic_probe: int | None = 8
 
     def with_(self, **changes) -> SynthConfig:
         """A copy with some fields changed."""

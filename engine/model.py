@@ -22,6 +22,7 @@ from .data import PhoneSegment, Utterance
 from .errors import InputError, ModelFileError
 from .formats import atomic_write, validate_phones
 from .lsf import lsf_at
+from .lsf_index import LsfIndex, build_index
 from .markers import fill_gaps, reference_pose, remove_head_motion
 from .pca import PCA, fit_pca
 from .phones import SILENCE, apply_label_map, context_ids, map_labels, segment_index
@@ -64,6 +65,8 @@ class Model:
         applied to D before eq 3.
     coord_std : ``(M * 3,)`` standard deviation of every head-normalised coordinate in training.
     train_utterances : ids of the training utterances (codebook ``token_utt`` indexes it).
+    index : the coarse index over the codebook LSFs for acoustic-only synthesis; built by
+        :func:`train`, or on first use by :meth:`lsf_index` (older model files have none).
     """
 
     config: TrainConfig
@@ -83,6 +86,7 @@ class Model:
     lip_corners: list[int] = field(default_factory=list)
     train_utterances: list[str] = field(default_factory=list)
     corpus_fingerprint: str = ""
+    index: LsfIndex | None = None
 
     # ------------------------------------------------------------------ derived quantities
     @property
@@ -105,6 +109,13 @@ class Model:
         coeffs = np.zeros(self.pca.n_components)
         coeffs[component] = value
         return self.pca.inverse(coeffs).reshape(self.n_markers, 3)
+
+    def lsf_index(self) -> LsfIndex:
+        """The coarse LSF index of the codebook (``engine.lsf_index``), built here and kept if the
+        model has none or has one for a codebook of another size."""
+        if self.index is None or self.index.n_codewords != self.codebook.lsf.shape[0]:
+            self.index = build_index(self.codebook.lsf, self.config.index_cells)
+        return self.index
 
     def normalise_markers(self, markers: np.ndarray) -> np.ndarray:
         """Fill short gaps and remove head motion: ``(T, M, 3)`` in the model's head frame."""
@@ -153,6 +164,9 @@ class Model:
             "cb_token_start": self.codebook.token_start, "cb_token_end": self.codebook.token_end,
             "means": self.means, "distances": self.distances, "coord_std": self.coord_std,
         }
+        if self.index is not None:
+            arrays.update(ix_centroids=self.index.centroids, ix_order=self.index.order,
+                          ix_offsets=self.index.offsets)
         with atomic_write(path, overwrite) as tmp, open(tmp, "wb") as handle:
             np.savez_compressed(handle, **arrays)
         return path
@@ -185,6 +199,8 @@ class Model:
                       float(meta["pca_total_variance"]))
             cb = Codebook(a["cb_contexts"], a["cb_lsf"], a["cb_pcs"], a["cb_token_utt"],
                           a["cb_token_start"], a["cb_token_end"], int(meta["n_per_phone"]))
+            index = (LsfIndex(a["ix_centroids"], a["ix_order"], a["ix_offsets"])
+                     if "ix_centroids" in a else None)
             return cls(
                 config=TrainConfig.from_dict(meta["config"]), phones=list(meta["phones"]),
                 marker_names=list(meta["marker_names"]), marker_rate=float(meta["marker_rate"]),
@@ -193,7 +209,7 @@ class Model:
                 distances=a["distances"], scale=float(meta["scale"]), coord_std=a["coord_std"],
                 lip_corners=list(meta.get("lip_corners", [])),
                 train_utterances=list(meta.get("train_utterances", [])),
-                corpus_fingerprint=meta.get("corpus_fingerprint", ""),
+                corpus_fingerprint=meta.get("corpus_fingerprint", ""), index=index,
             )
         except KeyError as exc:
             raise ModelFileError(path, f"model file is incomplete: missing {exc}") from exc
@@ -320,12 +336,15 @@ def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = 
     means = phone_means(cb.pcs, cb.codeword_phone(), len(phone_set))
     dist = phone_distances(means)
     scale = distance_scale(dist, config.distance_scale)
+    # 5. the coarse LSF index for acoustic-only synthesis
+    progress(0.97, "LSF index")
+    index = build_index(cb.lsf, config.index_cells)
     progress(1.0, "done")
     return Model(config=config, phones=phone_set, marker_names=names, marker_rate=rate,
                  fixed=fixed, reference=reference, upper_lip=upper, lower_lip=lower, pca=pca,
                  codebook=cb, means=means, distances=dist, scale=scale, coord_std=coord_std,
                  lip_corners=corners, train_utterances=[u.name for u in loaded],
-                 corpus_fingerprint=fingerprint)
+                 corpus_fingerprint=fingerprint, index=index)
 
 
 # ---------------------------------------------------------------------- synthesis
@@ -372,8 +391,10 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     """Synthesize face point trajectories from speech (paper section 2.3).
 
     With ``phones`` and ``mode="phonetic"``: per input phone, the top-N context-phones by eq 4,
-    and per frame eqs 5-8 over their 5N codewords. Otherwise (acoustic-only) eqs 5-8 over the whole
-    codebook. Then smoothing, and the PCs back to ``(T, M, 3)`` markers.
+    and per frame eqs 5-8 over their 5N codewords. Otherwise (acoustic-only) eqs 5-8 over the
+    ``config.acoustic_prefilter`` codewords nearest to each frame, found through the model's LSF
+    index (``acoustic_probe`` cells), or over the whole codebook as the paper does
+    (``acoustic_prefilter=None``). Then smoothing, and the PCs back to ``(T, M, 3)`` markers.
 
     ``n_frames`` defaults to every marker frame inside the audio. ``source`` names the input in
     error messages.
@@ -404,6 +425,10 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         segments = [SegmentChoice(seg, ctx[i], top[i], scores[i]) for i, seg in enumerate(segs)]
         frame_seg = segment_index(segs, times)
         candidates = cb.codewords_of(top)[frame_seg]
+    elif config.mode == "acoustic" and config.acoustic_prefilter is not None \
+            and config.acoustic_probe is not None:
+        candidates = model.lsf_index().nearest(w, cb.lsf, config.acoustic_prefilter,
+                                               config.acoustic_probe)
     elif config.mode == "acoustic":
         candidates = nearest_codewords(w, cb.lsf, config.acoustic_prefilter)
     else:

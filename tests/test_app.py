@@ -27,6 +27,7 @@ from app.browser import normalise_text
 from app.main import build_window
 from app.main_window import DEFAULT_SENTENCE, MainWindow
 from engine.cli import default_corpus
+from engine.config import SynthConfig
 
 pytestmark = pytest.mark.gui
 
@@ -184,6 +185,25 @@ def test_changing_n_resynthesizes(window, qtbot):
                     and win.view.synthesis.config.n_context_phones == 2, timeout=WAIT_MS)
     qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
     assert win.view.utterance.name == other and win.settings.n.value() == 2
+
+
+def test_acoustic_search_choice(window, qtbot):
+    """The search menu: indexed acoustic-only weights K codewords per frame, the whole-codebook
+    entry (the paper's) weights all 5L, and phonetic comes back with the default K."""
+    win = window
+    n_codewords = len(win.model.codebook.lsf)
+    mode = win.settings.mode
+    for key, width in (("acoustic", SynthConfig().acoustic_prefilter), ("acoustic-full", n_codewords)):
+        with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+            mode.setCurrentIndex(mode.findData(key))
+        qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+        synthesis = win.view.synthesis
+        assert synthesis.config.mode == "acoustic"
+        assert synthesis.frames.candidates.shape == (win.view.n_frames, width)
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        mode.setCurrentIndex(mode.findData("phonetic"))
+    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    assert win.synth_config == SynthConfig(n_context_phones=win.synth_config.n_context_phones)
 
 
 def _colour_count(img: np.ndarray, hex_colour: str, tol: float = 60.0) -> int:

@@ -31,9 +31,12 @@ def test_smoke_table(toy: Path, tmp_path: Path, capsys) -> None:
         "LSF extraction (lsf_at)", "PCA (fit_pca)", "train() total",
         "train() peak traced memory (tracemalloc)",
         "phonetic, 1 s input", "phonetic, 2 s input", "acoustic, 1 s input", "acoustic, 2 s input",
-        "acoustic, full search, codebook x1", "acoustic, full search, codebook x4",
-        "acoustic, prefilter K=32, codebook x1", "growth exponent, full search",
-        "test whole-face correlation, acoustic full search",
+        "LSF index build (k-means), codebook x4",
+        "acoustic, full search (paper), codebook x1", "acoustic, full search (paper), codebook x4",
+        "acoustic, exact prefilter K=32, codebook x1", "acoustic, indexed K=32, probe 8, codebook x4",
+        "growth exponent, full search (paper)", "growth exponent, indexed K=32",
+        "test whole-face correlation, acoustic full search (paper)",
+        "test whole-face correlation, acoustic indexed K=128 (default)",
     ]
     for name in expected:
         assert name in printed, name

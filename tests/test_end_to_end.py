@@ -39,7 +39,7 @@ def scores(default_model, default_corpus):
     # all of the test split; a third of the training split (resynthesis is the upper limit)
     sub = type(info)(**{**info.__dict__, "train": info.train[::3]})
     corpus = type(default_corpus)(default_corpus.root, sub)
-    configs = [SynthConfig(), SynthConfig(mode="acoustic", acoustic_prefilter=512)]
+    configs = [SynthConfig(), SynthConfig(mode="acoustic")]
     return evaluate(default_model, corpus, ("train", "test"), configs, ("triangular", "spline"))
 
 

@@ -39,6 +39,8 @@ def test_save_load_round_trip_bit_for_bit(toy_model, tmp_path):
         assert np.array_equal(getattr(back.pca, name), getattr(toy_model.pca, name))
     for name in ("contexts", "lsf", "pcs", "token_utt", "token_start", "token_end"):
         assert np.array_equal(getattr(back.codebook, name), getattr(toy_model.codebook, name))
+    for name in ("centroids", "order", "offsets"):
+        assert np.array_equal(getattr(back.index, name), getattr(toy_model.index, name))
     assert back.config == toy_model.config and back.phones == toy_model.phones
     assert back.marker_names == toy_model.marker_names and back.scale == toy_model.scale
     with zipfile.ZipFile(path) as z:
@@ -81,12 +83,21 @@ def test_synthesis_outputs(toy_model, toy_corpus):
     assert toy_model.codebook.centre[seg.chosen[0]] == seg.context[3]   # centre phone matches
     spline = resmooth(toy_model, res, "spline")
     assert spline.shape == res.markers.shape and not np.allclose(spline, res.markers)
-    acoustic = synthesize(toy_model, utt.audio, utt.sample_rate, None,
-                          SynthConfig(mode="acoustic"), n_frames=t)
-    assert acoustic.frames.candidates.shape[1] == len(toy_model.codebook.lsf)   # all 5L
-    pre = synthesize(toy_model, utt.audio, utt.sample_rate, None,
-                     SynthConfig(mode="acoustic", acoustic_prefilter=50), n_frames=t)
-    assert pre.frames.candidates.shape[1] == 50
+    full = synthesize(toy_model, utt.audio, utt.sample_rate, None,
+                      SynthConfig(mode="acoustic", acoustic_prefilter=None), n_frames=t)
+    assert full.frames.candidates.shape[1] == len(toy_model.codebook.lsf)   # all 5L
+    exact = synthesize(toy_model, utt.audio, utt.sample_rate, None,
+                       SynthConfig(mode="acoustic", acoustic_prefilter=50, acoustic_probe=None),
+                       n_frames=t)
+    assert exact.frames.candidates.shape[1] == 50
+    indexed = synthesize(toy_model, utt.audio, utt.sample_rate, None,
+                         SynthConfig(mode="acoustic", acoustic_prefilter=50), n_frames=t)
+    assert indexed.frames.candidates.shape[1] == 50
+    # the index finds most of the exact 50 nearest, and the faces agree closely
+    found = [len(np.intersect1d(a, b)) / 50 for a, b in
+             zip(indexed.frames.candidates, exact.frames.candidates, strict=True)]
+    assert np.mean(found) > 0.9
+    assert np.abs(indexed.markers - exact.markers).max() < 0.05 * np.ptp(exact.markers)
 
 
 def test_synthesis_bad_input(toy_model, toy_corpus):

@@ -60,7 +60,8 @@ def test_markdown_has_every_section(report: Path, small_corpus: Path) -> None:
     # the paper's numbers beside ours
     for value in ("0.9239", "0.7338", "0.8468", "0.7230"):
         assert value in text
-    for method in ("phonetic (N = 3)", "acoustic-only", "viseme lookup", "ridge regression"):
+    for method in ("phonetic (N = 3)", "acoustic-only", "acoustic-only, indexed", "viseme lookup",
+                   "ridge regression"):
         assert method in text
     # the paper's sentence was found (test split) and named
     assert f'"{FIGURE4_TEXT}.' in text and "not in the corpus" not in text
@@ -76,7 +77,7 @@ def test_json_holds_all_numbers(report: Path) -> None:
         for m in ("whole_face", "lower_lip", "upper_lip"):
             assert -1 <= r[m] <= 1
     modes = {r["mode"] for r in data["comparisons"]}
-    assert modes == {"phonetic", "acoustic", "viseme", "ridge"}
+    assert modes == {"phonetic", "acoustic", "acoustic-indexed", "viseme", "ridge"}
     assert data["sweep"]["ns"] == [1, 2]
     assert len(data["sweep"]["test"]["whole_face"]) == 2
     assert data["figure4"]["found"] and data["figure4"]["split"] == "test"
