@@ -150,8 +150,9 @@ def write_markdown(path: Path, rows: Sequence[BenchRow], ctx: BenchContext, elap
         "in a second call.",
         "- Scaling replicates the trained codebook with jitter; the growth exponent e fits "
         "time ~ size^e between the smallest and largest codebook, on a fixed input.",
-        "- The machine is shared (2 cores, other jobs running): numbers are the best of a few "
-        "runs where the input is short, a single run otherwise.",
+        "- The machine is shared (2 cores, other jobs running): synthesis of up to 10 s of input is "
+        "timed as the best of at least 3 runs and 0.5 s of repeats (as `timeit` does), longer inputs "
+        "and the scaling rows by a single run.",
         "",
     ]
     path.parent.mkdir(parents=True, exist_ok=True)

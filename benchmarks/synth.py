@@ -42,7 +42,7 @@ def run(ctx: BenchContext, durations: Sequence[float] | None = None) -> list[Ben
                 synthesize(model, audio, rate, labels, cfg)
 
             call()  # warm-up
-            tm = best_time(call, repeat=3 if seconds <= 10 else 1)
+            tm = best_time(call, repeat=3 if seconds <= 10 else 1, min_total_s=0.5 if seconds <= 10 else 0.0)
             t = tm.wall
             rtf = seconds / t
             aim = AIMS[mode]

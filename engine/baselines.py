@@ -22,7 +22,6 @@ import numpy as np
 
 from .data import Utterance
 from .evaluation import EvalConfig, UtteranceScore, speech_mask, trajectory_correlations
-from .lsf import lsf_at
 from .model import Model
 from .phones import normalise_label, segment_index
 from .smoothing import smooth
@@ -71,10 +70,8 @@ def frame_data(model: Model, utt: Utterance, eval_config: EvalConfig | None = No
     """Features, targets and the speech mask of one utterance with markers."""
     if utt.markers is None:
         raise ValueError(f"{utt.name}: no markers")
-    mc = model.config
     times = utt.frame_times()
-    lsf = lsf_at(utt.audio, utt.sample_rate, times, mc.lpc_order, mc.window_s, mc.audio_rate,
-                 mc.preemphasis)
+    lsf = model.input_lsf(utt.audio, utt.sample_rate, times)
     original = model.normalise_markers(utt.markers)
     pcs = model.to_pcs(original)
     return FrameData(utt.name, lsf, pcs, frame_phone_ids(model, utt, times), original,

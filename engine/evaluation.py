@@ -173,11 +173,13 @@ def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
                        smoothings: Sequence[str] = ("triangular", "spline"),
                        eval_config: EvalConfig | None = None,
                        synthesis: Synthesis | None = None, original: np.ndarray | None = None,
-                       speech: np.ndarray | None = None) -> list[UtteranceScore]:
+                       speech: np.ndarray | None = None,
+                       lsf: np.ndarray | None = None) -> list[UtteranceScore]:
     """Synthesize one utterance and score each smoothing against its original markers.
 
-    ``original`` (head-normalised markers) and ``speech`` (the speech-frame mask) may be passed
-    when already computed, e.g. when one utterance is scored under several configs.
+    ``original`` (head-normalised markers), ``speech`` (the speech-frame mask) and ``lsf`` (the
+    input LSFs, :meth:`Model.input_lsf`) may be passed when already computed, e.g. when one
+    utterance is scored under several configs.
     """
     config = config or SynthConfig()
     if utt.markers is None:
@@ -185,7 +187,7 @@ def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
     if original is None:
         original = model.normalise_markers(utt.markers)
     res = synthesis or synthesize(model, utt.audio, utt.sample_rate, utt.phones, config,
-                                  n_frames=utt.n_frames, source=utt.name)
+                                  n_frames=utt.n_frames, source=utt.name, lsf=lsf)
     mask = speech if speech is not None else speech_mask(utt.audio, utt.sample_rate, res.times,
                                                          eval_config)
     out = []
@@ -213,9 +215,11 @@ def evaluate(model: Model, corpus: Corpus, splits: Iterable[str] = ("train", "te
         utt = corpus.utterance(utt_id)
         original = model.normalise_markers(utt.markers)
         speech = speech_mask(utt.audio, utt.sample_rate, utt.frame_times(), eval_config)
+        lsf = model.input_lsf(utt.audio, utt.sample_rate,                 # synthesize()'s frames
+                              np.arange(utt.n_frames) / model.marker_rate)
         for cfg in configs:
             result.scores.extend(evaluate_utterance(model, utt, sp, cfg, smoothings, eval_config,
-                                                    original=original, speech=speech))
+                                                    original=original, speech=speech, lsf=lsf))
     if progress:
         progress(1.0, "done")
     return result

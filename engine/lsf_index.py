@@ -141,12 +141,14 @@ class LsfIndex:
             by_cell = np.argsort(flat, kind="stable")
             bounds = np.searchsorted(flat[by_cell], np.arange(self.n_cells + 1))
             for c in np.flatnonzero(np.diff(bounds)):
-                pairs = by_cell[bounds[c]:bounds[c + 1]]
-                rows = pairs // probe
                 lo, hi = self.offsets[c], self.offsets[c + 1]
-                block = np.matmul(np.abs(wc[rows, None, :] - cell_lsf[lo:hi]),
-                                  h[rows, :, None])[..., 0]                     # eq 5, (f, size)
-                d[(rows * width + col0[pairs])[:, None] + np.arange(hi - lo)] = block
+                step = max(1, int(4e6 // ((hi - lo) * order)))   # bound the (f, size, P) temporary
+                for r0 in range(bounds[c], bounds[c + 1], step):
+                    pairs = by_cell[r0:min(r0 + step, bounds[c + 1])]
+                    rows = pairs // probe
+                    block = np.matmul(np.abs(wc[rows, None, :] - cell_lsf[lo:hi]),
+                                      h[rows, :, None])[..., 0]                 # eq 5, (f, size)
+                    d[(rows * width + col0[pairs])[:, None] + np.arange(hi - lo)] = block
             d = d.reshape(b - a, width)
             cols = (np.argpartition(d, count - 1, axis=1)[:, :count] if count < width
                     else np.broadcast_to(np.arange(width), (b - a, width)))

@@ -110,6 +110,12 @@ class Model:
         coeffs[component] = value
         return self.pca.inverse(coeffs).reshape(self.n_markers, 3)
 
+    def input_lsf(self, audio: np.ndarray, sample_rate: int, times: np.ndarray) -> np.ndarray:
+        """The input LSF vectors w (eq 5) at ``times``, analysed as in training, ``(T, P)``."""
+        mc = self.config
+        return lsf_at(audio, sample_rate, times, mc.lpc_order, mc.window_s, mc.audio_rate,
+                      mc.preemphasis)
+
     def lsf_index(self) -> LsfIndex:
         """The coarse LSF index of the codebook (``engine.lsf_index``), built here and kept if the
         model has none or has one for a codebook of another size."""
@@ -387,7 +393,7 @@ class Synthesis:
 def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                phones: Sequence[PhoneSegment] | None = None, config: SynthConfig | None = None,
                n_frames: int | None = None, label_map: Mapping[str, str] | None = None,
-               source: str | None = None) -> Synthesis:
+               source: str | None = None, lsf: np.ndarray | None = None) -> Synthesis:
     """Synthesize face point trajectories from speech (paper section 2.3).
 
     With ``phones`` and ``mode="phonetic"``: per input phone, the top-N context-phones by eq 4,
@@ -397,7 +403,8 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     (``acoustic_prefilter=None``). Then smoothing, and the PCs back to ``(T, M, 3)`` markers.
 
     ``n_frames`` defaults to every marker frame inside the audio. ``source`` names the input in
-    error messages.
+    error messages. ``lsf`` may pass the input LSFs already computed by :meth:`Model.input_lsf`
+    for these frames (when one utterance is synthesized under several configs).
     """
     config = config or SynthConfig()
     duration = len(audio) / float(sample_rate)
@@ -408,7 +415,12 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         raise InputError(source, f"the audio is too short ({duration * 1000:.1f} ms) to synthesize")
     times = np.arange(n_frames) / rate
     mc = model.config
-    w = lsf_at(audio, sample_rate, times, mc.lpc_order, mc.window_s, mc.audio_rate, mc.preemphasis)
+    if lsf is None:
+        w = model.input_lsf(audio, sample_rate, times)
+    elif lsf.shape != (n_frames, mc.lpc_order):
+        raise ValueError(f"lsf must be ({n_frames}, {mc.lpc_order}) for these frames, got {lsf.shape}")
+    else:
+        w = lsf
     cb = model.codebook
     segments: list[SegmentChoice] = []
     frame_seg = None

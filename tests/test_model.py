@@ -98,6 +98,14 @@ def test_synthesis_outputs(toy_model, toy_corpus):
              zip(indexed.frames.candidates, exact.frames.candidates, strict=True)]
     assert np.mean(found) > 0.9
     assert np.abs(indexed.markers - exact.markers).max() < 0.05 * np.ptp(exact.markers)
+    # input LSFs computed once and passed in give the same synthesis
+    w = toy_model.input_lsf(utt.audio, utt.sample_rate, res.times)
+    again = synthesize(toy_model, utt.audio, utt.sample_rate, utt.phones, SynthConfig(),
+                       n_frames=t, lsf=w)
+    assert np.array_equal(again.markers, res.markers) and np.array_equal(again.lsf, res.lsf)
+    with pytest.raises(ValueError, match="lsf must be"):
+        synthesize(toy_model, utt.audio, utt.sample_rate, utt.phones, SynthConfig(), n_frames=t,
+                   lsf=w[1:])
 
 
 def test_synthesis_bad_input(toy_model, toy_corpus):
