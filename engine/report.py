@@ -503,7 +503,13 @@ def discussion(data: ReportData) -> list[str]:
                abs(ix["whole_face"] - ac["whole_face"]) <= 0.01 else
                f" The default indexed search (the {ix_k} codewords nearest by eq 5, found in the "
                f"model's LSF index) scores {_f(ix['whole_face'])} on the same frames "
-               f"({ix['whole_face'] - ac['whole_face']:+.4f})." if ix else ""))
+               f"({ix['whole_face'] - ac['whole_face']:+.4f}): slightly better, because leaving "
+               f"out the far codewords removes their small pull towards the codebook's average "
+               f"face." if ix and ix["whole_face"] > ac["whole_face"] else
+               f" The default indexed search (the {ix_k} codewords nearest by eq 5, found in the "
+               f"model's LSF index) scores {_f(ix['whole_face'])} on the same frames "
+               f"({ix['whole_face'] - ac['whole_face']:+.4f}): the price of its speed "
+               f"(`docs/benchmarks.md`)." if ix else ""))
     if te and vis and rid:
         best = max(("the paper's method", te["whole_face"]), ("the viseme lookup", vis["whole_face"]),
                    ("the ridge regression", rid["whole_face"]), key=lambda x: x[1])

@@ -1,0 +1,98 @@
+"""The 3-D view's face surface (app/view3d.face_triangles): one piece over every marker of the
+default face, open at the mouth, no triangle folded across the outline, none for 2-D data."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pyvistaqt")
+
+from app.view3d import face_triangles, lip_contours, unroll
+
+
+def _pieces(tri: np.ndarray) -> int:
+    """Number of edge-connected pieces of a triangle set."""
+    parent = list(range(len(tri)))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    owner: dict[tuple[int, int], int] = {}
+    for k, t in enumerate(tri.tolist()):
+        for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
+            e = (min(a, b), max(a, b))
+            if e in owner:
+                parent[root(k)] = root(owner[e])
+            else:
+                owner[e] = k
+    return len({root(k) for k in range(len(tri))})
+
+
+@pytest.fixture(scope="module")
+def face(default_model):
+    m = default_model
+    neutral = m.neutral_face()
+    contours = lip_contours(neutral, m.upper_lip, m.lower_lip, list(m.lip_corners))
+    return m, neutral, contours, face_triangles(neutral, contours)
+
+
+def test_surface_is_one_piece_over_every_marker(face):
+    m, _neutral, _contours, tri = face
+    assert set(np.unique(tri).tolist()) == set(range(m.n_markers))
+    assert _pieces(tri) == 1
+    # a closed 2-D triangulation of the unrolled face: Euler V - E + F = 1 - holes; the only hole
+    # is the mouth
+    edges = {tuple(sorted(e)) for t in tri.tolist() for e in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))}
+    assert m.n_markers - len(edges) + len(tri) == 0
+
+
+def test_mouth_stays_open(face):
+    _m, _neutral, contours, tri = face
+    up, lo = set(contours[0]), set(contours[1])
+    for t in tri.tolist():
+        s = set(t)
+        assert not (s <= up | lo and s & (up - lo) and s & (lo - up)), t
+
+
+def test_no_triangle_folds_or_bridges_the_outline(face):
+    m, neutral, contours, tri = face
+    uv = unroll(neutral)
+    a, b, c = uv[tri[:, 0]], uv[tri[:, 1]], uv[tri[:, 2]]
+    assert (0.5 * np.abs((b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0])).min() > 0
+    # outline edges (used by one triangle, not the mouth's) are ordinary edges, not bridges
+    count: dict[tuple[int, int], int] = {}
+    for t in tri.tolist():
+        for e in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
+            key = (min(e), max(e))
+            count[key] = count.get(key, 0) + 1
+    length = {e: float(np.linalg.norm(neutral[e[0]] - neutral[e[1]])) for e in count}
+    median = float(np.median(list(length.values())))
+    lips = set(contours[0]) | set(contours[1])
+    outline = [length[e] for e, k in count.items() if k == 1 and not set(e) <= lips]
+    assert max(outline) < 3.5 * median
+    # unrolling keeps the jaw line beside the cheeks: the lowest jaw-line markers are the
+    # outermost on each side, as they are around the head
+    names = m.marker_names
+    right, left = names.index("JL4_R"), names.index("JL4_L")
+    assert uv[right, 0] == uv[:, 0].min() and uv[left, 0] == uv[:, 0].max()
+
+
+def test_notch_in_the_outline_is_peeled():
+    """A U-shaped marker layout: Delaunay fills the notch up to the convex hull; the surface
+    does not."""
+    xy = [(x, y) for x in range(7) for y in range(7) if not (2 <= x <= 4 and y >= 3)]
+    pts = np.array([(x * 10.0, y * 10.0, 0.0) for x, y in xy])
+    tri = face_triangles(pts, [])
+    centres = pts[tri].mean(axis=1)
+    inside_notch = (centres[:, 0] > 15) & (centres[:, 0] < 45) & (centres[:, 1] > 25)
+    assert len(tri) > 30 and not inside_notch.any()
+    assert set(np.unique(tri).tolist()) == set(range(len(pts)))
+
+
+def test_no_surface_for_midsagittal_data():
+    flat = np.column_stack([np.zeros(6), np.arange(6.0), np.arange(6.0) ** 2])   # x constant
+    assert face_triangles(flat, [[0, 1], [2, 3]]).shape == (0, 3)
