@@ -152,7 +152,7 @@ def write_markdown(path: Path, rows: Sequence[BenchRow], ctx: BenchContext, elap
         "time ~ size^e between the smallest and largest codebook, on a fixed input.",
         "- The machine is shared (2 cores, other jobs running): synthesis of up to 10 s of input is "
         "timed as the best of at least 3 runs and 0.5 s of repeats (as `timeit` does), longer inputs "
-        "and the scaling rows by a single run.",
+        "by a single run; a scaling run is repeated the same way when it takes under a second.",
         "",
     ]
     path.parent.mkdir(parents=True, exist_ok=True)

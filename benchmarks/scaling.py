@@ -31,7 +31,7 @@ from engine.evaluation import speech_mask, trajectory_correlations
 from engine.model import Model, Synthesis, synthesize
 from engine.synthesis import nearest_codewords
 
-from .common import BenchContext, BenchRow, Timing, concatenate_input, timed
+from .common import BenchContext, BenchRow, Timing, best_time, concatenate_input, timed
 
 log = logging.getLogger(__name__)
 
@@ -87,7 +87,15 @@ def agreement(model: Model, a: np.ndarray, b: np.ndarray) -> float:
 
 
 def _timed(model: Model, audio: np.ndarray, rate: int, cfg: SynthConfig) -> tuple[Timing, Synthesis]:
-    tm, res = timed(lambda: synthesize(model, audio, rate, None, cfg))
+    """One synthesis call timed; a call under a second is repeated and the fastest kept (as the
+    synthesis benchmark does), slower ones are timed once."""
+    def call() -> Synthesis:
+        return synthesize(model, audio, rate, None, cfg)
+
+    tm, res = timed(call)
+    if tm.wall < 1.0:
+        again = best_time(call, repeat=2, min_total_s=0.5)
+        tm = again if again.wall < tm.wall else tm
     return tm, res  # type: ignore[return-value]
 
 
