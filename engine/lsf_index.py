@@ -140,7 +140,7 @@ class LsfIndex:
             flat = cells.ravel()
             by_cell = np.argsort(flat, kind="stable")
             bounds = np.searchsorted(flat[by_cell], np.arange(self.n_cells + 1))
-            for c in np.flatnonzero(np.diff(bounds)):
+            for c in np.flatnonzero((np.diff(bounds) > 0) & (sizes > 0)):   # opened, not empty
                 lo, hi = self.offsets[c], self.offsets[c + 1]
                 step = max(1, int(4e6 // ((hi - lo) * order)))   # bound the (f, size, P) temporary
                 for r0 in range(bounds[c], bounds[c + 1], step):

@@ -88,6 +88,19 @@ def test_probe_grows_when_the_cells_are_too_small():
         ix.nearest(w, lsf[:300], count=5, probe=2)
 
 
+def test_empty_cells_are_harmless():
+    """Repeated codewords can leave k-means cells empty (two equal starting centroids)."""
+    lsf = np.repeat(random_lsf(30, seed=8), 10, axis=0)            # every codeword 10 times
+    ix = build_index(lsf, n_cells=20, seed=1)
+    assert (ix.sizes == 0).any()
+    w = random_lsf(15, seed=9)
+    got = ix.nearest(w, lsf, count=10, probe=ix.n_cells)
+    for t in range(len(w)):
+        h = perceptual_weights(w[t])
+        d = (np.abs(w[t] - lsf) * h).sum(axis=1)
+        np.testing.assert_allclose(np.sort(d[got[t]]), np.sort(d)[:10])   # ties: any of the copies
+
+
 def test_model_keeps_its_index(toy_model, tmp_path):
     assert toy_model.index is not None
     assert toy_model.index.n_codewords == len(toy_model.codebook.lsf)
