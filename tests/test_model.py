@@ -67,6 +67,13 @@ def test_bad_model_files(toy_model, tmp_path):
         Model.load(tmp_path / "newer.npz")
     with pytest.raises(ModelFileError, match="no such model"):
         Model.load(tmp_path / "absent.npz")
+    # a damaged LSF index (codeword ids out of range) is refused, not used
+    with np.load(tmp_path / "good.npz", allow_pickle=False) as z:
+        arrays = {k: z[k] for k in z.files}
+    arrays["ix_order"] = arrays["ix_order"] + 1
+    np.savez(tmp_path / "badindex.npz", **arrays)
+    with pytest.raises(ModelFileError, match="badindex.npz: its LSF index does not match"):
+        Model.load(tmp_path / "badindex.npz")
 
 
 def test_synthesis_outputs(toy_model, toy_corpus):
