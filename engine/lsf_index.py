@@ -134,8 +134,10 @@ class LsfIndex:
             cells = (np.argpartition(dc, probe - 1, axis=1)[:, :probe] if probe < self.n_cells
                      else np.broadcast_to(np.arange(self.n_cells), dc.shape))
             sz = sizes[cells]                                                    # (t, probe)
-            col0 = (np.cumsum(sz, axis=1) - sz).ravel()          # where each cell's block starts
-            width = int(sz.sum(axis=1).max())
+            ends = np.cumsum(sz, axis=1)               # each opened cell's block in its row ends
+            starts = ends - sz                          # and starts here
+            col0 = starts.ravel()
+            width = int(ends[:, -1].max())
             d = np.full((b - a) * width, np.inf)      # row t: its cells' members side by side
             flat = cells.ravel()
             by_cell = np.argsort(flat, kind="stable")
@@ -153,10 +155,9 @@ class LsfIndex:
             cols = (np.argpartition(d, count - 1, axis=1)[:, :count] if count < width
                     else np.broadcast_to(np.arange(width), (b - a, width)))
             # column -> (which opened cell, place in it) -> codebook index
-            ends = np.cumsum(sz, axis=1)
             slot = (cols[:, :, None] >= ends[:, None, :]).sum(axis=2)
             rows = np.arange(b - a)[:, None]
-            within = cols - (ends - sz)[rows, slot]
+            within = cols - starts[rows, slot]
             out[a:b] = self.order[self.offsets[cells[rows, slot]] + within]
         return out
 
