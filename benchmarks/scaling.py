@@ -17,7 +17,6 @@ correlation with the original markers on test utterances, scored as in Table 2.
 
 from __future__ import annotations
 
-import inspect
 import logging
 import math
 from collections.abc import Sequence
@@ -29,7 +28,6 @@ from engine.codebook import Codebook
 from engine.config import SynthConfig
 from engine.evaluation import speech_mask, trajectory_correlations
 from engine.model import Model, Synthesis, synthesize
-from engine.synthesis import nearest_codewords
 
 from .common import BenchContext, BenchRow, Timing, best_time, concatenate_input, timed
 
@@ -46,19 +44,7 @@ LSF_JITTER = 0.01
 PC_JITTER = 0.05
 #: test utterances scored against the original markers (x1 codebook)
 N_TEST_UTTS = 8
-#: exact-prefilter runs whose distance temporaries would exceed this are skipped (shared machine)
-MAX_TEMP_BYTES = 2.5 * 1024**3
 FULL = SynthConfig(mode="acoustic", acoustic_prefilter=None)
-
-
-def prefilter_temp_bytes(n_frames: int, n_codewords: int, order: int) -> float:
-    """Peak temporaries of ``engine.synthesis.nearest_codewords`` as written when this benchmark
-    was: a float32 ``(chunk, 5L, P)`` difference and its absolute value per chunk of frames.
-    An implementation without a fixed integer ``chunk`` default is assumed to bound its memory."""
-    chunk = inspect.signature(nearest_codewords).parameters.get("chunk")
-    if chunk is None or not isinstance(chunk.default, int):
-        return 0.0
-    return 2.0 * min(chunk.default, n_frames) * n_codewords * order * 4
 
 
 def replicate_codebook(cb: Codebook, factor: int, rng: np.random.Generator) -> Codebook:
@@ -148,8 +134,7 @@ def run(ctx: BenchContext, factors: Sequence[int] | None = None,
         tm_full, full = _timed(model, audio, rate, FULL)
         add(("full", factor), f"acoustic, full search (paper), codebook x{factor}", tm_full,
             f"{size} codewords; {tm_full.wall * 1000 / full.times.size:.2f} ms/frame")
-        temp = prefilter_temp_bytes(full.times.size, size, base.config.lpc_order)
-        if k_exact < size and temp <= MAX_TEMP_BYTES:
+        if k_exact < size:
             cfg = default.with_(acoustic_prefilter=k_exact, acoustic_probe=None)
             tm, res = _timed(model, audio, rate, cfg)
             add(("exact", factor), f"acoustic, exact prefilter K={k_exact}, codebook x{factor}", tm,

@@ -448,12 +448,12 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         segments = [SegmentChoice(seg, ctx[i], top[i], scores[i]) for i, seg in enumerate(segs)]
         frame_seg = segment_index(segs, times)
         candidates = cb.codewords_of(top)[frame_seg]
-    elif config.mode == "acoustic" and config.acoustic_prefilter is not None \
-            and config.acoustic_probe is not None:
-        candidates = model.lsf_index().nearest(w, cb.lsf, config.acoustic_prefilter,
-                                               config.acoustic_probe)
     elif config.mode == "acoustic":
-        candidates = nearest_codewords(w, cb.lsf, config.acoustic_prefilter)
+        if config.acoustic_prefilter is not None and config.acoustic_probe is not None:
+            candidates = model.lsf_index().nearest(w, cb.lsf, config.acoustic_prefilter,
+                                                   config.acoustic_probe)
+        else:                                   # every codeword, or the exact K nearest
+            candidates = nearest_codewords(w, cb.lsf, config.acoustic_prefilter)
     else:
         raise ValueError(f"unknown mode {config.mode!r} (phonetic or acoustic)")
     gammas = gamma_grid(config.gamma_min, config.gamma_max, config.gamma_steps)
