@@ -115,9 +115,7 @@ def comparison(data: ReportData, path: Path) -> Path:
     names = {"phonetic": "ours, N = 3", "acoustic": "acoustic-only", "viseme": "viseme lookup",
              "ridge": "ridge (LSF)"}
     for mode, label in names.items():
-        test = next((r for r in data.comparisons if r["mode"] == mode and r["split"] == "test"
-                     and r["smoothing"] == "triangular"), None)
-        methods.append((label, test))
+        methods.append((label, data.row(mode)))
     fig = Figure(figsize=(8.0, 4.2))
     ax = fig.add_subplot()
     x = np.arange(len(METRICS))

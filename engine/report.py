@@ -148,10 +148,11 @@ class ReportData:
     figures: dict[str, str] = field(default_factory=dict)
     created: str = ""
 
-    def row(self, method: str, split: str, smoothing: str) -> dict | None:
-        """The comparison row of one method, split and smoothing."""
+    def row(self, mode: str, split: str = "test", smoothing: str = "triangular") -> dict | None:
+        """The comparison row of one mode (``phonetic``, ``acoustic``, ``acoustic-indexed``,
+        ``viseme``, ``ridge``), split and smoothing."""
         for r in self.comparisons:
-            if r["method"] == method and r["split"] == split and r["smoothing"] == smoothing:
+            if r["mode"] == mode and r["split"] == split and r["smoothing"] == smoothing:
                 return r
         return None
 
@@ -473,14 +474,8 @@ def discussion(data: ReportData) -> list[str]:
                "pick the best-matching codewords among the 5N candidates, so more candidates rarely "
                "hurt on this corpus, whose tokens of a phone vary little from one sentence to "
                "another."))
-    ac = data.row("acoustic-only", "test", "triangular")
-    ix = next((r for r in data.comparisons if r["mode"] == "acoustic-indexed" and r["split"] == "test"
-               and r["smoothing"] == "triangular"), None)
-    ix_k = SynthConfig().acoustic_prefilter
-    vis = next((r for r in data.comparisons if r["mode"] == "viseme" and r["split"] == "test"
-                and r["smoothing"] == "triangular"), None)
-    rid = next((r for r in data.comparisons if r["mode"] == "ridge" and r["split"] == "test"
-                and r["smoothing"] == "triangular"), None)
+    ac, ix = data.row("acoustic"), data.row("acoustic-indexed")
+    vis, rid = data.row("viseme"), data.row("ridge")
     if te and ac:
         out.append(
             f"**Acoustic-only.** Without labels (the whole codebook searched by eq 5) the test whole "
@@ -496,20 +491,15 @@ def discussion(data: ReportData) -> list[str]:
                "that N = 3 context-phones chosen by eq 4 often exclude the acoustically best "
                "codewords. ")
             + "The paper gives no number for this mode."
-            + (f" The default indexed search (eqs 6-8 over the {ix_k} codewords nearest by eq 5, "
-               f"found in the model's LSF index; `docs/algorithm.md`) scores {_f(ix['whole_face'])} "
-               f"on the same frames ({ix['whole_face'] - ac['whole_face']:+.4f}): leaving out the "
-               f"far codewords costs nothing measurable here." if ix and
-               abs(ix["whole_face"] - ac["whole_face"]) <= 0.01 else
-               f" The default indexed search (the {ix_k} codewords nearest by eq 5, found in the "
-               f"model's LSF index) scores {_f(ix['whole_face'])} on the same frames "
-               f"({ix['whole_face'] - ac['whole_face']:+.4f}): slightly better, because leaving "
-               f"out the far codewords removes their small pull towards the codebook's average "
-               f"face." if ix and ix["whole_face"] > ac["whole_face"] else
-               f" The default indexed search (the {ix_k} codewords nearest by eq 5, found in the "
-               f"model's LSF index) scores {_f(ix['whole_face'])} on the same frames "
-               f"({ix['whole_face'] - ac['whole_face']:+.4f}): the price of its speed "
-               f"(`docs/benchmarks.md`)." if ix else ""))
+            + (f" The default indexed search (the {SynthConfig().acoustic_prefilter} codewords "
+               f"nearest by eq 5, found in the model's LSF index) scores {_f(ix['whole_face'])} on "
+               f"the same frames ({ix['whole_face'] - ac['whole_face']:+.4f}): "
+               + ("leaving out the far codewords costs nothing measurable here."
+                  if abs(ix["whole_face"] - ac["whole_face"]) <= 0.01 else
+                  "slightly better, because leaving out the far codewords removes their small "
+                  "pull towards the codebook's average face."
+                  if ix["whole_face"] > ac["whole_face"] else
+                  "the price of its speed (`docs/benchmarks.md`).") if ix else ""))
     if te and vis and rid:
         best = max(("the paper's method", te["whole_face"]), ("the viseme lookup", vis["whole_face"]),
                    ("the ridge regression", rid["whole_face"]), key=lambda x: x[1])
