@@ -15,6 +15,22 @@ DEFAULT_CORPUS = ROOT / "data_samples"
 MOCHA = ROOT.parent / "shared" / "data" / "mocha_fsew0_001"
 
 
+def edited_model_file(src: Path, dst: Path, **arrays) -> Path:
+    """A copy of the saved model ``src`` at ``dst`` with some arrays replaced; an array given as
+    ``None`` is left out (as in a model file written by an older facetraj)."""
+    import numpy as np
+
+    with np.load(src, allow_pickle=False) as z:
+        out = {k: z[k] for k in z.files}
+    for name, value in arrays.items():
+        if value is None:
+            out.pop(name)
+        else:
+            out[name] = value
+    np.savez(dst, **out)
+    return dst
+
+
 @pytest.fixture(scope="session", autouse=True)
 def _isolated_cache(tmp_path_factory):
     """One private model cache for the whole session, never the user's."""

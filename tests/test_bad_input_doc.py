@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import soundfile as sf
+from conftest import edited_model_file
 
 from engine.config import SynthConfig
 from engine.corpus import CorpusInfo, load_corpus, save_corpus_info
@@ -117,7 +118,8 @@ def produce(case: str, tmp: Path, toy_dir: Path, model: Model, caplog) -> str:
             write("t.npz", model.save(tmp / "full.npz").read_bytes()[:500])),
         "a model file from a newer facetraj": lambda: (
             np.savez(tmp / "n.npz", meta=np.array(json.dumps(newer))), Model.load(tmp / "n.npz")),
-        "a model file whose LSF index was damaged": lambda: Model.load(damaged_index()),
+        "a model file whose LSF index was damaged": lambda: Model.load(edited_model_file(
+            model.save(tmp / "full.npz"), tmp / "d.npz", ix_offsets=model.index.offsets[:-1])),
         "a corpus folder without corpus.json": lambda: load_corpus(tmp),
         "a corpus.json that is not JSON": lambda: (write("corpus.json", "{"), load_corpus(tmp)),
         "a corpus.json naming an unknown marker": lambda: (
@@ -130,13 +132,6 @@ def produce(case: str, tmp: Path, toy_dir: Path, model: Model, caplog) -> str:
             write("x.ema", "0 1 2 3\n1 1 2 3\n")),
         "a label map line that is not a pair": lambda: read_label_map(write("map.txt", "a b c\n")),
     }
-    def damaged_index() -> Path:
-        with np.load(model.save(tmp / "full.npz"), allow_pickle=False) as z:
-            arrays = {k: z[k] for k in z.files}
-        arrays["ix_offsets"] = arrays["ix_offsets"][:-1]
-        np.savez(tmp / "d.npz", **arrays)
-        return tmp / "d.npz"
-
     caplog.clear()
     try:
         with caplog.at_level(logging.INFO):

@@ -5,6 +5,7 @@ import zipfile
 
 import numpy as np
 import pytest
+from conftest import edited_model_file
 
 from engine.config import SynthConfig, TrainConfig
 from engine.data import PhoneSegment, Utterance
@@ -68,12 +69,10 @@ def test_bad_model_files(toy_model, tmp_path):
     with pytest.raises(ModelFileError, match="no such model"):
         Model.load(tmp_path / "absent.npz")
     # a damaged LSF index (codeword ids out of range) is refused, not used
-    with np.load(tmp_path / "good.npz", allow_pickle=False) as z:
-        arrays = {k: z[k] for k in z.files}
-    arrays["ix_order"] = arrays["ix_order"] + 1
-    np.savez(tmp_path / "badindex.npz", **arrays)
+    bad = edited_model_file(tmp_path / "good.npz", tmp_path / "badindex.npz",
+                            ix_order=toy_model.index.order + 1)
     with pytest.raises(ModelFileError, match="badindex.npz: its LSF index does not match"):
-        Model.load(tmp_path / "badindex.npz")
+        Model.load(bad)
 
 
 def test_synthesis_outputs(toy_model, toy_corpus):
