@@ -7,17 +7,17 @@ import hashlib
 import json
 import logging
 import os
-from collections.abc import Callable
 from pathlib import Path
 
 from engine.config import TrainConfig
 from engine.corpus import Corpus
 from engine.errors import ModelFileError
-from engine.model import Model, train
+from engine.model import Model
+from engine.progress import Progress
+from engine.training import train
 
 log = logging.getLogger(__name__)
 
-Progress = Callable[[float, str], None]
 
 
 def cache_dir() -> Path:

@@ -44,9 +44,9 @@ from PyQt6.QtWidgets import (
 from app.analysis.common import ask_save_path
 from engine.corpus import FolderScan, init_corpus, scan_folder
 from engine.errors import FacetrajError
+from engine.export import write_trajectories
 from engine.formats import atomic_write
 from engine.labelmap import MOCHA_TO_ARPABET, read_label_map, write_label_map
-from engine.model import write_trajectories
 from engine.phones import ARPABET, SILENCE, SILENCE_LABELS, normalise_label
 
 log = logging.getLogger(__name__)

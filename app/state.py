@@ -13,7 +13,8 @@ import numpy as np
 from engine.config import SynthConfig
 from engine.data import Utterance
 from engine.evaluation import speech_mask
-from engine.model import Model, Synthesis, resmooth, synthesize
+from engine.model import Model
+from engine.pipeline import Synthesis, resmooth, synthesize
 
 
 @dataclass

@@ -18,7 +18,8 @@ import numpy as np
 
 from engine.data import Utterance
 from engine.formats import atomic_write, write_audio
-from engine.model import Model, Synthesis
+from engine.model import Model
+from engine.pipeline import Synthesis
 
 log = logging.getLogger(__name__)
 

@@ -22,7 +22,8 @@ import scipy
 
 from engine.corpus import Corpus, load_corpus
 from engine.data import PhoneSegment, Utterance
-from engine.model import MarkerSetup, Model, train
+from engine.model import Model
+from engine.training import MarkerSetup, train
 
 log = logging.getLogger(__name__)
 
@@ -254,7 +255,7 @@ def _toy_corpus() -> Path:
 
 def default_corpus_dir(smoke: bool) -> Path:
     """``data_samples/`` (or ``$FACETRAJ_CORPUS``); in smoke mode the toy corpus when it is absent."""
-    from engine.cli import default_corpus
+    from facetraj.paths import default_corpus
 
     root = default_corpus()
     if (root / "corpus.json").exists():

@@ -140,7 +140,7 @@ def format_result(r: dict) -> str:
 
 def main(argv: Sequence[str] | None = None) -> list:
     """Run the benchmark; returns :class:`benchmarks.common.BenchRow` rows (printed too)."""
-    from engine.cli import default_corpus
+    from facetraj.paths import default_corpus
 
     p = argparse.ArgumentParser(prog="python -m benchmarks.playback", description=__doc__.split("\n")[0])
     p.add_argument("--corpus", type=Path, default=None, help="corpus folder (default data_samples/)")

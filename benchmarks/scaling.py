@@ -27,7 +27,8 @@ import numpy as np
 from engine.codebook import Codebook
 from engine.config import SynthConfig
 from engine.evaluation import speech_mask, trajectory_correlations
-from engine.model import Model, Synthesis, synthesize
+from engine.model import Model
+from engine.pipeline import Synthesis, synthesize
 
 from .common import BenchContext, BenchRow, Timing, best_time, concatenate_input, timed
 

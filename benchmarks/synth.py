@@ -1,4 +1,4 @@
-"""Synthesis benchmark (paper section 2.3): real-time factor of :func:`engine.model.synthesize` for
+"""Synthesis benchmark (paper section 2.3): real-time factor of :func:`engine.pipeline.synthesize` for
 1 s, 10 s and 60 s of input, phonetic (N = 3) and acoustic-only, both with the default settings
 (acoustic-only: eqs 6-8 over the K = 128 codewords nearest by eq 5, found in the model's LSF index;
 the whole-codebook search of the paper is timed by the scaling benchmark).
@@ -14,7 +14,7 @@ import logging
 from collections.abc import Sequence
 
 from engine.config import SynthConfig
-from engine.model import synthesize
+from engine.pipeline import synthesize
 
 from .common import BenchContext, BenchRow, best_time, concatenate_input
 

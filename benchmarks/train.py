@@ -1,9 +1,9 @@
 """Training benchmark (paper sections 2.1-2.2): wall time and peak memory of
-:func:`engine.model.train`, split into LSF extraction, marker normalisation + PCA, and the rest of
+:func:`engine.training.train`, split into LSF extraction, marker normalisation + PCA, and the rest of
 the codebook.
 
 The split is measured inside one ``train()`` call by wrapping the engine's own functions as
-``engine.model`` calls them (``lsf_at``; ``fill_gaps``, ``reference_pose``,
+``engine.training`` calls them (``lsf_at``; ``fill_gaps``, ``reference_pose``,
 ``remove_head_motion``; ``fit_pca``); the codebook time is the remainder (context-phones, codeword
 times, PC interpolation, eqs 1-2). Peak memory is measured in a second call under
 ``tracemalloc`` (numpy reports its buffers to it), so that tracing does not slow the timed run.
@@ -19,8 +19,8 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from unittest import mock
 
-import engine.model as engine_model
-from engine.model import train
+import engine.training as engine_training
+from engine.training import train
 
 from .common import BenchContext, BenchRow, peak_rss_mib
 
@@ -38,7 +38,7 @@ TRAIN_AIM_S = 30.0
 
 @contextmanager
 def timed_engine_functions() -> Iterator[dict[str, float]]:
-    """Wrap the functions of :data:`STAGES` in ``engine.model``; yield seconds spent per function."""
+    """Wrap the functions of :data:`STAGES` in ``engine.training``; yield seconds spent per function."""
     spent: dict[str, float] = defaultdict(float)
 
     def wrap(name: str, fn: Callable) -> Callable:
@@ -51,7 +51,7 @@ def timed_engine_functions() -> Iterator[dict[str, float]]:
         return timed
 
     names = [n for group in STAGES.values() for n in group]
-    patches = [mock.patch.object(engine_model, n, wrap(n, getattr(engine_model, n))) for n in names]
+    patches = [mock.patch.object(engine_training, n, wrap(n, getattr(engine_training, n))) for n in names]
     for p in patches:
         p.start()
     try:

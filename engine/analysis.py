@@ -16,7 +16,7 @@ import csv
 import io
 import logging
 import os
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -29,13 +29,14 @@ from .corpus import Corpus
 from .data import PhoneSegment, Utterance
 from .evaluation import EvalConfig, EvalResult, pearson, speech_mask, trajectory_correlations
 from .formats import atomic_write
-from .model import Model, Synthesis, synthesize
+from .model import Model
 from .phones import SILENCE, segment_index
+from .pipeline import Synthesis, synthesize
+from .progress import Progress
 from .synthesis import lsf_distances, perceptual_weights
 
 log = logging.getLogger(__name__)
 
-Progress = Callable[[float, str], None]
 
 
 def _write_csv(path: str | os.PathLike[str], header: Sequence[str], rows: Iterable[Sequence],

@@ -14,7 +14,8 @@ from scipy.signal import medfilt
 from .config import SynthConfig
 from .corpus import Corpus
 from .data import Utterance
-from .model import Model, Synthesis, resmooth, synthesize
+from .model import Model
+from .pipeline import Synthesis, resmooth, synthesize
 
 log = logging.getLogger(__name__)
 

@@ -40,12 +40,14 @@ from .evaluation import (
     trajectory_correlations,
 )
 from .formats import atomic_write
-from .model import Model, resmooth, synthesize, train
+from .model import Model
+from .pipeline import resmooth, synthesize
+from .progress import Progress
 from .similarity import SimilarRow, top_similar
+from .training import train
 
 log = logging.getLogger(__name__)
 
-Progress = Callable[[float, str], None]
 
 #: the sentence of the paper's Figure 4
 FIGURE4_TEXT = "Tornadoes often destroy acres of farm land"

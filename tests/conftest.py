@@ -53,7 +53,7 @@ def toy_corpus(toy_corpus_dir):
 
 @pytest.fixture(scope="session")
 def toy_model(toy_corpus):
-    from engine.model import train
+    from engine.training import train
 
     return train(toy_corpus)
 

@@ -34,7 +34,7 @@ from engine.analysis import (
 )
 from engine.data import PhoneSegment
 from engine.evaluation import EvalResult, UtteranceScore, evaluate_utterance
-from engine.model import synthesize
+from engine.pipeline import synthesize
 
 
 def score(split, smoothing, n, wf, lo, up, mode="phonetic", utt="u"):

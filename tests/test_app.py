@@ -26,8 +26,8 @@ from app import style
 from app.browser import normalise_text
 from app.main import build_window
 from app.main_window import DEFAULT_SENTENCE, MainWindow
-from engine.cli import default_corpus
 from engine.config import SynthConfig
+from facetraj.paths import default_corpus
 
 pytestmark = pytest.mark.gui
 
@@ -251,7 +251,7 @@ def test_screenshot_shows_both_point_sets_and_lip_panels(window, tmp_path):
 def test_screenshot_command_line(trained_cache, tmp_path):
     out = tmp_path / "cli.png"
     env = {**os.environ, "FACETRAJ_CACHE_DIR": str(trained_cache)}
-    proc = subprocess.run([sys.executable, "-m", "engine.cli", "--screenshot", str(out), "--time", "1.0"],
+    proc = subprocess.run([sys.executable, "-m", "facetraj", "--screenshot", str(out), "--time", "1.0"],
                           cwd=ROOT, env=env, capture_output=True, text=True, timeout=180)
     assert proc.returncode == 0, proc.stderr[-2000:]
     img = _read_png(out)

@@ -26,7 +26,9 @@ from engine.formats import (
     write_c3d,
 )
 from engine.labelmap import read_label_map
-from engine.model import MarkerSetup, Model, synthesize, train
+from engine.model import Model
+from engine.pipeline import synthesize
+from engine.training import MarkerSetup, train
 
 DOC = Path(__file__).resolve().parent.parent / "docs" / "bad-input.md"
 

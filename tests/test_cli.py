@@ -5,8 +5,8 @@ import json
 import numpy as np
 import pytest
 
-from engine.cli import main
 from engine.formats import read_c3d, read_marker_table
+from facetraj.cli import main
 
 
 @pytest.fixture(scope="module")

@@ -6,7 +6,8 @@ import pytest
 
 from engine.config import SynthConfig
 from engine.evaluation import evaluate, speech_mask, trajectory_correlations
-from engine.model import Model, synthesize
+from engine.model import Model
+from engine.pipeline import synthesize
 
 
 def test_model_on_default_corpus(default_model, default_corpus):

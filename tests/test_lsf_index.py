@@ -7,12 +7,14 @@ import numpy as np
 import pytest
 from conftest import edited_model_file
 
-from engine.cli import _synth_config, build_parser
 from engine.codebook import Codebook
 from engine.config import SynthConfig
 from engine.lsf_index import build_index, kmeans
-from engine.model import Model, synthesize
+from engine.model import Model
+from engine.pipeline import synthesize
 from engine.synthesis import perceptual_weights
+from facetraj.cli import build_parser
+from facetraj.options import synth_config
 
 
 def random_lsf(n: int, p: int = 6, seed: int = 0) -> np.ndarray:
@@ -143,10 +145,10 @@ def test_default_acoustic_search_agrees_with_the_whole_codebook(default_model, d
 def test_cli_acoustic_search_options():
     parser = build_parser()
     base = ["synth", "m.npz", "a.wav", "-o", "o.c3d"]
-    assert _synth_config(parser.parse_args(base)) == SynthConfig()
-    cfg = _synth_config(parser.parse_args([*base, "--acoustic-prefilter", "all"]))
+    assert synth_config(parser.parse_args(base)) == SynthConfig()
+    cfg = synth_config(parser.parse_args([*base, "--acoustic-prefilter", "all"]))
     assert cfg.acoustic_prefilter is None
-    cfg = _synth_config(parser.parse_args([*base, "--acoustic-prefilter", "64", "--acoustic-probe", "ALL"]))
+    cfg = synth_config(parser.parse_args([*base, "--acoustic-prefilter", "64", "--acoustic-probe", "ALL"]))
     assert cfg.acoustic_prefilter == 64 and cfg.acoustic_probe is None
     with pytest.raises(SystemExit):
         parser.parse_args([*base, "--acoustic-probe", "0"])

@@ -11,7 +11,9 @@ from engine.config import SynthConfig, TrainConfig
 from engine.data import PhoneSegment, Utterance
 from engine.errors import InputError, ModelFileError
 from engine.evaluation import evaluate
-from engine.model import MarkerSetup, Model, resmooth, synthesize, train
+from engine.model import Model
+from engine.pipeline import resmooth, synthesize
+from engine.training import MarkerSetup, train
 
 
 def test_model_contents(toy_model, toy_corpus):

@@ -12,7 +12,8 @@ from engine.corpus import init_corpus, load_corpus
 from engine.errors import InputError
 from engine.formats import MOCHA_COILS, read_markers, read_mocha_ema, write_c3d
 from engine.labelmap import MOCHA_TO_ARPABET, read_label_map
-from engine.model import synthesize, train
+from engine.pipeline import synthesize
+from engine.training import train
 
 needs_mocha = pytest.mark.skipif(not (MOCHA / "fsew0_001.ema").exists(),
                                  reason="the MOCHA sample ../shared/data/mocha_fsew0_001 is absent")

@@ -6,7 +6,7 @@ import imageio_ffmpeg
 import numpy as np
 import pytest
 
-from engine.cli import main
+from facetraj.cli import main
 
 
 def _streams(path):

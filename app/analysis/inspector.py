@@ -23,7 +23,8 @@ from PyQt6.QtWidgets import (
 
 from app.style import ORIGINAL_COLOR, SYNTH_COLOR
 from engine.analysis import FrameInspection, inspect_frame
-from engine.model import Model, Synthesis
+from engine.model import Model
+from engine.pipeline import Synthesis
 
 from .common import Canvas, NumberItem, fill_table, heat_item, text_item
 

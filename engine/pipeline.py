@@ -1,0 +1,145 @@
+"""The synthesis pipeline (paper section 2.3): input LSFs, the candidate codewords of each frame
+(eq 4 in phonetic mode, the LSF index in acoustic-only mode), eqs 5-8 (``engine.synthesis``),
+smoothing, and the PCs back to face points.
+
+The rule for input without phone labels lives here, once: :func:`mode_for`.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .config import SynthConfig
+from .data import PhoneSegment
+from .errors import InputError
+from .formats import validate_phones
+from .model import Model
+from .phones import SILENCE, context_ids, map_labels, segment_index
+from .similarity import top_context_phones
+from .smoothing import smooth
+from .synthesis import FrameWeights, gamma_grid, nearest_codewords, weight_frames
+
+log = logging.getLogger(__name__)
+
+
+def mode_for(config: SynthConfig, phones: Sequence[PhoneSegment] | None) -> SynthConfig:
+    """``config``, switched to acoustic-only mode when phonetic mode has no phone labels.
+
+    >>> mode_for(SynthConfig(), None).mode
+    'acoustic'
+    >>> mode_for(SynthConfig(), [PhoneSegment(0.0, 0.1, "sil")]).mode
+    'phonetic'
+    """
+    if config.mode == "phonetic" and not phones:
+        log.info("no phone labels: acoustic-only synthesis")
+        return config.with_(mode="acoustic")
+    return config
+
+
+@dataclass
+class SegmentChoice:
+    """The context-phones chosen for one input phone segment (eq 4)."""
+
+    segment: PhoneSegment
+    context: np.ndarray      # (2C+1,) phone ids of the input context-phone
+    chosen: np.ndarray       # (N,) codebook context-phone indices, best first
+    scores: np.ndarray       # (N,) their n_j
+
+
+@dataclass
+class Synthesis:
+    """The result of :func:`synthesize`.
+
+    Attributes
+    ----------
+    times : ``(T,)`` frame times in seconds (frame t at ``t / marker_rate``).
+    lsf : ``(T, P)`` input LSF vectors w.
+    raw_pcs : ``(T, K)`` unsmoothed p-hat(t) (eq 8).
+    pcs : ``(T, K)`` smoothed PCs; ``markers`` ``(T, M, 3)`` rebuilt from them (head frame).
+    frames : per-frame eq 5-8 details (gamma, weights, candidates, w-hat).
+    segments : per input phone, the chosen context-phones (phonetic mode), else empty.
+    frame_segment : ``(T,)`` index into ``segments`` (phonetic mode), else -1.
+    """
+
+    times: np.ndarray
+    lsf: np.ndarray
+    raw_pcs: np.ndarray
+    pcs: np.ndarray
+    markers: np.ndarray
+    frames: FrameWeights
+    config: SynthConfig
+    segments: list[SegmentChoice] = field(default_factory=list)
+    frame_segment: np.ndarray | None = None
+
+
+def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
+               phones: Sequence[PhoneSegment] | None = None, config: SynthConfig | None = None,
+               n_frames: int | None = None, label_map: Mapping[str, str] | None = None,
+               source: str | None = None, lsf: np.ndarray | None = None) -> Synthesis:
+    """Synthesize face point trajectories from speech (paper section 2.3).
+
+    With ``phones`` and ``mode="phonetic"``: per input phone, the top-N context-phones by eq 4,
+    and per frame eqs 5-8 over their 5N codewords. Otherwise (acoustic-only) eqs 5-8 over the
+    ``config.acoustic_prefilter`` codewords nearest to each frame, found through the model's LSF
+    index (``acoustic_probe`` cells), or over the whole codebook as the paper does
+    (``acoustic_prefilter=None``). Then smoothing, and the PCs back to ``(T, M, 3)`` markers.
+
+    ``n_frames`` defaults to every marker frame inside the audio. ``source`` names the input in
+    error messages. ``lsf`` may pass the input LSFs already computed by :meth:`Model.input_lsf`
+    for these frames (when one utterance is synthesized under several configs).
+    """
+    config = config or SynthConfig()
+    duration = len(audio) / float(sample_rate)
+    rate = model.marker_rate
+    if n_frames is None:
+        n_frames = int(np.floor(duration * rate + 1e-9)) + 1
+    if n_frames < 2 or duration < 2.0 / rate:
+        raise InputError(source, f"the audio is too short ({duration * 1000:.1f} ms) to synthesize")
+    times = np.arange(n_frames) / rate
+    mc = model.config
+    if lsf is None:
+        w = model.input_lsf(audio, sample_rate, times)
+    elif lsf.shape != (n_frames, mc.lpc_order):
+        raise ValueError(f"lsf must be ({n_frames}, {mc.lpc_order}) for these frames, got {lsf.shape}")
+    else:
+        w = lsf
+    cb = model.codebook
+    segments: list[SegmentChoice] = []
+    frame_seg = None
+    if config.mode == "phonetic":
+        if not phones:
+            raise InputError(source, "phonetic mode needs phone labels (or use acoustic mode)")
+        segs = validate_phones(list(phones), duration, source)
+        segs = map_labels(segs, model.phones, label_map, source)
+        pid = {p: i for i, p in enumerate(model.phones)}
+        ctx = context_ids([pid[s.label] for s in segs], mc.context, pid[SILENCE])
+        s = model.similarity(config.nu)
+        top, scores = top_context_phones(ctx, cb.contexts, s, config.xi,
+                                         min(config.context, mc.context), config.n_context_phones)
+        segments = [SegmentChoice(seg, ctx[i], top[i], scores[i]) for i, seg in enumerate(segs)]
+        frame_seg = segment_index(segs, times)
+        candidates = cb.codewords_of(top)[frame_seg]
+    elif config.mode == "acoustic":
+        if config.acoustic_prefilter is not None and config.acoustic_probe is not None:
+            candidates = model.lsf_index().nearest(w, cb.lsf, config.acoustic_prefilter,
+                                                   config.acoustic_probe)
+        else:                                   # every codeword, or the exact K nearest
+            candidates = nearest_codewords(w, cb.lsf, config.acoustic_prefilter)
+    else:
+        raise ValueError(f"unknown mode {config.mode!r} (phonetic or acoustic)")
+    gammas = gamma_grid(config.gamma_min, config.gamma_max, config.gamma_steps)
+    fw = weight_frames(w, candidates, cb.lsf, cb.pcs, gammas)
+    pcs = smooth(fw.pcs, rate, config.smoothing, config.triangle_s, config.spline_knot_s)
+    return Synthesis(times=times, lsf=w, raw_pcs=fw.pcs, pcs=pcs, markers=model.to_markers(pcs),
+                     frames=fw, config=config, segments=segments, frame_segment=frame_seg)
+
+
+def resmooth(model: Model, result: Synthesis, method: str) -> np.ndarray:
+    """Markers ``(T, M, 3)`` from ``result``'s raw PCs smoothed with another ``method``."""
+    cfg = result.config
+    return model.to_markers(smooth(result.raw_pcs, model.marker_rate, method, cfg.triangle_s,
+                                   cfg.spline_knot_s))

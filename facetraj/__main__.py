@@ -1,0 +1,7 @@
+"""``python -m facetraj``: the same as the ``facetraj`` command."""
+
+import sys
+
+from .cli import main
+
+sys.exit(main())

@@ -1,0 +1,68 @@
+"""The ``facetraj`` command.
+
+``facetraj`` alone opens the app on the default corpus; subcommands train, synthesize, evaluate,
+sweep N, print the similarity table, render videos and the report, and build or describe corpora.
+Bad input gives a one-line message naming the file and the problem, and exit status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from collections.abc import Sequence
+
+from engine.errors import FacetrajError
+
+from .commands import corpus, evaluate, gui, render, synth, train
+from .paths import default_corpus
+
+log = logging.getLogger("facetraj")
+
+EXIT_BAD_INPUT = 2
+
+#: The subcommand modules, in the order ``facetraj --help`` lists them.
+COMMANDS = (gui, train, synth, evaluate, render, corpus)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="facetraj",
+        description="Speech-driven 3-D face point trajectory synthesis (Arslan & Talkin). "
+                    "Without a subcommand, opens the app on the default corpus.")
+    parser.add_argument("-v", "--verbose", action="store_true", help="log details")
+    parser.add_argument("-q", "--quiet", action="store_true", help="log only errors")
+    parser.add_argument("--screenshot", metavar="OUT.png",
+                        help="render the app window to a PNG and exit")
+    parser.add_argument("--utterance", help="utterance shown first")
+    parser.add_argument("--time", type=float, help="cursor time in seconds")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for module in COMMANDS:
+        module.register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    level = logging.DEBUG if args.verbose else logging.ERROR if args.quiet else logging.INFO
+    logging.basicConfig(level=level, format="%(levelname)s: %(message)s")
+    if args.command is None:
+        args.corpus = default_corpus()
+        args.func = gui.cmd_gui
+    elif args.command in ("gui", "report") and args.corpus is None:
+        args.corpus = default_corpus()
+    try:
+        return args.func(args)
+    except FacetrajError as exc:
+        print(f"facetraj: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except FileExistsError as exc:
+        print(f"facetraj: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

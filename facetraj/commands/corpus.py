@@ -1,0 +1,85 @@
+"""``facetraj corpus build|init|show``: the default corpus, and describing one's own recordings."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from pathlib import Path
+
+from engine.errors import FacetrajError
+
+from ..progress import TerminalProgress
+
+log = logging.getLogger("facetraj")
+
+
+def cmd_corpus_build(args: argparse.Namespace) -> int:
+    try:
+        from engine.corpusgen.build import build_corpus
+    except ImportError as exc:
+        raise FacetrajError(f"the corpus generator is not available ({exc}); "
+                            "install it with: pip install -e '.[corpus]'") from exc
+    kw = {"progress": TerminalProgress("corpus")}
+    if args.sentences is not None:
+        kw["n_sentences"] = args.sentences
+    if args.seed is not None:
+        kw["seed"] = args.seed
+    build_corpus(args.output, **kw)
+    print(args.output)
+    return 0
+
+
+def cmd_corpus_init(args: argparse.Namespace) -> int:
+    from engine.corpus import init_corpus
+
+    out, info = init_corpus(args.data_dir, args.output, args.fixed, args.upper_lip,
+                            args.lower_lip, args.lip_corners, args.label_map or "", args.rate,
+                            args.test, args.test_fraction, args.name or "")
+    log.info("%d train and %d test utterances, %d markers (%d-D)", len(info.train),
+             len(info.test), len(info.marker_names), info.dimensions)
+    print(out)
+    return 0
+
+
+def cmd_corpus_show(args: argparse.Namespace) -> int:
+    from engine.corpus import load_corpus
+
+    corpus = load_corpus(args.corpus)
+    info = corpus.info
+    print(f"{info.name or corpus.root.name}: {len(info.train)} train, {len(info.test)} test, "
+          f"{len(info.marker_names)} markers at {info.marker_rate:g} Hz ({info.dimensions}-D)")
+    print(f"fixed: {' '.join(info.fixed_markers)}; lips: {info.upper_lip} / {info.lower_lip}")
+    for split in ("train", "test"):
+        for utt_id in getattr(info, split):
+            utt = corpus.utterance(utt_id)
+            print(f"{split:<5} {utt_id:<12} {utt.duration:6.2f} s {len(utt.phones):4d} phones  "
+                  f"{utt.text}")
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("corpus", help="the default corpus: build it; describe your own folder")
+    csub = p.add_subparsers(dest="corpus_command", metavar="ACTION", required=True)
+    b = csub.add_parser("build", help="synthesize the default corpus into a folder")
+    b.add_argument("output", type=Path)
+    b.add_argument("--sentences", type=int, help="number of sentences")
+    b.add_argument("--seed", type=int, help="random seed")
+    b.set_defaults(func=cmd_corpus_build)
+    i = csub.add_parser("init", help="describe a folder of your own recordings as a corpus")
+    i.add_argument("data_dir", type=Path, help="folder with <id>.wav|flac, labels, markers")
+    i.add_argument("-o", "--output", type=Path,
+                   help="the description (default DATA_DIR/corpus.json; elsewhere for read-only data)")
+    i.add_argument("--fixed", nargs="+", required=True, metavar="MARKER",
+                   help="markers that move only with the head (3, or 2 for midsagittal data)")
+    i.add_argument("--upper-lip", required=True, metavar="MARKER")
+    i.add_argument("--lower-lip", required=True, metavar="MARKER")
+    i.add_argument("--lip-corners", nargs=2, metavar=("RIGHT", "LEFT"))
+    i.add_argument("--label-map", help="'mocha' or a label map file (label<TAB>arpabet)")
+    i.add_argument("--rate", type=float, default=60.0, help="marker rate to resample to (60 Hz)")
+    i.add_argument("--test", nargs="+", metavar="ID", help="test utterances")
+    i.add_argument("--test-fraction", type=float, default=1 / 3)
+    i.add_argument("--name")
+    i.set_defaults(func=cmd_corpus_init)
+    sh = csub.add_parser("show", help="list a corpus's utterances")
+    sh.add_argument("corpus", type=Path, help="corpus folder or description .json")
+    sh.set_defaults(func=cmd_corpus_show)

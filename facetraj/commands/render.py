@@ -1,0 +1,87 @@
+"""``facetraj video`` and ``facetraj report``: the headless renderers of ``app`` (a video of the
+face with its sound; the results report with its figures)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from engine.errors import FacetrajError
+
+from ..options import add_synth_options, synth_config
+from ..progress import TerminalProgress
+
+
+def cmd_video(args: argparse.Namespace) -> int:
+    from engine.model import Model
+    from engine.pipeline import mode_for, synthesize
+
+    try:
+        from app.video import VideoSettings, render_video
+    except ImportError as exc:
+        raise FacetrajError(f"video export needs the app's packages: {exc}") from exc
+    model = Model.load(args.model)
+    original = None
+    title = ""
+    if args.corpus:
+        from engine.corpus import load_corpus
+
+        if not args.utterance:
+            raise FacetrajError("give --utterance ID with --corpus")
+        utt = load_corpus(args.corpus).utterance(args.utterance)
+        audio, rate, phones, n_frames = utt.audio, utt.sample_rate, utt.phones, utt.n_frames
+        original = model.normalise_markers(utt.markers) if utt.markers is not None else None
+        title, source = utt.text or utt.name, utt.name
+    elif args.audio:
+        from engine.formats import read_audio, read_labels
+
+        audio, rate = read_audio(args.audio)
+        phones = read_labels(args.labels, rate) if args.labels else None
+        n_frames, source, title = None, str(args.labels or args.audio), args.audio.name
+    else:
+        raise FacetrajError("give an AUDIO file, or --corpus and --utterance")
+    cfg = mode_for(synth_config(args), phones)
+    res = synthesize(model, audio, rate, phones, cfg, n_frames=n_frames, source=source)
+    w, h = (int(v) for v in args.size.lower().split("x"))
+    render_video(model, res, audio, rate, args.output, original=original,
+                 settings=VideoSettings(w, h, args.fps), overwrite=args.overwrite,
+                 progress=TerminalProgress("video"), title=title)
+    print(args.output)
+    return 0
+
+
+def cmd_report(args: argparse.Namespace) -> int:
+    from engine.model import Model
+
+    try:
+        from app.report_figures import make_report
+    except ImportError as exc:
+        raise FacetrajError(f"the report's figures need matplotlib: {exc}") from exc
+    model = Model.load(args.model) if args.model else None
+    out = make_report(args.corpus, args.output, model=model, progress=TerminalProgress("report"),
+                      ns=range(1, args.max_n + 1))
+    print(out)
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("report", help="results report: Tables 1-2, Figures 4-5, baselines")
+    p.add_argument("corpus", type=Path, nargs="?", default=None, help="corpus (default data_samples)")
+    p.add_argument("-o", "--output", type=Path, default=Path("docs"),
+                   help="folder of results.md, results.json and figures/ (default docs)")
+    p.add_argument("--model", type=Path, help="a trained model (default: train on the corpus)")
+    p.add_argument("--max-n", type=int, default=10, help="the N sweep runs 1..MAX_N")
+    p.set_defaults(func=cmd_report)
+
+    p = sub.add_parser("video", help="an MP4 of the face points and lip panels with the sound")
+    p.add_argument("model", type=Path)
+    p.add_argument("audio", type=Path, nargs="?", help="WAV or FLAC (or use --corpus)")
+    p.add_argument("--labels", type=Path, help="phone labels for AUDIO")
+    p.add_argument("--corpus", type=Path, help="take the utterance (and its original) from a corpus")
+    p.add_argument("--utterance", help="utterance id in --corpus")
+    p.add_argument("-o", "--output", type=Path, required=True, help="an .mp4 file")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing file")
+    p.add_argument("--fps", type=float, default=30.0)
+    p.add_argument("--size", default="1280x544", help="WIDTHxHEIGHT")
+    add_synth_options(p)
+    p.set_defaults(func=cmd_video)

@@ -1,0 +1,44 @@
+"""``facetraj synth``: face point trajectories from a speech file (paper 2.3)."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from pathlib import Path
+
+from ..options import add_synth_options, synth_config
+
+log = logging.getLogger("facetraj")
+
+
+def cmd_synth(args: argparse.Namespace) -> int:
+    from engine.export import write_trajectories
+    from engine.formats import read_audio, read_labels
+    from engine.labelmap import read_label_map
+    from engine.model import Model
+    from engine.pipeline import mode_for, synthesize
+
+    model = Model.load(args.model)
+    audio, rate = read_audio(args.audio)
+    phones = read_labels(args.labels, rate) if args.labels else None
+    cfg = mode_for(synth_config(args), phones)
+    label_map = read_label_map(args.label_map) if args.label_map else None
+    res = synthesize(model, audio, rate, phones, cfg, label_map=label_map,
+                     source=str(args.labels or args.audio))
+    out = write_trajectories(args.output, res.markers, model, res, args.overwrite)
+    log.info("%d frames (%.2f s) synthesized, %s mode, %s smoothing", len(res.times),
+             res.times[-1], cfg.mode, cfg.smoothing)
+    print(out)
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("synth", help="synthesize face points from speech")
+    p.add_argument("model", type=Path)
+    p.add_argument("audio", type=Path, help="WAV or FLAC")
+    p.add_argument("--labels", type=Path, help="phone labels: .TextGrid, .lab or .phn")
+    p.add_argument("--label-map", help="a label map (TSV: label<TAB>arpabet)")
+    p.add_argument("-o", "--output", type=Path, required=True, help=".c3d, .tsv, .csv or .npz")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing file")
+    add_synth_options(p)
+    p.set_defaults(func=cmd_synth)

@@ -1,0 +1,36 @@
+"""``facetraj train``: a model from a corpus folder (paper 2.1-2.2)."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from pathlib import Path
+
+from ..options import add_train_options, train_config
+from ..progress import TerminalProgress
+
+log = logging.getLogger("facetraj")
+
+
+def cmd_train(args: argparse.Namespace) -> int:
+    from engine.corpus import load_corpus
+    from engine.training import train
+
+    corpus = load_corpus(args.corpus)
+    model = train(corpus, config=train_config(args), progress=TerminalProgress("train"))
+    out = model.save(args.output, overwrite=args.overwrite)
+    cb = model.codebook
+    log.info("trained on %d utterances: %d context-phones, %d codewords, %d PCs (%.2f %% of "
+             "variance), %d phones", len(model.train_utterances), cb.n_contexts, len(cb.lsf),
+             model.pca.n_components, 100 * model.pca.explained_ratio.sum(), len(model.phones))
+    print(out)
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("train", help="train a model on a corpus folder")
+    p.add_argument("corpus", type=Path)
+    p.add_argument("-o", "--output", type=Path, required=True, help="model file (.npz)")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing file")
+    add_train_options(p)
+    p.set_defaults(func=cmd_train)
