@@ -126,10 +126,11 @@ def trajectory_correlations(original: np.ndarray, synthesized: np.ndarray, mask:
 
 
 @dataclass
-class UtteranceScore:
-    """Correlations of one utterance under one condition."""
+class ConditionScores:
+    """The three correlations of section 3 (whole face, lower lip, upper lip) under one condition:
+    split, synthesis mode, smoothing and N. One utterance's scores (:class:`UtteranceScore`) and a
+    mean over utterances (a Table 2 row) share these fields."""
 
-    utterance: str
     split: str
     mode: str
     smoothing: str
@@ -137,6 +138,13 @@ class UtteranceScore:
     whole_face: float
     lower_lip: float
     upper_lip: float
+
+
+@dataclass(kw_only=True)
+class UtteranceScore(ConditionScores):
+    """Correlations of one utterance under one condition, on its ``speech_frames`` frames."""
+
+    utterance: str
     speech_frames: int
 
 
@@ -166,7 +174,9 @@ class EvalResult:
                  **self.mean(sp, sm, mo, n)} for sp, mo, sm, n in self.conditions()]
 
     def to_json(self) -> dict:
-        return {"table": self.table(), "utterances": [asdict(r) for r in self.scores]}
+        # the utterance first, as it reads
+        return {"table": self.table(),
+                "utterances": [{"utterance": r.utterance, **asdict(r)} for r in self.scores]}
 
 
 def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
@@ -195,8 +205,9 @@ def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
     for sm in smoothings:
         markers = resmooth(model, res, sm)
         c = trajectory_correlations(original, markers, mask, model, eval_config)
-        out.append(UtteranceScore(utt.name, split, config.mode, sm, config.n_context_phones,
-                                  c["whole_face"], c["lower_lip"], c["upper_lip"], int(mask.sum())))
+        out.append(UtteranceScore(split=split, mode=config.mode, smoothing=sm,
+                                  n_context_phones=config.n_context_phones, **c,
+                                  utterance=utt.name, speech_frames=int(mask.sum())))
     return out
 
 

@@ -121,6 +121,18 @@ def report_error(parent: QWidget, title: str, exc: BaseException) -> None:
     QMessageBox.warning(parent, title, str(exc))
 
 
+def export_with_dialog(parent: QWidget, title: str, default: str, filters: str,
+                       write: Callable[[Path], Any]) -> None:
+    """Ask for a file name and ``write(path)``; a failure (``OSError``, ``ValueError``) is shown,
+    not raised. The export buttons of every view go through here."""
+    path = ask_save_path(parent, title, default, filters)
+    if path:
+        try:
+            write(path)
+        except (OSError, ValueError) as exc:
+            report_error(parent, "Export failed", exc)
+
+
 def run_background(owner: QWidget, fn: Callable[[Progress], Any], on_done: Callable[[Any], None],
                    on_progress: Callable[[float, str], None] | None = None,
                    on_error: Callable[[BaseException], None] | None = None, label: str = "",

@@ -1,6 +1,6 @@
 """Error analysis: which phones synthesize worst, which utterances, which segments.
 
-The view runs :func:`engine.analysis.error_report` in a background worker and shows correlation
+The view runs :func:`engine.analysis.errors.error_report` in a background worker and shows correlation
 and RMS lip error per phone, a sortable per-utterance list and the worst segments; a click on an
 utterance or a segment jumps there (utterance and time). :class:`LipErrorPanel` adds
 ``|original - synthesized|`` of the lips to the time-aligned stack with the worst segments of
@@ -27,12 +27,12 @@ from PyQt6.QtWidgets import (
 )
 
 from app.style import ORIGINAL_COLOR, SYNTH_COLOR
-from engine.analysis import (
+from engine.analysis.common import subset_corpus
+from engine.analysis.errors import (
     ErrorReport,
     error_report,
     lip_error,
     segment_errors,
-    subset_corpus,
     worst_segments,
     write_error_csv,
 )
@@ -41,7 +41,7 @@ from engine.model import Model
 
 from .common import (
     NumberItem,
-    ask_save_path,
+    export_with_dialog,
     fill_table,
     heat_item,
     report_error,
@@ -207,12 +207,8 @@ class ErrorView(QWidget):
         return write_error_csv(path, self.report)
 
     def _export_csv(self) -> None:
-        path = ask_save_path(self, "Export per-utterance errors", "errors.csv", "CSV (*.csv)")
-        if path:
-            try:
-                self.export_csv(path)
-            except (OSError, ValueError) as exc:
-                report_error(self, "Export failed", exc)
+        export_with_dialog(self, "Export per-utterance errors", "errors.csv", "CSV (*.csv)",
+                           self.export_csv)
 
 
 class LipErrorPanel:

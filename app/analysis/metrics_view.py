@@ -25,10 +25,10 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from engine.analysis import (
+from engine.analysis.common import subset_corpus
+from engine.analysis.metrics import (
     SweepCurve,
     Table2Row,
-    subset_corpus,
     sweep_curves,
     table2_rows,
     write_sweep_csv,
@@ -37,12 +37,12 @@ from engine.analysis import (
 from engine.corpus import Corpus
 from engine.evaluation import METRICS, EvalResult, sweep_n, table2
 from engine.model import Model
-from engine.report import PAPER_TABLE2
+from engine.paper import TABLE2_N, table2_value
 
 from .common import (
     Canvas,
     NumberItem,
-    ask_save_path,
+    export_with_dialog,
     fill_table,
     heat_item,
     report_error,
@@ -58,9 +58,9 @@ METRIC_NAMES = {"whole_face": "Whole Face", "lower_lip": "Lower Lip", "upper_lip
 
 def _paper(row: Table2Row) -> tuple[float, float, float]:
     """The paper's Table 2 value of this condition (phonetic, N = 3), else NaN."""
-    if row.mode != "phonetic" or row.n_context_phones != 3:
+    if row.mode != "phonetic" or row.n_context_phones != TABLE2_N:
         return (float("nan"),) * 3
-    return PAPER_TABLE2.get((row.split, row.smoothing), (float("nan"),) * 3)
+    return table2_value(row.split, row.smoothing)
 
 
 def _short(row: Table2Row) -> str:
@@ -251,19 +251,11 @@ class MetricsView(QWidget):
         self.canvas.draw()
         return self.canvas.save_png(path)
 
-    def _export(self, title: str, default: str, filters: str, fn) -> None:
-        path = ask_save_path(self, title, default, filters)
-        if path:
-            try:
-                fn(path)
-            except (OSError, ValueError) as exc:
-                report_error(self, "Export failed", exc)
-
     def _export_table2(self) -> None:
-        self._export("Export Table 2", "table2.csv", "CSV (*.csv)", self.export_table2_csv)
+        export_with_dialog(self, "Export Table 2", "table2.csv", "CSV (*.csv)", self.export_table2_csv)
 
     def _export_sweep(self) -> None:
-        self._export("Export N sweep", "n_sweep.csv", "CSV (*.csv)", self.export_sweep_csv)
+        export_with_dialog(self, "Export N sweep", "n_sweep.csv", "CSV (*.csv)", self.export_sweep_csv)
 
     def _export_png(self) -> None:
-        self._export("Export plots", "metrics.png", "PNG image (*.png)", self.export_png)
+        export_with_dialog(self, "Export plots", "metrics.png", "PNG image (*.png)", self.export_png)
