@@ -20,6 +20,7 @@ from .errors import InputError
 from .formats import (
     MARKER_SUFFIXES,
     atomic_write,
+    check_output_path,
     read_audio,
     read_labels,
     read_markers,
@@ -118,10 +119,11 @@ def _json_path(root: str | os.PathLike[str]) -> Path:
     return root if root.suffix.lower() == ".json" else root / "corpus.json"
 
 
-def save_corpus_info(root: str | os.PathLike[str], info: CorpusInfo) -> Path:
+def save_corpus_info(root: str | os.PathLike[str], info: CorpusInfo,
+                     overwrite: bool = True) -> Path:
     """Write ``root/corpus.json`` (or ``root`` itself when it names a ``.json`` file)."""
     path = _json_path(root)
-    with atomic_write(path) as tmp:
+    with atomic_write(path, overwrite) as tmp:
         tmp.write_text(json.dumps(info.to_json(), indent=2) + "\n", encoding="utf-8")
     return path
 
@@ -323,16 +325,20 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
                 fixed: list[str] | None = None, upper_lip: str = "", lower_lip: str = "",
                 lip_corners: list[str] | None = None, label_map: str = "",
                 marker_rate: float = 60.0, test: list[str] | None = None,
-                test_fraction: float = 1 / 3, name: str = "") -> tuple[Path, CorpusInfo]:
+                test_fraction: float = 1 / 3, name: str = "",
+                overwrite: bool = True) -> tuple[Path, CorpusInfo]:
     """Describe a folder of someone's own recordings as a corpus and write the description.
 
     Utterances are the file stems that have audio, labels and markers. The marker roles (fixed
     references, lip centres) are given by name; the test split is ``test`` or every
     ``round(1 / test_fraction)``-th utterance. ``output`` defaults to ``data_dir/corpus.json``;
     when it lies elsewhere (a read-only data folder), the description records ``data_dir``
-    relative to it.
+    relative to it. An existing description is replaced only with ``overwrite``.
     """
     data_dir = Path(data_dir).resolve()
+    out = Path(output) if output else data_dir / "corpus.json"
+    out = out if out.suffix.lower() == ".json" else out / "corpus.json"
+    check_output_path(out, overwrite)
     scan = scan_folder(data_dir)
     ids, names, planar = scan.ids, scan.marker_names, scan.dimensions == 2
     for role in [*(fixed or []), upper_lip, lower_lip, *(lip_corners or [])]:
@@ -345,15 +351,13 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
     train_ids = [u for u in ids if u not in test]
     if not train_ids:
         train_ids, test = ids, [u for u in test if u in ids]
-    out = Path(output) if output else data_dir / "corpus.json"
-    out = out if out.suffix.lower() == ".json" else out / "corpus.json"
     rel = "" if out.parent.resolve() == data_dir else os.path.relpath(data_dir, out.parent.resolve())
     info = CorpusInfo(marker_names=names, marker_rate=float(marker_rate), fixed_markers=list(fixed or []),
                       upper_lip=upper_lip, lower_lip=lower_lip, train=train_ids, test=list(test),
                       lip_corners=list(lip_corners or []), label_map=label_map, data_dir=rel,
                       dimensions=2 if planar else 3, name=name or data_dir.name)
     CorpusInfo.from_json(info.to_json(), out)  # the same checks as on loading
-    save_corpus_info(out, info)
+    save_corpus_info(out, info, overwrite)
     return out, info
 
 

@@ -27,5 +27,9 @@ class InputError(FacetrajError):
         super().__init__(f"{self.path}: {problem}" if self.path else problem)
 
 
+class OutputExistsError(InputError, FileExistsError):
+    """The output file exists and replacing it was not asked for (``--overwrite``)."""
+
+
 class ModelFileError(InputError):
     """A model file that is not ours, truncated, or of a newer format."""
