@@ -193,6 +193,8 @@ def write_audio(path: str | os.PathLike[str], samples: np.ndarray, rate: int,
 def _read_text(path: Path) -> str:
     if not path.exists():
         raise InputError(path, "no such label file")
+    if path.is_dir():
+        raise InputError(path, "is a folder, not a file")
     raw = path.read_bytes()
     try:
         if raw.startswith((b"\xff\xfe", b"\xfe\xff")):  # UTF-16 (Praat writes it) only with a BOM

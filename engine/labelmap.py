@@ -32,6 +32,8 @@ def read_label_map(path: str | os.PathLike[str]) -> dict[str, str]:
     path = Path(path)
     if not path.exists():
         raise InputError(path, "no such label map")
+    if path.is_dir():
+        raise InputError(path, "is a folder, not a label map file")
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError as exc:
