@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import resample_poly
 
+from .c3d_check import check_c3d
 from .data import PhoneSegment
 from .errors import InputError, OutputExistsError
 
@@ -358,10 +359,14 @@ def read_c3d(path: str | os.PathLike[str]) -> MarkerData:
     path = Path(path)
     if not path.exists():
         raise InputError(path, "no such C3D file")
+    if path.is_dir():
+        raise InputError(path, "is a folder, not a C3D file")
+    check_c3d(path)
     try:
         c3d = ezc3d.c3d(str(path))
     except Exception as exc:
-        raise InputError(path, f"not a readable C3D file ({exc})") from exc
+        reason = str(exc).split(". ")[0].split("\n")[0]  # not ezc3d's advice to set options
+        raise InputError(path, f"not a readable C3D file ({reason})") from exc
     point = c3d["parameters"]["POINT"]
     pts = np.asarray(c3d["data"]["points"], dtype=np.float64)[:3]  # (3, M, T)
     if pts.ndim != 3 or pts.shape[1] == 0 or pts.shape[2] == 0:
