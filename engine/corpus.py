@@ -324,7 +324,7 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
     mdata = read_markers(mpath, info.marker_rate)
     if mdata.names != info.marker_names:
         raise InputError(mpath, f"marker set differs from the corpus description "
-                                f"({len(mdata.names)} markers, {len(info.marker_names)} expected)")
+                                f"({marker_set_difference(mdata.names, info.marker_names)})")
     markers = mdata.markers
     n_audio = int(np.floor(len(audio) / rate * info.marker_rate + 1e-9)) + 1
     if markers.shape[0] < n_audio - 1:
@@ -432,6 +432,26 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
     CorpusInfo.from_json(info.to_json(), out)  # the same checks as on loading
     save_corpus_info(out, info, overwrite)
     return out, info
+
+
+def marker_set_difference(found: list[str], expected: list[str]) -> str:
+    """How a marker set differs from the expected one, in words (for error messages).
+
+    >>> marker_set_difference(["a", "b", "x"], ["a", "b", "c"])
+    "3 markers, 3 expected; 'c' missing; 'x' not expected"
+    >>> marker_set_difference(["b", "a"], ["a", "b"])
+    '2 markers, 2 expected; the same names in another order'
+    """
+    parts = [f"{len(found)} markers, {len(expected)} expected"]
+    missing = [n for n in expected if n not in found]
+    extra = [n for n in found if n not in expected]
+    if missing:
+        parts.append(f"{', '.join(map(repr, missing[:5]))}{' ...' if len(missing) > 5 else ''} missing")
+    if extra:
+        parts.append(f"{', '.join(map(repr, extra[:5]))}{' ...' if len(extra) > 5 else ''} not expected")
+    if not missing and not extra and found != expected:
+        parts.append("the same names in another order")
+    return "; ".join(parts)
 
 
 def marker_coverage(markers: np.ndarray) -> float:

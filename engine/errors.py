@@ -23,7 +23,7 @@ class InputError(FacetrajError):
 
     def __init__(self, path: str | PathLike[str] | None, problem: str):
         self.path = None if path is None else str(path)
-        self.problem = problem
+        self.problem = " ".join(str(problem).split())  # always one line (library texts may wrap)
         super().__init__(f"{self.path}: {problem}" if self.path else problem)
 
 

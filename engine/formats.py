@@ -210,7 +210,7 @@ def read_textgrid_tiers(path: str | os.PathLike[str]) -> dict[str, list[PhoneSeg
     from praatio import textgrid
 
     path = Path(path)
-    _read_text(path)  # existence and encoding, with our own message
+    _check_interval_order(path, _read_text(path))  # our own messages, before praatio's
     try:
         tg = textgrid.openTextgrid(str(path), includeEmptyIntervals=True)
     except Exception as exc:
@@ -223,6 +223,35 @@ def read_textgrid_tiers(path: str | os.PathLike[str]) -> dict[str, list[PhoneSeg
         tiers[name] = [PhoneSegment(float(s), float(e), str(lab).strip())
                        for s, e, lab in tier.entries]
     return tiers
+
+
+def _check_interval_order(path: Path, text: str) -> None:
+    """Refuse interval tiers whose intervals are out of order, overlap or are not numbers (praatio
+    would sort them silently, or fail with its own text)."""
+    from praatio.utilities import textgrid_io
+
+    try:
+        parsed = textgrid_io.parseTextgridStr(text, includeEmptyIntervals=True)
+    except Exception as exc:  # praatio raises several types for malformed text
+        raise InputError(path, f"not a readable TextGrid ({exc})") from exc
+    for tier in parsed.get("tiers", []):
+        if tier.get("class") != "IntervalTier":
+            continue
+        prev_end = -np.inf
+        for i, (start, end, label) in enumerate(tier["entries"]):
+            try:
+                start, end = float(start), float(end)
+            except ValueError:
+                raise InputError(path, f"tier {tier['name']!r}: interval {i + 1} has a time that "
+                                       f"is not a number ({start} {end})") from None
+            if not (np.isfinite(start) and np.isfinite(end)):
+                raise InputError(path, f"tier {tier['name']!r}: interval {i + 1} has a time that "
+                                       f"is not a finite number ({start} {end})")
+            if start < prev_end - 1e-6:
+                raise InputError(path, f"tier {tier['name']!r}: interval {i + 1} ({label!r}) at "
+                                       f"{start:.3f} s overlaps or precedes the one before, "
+                                       f"ending {prev_end:.3f} s")
+            prev_end = max(prev_end, end)
 
 
 def read_textgrid(path: str | os.PathLike[str], tier: str = "phones") -> list[PhoneSegment]:
@@ -272,6 +301,10 @@ def read_lab(path: str | os.PathLike[str]) -> list[PhoneSegment]:
         times = np.array([[float(r[0]), float(r[1])] for r in rows])
     except ValueError as exc:
         raise InputError(path, f"a start or end time is not a number ({exc})") from exc
+    if times.size and not np.all(np.isfinite(times)):
+        row = int(np.flatnonzero(~np.isfinite(times).all(axis=1))[0])
+        raise InputError(path, f"segment {row + 1} has a time that is not a finite number "
+                               f"({rows[row][0]} {rows[row][1]})")
     scale = 1e-7 if times.size and times.max() > 1e4 else 1.0
     return [PhoneSegment(a * scale, b * scale, r[2]) for (a, b), r in zip(times, rows, strict=True)]
 
@@ -296,12 +329,16 @@ def read_labels(path: str | os.PathLike[str], sample_rate: int = 16000,
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".textgrid":
-        return read_textgrid(path, tier)
-    if suffix == ".lab":
-        return read_lab(path)
-    if suffix == ".phn":
-        return read_phn(path, sample_rate)
-    raise InputError(path, f"unknown label format {suffix!r} (use .TextGrid, .lab or .phn)")
+        segs = read_textgrid(path, tier)
+    elif suffix == ".lab":
+        segs = read_lab(path)
+    elif suffix == ".phn":
+        segs = read_phn(path, sample_rate)
+    else:
+        raise InputError(path, f"unknown label format {suffix!r} (use .TextGrid, .lab or .phn)")
+    if not segs:
+        raise InputError(path, "the label file holds no segments")
+    return segs
 
 
 def validate_phones(phones: Sequence[PhoneSegment], duration: float,

@@ -41,7 +41,8 @@ def cmd_video(args: argparse.Namespace) -> int:
     else:
         raise FacetrajError("give an AUDIO file, or --corpus and --utterance")
     cfg = mode_for(synth_config(args), phones)
-    res = synthesize(model, audio, rate, phones, cfg, n_frames=n_frames, source=source)
+    res = synthesize(model, audio, rate, phones, cfg, n_frames=n_frames, source=source,
+                     audio_source=str(args.audio or source))
     w, h = args.size
     render_video(model, res, audio, rate, args.output, original=original,
                  settings=VideoSettings(w, h, args.fps), overwrite=args.overwrite,
