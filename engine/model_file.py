@@ -46,7 +46,10 @@ def read_members(path: Path) -> tuple[dict, dict[str, np.ndarray]]:
                     arrays[name] = _read_npy(path, name, handle, info.file_size, limit)
     except ModelFileError:
         raise
-    except (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError, RuntimeError,
+    except OSError as exc:
+        raise ModelFileError(path, f"not a readable facetraj model (damaged zip structure: "
+                                   f"{exc.strerror or exc})") from exc
+    except (zipfile.BadZipFile, zlib.error, EOFError, ValueError, RuntimeError,
             NotImplementedError) as exc:
         raise ModelFileError(path, f"not a readable facetraj model ({exc})") from exc
     if "meta" not in arrays:
