@@ -130,7 +130,8 @@ def make_workspace(root: Path, toy_dir: Path | None = None, model_path: Path | N
 
 
 # --------------------------------------------------------------------------- byte mutations
-def mutate_bytes(rng: random.Random, data: bytes, start: int = 0, end: int | None = None) -> tuple[bytes, str]:
+def mutate_bytes(rng: random.Random, data: bytes, start: int = 0,
+                 end: int | None = None) -> tuple[bytes, str]:
     """A random damage: truncation, bit flips, random bytes, a zeroed or repeated block."""
     end = len(data) if end is None else min(end, len(data))
     start = min(start, max(end - 1, 0))
@@ -332,7 +333,7 @@ def _model_variant(rng: random.Random, src: Path, dst: Path) -> str:
     kind = rng.choice(["meta", "meta", "array", "array", "header", "compression", "deflate",
                        "bytes", "missing", "pickle"])
     if kind == "meta":
-        field_ = rng.choice(list(meta) + ["config"])
+        field_ = rng.choice([*list(meta), "config"])
         value = rng.choice([None, [], {}, "x", -1, 0, 1e309, True, 3.5, [1, 2], "nan", 10**30])
         if rng.random() < 0.15:
             meta = rng.choice([[], "text", 5, None])
@@ -360,7 +361,7 @@ def _model_variant(rng: random.Random, src: Path, dst: Path) -> str:
         elif how == "shape":
             b = a.reshape(-1)[: max(a.size - 1, 0)]
         elif how == "empty":
-            b = np.zeros((0,) + a.shape[1:], a.dtype)
+            b = np.zeros((0, *a.shape[1:]), a.dtype)
         elif how == "big":
             b = np.concatenate([a, a]) if a.ndim else a
         elif how == "str":
@@ -376,7 +377,7 @@ def _model_variant(rng: random.Random, src: Path, dst: Path) -> str:
         name = rng.choice(list(members))
         shape = rng.choice([(2**40,), (2**20, 2**20), (-1,), (10**12, 20), (3, 0, 2**62)])
         descr = rng.choice(["<f8", "|O", "<U100000", "<f8", "|V8"])
-        hdr = "{'descr': '%s', 'fortran_order': False, 'shape': %r, }" % (descr, shape)
+        hdr = f"{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape!r}, }}"
         hdr = hdr.ljust(118) + "\n"
         members[name] = b"\x93NUMPY\x01\x00" + struct.pack("<H", len(hdr)) + hdr.encode() + b"\0" * 64
         _write_npz(dst, members)
@@ -441,7 +442,7 @@ def corpus_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
         obj = json.loads(json.dumps(info))
         kind = rng.random()
         if kind < 0.6:
-            key = rng.choice(list(obj) + ["data_dir", "label_map"])
+            key = rng.choice([*list(obj), "data_dir", "label_map"])
             obj[key] = rng.choice(_VALUES)
             text = json.dumps(obj).replace("Infinity", "1e999")
             name = f"{key} = {json.dumps(obj[key])[:30]}"
@@ -573,7 +574,7 @@ def option_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
     while True:
         path, parser, action = rng.choice(targets)
         d = ws.fresh("options")
-        value = rng.choice(BAD_NUMBERS + (list(action.choices or [])[:1] + ["bogus"]
+        value = rng.choice(BAD_NUMBERS + ([*list(action.choices or [])[:1], "bogus"]
                                           if action.choices else []))
         argv = list(path)
         for pos in parser._actions:
@@ -734,7 +735,7 @@ def run_in_process(case: Case) -> Outcome:
                 code = _invoke(case)
             except SystemExit as exc:
                 code = exc.code if isinstance(exc.code, int) else 2
-            except BaseException:  # noqa: BLE001 - every escape is the failure being looked for
+            except BaseException:
                 traceback.print_exc()
                 code = 1
     finally:
@@ -764,7 +765,7 @@ def run_forked(case: Case, timeout: float = TIMEOUT_S, memory: int = MEMORY_LIMI
                 code = _invoke(case)
             except SystemExit as exc:
                 code = exc.code if isinstance(exc.code, int) else 2
-            except BaseException:  # noqa: BLE001
+            except BaseException:
                 traceback.print_exc()
                 code = 1
             sys.stderr.flush()
