@@ -23,6 +23,8 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import resample_poly
 
+from .c3d_check import MAX_RATE as MAX_C3D_RATE
+from .c3d_check import MIN_RATE as MIN_C3D_RATE
 from .c3d_check import check_c3d
 from .data import PhoneSegment
 from .errors import InputError, OutputExistsError
@@ -404,19 +406,30 @@ def read_c3d(path: str | os.PathLike[str]) -> MarkerData:
     except Exception as exc:
         reason = str(exc).split(". ")[0].split("\n")[0]  # not ezc3d's advice to set options
         raise InputError(path, f"not a readable C3D file ({reason})") from exc
-    point = c3d["parameters"]["POINT"]
+    point = c3d["parameters"].get("POINT", {})
+
+    def values(name: str) -> list:
+        return list(point.get(name, {}).get("value", []))
+
     pts = np.asarray(c3d["data"]["points"], dtype=np.float64)[:3]  # (3, M, T)
     if pts.ndim != 3 or pts.shape[1] == 0 or pts.shape[2] == 0:
         raise InputError(path, "the C3D file holds no points")
-    names = [str(n).strip() for n in point["LABELS"]["value"]][: pts.shape[1]]
-    unit = str(point.get("UNITS", {}).get("value", ["mm"])[0]).strip().lower() or "mm"
+    names = [str(n).strip() for n in values("LABELS")][: pts.shape[1]]
+    if len(names) != pts.shape[1]:
+        raise InputError(path, f"the C3D file names {len(names)} of its {pts.shape[1]} points "
+                               f"(POINT:LABELS)")
+    unit = str((values("UNITS") or ["mm"])[0]).strip().lower() or "mm"
     scale = _UNIT_TO_MM.get(unit)
     if scale is None:
         raise InputError(path, f"unknown point unit {unit!r}")
+    rate = float((values("RATE") or [c3d["header"]["points"]["frame_rate"]])[0])
+    if not MIN_C3D_RATE <= rate <= MAX_C3D_RATE:  # NaN fails too
+        raise InputError(path, f"the C3D frame rate {rate:g} Hz is outside {MIN_C3D_RATE:g}-"
+                               f"{MAX_C3D_RATE:g} Hz")
     residuals = np.asarray(c3d["data"]["meta_points"]["residuals"])[0]  # (M, T)
     markers = np.transpose(pts, (2, 1, 0)) * scale
     markers[residuals.T < 0] = np.nan
-    return MarkerData(markers, float(point["RATE"]["value"][0]), names)
+    return MarkerData(markers, rate, names)
 
 
 C3D_INT_SCALE = 0.01  # mm per integer step in integer C3D files
