@@ -72,6 +72,8 @@ def read_c3d_parameters(path: Path, data: bytes) -> tuple[str, bool, dict[tuple[
             raise bad(f"parameter {name!r} points outside the parameter section")
         body = name_end + 2
         if gid < 0:
+            if body + 1 > nxt or body + 1 + data[body] > nxt:
+                raise bad(f"the description of group {name!r} runs past its entry")
             groups[-gid] = name
         elif gid > 0:
             if body + 2 > nxt:
@@ -85,6 +87,8 @@ def read_c3d_parameters(path: Path, data: bytes) -> tuple[str, bool, dict[tuple[
             first = body + 2 + ndim
             if first + size > nxt:
                 raise bad(f"parameter {name!r} declares {size} bytes of data, more than its entry holds")
+            if first + size + 1 > nxt or first + size + 1 + data[first + size] > nxt:
+                raise bad(f"the description of parameter {name!r} runs past its entry")
             if dtype in (1, 2, 4):
                 raw_params.append((gid, name, dtype, dims, data[first:first + size]))
         if offset == 0:

@@ -487,6 +487,18 @@ def write_marker_tsv(path: str | os.PathLike[str], markers: np.ndarray, rate: fl
                    fmt=["%.6f"] + ["%.4f"] * (table.shape[1] - 1))
 
 
+def _rate_of(path: Path, times: np.ndarray) -> float:
+    """The frame rate of a time column: (frames - 1) / span, refused unless the span is finite and
+    positive and the rate within the marker rates facetraj reads."""
+    span = float(times[-1] - times[0])
+    rate = (len(times) - 1) / span if np.isfinite(span) and span > 0 else np.nan
+    if not MIN_C3D_RATE <= rate <= MAX_C3D_RATE:  # NaN fails too
+        raise InputError(path, f"its times ({times[0]:g} to {times[-1]:g} s over {len(times)} "
+                               f"frames) give no marker rate within {MIN_C3D_RATE:g}-"
+                               f"{MAX_C3D_RATE:g} Hz")
+    return rate
+
+
 def read_marker_table(path: str | os.PathLike[str], rate: float | None = None) -> MarkerData:
     """Read TSV/CSV trajectories with a header ``[time] name_x name_y name_z ...`` (mm).
 
@@ -522,7 +534,7 @@ def read_marker_table(path: str | os.PathLike[str], rate: float | None = None) -
         base, _, axis = h.rpartition("_")
         markers[:, names.index(base), "xyz".index(axis.lower())] = table[:, col]
     if times is not None and len(times) > 1:
-        rate = (len(times) - 1) / (times[-1] - times[0])
+        rate = _rate_of(path, times)
         rate = float(round(rate)) if abs(rate - round(rate)) < 1e-3 * rate else float(rate)
     if rate is None:
         raise InputError(path, "no time column: give the marker rate")
@@ -620,7 +632,7 @@ def read_mocha_ema(path: str | os.PathLike[str]) -> MarkerData:
     markers = np.stack([_midsagittal(chans[:, cx], chans[:, cy]) for cx, cy in cols], axis=1)
     rate = MOCHA_RATE
     if len(times) > 1:
-        rate = float(round((len(times) - 1) / (times[-1] - times[0])))
+        rate = float(round(_rate_of(path, times)))
     return MarkerData(markers, rate, names)
 
 
@@ -665,6 +677,11 @@ def read_markers(path: str | os.PathLike[str], rate: float | None = None) -> Mar
         data = read_mocha_ema(path)
     else:
         raise InputError(path, f"unknown marker format {suffix!r} (use .c3d, .tsv, .csv or .ema)")
+    if not MIN_C3D_RATE <= data.rate <= MAX_C3D_RATE:  # NaN fails too
+        raise InputError(path, f"the marker rate {data.rate:g} Hz (from the file's times) is "
+                               f"outside {MIN_C3D_RATE:g}-{MAX_C3D_RATE:g} Hz")
+    if data.markers.shape[0] == 0 or data.markers.shape[1] == 0:
+        raise InputError(path, "the marker file holds no frames or no markers")
     if rate is not None and abs(data.rate - rate) > 1e-6:
         log.info("%s: markers resampled from %g Hz to %g Hz", path, data.rate, rate)
         data = MarkerData(resample_markers(data.markers, data.rate, rate), float(rate), data.names)

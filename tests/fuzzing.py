@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import hashlib
 import io
 import json
 import os
@@ -44,7 +45,7 @@ PARSE_ONLY = {"gui", "report", "video", "build", None}
 BAD_NUMBERS = ["0", "-1", "-20", "nan", "inf", "-inf", "1e309", "1e-320", "abc", "", "3.5",
                "99999999999999999999", "0x10", "1e6", "-0", "1e-9", "2"]
 
-CATEGORIES = ("audio", "labels", "model", "corpus", "c3d", "options", "output")
+CATEGORIES = ("audio", "labels", "model", "corpus", "c3d", "markers", "options", "output")
 
 
 @dataclass
@@ -54,7 +55,7 @@ class Case:
     category: str
     name: str
     argv: list[str]
-    protected: dict[Path, tuple[bytes, int]] = field(default_factory=dict)
+    protected: dict[Path, tuple[str, int]] = field(default_factory=dict)  # sha256, mode
     output: Path | None = None
     parse_only: bool = False
     keep_mode: int | None = None   # the mode an overwritten output must keep
@@ -123,8 +124,10 @@ def make_workspace(root: Path, toy_dir: Path | None = None, model_path: Path | N
 
         train(load_corpus(toy_dir)).save(model)
     lab = root / "toy030.lab"
-    lab.write_text("".join(f"{s.start:.4f} {s.end:.4f} {s.label}\n"
-                           for s in read_labels(corpus / "toy030.TextGrid")))
+    segs = read_labels(corpus / "toy030.TextGrid")
+    lab.write_text("".join(f"{s.start:.4f} {s.end:.4f} {s.label}\n" for s in segs))
+    (root / "toy030.phn").write_text("".join(f"{round(s.start * 16000)} {round(s.end * 16000)} "
+                                             f"{s.label}\n" for s in segs))
     return Workspace(root, corpus, model, corpus / "toy030.wav", corpus / "toy030.TextGrid", lab,
                      corpus / "toy030.c3d")
 
@@ -159,8 +162,13 @@ def mutate_bytes(rng: random.Random, data: bytes, start: int = 0,
     return bytes(d), kind
 
 
-def _protect(*paths: Path) -> dict[Path, tuple[bytes, int]]:
-    return {p: (p.read_bytes(), p.stat().st_mode) for p in paths if p.is_file()}
+def _digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _protect(*paths: Path) -> dict[Path, tuple[str, int]]:
+    """Files a case must leave as they are: their digests and modes."""
+    return {p: (_digest(p), p.stat().st_mode) for p in paths if p.is_file()}
 
 
 def _synth_argv(ws: Workspace, model: Path, audio: Path, out: Path, labels: Path | None = None,
@@ -266,7 +274,7 @@ def _mutate_text(rng: random.Random, text: str) -> tuple[str, str]:
 def label_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
     while True:
         d = ws.fresh("labels")
-        src = rng.choice([ws.textgrid, ws.textgrid, ws.lab])
+        src = rng.choice([ws.textgrid, ws.textgrid, ws.lab, ws.lab.with_suffix(".phn")])
         path = d / src.name
         kind = rng.random()
         if kind < 0.7:
@@ -533,12 +541,55 @@ def c3d_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
         r = rng.random()
         if r < 0.5:
             argv, out = ["corpus", "show", str(corpus), "-q"], None
-        elif r < 0.75:
+        elif r < 0.7:
             argv, out = ["eval", str(ws.model), str(corpus), "--split", "test", "-q"], None
-        else:
+        elif r < 0.85:
             shutil.copy(corpus / "toy030.c3d", corpus / "toy000.c3d")
             argv = ["train", str(corpus), "-o", str(out), "-q"]
+        else:  # describing the folder reads the first marker file
+            shutil.copy(corpus / "toy030.c3d", corpus / "toy000.c3d")
+            out = d / "described.json"
+            argv = ["corpus", "init", str(corpus), "-o", str(out), "--fixed", "FH_L", "FH_R", "NB",
+                    "NT", "--upper-lip", "UL_C", "--lower-lip", "LL_C", "-q"]
         yield Case("c3d", f"{kind} {how}", argv, _protect(ws.model), out)
+
+
+# --------------------------------------------------------------------------- TSV / EMA markers
+def marker_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
+    """Marker tables (TSV/CSV) and MOCHA EMA text in place of the C3D, damaged as text."""
+    from engine.formats import read_c3d, write_marker_tsv
+
+    m = read_c3d(ws.c3d)
+    while True:
+        d = ws.fresh("markers")
+        corpus = d / "corpus"
+        shutil.copytree(ws.corpus, corpus)
+        (corpus / "toy030.c3d").unlink()
+        kind = rng.choice(["tsv", "tsv", "csv", "ema", "folder"])
+        if kind in ("tsv", "csv"):
+            path = corpus / f"toy030.{kind}"
+            write_marker_tsv(path, m.markers, m.rate, m.names)
+            text, how = _mutate_text(rng, path.read_text())
+            if rng.random() < 0.3:  # equal, reversed or absurd times
+                lines = text.splitlines()
+                t = rng.choice(["0", "1e300", "nan", "-1", "1e-300"])
+                text = "\n".join(lines[:1] + [t + ln[ln.find("\t"):] for ln in lines[1:]]) + "\n"
+                how += f", times {t}"
+            path.write_text(text)
+        elif kind == "ema":
+            path = corpus / "toy030.ema"
+            rows = ["0.0 1 " + " ".join(["100"] * 20)] * 3
+            text, how = _mutate_text(rng, "\n".join(rows))
+            path.write_text(text)
+        else:
+            path = corpus / "toy030.tsv"
+            path.mkdir()
+            how = "a folder"
+        if rng.random() < 0.5:
+            argv, out = ["corpus", "show", str(corpus), "-q"], None
+        else:
+            argv, out = ["eval", str(ws.model), str(corpus), "--split", "test", "-q"], None
+        yield Case("markers", f"{kind} {how}", argv, _protect(ws.model), out)
 
 
 # --------------------------------------------------------------------------- options
@@ -662,7 +713,7 @@ def output_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
 
 GENERATORS: dict[str, Callable[[Workspace, random.Random], Iterator[Case]]] = {
     "audio": audio_cases, "labels": label_cases, "model": model_cases, "corpus": corpus_cases,
-    "c3d": c3d_cases, "options": option_cases, "output": output_cases,
+    "c3d": c3d_cases, "markers": marker_cases, "options": option_cases, "output": output_cases,
 }
 
 
@@ -699,7 +750,7 @@ def _judge(case: Case, code: int, err: str, status: str | None = None) -> Outcom
         if len(errors) != 1:
             return Outcome(case, "unclear message", code, err[-300:])
     for path, (data, mode) in case.protected.items():
-        if not path.is_file() or path.read_bytes() != data:
+        if not path.is_file() or _digest(path) != data:
             return Outcome(case, "clobbered", code, f"{path} changed")
         if path.stat().st_mode != mode:
             return Outcome(case, "clobbered", code, f"{path} mode changed")
