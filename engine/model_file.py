@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .c3d_check import MAX_RATE, MIN_RATE
 from .errors import ModelFileError
 
 #: Largest single array a model file may hold (a codebook of about 10^7 codewords).
@@ -137,6 +138,8 @@ def check_meta(path: Path, meta: dict, newest: int, fmt: str) -> None:
     for key in ("marker_rate", "pca_total_variance", "scale"):
         if not _is_num(meta[key]) or meta[key] <= 0:
             raise bad(key, "a positive number")
+    if not MIN_RATE <= meta["marker_rate"] <= MAX_RATE:
+        raise bad("marker_rate", f"a frame rate from {MIN_RATE:g} to {MAX_RATE:g} Hz")
     n_markers = len(meta["marker_names"])
     for key in ("upper_lip", "lower_lip"):
         if not _is_int(meta[key]) or not 0 <= meta[key] < n_markers:
