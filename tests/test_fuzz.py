@@ -38,7 +38,9 @@ def workspace(tmp_path_factory, toy_corpus_dir, toy_model):
 def test_bounded_fuzz_run(workspace):
     """Seeded mutated inputs of every category: no traceback, exit 0 or 2 with one error line,
     nothing partial or clobbered, no NaN written."""
+    here = sorted(os.listdir("."))
     outcomes = [run_in_process(c) for c in cases(workspace, N_CASES, seed=1)]
+    assert sorted(os.listdir(".")) == here, "a case wrote outside its own folder"
     report = table(outcomes)
     failures = [f"[{o.case.category}] {o.case.name}: {o.status} {o.detail}\n  facetraj "
                 f"{' '.join(o.case.argv)}" for o in outcomes if o.failed]
@@ -252,8 +254,8 @@ def test_c3d_parameter_block_damage_is_bounded(workspace, tmp_path):
         for i in rng.integers(512, 512 * (src[16] - 1), 4):
             d[i] = int(rng.integers(256))
         (corpus / "toy030.c3d").write_bytes(bytes(d))
-        o = run_forked(Case("c3d", f"params {k}", ["corpus", "show", str(corpus), "-q"]),
-                       timeout=60)
+        o = run_forked(Case("c3d", f"params {k}", ["corpus", "show", str(corpus), "-q"],
+                            cwd=tmp_path), timeout=60)
         assert not o.failed, (o.status, o.detail)
         assert o.max_rss < 1 << 30
 
