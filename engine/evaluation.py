@@ -149,6 +149,14 @@ class UtteranceScore(ConditionScores):
     speech_frames: int
 
 
+def _nanmean(values: Sequence[float]) -> float:
+    """Mean of the finite values; NaN (without numpy's warning) when there are none, e.g. an
+    utterance whose markers have no complete frame."""
+    v = np.asarray(values, dtype=np.float64)
+    v = v[np.isfinite(v)]
+    return float(v.mean()) if v.size else float("nan")
+
+
 @dataclass
 class EvalResult:
     """Per-utterance scores and their averages per condition."""
@@ -160,8 +168,7 @@ class EvalResult:
         """Mean correlation over utterances of one condition (the paper averages utterances)."""
         rows = [r for r in self.scores if r.split == split and r.smoothing == smoothing
                 and r.mode == mode and (n is None or r.n_context_phones == n)]
-        return {m: float(np.nanmean([getattr(r, m) for r in rows])) if rows else float("nan")
-                for m in METRICS}
+        return {m: _nanmean([getattr(r, m) for r in rows]) for m in METRICS}
 
     def conditions(self) -> list[tuple[str, str, str, int]]:
         seen: dict[tuple[str, str, str, int], None] = {}
