@@ -1,15 +1,21 @@
-"""The bars above and below the 3-D view: camera and display options, and the transport.
+"""The main window's controls: the bars above and below the 3-D view (camera and display
+options; the transport), the loop range, keyboard shortcuts and the File-menu dialogs.
 
-Both are plain widgets: :class:`ViewBar` drives a :class:`~app.view3d.FaceView` directly;
-:class:`TransportBar` only emits signals, which the main window wires to the playback clock.
+:class:`ViewBar` drives a :class:`~app.view3d.FaceView` directly; :class:`TransportBar` only emits
+signals, which the main window wires to the playback clock.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from pathlib import Path
+
 from PyQt6.QtCore import Qt, pyqtSignal
+from PyQt6.QtGui import QKeySequence, QShortcut
 from PyQt6.QtWidgets import (
     QCheckBox,
     QComboBox,
+    QFileDialog,
     QHBoxLayout,
     QLabel,
     QPushButton,
@@ -20,6 +26,8 @@ from PyQt6.QtWidgets import (
 )
 
 from .style import ORIGINAL_COLOR, SYNTH_COLOR
+from .timeline import Timeline
+from .transport import PlaybackClock
 from .view3d import CAMERA_PRESETS, FaceView
 
 SPEEDS = (1.0, 0.5, 0.25)
@@ -134,3 +142,65 @@ class TransportBar(QWidget):
         self.slider.setValue(frame)
         self.slider.blockSignals(False)
         self.time_label.setText(text)
+
+
+def add_shortcuts(widget: QWidget,
+                  bindings: list[tuple[QKeySequence, Callable[[], object]]]) -> list[QShortcut]:
+    """Window-wide keyboard shortcuts on ``widget``."""
+    shortcuts = []
+    for seq, slot in bindings:
+        sc = QShortcut(seq, widget)
+        sc.setContext(Qt.ShortcutContext.WindowShortcut)
+        sc.activated.connect(slot)
+        shortcuts.append(sc)
+    return shortcuts
+
+
+class LoopRange:
+    """The loop range: kept by the clock, drawn on the timeline, switched by the loop box; a drag
+    on the timeline selects it (and seeks to its start)."""
+
+    def __init__(self, clock: PlaybackClock, timeline: Timeline, box: QCheckBox,
+                 seek: Callable[[float], None]):
+        self.clock, self.timeline, self.box, self.seek = clock, timeline, box, seek
+        box.toggled.connect(self._on_toggled)
+        timeline.loopSelected.connect(self.select)
+
+    def select(self, a: float, b: float) -> None:
+        self.clock.set_loop(a, b)
+        self.box.setChecked(True)
+        self.seek(a)
+
+    def clear(self) -> None:
+        self.box.setChecked(False)
+        self.clock.set_loop(None)
+        self.timeline.set_loop(None)
+
+    def _on_toggled(self, on: bool) -> None:
+        self.clock.looping = bool(on)
+        if not on:
+            self.timeline.set_loop(None)
+        elif self.clock.loop is not None:
+            self.timeline.set_loop(self.clock.loop)
+
+
+def ask_corpus_folder(parent: QWidget) -> tuple[Path] | None:
+    path = QFileDialog.getExistingDirectory(parent, "Open a corpus folder")
+    return (Path(path),) if path else None
+
+
+def ask_audio_and_labels(parent: QWidget) -> tuple[Path, Path | None] | None:
+    """An audio file, then its phone labels (Cancel: none, acoustic-only synthesis)."""
+    audio, _ = QFileDialog.getOpenFileName(parent, "Open audio for synthesis", "",
+                                           "Audio (*.wav *.flac);;All files (*)")
+    if not audio:
+        return None
+    labels, _ = QFileDialog.getOpenFileName(
+        parent, "Phone labels (Cancel: acoustic-only synthesis)", str(Path(audio).parent),
+        "Labels (*.TextGrid *.lab *.phn);;All files (*)")
+    return Path(audio), Path(labels) if labels else None
+
+
+def ask_screenshot_path(parent: QWidget) -> tuple[Path] | None:
+    path, _ = QFileDialog.getSaveFileName(parent, "Save a screenshot", "facetraj.png", "PNG (*.png)")
+    return (Path(path),) if path else None

@@ -47,15 +47,13 @@ from pathlib import Path
 from typing import Any
 
 from PyQt6.QtCore import QEvent, Qt, QTimer, pyqtSignal
-from PyQt6.QtGui import QAction, QKeySequence, QShortcut
+from PyQt6.QtGui import QAction, QKeySequence
 from PyQt6.QtWidgets import (
     QDockWidget,
-    QFileDialog,
     QLabel,
     QMainWindow,
     QMenu,
     QMessageBox,
-    QProgressBar,
     QSplitter,
     QVBoxLayout,
     QWidget,
@@ -65,29 +63,36 @@ from engine.config import SynthConfig
 from engine.corpus import Corpus, load_corpus
 from engine.data import Utterance
 from engine.errors import FacetrajError
-from engine.evaluation import trajectory_correlations
 from engine.formats import read_audio, read_labels
 from engine.model import Model
 
 from .browser import UtteranceBrowser
 from .cache import load_or_train
-from .controls import SPEEDS, TransportBar, ViewBar
+from .controls import (
+    SPEEDS,
+    LoopRange,
+    TransportBar,
+    ViewBar,
+    add_shortcuts,
+    ask_audio_and_labels,
+    ask_corpus_folder,
+    ask_screenshot_path,
+)
+from .correlations import BrowserScores
 from .marker_panels import MarkerPanels
 from .playback import PlaybackScheduler
 from .settings_panel import SynthSettingsPanel
 from .state import UtteranceView
+from .status import StatusArea
 from .timeline import LipPanel, PhoneTierPanel, SpectrogramPanel, Timeline, WaveformPanel
 from .transport import PlaybackClock
 from .view3d import FaceView
-from .viewer_model import DEFAULT_SENTENCE, SynthRequest, ViewerModel, correlation_sweep, load_model
+from .viewer_model import DEFAULT_SENTENCE, SynthRequest, ViewerModel, load_model, view_summary, view_title
 from .workers import Progress, Task, TaskRunner
 
 __all__ = ["DEFAULT_SENTENCE", "SPEEDS", "MainWindow"]
 
 log = logging.getLogger(__name__)
-
-SMOOTHING_NAMES = {"triangular": "triangular", "spline": "spline", "none": "unsmoothed"}
-
 
 class MainWindow(QMainWindow):
     """Speech plays while original and synthesized face points move, with the lip trajectories."""
@@ -106,14 +111,11 @@ class MainWindow(QMainWindow):
         self.setWindowTitle("facetraj — speech-driven 3-D face point trajectories")
         self.state = ViewerModel(pending_utterance=utterance, pending_time=start_time)
         self.tasks = TaskRunner(self, error_handler=self.report_error)
-        self.tasks.started.connect(self._on_task_started)
-        self.tasks.progressed.connect(self._on_task_progress)
-        self.tasks.busyChanged.connect(self._on_busy_changed)
+        self.tasks.busyChanged.connect(self.busyChanged)
         self.clock = PlaybackClock(self, use_audio=use_audio)
         self.playback = PlaybackScheduler(self.clock, self)
         self.playback.frameDue.connect(lambda t: self._show_time(t, force=True))
         self.clock.playingChanged.connect(self._on_playing_changed)
-        self._corr_task: Task | None = None
         self._error_handler: Callable[[str], None] | None = None
         self._extensions: dict[str, object] = {}
         self._menus: dict[str, QMenu] = {}
@@ -124,43 +126,16 @@ class MainWindow(QMainWindow):
             QTimer.singleShot(0, lambda: self.open_corpus(Path(corpus_path), model_path))
 
     # ================================================================== state (read-only views)
-    @property
-    def model(self) -> Model | None:
-        return self.state.model
-
-    @property
-    def corpus(self) -> Corpus | None:
-        return self.state.corpus
-
-    @property
-    def view(self) -> UtteranceView | None:
-        return self.state.view
-
-    @property
-    def synth_config(self) -> SynthConfig:
-        return self.state.synth_config
-
-    @property
-    def displayed_frame(self) -> int:
-        return self.playback.displayed_frame
-
-    @property
-    def stats(self) -> list | None:
-        """The playback benchmark's hook (see :class:`PlaybackScheduler`)."""
-        return self.playback.stats
-
-    @stats.setter
-    def stats(self, value: list | None) -> None:
-        self.playback.stats = value
-
-    @property
-    def busy(self) -> bool:
-        """Whether foreground work (model, synthesis) is running (background correlations aside)."""
-        return self.tasks.busy
-
-    @property
-    def correlations_running(self) -> bool:
-        return self.tasks.running(self._corr_task)
+    model = property(lambda self: self.state.model, doc="The model (None until one is loaded).")
+    corpus = property(lambda self: self.state.corpus, doc="The corpus (None until one is opened).")
+    view = property(lambda self: self.state.view, doc="The utterance shown (``UtteranceView``).")
+    synth_config = property(lambda self: self.state.synth_config, doc="The synthesis settings.")
+    displayed_frame = property(lambda self: self.playback.displayed_frame, doc="The frame on screen.")
+    busy = property(lambda self: self.tasks.busy, doc="Whether foreground work (model, synthesis) runs.")
+    correlations_running = property(lambda self: self.scores.running,
+                                    doc="Whether the background lip-correlation sweep runs.")
+    stats = property(lambda self: self.playback.stats, lambda self, v: setattr(self.playback, "stats", v),
+                     doc="The playback benchmark's hook (see :class:`PlaybackScheduler`).")
 
     # ================================================================== construction
     def _build_widgets(self) -> None:
@@ -172,22 +147,15 @@ class MainWindow(QMainWindow):
                       LipPanel(self, "upper"), LipPanel(self, "lower")):
             self.timeline.panels.append(panel)
         self.timeline.seekRequested.connect(self.seek)
-        self.timeline.loopSelected.connect(self._on_loop_selected)
         self.marker_panels = MarkerPanels(self.timeline)
         self.view_bar = ViewBar(self.face)
         self.camera_buttons = self.view_bar.camera_buttons
         self.transport = self._build_transport()
         self.title = QLabel("")
         self.title.setStyleSheet("font-size: 15px; font-weight: 600; padding: 2px 6px;")
-        split = QSplitter(Qt.Orientation.Vertical)
-        split.addWidget(_column([self.view_bar, self.face, self.transport], 2, stretch=self.face))
-        split.addWidget(_column([self.title, self.timeline], 0, stretch=self.timeline))
-        split.setStretchFactor(0, 1)
-        split.setStretchFactor(1, 1)
-        split.setSizes([480, 520])
-        split.setChildrenCollapsible(False)
-        self.splitter = split
-        self.setCentralWidget(split)
+        self.splitter = _split(_column([self.view_bar, self.face, self.transport], 2, stretch=self.face),
+                               _column([self.title, self.timeline], 0, stretch=self.timeline))
+        self.setCentralWidget(self.splitter)
         self.browser = UtteranceBrowser(self)
         self.browser.utteranceSelected.connect(self.set_utterance)
         self.browser_dock = self._dock(self.browser, "Utterances", Qt.DockWidgetArea.LeftDockWidgetArea)
@@ -197,7 +165,10 @@ class MainWindow(QMainWindow):
                                         Qt.DockWidgetArea.LeftDockWidgetArea)
         self.resizeDocks([self.browser_dock], [400], Qt.Orientation.Horizontal)
         self._extra_docks: dict[Qt.DockWidgetArea, QDockWidget] = {}
-        self._build_status_bar()
+        self.status = StatusArea(self.statusBar(), self.tasks)
+        self.status_label, self.progress = self.status.label, self.status.progress
+        self.dimensions_label = self.status.dimensions_label
+        self.scores = BrowserScores(self.browser, self.tasks, self.playback.idle)
 
     def _build_transport(self) -> TransportBar:
         bar = TransportBar()
@@ -206,23 +177,9 @@ class MainWindow(QMainWindow):
         bar.stepClicked.connect(self.step_frames)
         bar.speedChanged.connect(self.clock.set_speed)
         bar.slider.valueChanged.connect(self._on_slider)
-        bar.loop_box.toggled.connect(self._on_loop_toggled)
         self.slider, self.speed, self.loop_box = bar.slider, bar.speed, bar.loop_box
-        self.time_label = bar.time_label
+        self.loop = LoopRange(self.clock, self.timeline, bar.loop_box, self.seek)
         return bar
-
-    def _build_status_bar(self) -> None:
-        self.status_label = QLabel("")
-        self.progress = QProgressBar()
-        self.progress.setRange(0, 1000)
-        self.progress.setFixedWidth(300)
-        self.progress.setVisible(False)
-        self.dimensions_label = QLabel("midsagittal (2-D) data: profile view, y up, z forward")
-        self.dimensions_label.setStyleSheet("font-weight: 600; padding: 0 8px;")
-        self.dimensions_label.hide()
-        self.statusBar().addWidget(self.status_label, 1)
-        self.statusBar().addPermanentWidget(self.dimensions_label)
-        self.statusBar().addPermanentWidget(self.progress)
 
     def _dock(self, widget: QWidget, title: str, area: Qt.DockWidgetArea) -> QDockWidget:
         dock = QDockWidget(title, self)
@@ -235,16 +192,25 @@ class MainWindow(QMainWindow):
         return dock
 
     def _action(self, menu: str, text: str, slot: Callable[[], Any]) -> QAction:
+        """A menu entry; an engine error its slot raises is reported, never raised."""
+        def run(_checked: bool = False) -> None:
+            try:
+                slot()
+            except FacetrajError as exc:
+                self.report_error(exc)
+
         action = QAction(text, self)
-        action.triggered.connect(lambda _c=False: slot())
+        action.triggered.connect(run)
         self.menu(menu).addAction(action)
         return action
 
     def _build_menus(self) -> None:
-        self.action_open_corpus = self._action("File", "Open &corpus folder…", self._menu_open_corpus)
+        self.action_open_corpus = self._action("File", "Open &corpus folder…",
+                                               lambda: _given(ask_corpus_folder(self), self.open_corpus))
         self.action_open_audio = self._action("File", "Open &audio (+ labels) for synthesis…",
-                                              self._menu_open_audio)
-        self.action_screenshot = self._action("File", "Save &screenshot…", self._menu_screenshot)
+                                              lambda: _given(ask_audio_and_labels(self), self.open_audio))
+        self.action_screenshot = self._action("File", "Save &screenshot…",
+                                              lambda: _given(ask_screenshot_path(self), self.save_screenshot))
         self.menu("File").addSeparator()
         self._action("File", "&Quit", self.close).setShortcut(QKeySequence.StandardKey.Quit)
         self.view_menu = self.menu("View")
@@ -253,7 +219,7 @@ class MainWindow(QMainWindow):
         self._action("View", "Show the whole utterance", self.timeline.reset_zoom)
         self.view_menu.addSeparator()
         self.action_add_marker_panel = self._action("View", "Add a marker trajectory panel…",
-                                                    self._ask_marker_panel)
+                                                    lambda: self.marker_panels.ask(self.model, self))
         self._action("View", "Remove the marker trajectory panels", self.marker_panels.clear)
         self.analysis_menu = self.menu("Analysis")
         self._action("Help", "Keys", lambda: QMessageBox.information(self, "Keys", KEYS_HELP))
@@ -268,14 +234,9 @@ class MainWindow(QMainWindow):
             (QKeySequence(M.ShiftModifier | K.Key_Right), lambda: self.step_phone(1)),
             (QKeySequence(K.Key_Home), lambda: self.seek(0.0)),
             (QKeySequence(K.Key_End), lambda: self.seek(self.clock.duration)),
-            (QKeySequence(K.Key_Escape), self.clear_loop),
+            (QKeySequence(K.Key_Escape), self.loop.clear),
         ]
-        self._shortcuts = []
-        for seq, slot in bindings:
-            sc = QShortcut(seq, self)
-            sc.setContext(Qt.ShortcutContext.WindowShortcut)
-            sc.activated.connect(slot)
-            self._shortcuts.append(sc)
+        self._shortcuts = add_shortcuts(self, bindings)
 
     # ================================================================== public contract
     def menu(self, name: str) -> QMenu:
@@ -325,10 +286,7 @@ class MainWindow(QMainWindow):
 
     def show_status(self, text: str, timeout_ms: int = 0) -> None:
         """A message in the status bar (a temporary one with ``timeout_ms``)."""
-        if timeout_ms:
-            self.statusBar().showMessage(text, timeout_ms)
-        else:
-            self.status_label.setText(text)
+        self.status.show(text, timeout_ms)
 
     def add_extension(self, name: str, extension: object) -> None:
         self._extensions[name] = extension
@@ -356,9 +314,6 @@ class MainWindow(QMainWindow):
     def current_time(self) -> float:
         return self.clock.time()
 
-    def default_utterance(self) -> str | None:
-        return self.state.default_utterance()
-
     # ================================================================== corpus and model
     def open_corpus(self, path: Path, model_path: Path | None = None) -> None:
         """Open a corpus folder; its model is loaded from ``model_path``, the cache, or trained."""
@@ -385,19 +340,13 @@ class MainWindow(QMainWindow):
         self.modelReady.emit()
         if first:
             self.set_utterance(first)
-        self._start_correlations()
+        self.scores.start(self.state, lambda _r: self.correlationsDone.emit())
 
     def _show_planar(self, planar: bool) -> None:
         """Midsagittal (2-D) data is shown as such: the profile camera and a status-bar note."""
         self.dimensions_label.setVisible(planar)
         if planar:
             self.view_bar.set_camera("profile")
-
-    def _ask_marker_panel(self) -> None:
-        if self.model is None:
-            self.report_error(FacetrajError("no model yet"))
-            return
-        self.marker_panels.ask(self.model, self)
 
     # ================================================================== synthesis
     def set_synth_config(self, cfg: SynthConfig) -> None:
@@ -408,7 +357,7 @@ class MainWindow(QMainWindow):
         self.settings.set_config(cfg)
         if request is not None:
             self._synthesize(request)
-        self._start_correlations()
+        self.scores.start(self.state, lambda _r: self.correlationsDone.emit())
 
     def _synthesize(self, request: SynthRequest) -> None:
         def done(view: UtteranceView) -> None:
@@ -440,48 +389,10 @@ class MainWindow(QMainWindow):
         self.synthesisChanged.emit()
 
     def _show_titles(self, view: UtteranceView) -> None:
-        utt, cfg = view.utterance, view.synthesis.config
-        text = f" — “{utt.text}”" if utt.text else ""
-        self.title.setText(f"{utt.name} ({view.split}){text}    ·    3-D: {SMOOTHING_NAMES[cfg.smoothing]} "
-                           f"synthesis, {cfg.mode}, N={cfg.n_context_phones}")
-        self.browser.set_current(utt.name)
-        self._score_current()
-        self.status_label.setText(f"{utt.name}: {view.n_frames} frames at {view.rate:g} Hz, "
-                                  f"{int(view.speech.sum())} speech frames")
-
-    def _score_current(self) -> None:
-        v = self.view
-        if v is None or v.original is None or self.model is None:
-            return
-        try:
-            c = trajectory_correlations(v.original, v.shown, v.speech, self.model)
-            self.browser.set_scores(v.utterance.name, c["lower_lip"], c["upper_lip"])
-        except Exception:
-            log.debug("scoring the current utterance failed", exc_info=True)
-
-    def _start_correlations(self) -> None:
-        """Lip correlations of every corpus utterance under the current settings, in the background;
-        the sweep waits while sound plays (playback first)."""
-        if self._corr_task is not None:
-            self._corr_task.cancel()
-        st = self.state
-        if st.corpus is None or st.model is None:
-            return
-        self.browser.clear_scores()
-        corpus, model, cfg, ids = st.corpus, st.model, st.synth_config, st.correlation_ids()
-        idle = self.playback.idle
-
-        def work(progress: Progress) -> None:
-            def before(k: int, utt_id: str) -> None:
-                progress.wait_open(idle)
-                progress(k / max(len(ids), 1), f"lip correlations: {utt_id}")
-
-            for _k, utt_id, lower, upper in correlation_sweep(model, corpus, ids, cfg, before):
-                progress.partial((utt_id, lower, upper))
-
-        self._corr_task = self.run_task(work, lambda _r: self.correlationsDone.emit(), "lip correlations",
-                                        on_partial=lambda obj: self.browser.set_scores(*obj),
-                                        background=True)
+        self.title.setText(view_title(view))
+        self.browser.set_current(view.utterance.name)
+        self.scores.score(view, self.model)
+        self.status_label.setText(view_summary(view))
 
     # ================================================================== playback
     def toggle_play(self) -> None:
@@ -497,8 +408,7 @@ class MainWindow(QMainWindow):
 
     def stop(self) -> None:
         self.clock.stop()
-        if self.view is not None:
-            self._show_time(self.clock.time(), force=True)
+        self._show_time(self.clock.time(), force=True)      # nothing without a view
 
     def step_frames(self, n: int) -> None:
         if self.view is not None:
@@ -511,30 +421,13 @@ class MainWindow(QMainWindow):
             self.clock.pause()
             self.seek(self.state.step_phone_target(self.clock.time(), direction))
 
-    def clear_loop(self) -> None:
-        self.loop_box.setChecked(False)
-        self.clock.set_loop(None)
-        self.timeline.set_loop(None)
-
-    def _on_loop_selected(self, a: float, b: float) -> None:
-        self.clock.set_loop(a, b)
-        self.loop_box.setChecked(True)
-        self.seek(a)
-
-    def _on_loop_toggled(self, on: bool) -> None:
-        self.clock.looping = bool(on)
-        if not on:
-            self.timeline.set_loop(None)
-        elif self.clock.loop is not None:
-            self.timeline.set_loop(self.clock.loop)
-
     def _on_slider(self, value: int) -> None:
         if self.view is not None:
             self.seek(value / self.view.rate)
 
     def _on_playing_changed(self, playing: bool) -> None:
         self.transport.set_playing(playing)
-        if not playing and self.view is not None:
+        if not playing:
             self._show_time(self.clock.time(), force=True)
 
     def event(self, e: QEvent) -> bool:
@@ -565,21 +458,6 @@ class MainWindow(QMainWindow):
         self.cursorMoved.emit(float(t))
 
     # ================================================================== files
-    def _menu_open_corpus(self) -> None:
-        path = QFileDialog.getExistingDirectory(self, "Open a corpus folder")
-        if path:
-            self.open_corpus(Path(path))
-
-    def _menu_open_audio(self) -> None:
-        audio, _ = QFileDialog.getOpenFileName(self, "Open audio for synthesis", "",
-                                               "Audio (*.wav *.flac);;All files (*)")
-        if not audio:
-            return
-        labels, _ = QFileDialog.getOpenFileName(
-            self, "Phone labels (Cancel: acoustic-only synthesis)", str(Path(audio).parent),
-            "Labels (*.TextGrid *.lab *.phn);;All files (*)")
-        self.open_audio(Path(audio), Path(labels) if labels else None)
-
     def open_audio(self, audio_path: Path, labels_path: Path | None = None) -> None:
         """Synthesize from an audio file (and phone labels) that has no original markers."""
         model = self.model
@@ -592,17 +470,11 @@ class MainWindow(QMainWindow):
         except FacetrajError as exc:
             self.report_error(exc)
             return
-        utt = Utterance(name=audio_path.stem, audio=audio, sample_rate=rate, phones=list(phones),
-                        markers=None, marker_rate=model.marker_rate,
-                        marker_names=list(model.marker_names), text=str(audio_path))
-        name = self.state.add_external(utt)
+        name = self.state.add_external(Utterance(
+            name=audio_path.stem, audio=audio, sample_rate=rate, phones=list(phones), markers=None,
+            marker_rate=model.marker_rate, marker_names=list(model.marker_names), text=str(audio_path)))
         self.browser.add_external(name)
         self.set_utterance(name)
-
-    def _menu_screenshot(self) -> None:
-        path, _ = QFileDialog.getSaveFileName(self, "Save a screenshot", "facetraj.png", "PNG (*.png)")
-        if path:
-            self.save_screenshot(Path(path))
 
     def save_screenshot(self, path: Path) -> Path:
         """Render the whole window (with the 3-D view) to a PNG."""
@@ -616,30 +488,30 @@ class MainWindow(QMainWindow):
             raise FacetrajError(f"{path}: cannot write the screenshot")
         return path
 
-    # ================================================================== tasks
-    def _on_task_started(self, task: Task) -> None:
-        self.progress.setVisible(True)
-        self.progress.setValue(0)
-        self.progress.setFormat(f"{task.label}: %p%")
-
-    def _on_task_progress(self, task: Task, fraction: float, message: str) -> None:
-        if task.background and self.tasks.busy:
-            return   # foreground work owns the bar
-        self.progress.setValue(int(1000 * fraction))
-        self.progress.setFormat(f"{task.label}: %p%")
-        if message and not task.background:
-            self.status_label.setText(message)
-
-    def _on_busy_changed(self, busy: bool) -> None:
-        self.progress.setVisible(busy)
-        self.busyChanged.emit(busy)
-
     def closeEvent(self, event) -> None:
         self.playback.stop()
         self.clock.close()
         self.tasks.close()
         self.face.close_view()
         super().closeEvent(event)
+
+
+def _given(args: tuple | None, fn: Callable[..., Any]) -> None:
+    """``fn(*args)`` unless a dialog was cancelled (``args`` None)."""
+    if args is not None:
+        fn(*args)
+
+
+def _split(top: QWidget, bottom: QWidget) -> QSplitter:
+    """Two widgets one above the other, sharing the height, neither collapsible."""
+    split = QSplitter(Qt.Orientation.Vertical)
+    split.addWidget(top)
+    split.addWidget(bottom)
+    split.setStretchFactor(0, 1)
+    split.setStretchFactor(1, 1)
+    split.setSizes([480, 520])
+    split.setChildrenCollapsible(False)
+    return split
 
 
 def _column(widgets: list[QWidget], spacing: int, stretch: QWidget) -> QWidget:

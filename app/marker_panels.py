@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from PyQt6.QtWidgets import QComboBox, QDialog, QDialogButtonBox, QFormLayout, QWidget
 
+from engine.errors import FacetrajError
 from engine.model import Model
 
 from .style import ORIGINAL_COLOR, SPLINE_COLOR, TRIANGULAR_COLOR
@@ -97,8 +98,10 @@ class MarkerPanels:
             self.timeline.remove_panel(panel)
         self.panels.clear()
 
-    def ask(self, model: Model, parent: QWidget | None = None) -> None:
+    def ask(self, model: Model | None, parent: QWidget | None = None) -> None:
         """Let the user choose a marker and a coordinate; add that panel."""
+        if model is None:
+            raise FacetrajError("no model yet")
         dlg = MarkerPanelDialog(list(model.marker_names), parent)
         if dlg.exec() == QDialog.DialogCode.Accepted:
             self.add(dlg.panel())

@@ -210,6 +210,23 @@ class ViewerModel:
         return [(s, u) for s in ("test", "train") for u in getattr(info, s)]
 
 
+SMOOTHING_NAMES = {"triangular": "triangular", "spline": "spline", "none": "unsmoothed"}
+
+
+def view_title(view: UtteranceView) -> str:
+    """The title over the panels: utterance, split, text and how the 3-D synthesis was made."""
+    utt, cfg = view.utterance, view.synthesis.config
+    text = f" — “{utt.text}”" if utt.text else ""
+    return (f"{utt.name} ({view.split}){text}    ·    3-D: {SMOOTHING_NAMES[cfg.smoothing]} synthesis, "
+            f"{cfg.mode}, N={cfg.n_context_phones}")
+
+
+def view_summary(view: UtteranceView) -> str:
+    """The status line of a new view: frames, rate and speech frames."""
+    return (f"{view.utterance.name}: {view.n_frames} frames at {view.rate:g} Hz, "
+            f"{int(view.speech.sum())} speech frames")
+
+
 def read_texts(corpus: Corpus) -> dict[str, str]:
     """The orthographic text of each utterance that has a ``<id>.txt`` file."""
     texts = {}
