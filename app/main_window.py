@@ -29,10 +29,17 @@ Methods
     ``run_task(fn, on_done, label, *, on_error=None, on_partial=None, on_progress=None,
     background=False) -> Task``: ``fn(progress)`` in a worker thread, the status bar shows its
     progress, the callbacks run on the GUI thread, an error goes to ``on_error`` or
-    ``report_error``; ``report_error(exc)`` (a dialog, or the handler set with
-    ``set_error_handler(fn)``); ``show_status(text, timeout_ms=0)``;
+    ``report_error``; ``report_error(exc)`` and ``show_error(message)`` (a dialog, or the handler
+    set with ``set_error_handler(fn)``); ``show_status(text, timeout_ms=0)``;
     ``add_extension(name, obj)`` / ``extension(name)``; ``set_utterance(utt_id)``, ``seek(t)``,
     ``current_time()``, ``open_corpus(path)``, ``open_audio(path, labels)``.
+
+Adding a feature
+    Write an object that takes the window (like ``OwnData``): its menu entries go into
+    ``menu(...)`` (File entries before ``action_screenshot``), a toggle can live in a
+    ``QToolBar`` added with ``addToolBar``, its work goes through ``run_task`` and its errors through
+    ``report_error``; it follows the window through the signals above. Install it in
+    ``app/main.py: build_window`` with ``add_extension``.
 
 Timeline panels
     ``timeline.add_panel(panel)`` / ``timeline.remove_panel(panel)``; a panel is any object with
@@ -267,18 +274,17 @@ class MainWindow(QMainWindow):
         return self.tasks.run(fn, on_done, label, **options)
 
     def report_error(self, exc: BaseException) -> None:
-        """Show an error: the engine's own errors as they are, anything else as an internal one."""
-        if isinstance(exc, FacetrajError):
-            msg = str(exc)
-        else:
-            log.error("unexpected error", exc_info=exc)
-            msg = f"internal error: {type(exc).__name__}: {exc}"
-        self.status_label.setText(msg)
-        log.error("%s", msg)
+        """Show an error (:func:`error_message`) with :meth:`show_error`."""
+        self.show_error(error_message(exc))
+
+    def show_error(self, message: str) -> None:
+        """An error message: in the status bar, and a dialog (or the ``set_error_handler`` one)."""
+        self.status_label.setText(message)
+        log.error("%s", message)
         if self._error_handler is not None:
-            self._error_handler(msg)
+            self._error_handler(message)
         else:
-            QMessageBox.critical(self, "facetraj", msg)
+            QMessageBox.critical(self, "facetraj", message)
 
     def set_error_handler(self, handler: Callable[[str], None] | None) -> None:
         """Route error messages to ``handler`` instead of a dialog (None: dialogs again)."""
@@ -494,6 +500,15 @@ class MainWindow(QMainWindow):
         self.tasks.close()
         self.face.close_view()
         super().closeEvent(event)
+
+
+def error_message(exc: BaseException) -> str:
+    """The engine's own errors as they are (they name the file), anything else as an internal one
+    (logged with its traceback)."""
+    if isinstance(exc, FacetrajError):
+        return str(exc)
+    log.error("unexpected error", exc_info=exc)
+    return f"internal error: {type(exc).__name__}: {exc}"
 
 
 def _given(args: tuple | None, fn: Callable[..., Any]) -> None:

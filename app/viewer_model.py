@@ -45,7 +45,7 @@ def normalise_text(text: str) -> str:
     return " ".join(re.sub(r"[^a-z' ]+", " ", text.lower()).split())
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class SynthRequest:
     """One synthesis asked for: which utterance (loaded by ``load``), with which model and settings.
 
