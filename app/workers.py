@@ -128,6 +128,9 @@ class Task(QThread):
             self.succeeded.emit(result)
 
 
+_DETACHED: list[Task] = []     # cancelled tasks that outlived their runner's close (see close)
+
+
 class TaskRunner(QObject):
     """Starts tasks, keeps them until they finish, routes their results and errors, stops them.
 
@@ -183,12 +186,19 @@ class TaskRunner(QObject):
         return task is not None and task in self.tasks
 
     def close(self, timeout_ms: int = 5000) -> None:
-        """Start nothing more; cancel every task and wait for it (before the owner closes)."""
+        """Start nothing more; cancel every task and wait for it (before the owner closes).
+
+        A task still running after ``timeout_ms`` (a long synthesis notices the cancellation only
+        at its next progress call) is detached from the owner and kept alive until it ends, so
+        that closing the owner never destroys a running thread (Qt aborts the process then)."""
         self.closed = True
         for task in list(self.tasks):
             task.cancel()
         for task in list(self.tasks):
-            task.wait(timeout_ms)
+            if not task.wait(timeout_ms):
+                log.warning("task %r still running after %d ms: detached", task.label, timeout_ms)
+                task.setParent(None)
+                _DETACHED.append(task)
 
     def _safe(self, fn: Callable[[Any], None] | None, arg: Any) -> None:
         """Call a completion handler; its exception goes to the error handler (never a crash)."""
