@@ -197,6 +197,8 @@ class TaskRunner(QObject):
         for task in list(self.tasks):
             if not task.wait(timeout_ms):
                 log.warning("task %r still running after %d ms: detached", task.label, timeout_ms)
+                for signal in (task.finished, task.progress, task.partial):
+                    signal.disconnect()     # its receivers close with the owner
                 task.setParent(None)
                 _DETACHED.append(task)
 
