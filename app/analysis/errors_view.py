@@ -45,8 +45,8 @@ from .common import (
     fill_table,
     heat_item,
     report_error,
-    run_background,
-    stop_tasks,
+    stop_own_tasks,
+    task_runner,
     text_item,
 )
 
@@ -66,6 +66,7 @@ class ErrorView(QWidget):
         self.model = model
         self.corpus = corpus
         self.window_ = window
+        self.tasks = task_runner(self, window)
         self.report: ErrorReport | None = None
         self._pending_seek: tuple[str, float] | None = None
 
@@ -120,8 +121,8 @@ class ErrorView(QWidget):
         splits = SPLITS[self.splits.currentText()]
         config = getattr(self.window_, "synth_config", None)
         self.run_btn.setEnabled(False)
-        run_background(self, lambda p: error_report(model, corpus, splits, config, progress=p),
-                       self._done, self._on_progress, self._failed, "Error analysis", self.window_)
+        self.tasks.run(lambda p: error_report(model, corpus, splits, config, progress=p),
+                       self._done, "Error analysis", on_progress=self._on_progress, on_error=self._failed)
 
     def _on_progress(self, fraction: float, message: str) -> None:
         self.progress.setValue(int(1000 * fraction))
@@ -197,7 +198,7 @@ class ErrorView(QWidget):
             self.window_.seek(t)
 
     def closeEvent(self, event) -> None:
-        stop_tasks(self)
+        stop_own_tasks(self, self.tasks)
         super().closeEvent(event)
 
     # ------------------------------------------------------------------ export

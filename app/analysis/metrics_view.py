@@ -46,8 +46,8 @@ from .common import (
     fill_table,
     heat_item,
     report_error,
-    run_background,
-    stop_tasks,
+    stop_own_tasks,
+    task_runner,
     text_item,
 )
 
@@ -80,6 +80,7 @@ class MetricsView(QWidget):
         self.model = model
         self.corpus = corpus
         self.window_ = window
+        self.tasks = task_runner(self, window)
         self.table2_result: EvalResult | None = None
         self.sweep_result: EvalResult | None = None
         self.rows: list[Table2Row] = []
@@ -156,15 +157,15 @@ class MetricsView(QWidget):
     def start_table2(self) -> None:
         corpus, model, acoustic = self._subset(), self.model, self.acoustic.isChecked()
         self._busy(True)
-        run_background(self, lambda p: table2(model, corpus, acoustic=acoustic, progress=p),
-                       self._table2_done, self._on_progress, self._failed, "Table 2", self.window_)
+        self.tasks.run(lambda p: table2(model, corpus, acoustic=acoustic, progress=p),
+                       self._table2_done, "Table 2", on_progress=self._on_progress, on_error=self._failed)
 
     def start_sweep(self) -> None:
         corpus, model = self._subset(), self.model
         ns = tuple(range(1, int(self.max_n.value()) + 1))
         self._busy(True)
-        run_background(self, lambda p: sweep_n(model, corpus, ns, progress=p),
-                       self._sweep_done, self._on_progress, self._failed, "N sweep", self.window_)
+        self.tasks.run(lambda p: sweep_n(model, corpus, ns, progress=p),
+                       self._sweep_done, "N sweep", on_progress=self._on_progress, on_error=self._failed)
 
     def _table2_done(self, result: EvalResult) -> None:
         self._busy(False)
@@ -233,7 +234,7 @@ class MetricsView(QWidget):
         self.canvas.draw_idle()
 
     def closeEvent(self, event) -> None:
-        stop_tasks(self)
+        stop_own_tasks(self, self.tasks)
         super().closeEvent(event)
 
     # ------------------------------------------------------------------ export
