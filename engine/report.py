@@ -32,6 +32,7 @@ from .evaluation import (
     METRICS,
     EvalResult,
     UtteranceScore,
+    default_workers,
     evaluate,
     moving_coordinates,
     speech_mask,
@@ -279,9 +280,11 @@ def compute_report(corpus_dir: str | os.PathLike[str], model: Model | None = Non
                    progress: Progress | None = None, ns: Iterable[int] = range(1, 11)) -> ReportData:
     """Compute every number of the report on the corpus's own train/test split.
 
-    Trains a model on the train split when ``model`` is ``None``.
+    Trains a model on the train split when ``model`` is ``None``. The evaluations use every
+    core (:func:`default_workers`); their scores equal a serial run's.
     """
     progress = progress or (lambda f, m: None)
+    workers = default_workers()
     corpus = load_corpus(corpus_dir)
     info = corpus.info
     ns = list(ns)
@@ -294,17 +297,18 @@ def compute_report(corpus_dir: str | os.PathLike[str], model: Model | None = Non
     rows1 = top_similar(model.similarity(), model.phones, 3)
     # Table 2 and acoustic-only (N = 3, triangular and spline)
     t = time.perf_counter()
-    res2 = table2(model, corpus, acoustic=True, progress=_stage(progress, 0.1, 0.45))
+    res2 = table2(model, corpus, acoustic=True, progress=_stage(progress, 0.1, 0.45),
+                  workers=workers)
     timings["table2_and_acoustic"] = time.perf_counter() - t
     # acoustic-only with the default (indexed) search, as the app and `facetraj synth` run it
     t = time.perf_counter()
     indexed = SynthConfig(mode="acoustic")
     res_ix = evaluate(model, corpus, ("train", "test"), [indexed], ("triangular", "spline"),
-                      progress=_stage(progress, 0.45, 0.47))
+                      progress=_stage(progress, 0.45, 0.47), workers=workers)
     timings["acoustic_indexed"] = time.perf_counter() - t
     # Figure 5
     t = time.perf_counter()
-    res5 = sweep_n(model, corpus, ns, progress=_stage(progress, 0.47, 0.8))
+    res5 = sweep_n(model, corpus, ns, progress=_stage(progress, 0.47, 0.8), workers=workers)
     timings["sweep_n"] = time.perf_counter() - t
     # baselines
     t = time.perf_counter()
