@@ -12,7 +12,6 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
-from scipy.signal import medfilt
 
 from .config import SynthConfig
 from .corpus import Corpus
@@ -78,6 +77,8 @@ def speech_mask(audio: np.ndarray, rate: int, times: np.ndarray,
     e_db, _e_t = short_time_energy_db(audio, rate, config.energy_window_s, config.energy_hop_s)
     k = int(round(config.median_s / config.energy_hop_s))
     k = k + 1 if k % 2 == 0 else k
+    from scipy.signal import medfilt   # here: scipy.signal takes 1-2 s to import
+
     filtered = medfilt(e_db, k) if len(e_db) >= k else e_db
     floor, peak = np.percentile(filtered, [5, 99])
     threshold = floor + config.threshold_fraction * (peak - floor)

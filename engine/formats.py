@@ -17,7 +17,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.signal import resample_poly
 
 from .data import PhoneSegment
 from .errors import InputError
@@ -494,6 +493,8 @@ def resample_markers(markers: np.ndarray, rate: float, target: float) -> np.ndar
         from fractions import Fraction
 
         frac = Fraction(target / rate).limit_denominator(1000)
+        from scipy.signal import resample_poly   # here: scipy.signal takes 1-2 s to import
+
         out = resample_poly(markers, frac.numerator, frac.denominator, axis=0, padtype="line")
         if out.shape[0] >= n_out:
             return out[:n_out]
