@@ -61,6 +61,22 @@ def short_time_energy_db(audio: np.ndarray, rate: int, window_s: float = 0.02,
     return 10 * np.log10(energy + 1e-12), np.arange(count) * hop / rate
 
 
+def median_filter(x: np.ndarray, k: int) -> np.ndarray:
+    """Running median of odd length ``k``, zero-padded at both ends (the values of
+    ``scipy.signal.medfilt``, tested; here so that the app's first frame does not wait 1-2 s for
+    scipy.signal to import).
+
+    >>> median_filter(np.array([3.0, 1.0, 2.0, 5.0, 4.0]), 3).tolist()
+    [1.0, 2.0, 2.0, 4.0, 4.0]
+    """
+    if k % 2 == 0:
+        raise ValueError("the median filter length must be odd")
+    x = np.asarray(x, dtype=np.float64)
+    half = k // 2
+    padded = np.concatenate([np.zeros(half), x, np.zeros(half)])
+    return np.median(np.lib.stride_tricks.sliding_window_view(padded, k), axis=1)
+
+
 def speech_mask(audio: np.ndarray, rate: int, times: np.ndarray,
                 config: EvalConfig | None = None) -> np.ndarray:
     """Speech (True) or silence per time in ``times``: energy, 112 ms median filter, threshold.
@@ -77,9 +93,7 @@ def speech_mask(audio: np.ndarray, rate: int, times: np.ndarray,
     e_db, _e_t = short_time_energy_db(audio, rate, config.energy_window_s, config.energy_hop_s)
     k = int(round(config.median_s / config.energy_hop_s))
     k = k + 1 if k % 2 == 0 else k
-    from scipy.signal import medfilt   # here: scipy.signal takes 1-2 s to import
-
-    filtered = medfilt(e_db, k) if len(e_db) >= k else e_db
+    filtered = median_filter(e_db, k) if len(e_db) >= k else e_db
     floor, peak = np.percentile(filtered, [5, 99])
     threshold = floor + config.threshold_fraction * (peak - floor)
     idx = np.clip(np.round(np.asarray(times) / config.energy_hop_s).astype(int), 0, len(e_db) - 1)

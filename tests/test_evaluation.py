@@ -73,3 +73,13 @@ def test_evaluate_in_two_processes_equals_serial(toy_model, toy_corpus):
     assert parallel.scores == serial.scores        # dataclass equality: every float bit-equal
     assert parallel.table() == serial.table()
     assert seen[-1] == 1.0 and seen == sorted(seen)
+
+
+@pytest.mark.parametrize("k", [1, 3, 29])
+def test_median_filter_equals_scipy_medfilt(k):
+    from scipy.signal import medfilt
+
+    from engine.evaluation import median_filter
+
+    x = np.random.default_rng(k).standard_normal(500) * 20 - 40      # an energy contour in dB
+    np.testing.assert_array_equal(median_filter(x, k), medfilt(x, k))
