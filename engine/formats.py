@@ -493,7 +493,7 @@ def resample_markers(markers: np.ndarray, rate: float, target: float) -> np.ndar
         from fractions import Fraction
 
         frac = Fraction(target / rate).limit_denominator(1000)
-        from scipy.signal import resample_poly   # here: scipy.signal takes 1-2 s to import
+        from scipy.signal import resample_poly  # here: scipy.signal takes 1-2 s to import
 
         out = resample_poly(markers, frac.numerator, frac.denominator, axis=0, padtype="line")
         if out.shape[0] >= n_out:

@@ -166,7 +166,7 @@ def resample_audio(audio: np.ndarray, rate: int, target: int) -> np.ndarray:
     if rate == target:
         return np.asarray(audio, dtype=np.float64)
     g = np.gcd(int(rate), int(target))
-    from scipy.signal import resample_poly   # here: scipy.signal takes 1-2 s to import
+    from scipy.signal import resample_poly  # here: scipy.signal takes 1-2 s to import
 
     return resample_poly(np.asarray(audio, dtype=np.float64), target // g, rate // g)
 
