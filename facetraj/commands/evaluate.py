@@ -70,7 +70,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--split", choices=["train", "test", "all"], default="all")
     p.add_argument("--acoustic", action="store_true", help="add acoustic-only rows")
     p.add_argument("--json", action="store_true", help="JSON output with per-utterance scores")
-    p.add_argument("--jobs", "-j", type=int, metavar="N",
+    p.add_argument("--jobs", "-j", type=integer(1, 256), metavar="N",
                    help="utterances scored in N processes (default: every core)")
     add_synth_options(p)
     p.set_defaults(func=cmd_eval)
@@ -81,7 +81,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--max-n", type=integer(1, 100), default=10)
     p.add_argument("--split", choices=["train", "test", "all"], default="all")
     p.add_argument("--json", action="store_true")
-    p.add_argument("--jobs", "-j", type=int, metavar="N",
+    p.add_argument("--jobs", "-j", type=integer(1, 256), metavar="N",
                    help="utterances scored in N processes (default: every core)")
     p.set_defaults(func=cmd_sweep)
 
