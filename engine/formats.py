@@ -21,7 +21,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.signal import resample_poly
 
 from .c3d_check import MAX_RATE as MAX_C3D_RATE
 from .c3d_check import MIN_RATE as MIN_C3D_RATE
@@ -650,6 +649,8 @@ def resample_markers(markers: np.ndarray, rate: float, target: float) -> np.ndar
         from fractions import Fraction
 
         frac = Fraction(target / rate).limit_denominator(1000)
+        from scipy.signal import resample_poly  # here: scipy.signal takes 1-2 s to import
+
         out = resample_poly(markers, frac.numerator, frac.denominator, axis=0, padtype="line")
         if out.shape[0] >= n_out:
             return out[:n_out]
