@@ -259,3 +259,75 @@ def relabelled(corpus: Corpus, method: str = "aligned",
         log.warning("%d utterances without automatic labels left out: %s", len(auto.missing),
                     ", ".join(auto.missing))
     return RelabelledCorpus(corpus.root, info, auto=auto)
+
+
+# --------------------------------------------------------------------------- folders
+@dataclass
+class FolderLabelling:
+    """What :func:`label_folder` did: TextGrids written (and their source), existing ones kept,
+    files not labelled (``failed``) and transcripts that did not align (``fell_back``: recognized
+    instead), each with its error message."""
+
+    written: dict[str, Path] = field(default_factory=dict)
+    sources: dict[str, str] = field(default_factory=dict)
+    kept: list[str] = field(default_factory=list)
+    failed: dict[str, str] = field(default_factory=dict)
+    fell_back: dict[str, str] = field(default_factory=dict)
+
+    def summary(self) -> str:
+        n_al = sum(s == "aligned" for s in self.sources.values())
+        n_rec = sum(s == "recognized" for s in self.sources.values())
+        text = (f"{len(self.written)} TextGrids written ({n_al} aligned, {n_rec} recognized), "
+                f"{len(self.kept)} existing kept, {len(self.failed)} could not be labelled")
+        text += "".join(f"\n  not labelled: {why}" for why in self.failed.values())
+        return text + "".join(f"\n  recognized instead: {why}" for why in self.fell_back.values())
+
+
+def write_labels(path: str | os.PathLike[str], labels: Labels, duration: float,
+                 overwrite: bool = False) -> None:
+    """Write ``labels`` as a TextGrid (``words`` tier when any, then ``phones``)."""
+    from .formats import write_textgrid
+
+    write_textgrid(path, labels.tiers(), duration, overwrite)
+
+
+def label_folder(folder: str | os.PathLike[str], method: str = "aligned",
+                 extra_dict: Mapping[str, Sequence[str]] | None = None, overwrite: bool = False,
+                 progress: Progress | None = None, use_cache: bool = True) -> FolderLabelling:
+    """Write ``<stem>.TextGrid`` beside every audio file of ``folder``: aligned from ``<stem>.txt``
+    (``method="aligned"``; recognized where the transcript is missing or does not align), or
+    recognized for all (``"recognized"``). Existing TextGrids are kept unless ``overwrite``."""
+    from .formats import AUDIO_SUFFIXES, read_audio
+
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise InputError(folder, "not a folder")
+    audio_files = sorted(p for p in folder.iterdir() if p.suffix.lower() in AUDIO_SUFFIXES)
+    if not audio_files:
+        raise InputError(folder, "no .wav or .flac audio files")
+    out = FolderLabelling()
+    for k, apath in enumerate(audio_files):
+        stem = apath.stem
+        if progress:
+            progress(k / len(audio_files), stem)
+        target = apath.with_suffix(".TextGrid")
+        if target.exists() and not overwrite:
+            out.kept.append(stem)
+            continue
+        try:
+            audio, rate = read_audio(apath)
+            text = read_transcript(apath.with_suffix(".txt")) \
+                if method == "aligned" and apath.with_suffix(".txt").is_file() else ""
+            utt = Utterance(stem, audio, rate, text=text)
+            labels, error = label_utterance(utt, method, extra_dict, use_cache)
+            write_labels(target, labels, len(audio) / rate, overwrite)
+        except (InputError, OSError) as exc:
+            out.failed[stem] = str(exc)
+            continue
+        out.written[stem] = target
+        out.sources[stem] = labels.source
+        if error:
+            out.fell_back[stem] = error
+    if progress:
+        progress(1.0, "done")
+    return out
