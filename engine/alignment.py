@@ -324,8 +324,8 @@ def align(audio: np.ndarray, rate: int, text: str, extra_dict: Mapping[str, Sequ
     sentence = " ".join(words)
     alignment = _phone_alignment(decoder, pcm, sentence)
     if alignment is None:
-        raise UnalignableError(source, f"the text {sentence!r} could not be aligned to the audio "
-                                       "(wrong sentence, silence or noise?)")
+        raise UnalignableError(source, f"the text {sentence!r} does not match the audio: no "
+                                       "alignment found (wrong sentence, silence or noise?)")
     entries, word_segs = [], []
     for w in alignment:
         name = re.sub(r"\(\d+\)$", "", w.name)

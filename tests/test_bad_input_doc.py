@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import soundfile as sf
+from alignment_cases import alignment_cases
 from conftest import edited_model_file
 
 from engine.config import SynthConfig
@@ -134,6 +135,7 @@ def produce(case: str, tmp: Path, toy_dir: Path, model: Model, caplog) -> str:
             write("x.ema", "0 1 2 3\n1 1 2 3\n")),
         "a label map line that is not a pair": lambda: read_label_map(write("map.txt", "a b c\n")),
     }
+    cases.update(alignment_cases(tmp))
     caplog.clear()
     try:
         with caplog.at_level(logging.INFO):
