@@ -71,11 +71,11 @@ from engine.corpus import Corpus, load_corpus
 from engine.data import Utterance
 from engine.errors import FacetrajError
 from engine.evaluation import evaluate_utterance, trajectory_correlations
-from engine.formats import read_audio, read_labels
 from engine.model import Model
 
 from .browser import UtteranceBrowser, normalise_text
 from .cache import load_or_train
+from .open_audio import AudioOpener
 from .settings_panel import SynthSettingsPanel
 from .state import UtteranceView, build_view
 from .style import ORIGINAL_COLOR, SYNTH_COLOR
@@ -136,6 +136,8 @@ class MainWindow(QMainWindow):
         self.clock.playingChanged.connect(self._on_playing_changed)
 
         self._build_widgets()
+        self.audio_opener = AudioOpener(self)       # "Open audio…" and its label sources
+        self.settings.add_widget(self.audio_opener.box)
         self._build_menus()
         self._build_shortcuts()
         self._timer = QTimer(self)
@@ -299,7 +301,7 @@ class MainWindow(QMainWindow):
         file_menu = mb.addMenu("&File")
         self.action_open_corpus = QAction("Open &corpus folder…", self)
         self.action_open_corpus.triggered.connect(self._menu_open_corpus)
-        self.action_open_audio = QAction("Open &audio (+ labels) for synthesis…", self)
+        self.action_open_audio = QAction("Open &audio for synthesis…", self)
         self.action_open_audio.triggered.connect(self._menu_open_audio)
         self.action_screenshot = QAction("Save &screenshot…", self)
         self.action_screenshot.triggered.connect(self._menu_screenshot)
@@ -711,35 +713,19 @@ class MainWindow(QMainWindow):
             self.open_corpus(Path(path))
 
     def _menu_open_audio(self) -> None:
-        audio, _ = QFileDialog.getOpenFileName(self, "Open audio for synthesis", "",
-                                               "Audio (*.wav *.flac);;All files (*)")
-        if not audio:
-            return
-        labels, _ = QFileDialog.getOpenFileName(
-            self, "Phone labels (Cancel: acoustic-only synthesis)", str(Path(audio).parent),
-            "Labels (*.TextGrid *.lab *.phn);;All files (*)")
-        self.open_audio(Path(audio), Path(labels) if labels else None)
+        self.audio_opener.ask()
 
-    def open_audio(self, audio_path: Path, labels_path: Path | None = None) -> None:
-        """Synthesize from an audio file (and phone labels) that has no original markers."""
-        if self.model is None:
-            self._report_error(FacetrajError("no model yet: open a corpus first"))
-            return
-        try:
-            audio, rate = read_audio(audio_path)
-            phones = read_labels(labels_path, rate) if labels_path else []
-        except FacetrajError as exc:
-            self._report_error(exc)
-            return
-        name = audio_path.stem
-        while name in (self.corpus.info.ids if self.corpus else []):
-            name += "'"
-        utt = Utterance(name=name, audio=audio, sample_rate=rate, phones=list(phones),
-                        markers=None, marker_rate=self.model.marker_rate,
-                        marker_names=list(self.model.marker_names), text=str(audio_path))
-        self.external[name] = utt
-        self.browser.add_external(name)
-        self.set_utterance(name)
+    def open_audio(self, audio_path: Path, labels_path: Path | None = None, **kw) -> None:
+        """Synthesize from an audio file that has no original markers; phone labels from
+        ``labels_path``, ``text=`` (aligned), ``recognize=True``, ``acoustic_only=True`` or the
+        files beside the audio (``app.open_audio.AudioOpener.open``)."""
+        self.audio_opener.open(Path(audio_path), labels_path, **kw)
+
+    def show_external(self, utt: Utterance) -> None:
+        """Show an utterance opened from files (listed under "opened" in the browser)."""
+        self.external[utt.name] = utt
+        self.browser.add_external(utt.name)
+        self.set_utterance(utt.name)
 
     def _menu_screenshot(self) -> None:
         path, _ = QFileDialog.getSaveFileName(self, "Save a screenshot", "facetraj.png", "PNG (*.png)")

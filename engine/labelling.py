@@ -227,7 +227,8 @@ def label_corpus(corpus: Corpus, method: str = "aligned", split: str = "all",
 
 def with_labels(utt: Utterance, labels: Labels) -> Utterance:
     """``utt`` with its phones (and words, when any) replaced by ``labels``."""
-    return replace(utt, phones=list(labels.phones), words=list(labels.words) or utt.words)
+    return replace(utt, phones=list(labels.phones), words=list(labels.words) or utt.words,
+                   label_source=labels.source)
 
 
 @dataclass
