@@ -134,6 +134,8 @@ class ReportData:
     comparisons : rows ``{method, split, smoothing, whole_face, lower_lip, upper_lip, *_std, n}``.
     sweep : ``{"ns": [...], "train": {metric: [...]}, "test": {metric: [...]}}`` (triangular).
     figure4 : the Figure-4 example (``None`` when the corpus has no test utterance).
+    labels : the automatic-label section (``engine.label_accuracy.label_section``), ``None``
+        when the corpus has no transcripts.
     figures : figure name -> path relative to the report folder (filled by the figures callable).
     timings : seconds per stage.
     """
@@ -146,6 +148,7 @@ class ReportData:
     comparisons: list[dict]
     sweep: dict
     figure4: Figure4Data | None
+    labels: dict | None = None
     timings: dict[str, float] = field(default_factory=dict)
     figures: dict[str, str] = field(default_factory=dict)
     created: str = ""
@@ -177,7 +180,7 @@ class ReportData:
             "comparisons": self.comparisons, "sweep": self.sweep, "figure4": fig4,
             "table1_agreement": table1_agreement(self.table1, self.paper_table1),
             "at_a_glance": at_a_glance(self),
-            "timings_s": self.timings, "figures": self.figures,
+            "timings_s": self.timings, "figures": self.figures, "labels": self.labels,
         })
 
 
@@ -276,10 +279,13 @@ def _stage(progress: Progress, lo: float, hi: float) -> Progress:
 
 
 def compute_report(corpus_dir: str | os.PathLike[str], model: Model | None = None,
-                   progress: Progress | None = None, ns: Iterable[int] = range(1, 11)) -> ReportData:
+                   progress: Progress | None = None, ns: Iterable[int] = range(1, 11),
+                   labels_section: bool = True) -> ReportData:
     """Compute every number of the report on the corpus's own train/test split.
 
-    Trains a model on the train split when ``model`` is ``None``.
+    Trains a model on the train split when ``model`` is ``None``. With ``labels_section`` and a
+    corpus with transcripts, adds the automatic-label section (PocketSphinx; slow on the first
+    run, then cached).
     """
     progress = progress or (lambda f, m: None)
     corpus = load_corpus(corpus_dir)
@@ -354,10 +360,19 @@ def compute_report(corpus_dir: str | os.PathLike[str], model: Model | None = Non
         "moving_coordinates": int(len(moving_coordinates(model))),
         "config": model.config.to_dict(), "ridge_lambda": base.ridge.lam,
     }
+    labels = None
+    if labels_section and info.test and (corpus.data_root / f"{info.test[0]}.txt").exists():
+        from .label_accuracy import MOCHA_SAMPLE, label_section
+
+        t = time.perf_counter()
+        mocha = Path(__file__).resolve().parents[1].parent / "shared" / MOCHA_SAMPLE[0]
+        labels = label_section(corpus, model, comparisons, mocha if mocha.is_dir() else None,
+                               _stage(progress, 0.97, 0.995))
+        timings["automatic_labels"] = time.perf_counter() - t
     progress(1.0, "done")
     return ReportData(corpus=summary, model=model_summary, table1=rows1, paper_table1=paper_table1(),
-                      table2=t2, comparisons=comparisons, sweep=sweep, figure4=fig4, timings=timings,
-                      created=f"{dt.datetime.now(dt.UTC):%Y-%m-%d %H:%M} UTC")
+                      table2=t2, comparisons=comparisons, sweep=sweep, figure4=fig4, labels=labels,
+                      timings=timings, created=f"{dt.datetime.now(dt.UTC):%Y-%m-%d %H:%M} UTC")
 
 
 def _minutes(corpus: Corpus, ids: Sequence[str]) -> float:
@@ -656,7 +671,13 @@ def render_markdown(data: ReportData) -> str:
                                                      order.get(r["mode"], 9))):
         lines.append(f"| {r['method']} | {r['split']} | {r['smoothing']} | {_pm(r, 'whole_face')} | "
                      f"{_pm(r, 'lower_lip')} | {_pm(r, 'upper_lip')} | {r['n']} |")
-    lines += ["", "## Table 1: the three visually most similar phones", ""]
+    if data.labels:
+        from .label_accuracy import render_section
+
+        lines += ["", *render_section(data.labels)]
+    else:
+        lines.append("")
+    lines += ["## Table 1: the three visually most similar phones", ""]
     agree = table1_agreement(data.table1, data.paper_table1)
     lines += [f"Eqs 1-3 (nu = {m['config']['nu']:g}, distances scaled by "
               f"`{m['config']['distance_scale']}`). Of the {agree['phones_compared']} phones in both "

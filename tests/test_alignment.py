@@ -286,3 +286,19 @@ def test_corpus_align_command(tmp_path, caplog):
     assert "3 TextGrids written (0 aligned, 3 recognized)" in caplog.text
     assert list(read_textgrid_tiers(tmp_path / "s001.TextGrid")) == ["phones"]
     assert main(["corpus", "align", str(tmp_path / "nowhere")]) == 2
+
+
+def test_report_section_renders_the_accuracy_table(clip, clip_aligned):
+    from engine.label_accuracy import render_section
+
+    _, _, truth, _ = clip
+    row = {"data": "clip (exact labels)", **summarise("aligned", [(truth, clip_aligned.phones)]).to_json()}
+    t2 = {"trained_on": "aligned", "tested_on": "recognized", "split": "test",
+          "smoothing": "triangular", "whole_face": 0.5, "lower_lip": 0.4, "upper_lip": 0.3,
+          "whole_face_std": 0.1, "lower_lip_std": float("nan"), "upper_lip_std": 0.1, "n": 3}
+    md = render_section({"pocketsphinx": "5.1.1", "accuracy": [row], "table2": [t2]})
+    line = next(x for x in md if x.startswith("| clip"))
+    cells = [c.strip() for c in line.strip("|").split("|")]
+    assert cells[:4] == ["clip (exact labels)", "aligned", "1", str(row["boundaries"])]
+    assert float(cells[4]) == pytest.approx(row["median_error_ms"], abs=0.05)
+    assert "| aligned | recognized | test | triangular | 0.500 ± 0.100 | 0.400 | 0.300 ± 0.100 | 3 |" in md
