@@ -302,3 +302,17 @@ def test_report_section_renders_the_accuracy_table(clip, clip_aligned):
     assert cells[:4] == ["clip (exact labels)", "aligned", "1", str(row["boundaries"])]
     assert float(cells[4]) == pytest.approx(row["median_error_ms"], abs=0.05)
     assert "| aligned | recognized | test | triangular | 0.500 ± 0.100 | 0.400 | 0.300 ± 0.100 | 3 |" in md
+
+
+def test_labelling_benchmark_smoke():
+    """The benchmark's rows are there with positive finite numbers (no timing threshold)."""
+    import math
+
+    from benchmarks.common import load_context
+    from benchmarks.labels import run
+
+    rows = run(load_context(DEFAULT_CORPUS, smoke=True))
+    assert [r.name for r in rows] == ["align, per second of speech",
+                                      "align, no fit check, per second of speech",
+                                      "recognize, per second of speech"]
+    assert all(math.isfinite(r.value) and r.value > 0 and r.unit == "s/s" for r in rows)
