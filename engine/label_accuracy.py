@@ -200,7 +200,7 @@ def aligned_table2(corpus, model_exact, progress=None, train_config=None) -> lis
 
     progress = progress or (lambda f, m: None)
     aligned = relabelled(corpus, "aligned")
-    recognized = relabelled(corpus, "recognized")
+    recognized = relabelled(corpus, "recognized", split="test")
     progress(0.05, "training on aligned labels")
     model_aligned = train(aligned, config=train_config)
     phonetic = [SynthConfig(mode="phonetic")]

@@ -250,9 +250,11 @@ class RelabelledCorpus(Corpus):
 
 def relabelled(corpus: Corpus, method: str = "aligned",
                extra_dict: Mapping[str, Sequence[str]] | None = None,
-               progress: Progress | None = None, use_cache: bool = True) -> RelabelledCorpus:
-    """``corpus`` with every utterance labelled by ``method`` (see :func:`label_corpus`)."""
-    auto = label_corpus(corpus, method, "all", extra_dict, progress, use_cache)
+               progress: Progress | None = None, use_cache: bool = True,
+               split: str = "all") -> RelabelledCorpus:
+    """``corpus`` with every utterance of ``split`` labelled by ``method`` (see
+    :func:`label_corpus`); the other split is left out."""
+    auto = label_corpus(corpus, method, split, extra_dict, progress, use_cache)
     keep = set(auto.labels)
     info = replace(corpus.info, train=[u for u in corpus.info.train if u in keep],
                    test=[u for u in corpus.info.test if u in keep])
