@@ -6,9 +6,9 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
-import os
 from pathlib import Path
 
+from engine.cachedir import cache_dir
 from engine.config import TrainConfig
 from engine.corpus import Corpus
 from engine.errors import ModelFileError
@@ -18,16 +18,7 @@ from engine.training import train
 
 log = logging.getLogger(__name__)
 
-
-
-def cache_dir() -> Path:
-    """Where trained models are kept (created on demand)."""
-    env = os.environ.get("FACETRAJ_CACHE_DIR")
-    if env:
-        return Path(env)
-    from platformdirs import user_cache_dir
-
-    return Path(user_cache_dir("facetraj"))
+__all__ = ["cache_dir", "cached_model_path", "load_or_train", "model_key"]
 
 
 def model_key(fingerprint: str, config: TrainConfig) -> str:

@@ -189,18 +189,6 @@ def ask_corpus_folder(parent: QWidget) -> tuple[Path] | None:
     return (Path(path),) if path else None
 
 
-def ask_audio_and_labels(parent: QWidget) -> tuple[Path, Path | None] | None:
-    """An audio file, then its phone labels (Cancel: none, acoustic-only synthesis)."""
-    audio, _ = QFileDialog.getOpenFileName(parent, "Open audio for synthesis", "",
-                                           "Audio (*.wav *.flac);;All files (*)")
-    if not audio:
-        return None
-    labels, _ = QFileDialog.getOpenFileName(
-        parent, "Phone labels (Cancel: acoustic-only synthesis)", str(Path(audio).parent),
-        "Labels (*.TextGrid *.lab *.phn);;All files (*)")
-    return Path(audio), Path(labels) if labels else None
-
-
 def ask_screenshot_path(parent: QWidget) -> tuple[Path] | None:
     path, _ = QFileDialog.getSaveFileName(parent, "Save a screenshot", "facetraj.png", "PNG (*.png)")
     return (Path(path),) if path else None

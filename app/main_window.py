@@ -70,7 +70,6 @@ from engine.config import SynthConfig
 from engine.corpus import Corpus, load_corpus
 from engine.data import Utterance
 from engine.errors import FacetrajError
-from engine.formats import read_audio, read_labels
 from engine.model import Model
 
 from .browser import UtteranceBrowser
@@ -81,12 +80,12 @@ from .controls import (
     TransportBar,
     ViewBar,
     add_shortcuts,
-    ask_audio_and_labels,
     ask_corpus_folder,
     ask_screenshot_path,
 )
 from .correlations import BrowserScores
 from .marker_panels import MarkerPanels
+from .open_audio import AudioOpener
 from .playback import PlaybackScheduler
 from .settings_panel import SynthSettingsPanel
 from .state import UtteranceView
@@ -127,6 +126,8 @@ class MainWindow(QMainWindow):
         self._extensions: dict[str, object] = {}
         self._menus: dict[str, QMenu] = {}
         self._build_widgets()
+        self.audio_opener = AudioOpener(self)       # "Open audio…" and its label sources
+        self.settings.add_widget(self.audio_opener.box)
         self._build_menus()
         self._build_shortcuts()
         if corpus_path is not None:
@@ -214,8 +215,8 @@ class MainWindow(QMainWindow):
     def _build_menus(self) -> None:
         self.action_open_corpus = self._action("File", "Open &corpus folder…",
                                                lambda: _given(ask_corpus_folder(self), self.open_corpus))
-        self.action_open_audio = self._action("File", "Open &audio (+ labels) for synthesis…",
-                                              lambda: _given(ask_audio_and_labels(self), self.open_audio))
+        self.action_open_audio = self._action("File", "Open &audio for synthesis…",
+                                              lambda: self.audio_opener.ask())
         self.action_screenshot = self._action("File", "Save &screenshot…",
                                               lambda: _given(ask_screenshot_path(self), self.save_screenshot))
         self.menu("File").addSeparator()
@@ -464,21 +465,15 @@ class MainWindow(QMainWindow):
         self.cursorMoved.emit(float(t))
 
     # ================================================================== files
-    def open_audio(self, audio_path: Path, labels_path: Path | None = None) -> None:
-        """Synthesize from an audio file (and phone labels) that has no original markers."""
-        model = self.model
-        if model is None:
-            self.report_error(FacetrajError("no model yet: open a corpus first"))
-            return
-        try:
-            audio, rate = read_audio(audio_path)
-            phones = read_labels(labels_path, rate) if labels_path else []
-        except FacetrajError as exc:
-            self.report_error(exc)
-            return
-        name = self.state.add_external(Utterance(
-            name=audio_path.stem, audio=audio, sample_rate=rate, phones=list(phones), markers=None,
-            marker_rate=model.marker_rate, marker_names=list(model.marker_names), text=str(audio_path)))
+    def open_audio(self, audio_path: Path, labels_path: Path | None = None, **kw) -> None:
+        """Synthesize from an audio file that has no original markers; phone labels from
+        ``labels_path``, ``text=`` (aligned), ``recognize=True``, ``acoustic_only=True`` or the
+        files beside the audio (``app.open_audio.AudioOpener.open``)."""
+        self.audio_opener.open(Path(audio_path), labels_path, **kw)
+
+    def show_external(self, utt: Utterance) -> None:
+        """Show an utterance opened from files (listed under "opened" in the browser)."""
+        name = self.state.add_external(utt)
         self.browser.add_external(name)
         self.set_utterance(name)
 

@@ -79,6 +79,7 @@ class SynthSettingsPanel(QWidget):
         form.addRow("search", self.mode)
         form.addRow("smoothing", self.smoothing)
         lay = QVBoxLayout(self)
+        self._layout = lay
         lay.addLayout(form)
         lay.addWidget(self.reset)
         lay.addWidget(self.status)
@@ -93,6 +94,10 @@ class SynthSettingsPanel(QWidget):
         self.mode.currentIndexChanged.connect(self._changed)
         self.smoothing.currentIndexChanged.connect(self._changed)
         self.reset.clicked.connect(lambda: (self.set_config(SynthConfig()), self._changed()))
+
+    def add_widget(self, widget: QWidget) -> None:
+        """Add a widget under the settings (e.g. the label source of an opened recording)."""
+        self._layout.insertWidget(self._layout.count() - 2, widget)
 
     def set_limits(self, max_context: int, default_nu: float) -> None:
         """Fit the controls to a model: C up to its trained context, ν's default."""

@@ -128,7 +128,9 @@ class PhoneTierPanel:
         utt = view.utterance
         ax.set_ylim(0, 2 if utt.words else 1)
         ax.set_yticks([])
-        ax.set_ylabel("words\nphones" if utt.words else "phones", fontsize=8)
+        tier = "words\nphones" if utt.words else "phones"
+        source = f"\n({utt.label_source})" if utt.phones else ""
+        ax.set_ylabel(tier + source, fontsize=8)
         for seg in utt.phones:
             silent = seg.label in ("sil", "", "sp", "pau", "h#")
             if silent:

@@ -1,6 +1,6 @@
 """``python -m benchmarks [--smoke] [--corpus DIR] [--out FILE] [--only GROUP ...]``
 
-Runs the training, synthesis and scaling benchmarks (and the app playback benchmark,
+Runs the training, synthesis, scaling and phone-labelling benchmarks (and the app playback benchmark,
 ``benchmarks/playback.py``, when it exists and a display is available), prints one table and
 writes it, with the machine described, to ``docs/benchmarks.md``.
 
@@ -22,7 +22,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from . import scaling, startup, synth, train
+from . import labels, scaling, startup, synth, train
 from .common import (
     REPO,
     BenchContext,
@@ -37,7 +37,7 @@ from .common import (
 
 log = logging.getLogger("benchmarks")
 
-GROUPS = ("train", "synth", "scaling", "eval", "playback", "startup")
+GROUPS = ("train", "synth", "scaling", "eval", "labels", "playback", "startup")
 DEFAULT_OUT = REPO / "docs" / "benchmarks.md"
 #: hand-written profile notes (per stage, before and after a change), copied into the Markdown
 NOTES = REPO / "benchmarks" / "profile_notes.md"
@@ -87,6 +87,8 @@ def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS, factors: Sequence[i
         rows += scaling.run(ctx, factors, prefilters)
     if "eval" in only:
         rows += startup.evaluation(ctx)
+    if "labels" in only:
+        rows += labels.run(ctx)
     if "playback" in only:
         rows += run_playback(ctx.smoke, ctx.corpus.root)
     if "startup" in only:
@@ -156,6 +158,9 @@ def write_markdown(path: Path, rows: Sequence[BenchRow], ctx: BenchContext, elap
         "- Training times are measured inside one `engine.training.train()` call by wrapping the "
         "engine's functions; the codebook row is the remainder of the call. Peak memory is traced "
         "in a second call.",
+        "- `s/s` (labels) is seconds of computation per second of speech (lower is better): "
+        "PocketSphinx forced alignment of the transcript (two passes; the fit check adds a free "
+        "phone-loop recognition to reject text that does not match) and phone recognition.",
         "- Scaling replicates the trained codebook with jitter; the growth exponent e fits "
         "time ~ size^e between the smallest and largest codebook, on a fixed input.",
         "- The machine is shared (2 cores, other jobs running): synthesis of up to 10 s of input is "

@@ -36,6 +36,9 @@ class Utterance:
     marker_names : one name per marker.
     words : optional word segments (display only).
     text : optional orthographic text.
+    label_source : where ``phones`` came from: ``"file"`` (a label file), ``"aligned"`` (forced
+        alignment of ``text``), ``"recognized"`` (phone recognition) or ``"none"``
+        (``engine.alignment`` / ``engine.labelling``).
     """
 
     name: str
@@ -47,6 +50,7 @@ class Utterance:
     marker_names: list[str] = field(default_factory=list)
     words: list[PhoneSegment] = field(default_factory=list)
     text: str = ""
+    label_source: str = "file"
 
     @property
     def duration(self) -> float:

@@ -284,11 +284,17 @@ def test_corrupt_file_shows_error_and_app_keeps_working(window, qtbot, tmp_path,
     win.action_open_corpus.trigger()
     assert len(shown) == 2 and "corpus.json" in shown[1]
     assert win.corpus.root.resolve() == default_corpus().resolve()
-    # a good audio file without labels: acoustic-only synthesis, no original markers
+    # a good audio file without labels, opened with "No labels": acoustic-only synthesis, no
+    # original markers
+    import shutil
+
+    from app.open_audio import SentenceDialog
     from engine.corpus import audio_path
 
-    good = audio_path(win.corpus.root, win.corpus.info.test[-1])
-    answers = iter([(str(good), ""), ("", "")])
+    good = tmp_path / audio_path(win.corpus.root, win.corpus.info.test[-1]).name
+    shutil.copy(audio_path(win.corpus.root, win.corpus.info.test[-1]), good)
+    answers = iter([(str(good), "")])
+    monkeypatch.setattr(SentenceDialog, "exec", lambda self: (self._acoustic_only(), 1)[1])
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
         win.action_open_audio.trigger()
     assert len(shown) == 2

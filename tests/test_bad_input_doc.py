@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import soundfile as sf
+from alignment_cases import alignment_cases
 from conftest import edited_model_file
 from fuzzing import _c3d_rate
 
@@ -194,6 +195,7 @@ def produce(case: str, tmp: Path, toy_dir: Path, model: Model, caplog) -> str:
         "an output on a read-only file system": lambda: _patched(
             tempfile, "mkstemp", _erofs, lambda: atomic_write(tmp / "o.tsv").__enter__()),
     }
+    cases.update(alignment_cases(tmp))
     caplog.clear()
     try:
         with caplog.at_level(logging.INFO):

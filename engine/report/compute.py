@@ -11,6 +11,7 @@ import re
 import time
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
+from pathlib import Path
 
 from ..baselines import Baselines, FrameData, evaluate_baselines, fit_baselines, frame_data
 from ..config import SynthConfig
@@ -163,12 +164,25 @@ def model_summary(model: Model, baselines: Baselines) -> ModelSummary:
         ridge_lambda=baselines.ridge.lam)
 
 
+def _automatic_labels(corpus: Corpus, model: Model, comparisons: list[ComparisonRow],
+                      progress: Progress) -> dict:
+    """The automatic-label section (``engine.label_accuracy``), with the MOCHA-TIMIT sample in
+    ``../shared`` beside the repository when it is there."""
+    from ..label_accuracy import MOCHA_SAMPLE, label_section
+
+    mocha = Path(__file__).resolve().parents[3] / "shared" / MOCHA_SAMPLE[0]
+    return label_section(corpus, model, comparisons, mocha if mocha.is_dir() else None, progress)
+
+
 def compute_report(corpus_dir: str | os.PathLike[str], model: Model | None = None,
-                   progress: Progress | None = None, ns: Iterable[int] = range(1, 11)) -> ReportData:
+                   progress: Progress | None = None, ns: Iterable[int] = range(1, 11),
+                   labels_section: bool = True) -> ReportData:
     """Compute every number of the report on the corpus's own train/test split.
 
     Trains a model on the train split when ``model`` is ``None``. The evaluations use every
-    core (:func:`default_workers`); their scores equal a serial run's.
+    core (:func:`default_workers`); their scores equal a serial run's. With ``labels_section`` and
+    a corpus with transcripts, adds the automatic-label section (PocketSphinx; slow on the first
+    run, then cached).
     """
     progress = progress or (lambda f, m: None)
     workers = default_workers()
@@ -195,13 +209,17 @@ def compute_report(corpus_dir: str | os.PathLike[str], model: Model | None = Non
         progress(0.96, "Figure 4")
         fig4 = figure4_data(model, corpus)
     comparisons = comparison_rows(res2, res_ix, indexed, base, base_scores)
+    labels = None
+    if labels_section and corpus.info.test and (corpus.data_root / f"{corpus.info.test[0]}.txt").exists():
+        with _timed(timings, "automatic_labels"):
+            labels = _automatic_labels(corpus, model, comparisons, _stage(progress, 0.97, 0.995))
     summary = corpus_summary(corpus)
     progress(1.0, "done")
     return ReportData(corpus=summary, model=model_summary(model, base), table1=rows1,
                       paper_table1=paper_table1(),
                       table2=[r for r in comparisons if r.mode == "phonetic"],
                       comparisons=comparisons, sweep=sweep_table(res5, ns), figure4=fig4,
-                      timings=timings, created=f"{dt.datetime.now(dt.UTC):%Y-%m-%d %H:%M} UTC")
+                      labels=labels, timings=timings, created=f"{dt.datetime.now(dt.UTC):%Y-%m-%d %H:%M} UTC")
 
 
 __all__ = ["comparison_rows", "compute_report", "corpus_summary", "figure4_data", "find_utterance",

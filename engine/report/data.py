@@ -76,6 +76,8 @@ class ReportData:
     comparisons : one row per method, split and smoothing.
     sweep : the N sweep (Figure 5, triangular).
     figure4 : the Figure-4 example (``None`` when the corpus has no test utterance).
+    labels : the automatic-label section (``engine.label_accuracy.label_section``), ``None``
+        when the corpus has no transcripts.
     figures : figure name -> path relative to the report folder (filled by the figures callable).
     timings : seconds per stage.
     """
@@ -88,6 +90,7 @@ class ReportData:
     comparisons: list[ComparisonRow]
     sweep: SweepTable
     figure4: Figure4Data | None
+    labels: dict | None = None
     timings: dict[str, float] = field(default_factory=dict)
     figures: dict[str, str] = field(default_factory=dict)
     created: str = ""
@@ -118,7 +121,7 @@ class ReportData:
             "figure4": self.figure4.to_json() if self.figure4 is not None else None,
             "table1_agreement": asdict(table1_agreement(self.table1, self.paper_table1)),
             "at_a_glance": [asdict(g) for g in at_a_glance(self)],
-            "timings_s": self.timings, "figures": self.figures,
+            "timings_s": self.timings, "figures": self.figures, "labels": self.labels,
         })
 
 

@@ -122,6 +122,15 @@ def comparisons_section(data: ReportData) -> list[str]:
     return lines
 
 
+def labels_section(data: ReportData) -> list[str]:
+    """Automatic phone labels: their accuracy, and Table 2 with them (none without transcripts)."""
+    if not data.labels:
+        return []
+    from ..label_accuracy import render_section
+
+    return render_section(data.labels)[:-1]
+
+
 def table1_section(data: ReportData) -> list[str]:
     """Table 1, ours beside the paper's, and how many agree."""
     config = data.model.config
@@ -158,17 +167,20 @@ def reproducing_section(data: ReportData) -> list[str]:
 
 #: the sections of ``results.md``, in order
 SECTIONS = (header_section, glance_section, table2_section, figure5_section, figure4_section,
-            comparisons_section, table1_section, discussion_section, reproducing_section)
+            comparisons_section, labels_section, table1_section, discussion_section,
+            reproducing_section)
 
 
 def render_markdown(data: ReportData) -> str:
     """``results.md`` from the report data."""
     lines: list[str] = []
     for section in SECTIONS:
-        lines += [*section(data), ""]
+        body = section(data)
+        if body:
+            lines += [*body, ""]
     return "\n".join(lines)
 
 
 __all__ = ["COMPARISON_ORDER", "SECTIONS", "comparisons_section", "discussion_section",
-           "figure4_section", "figure5_section", "glance_section", "header_section",
+           "figure4_section", "figure5_section", "glance_section", "header_section", "labels_section",
            "render_markdown", "reproducing_section", "table1_section", "table2_section"]

@@ -1,4 +1,5 @@
-"""``facetraj corpus build|init|show``: the default corpus, and describing one's own recordings."""
+"""``facetraj corpus build|init|show|align``: the default corpus, describing one's own
+recordings, and labelling them by forced alignment of their transcripts."""
 
 from __future__ import annotations
 
@@ -59,6 +60,23 @@ def cmd_corpus_show(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_corpus_align(args: argparse.Namespace) -> int:
+    from engine.labelling import label_folder
+
+    from .align import extra_dictionary
+
+    folder = args.folder
+    if folder.is_file() or (folder / "corpus.json").is_file():
+        from engine.corpus import load_corpus
+
+        folder = load_corpus(folder).data_root
+    done = label_folder(folder, "recognized" if args.recognize else "aligned",
+                        extra_dictionary(args), args.overwrite, TerminalProgress("align"))
+    log.info("%s", done.summary())
+    print(folder)
+    return 0 if done.written or done.kept else 2
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("corpus", help="the default corpus: build it; describe your own folder")
     csub = p.add_subparsers(dest="corpus_command", metavar="ACTION", required=True)
@@ -86,3 +104,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     sh = csub.add_parser("show", help="list a corpus's utterances")
     sh.add_argument("corpus", type=Path, help="corpus folder or description .json")
     sh.set_defaults(func=cmd_corpus_show)
+    a = csub.add_parser("align", help="phone labels (TextGrids) for every recording of a folder, "
+                                      "aligned from its .txt transcripts")
+    a.add_argument("folder", type=Path, help="folder of <id>.wav|flac and <id>.txt (or a corpus)")
+    a.add_argument("--recognize", action="store_true",
+                   help="recognize the phones of every utterance, ignoring transcripts")
+    a.add_argument("--dict", type=Path, metavar="FILE",
+                   help="extra pronunciations, CMUdict lines 'WORD  PH1 PH2 ...'")
+    a.add_argument("--overwrite", action="store_true", help="replace existing TextGrids")
+    a.set_defaults(func=cmd_corpus_align)

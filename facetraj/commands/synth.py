@@ -7,27 +7,36 @@ import logging
 from pathlib import Path
 
 from ..options import add_synth_options, synth_config
+from .align import add_label_source_options, extra_dictionary
 
 log = logging.getLogger("facetraj")
 
 
 def cmd_synth(args: argparse.Namespace) -> int:
     from engine.export import write_trajectories
-    from engine.formats import read_audio, read_labels
+    from engine.formats import read_audio
+    from engine.labelling import labels_for_audio
     from engine.labelmap import read_label_map
     from engine.model import Model
     from engine.pipeline import mode_for, synthesize
 
     model = Model.load(args.model)
     audio, rate = read_audio(args.audio)
-    phones = read_labels(args.labels, rate) if args.labels else None
-    cfg = mode_for(synth_config(args), phones)
-    label_map = read_label_map(args.label_map) if args.label_map else None
+    cfg = synth_config(args)
+    labels = None
+    if cfg.mode == "phonetic":
+        labels = labels_for_audio(args.audio, audio, rate, labels=args.labels, text=args.text,
+                                  transcript=args.transcript, recognize=args.recognize,
+                                  extra_dict=extra_dictionary(args))
+    phones = labels.phones if labels else None
+    cfg = mode_for(cfg, phones)
+    label_map = read_label_map(args.label_map) if args.label_map and labels and \
+        labels.source == "file" else None
     res = synthesize(model, audio, rate, phones, cfg, label_map=label_map,
                      source=str(args.labels or args.audio), audio_source=str(args.audio))
     out = write_trajectories(args.output, res.markers, model, res, args.overwrite)
-    log.info("%d frames (%.2f s) synthesized, %s mode, %s smoothing", len(res.times),
-             res.times[-1], cfg.mode, cfg.smoothing)
+    log.info("%d frames (%.2f s) synthesized, %s mode (labels: %s), %s smoothing", len(res.times),
+             res.times[-1], cfg.mode, labels.source if labels else "none", cfg.smoothing)
     print(out)
     return 0
 
@@ -36,7 +45,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("synth", help="synthesize face points from speech")
     p.add_argument("model", type=Path)
     p.add_argument("audio", type=Path, help="WAV or FLAC")
-    p.add_argument("--labels", type=Path, help="phone labels: .TextGrid, .lab or .phn")
+    p.add_argument("--labels", type=Path, help="phone labels: .TextGrid, .lab or .phn (default: "
+                   "one beside the audio, else the sentence of a .txt beside it, aligned)")
+    add_label_source_options(p)
     p.add_argument("--label-map", help="a label map (TSV: label<TAB>arpabet)")
     p.add_argument("-o", "--output", type=Path, required=True, help=".c3d, .tsv, .csv or .npz")
     p.add_argument("--overwrite", action="store_true", help="replace an existing file")

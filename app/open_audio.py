@@ -1,0 +1,317 @@
+"""Opening a recording for synthesis, with phone labels from wherever they can come from.
+
+"Open audio…" uses a label file or a ``.txt`` transcript beside the audio (the one rule,
+``engine.labelling.labels_for_audio``), otherwise asks for the sentence (:class:`SentenceDialog`:
+empty = recognize the phones; or no labels, acoustic-only). Alignment runs in a worker with the
+window's busy indicator; words missing from the dictionary are asked for
+(:class:`MissingWordsDialog`) and the alignment retried. The :class:`LabelSourceBox` in the settings
+panel switches the same audio between its label file, aligned, recognized and no labels, so the
+lips of each can be compared.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from PyQt6.QtCore import QObject, pyqtSignal
+from PyQt6.QtWidgets import (
+    QComboBox,
+    QDialog,
+    QDialogButtonBox,
+    QFileDialog,
+    QFormLayout,
+    QLabel,
+    QLineEdit,
+    QPushButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+from engine.alignment import Labels, MissingWordsError
+from engine.data import Utterance
+from engine.errors import FacetrajError, InputError
+from engine.formats import read_audio
+from engine.labelling import beside, file_labels, label_audio, labels_for_audio
+from engine.phones import ARPABET
+
+if TYPE_CHECKING:
+    from .main_window import MainWindow
+
+log = logging.getLogger(__name__)
+
+#: Label sources the user can switch between, as (combo text, source).
+SOURCE_CHOICES = (("from the label file", "file"), ("aligned from the sentence", "aligned"),
+                  ("recognized (no text)", "recognized"), ("none: acoustic only", "none"))
+
+
+# --------------------------------------------------------------------------- dialogs
+class SentenceDialog(QDialog):
+    """Asks for the sentence spoken in a recording. ``choice()`` after ``exec()``: ``("aligned",
+    text)``, ``("recognized", "")`` for empty text, ``("none", "")`` for acoustic-only."""
+
+    def __init__(self, audio_name: str, parent: QWidget | None = None):
+        super().__init__(parent)
+        self.setWindowTitle("The sentence spoken")
+        self.text = QLineEdit()
+        self.text.setPlaceholderText("e.g. The boy enjoyed the noisy toy.  (empty: recognize)")
+        self.text.setMinimumWidth(460)
+        self._none = False
+        info = QLabel(f"No labels or transcript beside <b>{audio_name}</b>.<br>Type the English "
+                      "sentence spoken to align its phones, or leave it empty to recognize them.")
+        info.setWordWrap(True)
+        buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Ok
+                                   | QDialogButtonBox.StandardButton.Cancel)
+        self.acoustic = QPushButton("No labels (acoustic only)")
+        buttons.addButton(self.acoustic, QDialogButtonBox.ButtonRole.AcceptRole)
+        self.acoustic.clicked.connect(self._acoustic_only)
+        buttons.accepted.connect(self.accept)
+        buttons.rejected.connect(self.reject)
+        lay = QVBoxLayout(self)
+        lay.addWidget(info)
+        lay.addWidget(self.text)
+        lay.addWidget(buttons)
+
+    def _acoustic_only(self) -> None:
+        self._none = True
+        self.accept()
+
+    def choice(self) -> tuple[str, str]:
+        if self._none:
+            return "none", ""
+        text = self.text.text().strip()
+        return ("aligned", text) if text else ("recognized", "")
+
+
+class MissingWordsDialog(QDialog):
+    """Asks the pronunciation (ARPAbet phones) of each word the dictionary lacks.
+    ``pronunciations()`` -> word -> phones, after ``exec()``."""
+
+    def __init__(self, words: Sequence[str], parent: QWidget | None = None):
+        super().__init__(parent)
+        self.setWindowTitle("Words not in the pronouncing dictionary")
+        self.edits: dict[str, QLineEdit] = {}
+        form = QFormLayout()
+        for w in words:
+            e = QLineEdit()
+            e.setPlaceholderText("ARPAbet phones, e.g. N OY Z IY")
+            e.textChanged.connect(self._check)
+            self.edits[w] = e
+            form.addRow(w, e)
+        self.message = QLabel("Give each word's phones (ARPAbet, as in the CMU dictionary).")
+        self.message.setWordWrap(True)
+        self.buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Ok
+                                        | QDialogButtonBox.StandardButton.Cancel)
+        self.buttons.accepted.connect(self.accept)
+        self.buttons.rejected.connect(self.reject)
+        lay = QVBoxLayout(self)
+        lay.addWidget(self.message)
+        lay.addLayout(form)
+        lay.addWidget(self.buttons)
+        self._check()
+
+    def pronunciations(self) -> dict[str, list[str]]:
+        return {w: [p.lower().rstrip("012") for p in e.text().split()] for w, e in self.edits.items()}
+
+    def _check(self, *_args) -> None:
+        bad = sorted({p for phones in self.pronunciations().values() for p in phones
+                      if p not in ARPABET})
+        empty = [w for w, phones in self.pronunciations().items() if not phones]
+        self.buttons.button(QDialogButtonBox.StandardButton.Ok).setEnabled(not bad and not empty)
+        self.message.setText(f"not ARPAbet: {' '.join(bad)}" if bad else
+                             "Give each word's phones (ARPAbet, as in the CMU dictionary).")
+
+
+# --------------------------------------------------------------------------- the opened recording
+@dataclass
+class OpenedAudio:
+    """A recording opened for synthesis and the labels computed for it so far (by source)."""
+
+    name: str
+    path: Path
+    audio: object
+    rate: int
+    text: str = ""
+    label_file: Path | None = None
+    extra_dict: dict[str, list[str]] = field(default_factory=dict)
+    labels: dict[str, Labels | None] = field(default_factory=dict)
+
+    def labels_for(self, source: str) -> Labels | None:
+        """Labels of ``source`` (computed on the first call: run in a worker)."""
+        if source not in self.labels:
+            if source == "none":
+                self.labels[source] = None
+            elif source == "file":
+                if self.label_file is None:
+                    raise InputError(self.path, "no label file beside the audio")
+                self.labels[source] = file_labels(self.label_file, self.rate,
+                                                  len(self.audio) / self.rate)
+            elif source == "aligned":
+                if not self.text:
+                    raise InputError(self.path, "no sentence to align: give one with Open audio…")
+                self.labels[source] = label_audio(self.audio, self.rate, "aligned", self.text,
+                                                  self.extra_dict, self.path)
+            else:
+                self.labels[source] = label_audio(self.audio, self.rate, "recognized",
+                                                  source=self.path)
+        return self.labels[source]
+
+    def utterance(self, source: str, marker_rate: float, marker_names: list[str]) -> Utterance:
+        labels = self.labels_for(source)
+        return Utterance(name=self.name, audio=self.audio, sample_rate=self.rate,
+                         phones=list(labels.phones) if labels else [],
+                         words=list(labels.words) if labels else [], markers=None,
+                         marker_rate=marker_rate, marker_names=list(marker_names),
+                         text=self.text or str(self.path),
+                         label_source=labels.source if labels else "none")
+
+
+class LabelSourceBox(QWidget):
+    """The label source of an opened recording (settings panel): file, aligned, recognized,
+    none. Disabled for corpus utterances."""
+
+    sourceChosen = pyqtSignal(str)
+
+    def __init__(self, parent: QWidget | None = None):
+        super().__init__(parent)
+        self.combo = QComboBox()
+        for text, source in SOURCE_CHOICES:
+            self.combo.addItem(text, source)
+        self.combo.setToolTip("Phone labels of the opened audio: switch to compare the lips "
+                              "synthesized from each (phonetic search needs labels).")
+        lay = QFormLayout(self)
+        lay.setContentsMargins(0, 0, 0, 0)
+        lay.addRow("labels", self.combo)
+        self.combo.activated.connect(lambda i: self.sourceChosen.emit(self.combo.itemData(i)))
+        self.show_for(None, "file")
+
+    def show_for(self, opened: OpenedAudio | None, source: str) -> None:
+        """Show the choices of ``opened`` (``None``: a corpus utterance) with ``source`` current."""
+        model = self.combo.model()
+        for i, (_, src) in enumerate(SOURCE_CHOICES):
+            ok = opened is not None and (src != "file" or opened.label_file is not None) \
+                and (src != "aligned" or bool(opened.text))
+            model.item(i).setEnabled(ok)
+        self.combo.setEnabled(opened is not None)
+        self.combo.setCurrentIndex(max(0, self.combo.findData(source)))
+
+
+# --------------------------------------------------------------------------- the controller
+class AudioOpener(QObject):
+    """"Open audio…" for a :class:`MainWindow`: finds or asks for the labels, aligns in a worker,
+    shows the result, and switches label sources."""
+
+    def __init__(self, window: MainWindow):
+        super().__init__(window)
+        self.window = window
+        self.opened: dict[str, OpenedAudio] = {}
+        self.box = LabelSourceBox()
+        self.box.sourceChosen.connect(self.switch)
+        window.utteranceChanged.connect(self._on_utterance)
+
+    # -- asking
+    def ask(self) -> None:
+        """The File menu's "Open audio…": the file, then (if nothing is beside it) the sentence."""
+        path, _ = QFileDialog.getOpenFileName(self.window, "Open audio for synthesis", "",
+                                              "Audio (*.wav *.flac);;All files (*)")
+        if not path:
+            return
+        path = Path(path)
+        label_file, txt = beside(path)
+        if label_file is not None or txt is not None:
+            self.open(path)
+            return
+        dialog = SentenceDialog(path.name, self.window)
+        if dialog.exec() != QDialog.DialogCode.Accepted:
+            return
+        source, text = dialog.choice()
+        self.open(path, text=text or None, recognize=source == "recognized",
+                  acoustic_only=source == "none")
+
+    # -- opening
+    def open(self, audio_path: Path, labels_path: Path | None = None, text: str | None = None,
+             recognize: bool = False, acoustic_only: bool = False,
+             extra_dict: dict[str, list[str]] | None = None) -> None:
+        """Open ``audio_path`` for synthesis; labels by ``engine.labelling.labels_for_audio``
+        (alignment in a worker), none with ``acoustic_only``."""
+        win = self.window
+        if win.model is None:
+            win.show_error("no model yet: open a corpus first")
+            return
+        try:
+            audio, rate = read_audio(audio_path)
+        except FacetrajError as exc:
+            win.show_error(str(exc))
+            return
+        name = audio_path.stem
+        while name in (win.corpus.info.ids if win.corpus else []):
+            name += "'"
+        label_file, txt = beside(audio_path)
+        sentence = text if text is not None else None
+        opened = OpenedAudio(name, audio_path, audio, rate, label_file=labels_path or label_file,
+                             extra_dict=dict(extra_dict or {}))
+        if sentence is None and labels_path is None and not recognize and label_file is None \
+                and txt is not None:
+            sentence = txt.read_text(encoding="utf-8-sig").strip()
+        opened.text = sentence or ""
+
+        def work(progress) -> tuple[OpenedAudio, str]:
+            if acoustic_only:
+                return opened, "none"
+            progress(0.1, f"labelling {audio_path.name}")
+            labels = labels_for_audio(audio_path, audio, rate, labels=labels_path, text=sentence,
+                                      recognize=recognize, extra_dict=opened.extra_dict)
+            source = labels.source if labels else "none"
+            opened.labels[source] = labels
+            return opened, source
+
+        def failed(exc: BaseException) -> None:
+            if isinstance(exc, MissingWordsError):
+                dialog = MissingWordsDialog(exc.words, win)
+                if dialog.exec() == QDialog.DialogCode.Accepted:
+                    self.open(audio_path, labels_path, sentence, recognize, acoustic_only,
+                              {**opened.extra_dict, **dialog.pronunciations()})
+                return
+            win.show_error(str(exc) if isinstance(exc, FacetrajError)
+                           else f"internal error: {type(exc).__name__}: {exc}")
+
+        win.run_task(work, lambda r: self._show(*r), "aligning the phones",
+                              on_error=failed)
+
+    def _show(self, opened: OpenedAudio, source: str) -> None:
+        win = self.window
+        self.opened[opened.name] = opened
+        utt = opened.utterance(source, win.model.marker_rate, win.model.marker_names)
+        win.show_external(utt)
+
+    # -- switching
+    def switch(self, source: str) -> None:
+        """Re-synthesize the current opened recording with labels from ``source``."""
+        view = self.window.view
+        opened = self.opened.get(view.utterance.name) if view is not None else None
+        if opened is None:
+            return
+        win = self.window
+
+        def work(progress) -> Utterance:
+            progress(0.1, f"labels: {source}")
+            return opened.utterance(source, win.model.marker_rate, win.model.marker_names)
+
+        def failed(exc: BaseException) -> None:
+            self.box.show_for(opened, view.utterance.label_source)
+            win.show_error(str(exc))
+
+        win.run_task(work, win.show_external, f"labels: {source}", on_error=failed)
+
+    def _on_utterance(self, name: str) -> None:
+        view = self.window.view
+        opened = self.opened.get(name)
+        self.box.show_for(opened, view.utterance.label_source if view is not None else "file")
+
+    def current(self) -> OpenedAudio | None:
+        view = self.window.view
+        return self.opened.get(view.utterance.name) if view is not None else None
+

@@ -1,0 +1,144 @@
+"""Opening a recording in the app (real window under Xvfb): the sentence is aligned in a worker and
+the phone tier shows the aligned labels; the label source switches to recognized and to none; a
+missing word is asked for; a wrong sentence is refused with a message."""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pytestqt")
+pytest.importorskip("pyvistaqt")
+
+if not os.environ.get("DISPLAY"):
+    pytest.skip("the app tests need an X display (run under xvfb-run)", allow_module_level=True)
+
+from PyQt6.QtWidgets import QDialog, QFileDialog, QMessageBox
+
+from app.main import build_window
+from app.open_audio import MissingWordsDialog, SentenceDialog
+from facetraj.paths import default_corpus
+
+pytestmark = pytest.mark.gui
+
+ROOT = Path(__file__).resolve().parent.parent
+CLIP = ROOT / "data_samples" / "s002.flac"          # "The boy enjoyed the noisy toy."
+SENTENCE = "The boy enjoyed the noisy toy."
+WAIT_MS = 60_000
+
+
+@pytest.fixture
+def window(qtbot, trained_cache):
+    win = build_window(default_corpus(), use_audio=False)
+    qtbot.addWidget(win)
+    win.resize(1600, 1000)
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        win.show()
+    qtbot.waitExposed(win)
+    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    yield win
+    win.close()
+
+
+@pytest.fixture
+def clip(tmp_path) -> Path:
+    """The sentence's audio alone in a folder (no labels, no transcript beside it)."""
+    path = tmp_path / "recording.flac"
+    shutil.copy(CLIP, path)
+    return path
+
+
+def _phone_axis(win):
+    return next(ax for ax, p in zip(win.timeline.axes, win.timeline.panels, strict=True)
+                if p.title == "phones")
+
+
+def test_open_audio_with_a_sentence_shows_aligned_phones(window, qtbot, clip, tmp_path):
+    win = window
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        win.open_audio(clip, text=SENTENCE)
+    view = win.view
+    utt = view.utterance
+    assert view.split == "external" and utt.name == "recording" and view.original is None
+    assert utt.label_source == "aligned" and view.synthesis.config.mode == "phonetic"
+    assert [w.label for w in utt.words] == ["the", "boy", "enjoyed", "the", "noisy", "toy"]
+    assert [p.label for p in utt.phones if p.label != "sil"][:4] == ["dh", "ah", "b", "oy"]
+    ax = _phone_axis(win)
+    assert ax.get_ylabel() == "words\nphones\n(aligned)"
+    assert "boy" in [t.get_text() for t in ax.texts] and "oy" in [t.get_text() for t in ax.texts]
+    assert win.audio_opener.box.combo.currentData() == "aligned"
+    assert win.audio_opener.box.combo.isEnabled()
+    shot = win.save_screenshot(tmp_path / "aligned.png")
+    assert shot.stat().st_size > 10_000
+    aligned_lips = view.shown.copy()
+
+    # the same audio with recognized labels, then with none: the lips change
+    box = win.audio_opener.box
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        box.combo.setCurrentIndex(box.combo.findData("recognized"))
+        box.combo.activated.emit(box.combo.currentIndex())
+    assert win.view.utterance.label_source == "recognized" and win.view.utterance.words == []
+    assert _phone_axis(win).get_ylabel() == "phones\n(recognized)"
+    assert not np.allclose(win.view.shown, aligned_lips)
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        box.combo.setCurrentIndex(box.combo.findData("none"))
+        box.combo.activated.emit(box.combo.currentIndex())
+    assert win.view.synthesis.config.mode == "acoustic" and not win.view.utterance.phones
+    # back to a corpus utterance: the box is off
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        win.set_utterance(win.corpus.info.test[0])
+    assert not box.combo.isEnabled()
+    assert _phone_axis(win).get_ylabel().endswith("(file)")
+
+
+def test_menu_asks_the_sentence_and_a_missing_word(window, qtbot, clip, monkeypatch):
+    win = window
+    monkeypatch.setattr(QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: (str(clip), "")))
+
+    def sentence(self):
+        self.text.setText("The boy enjoyed the noizee toy")
+        return QDialog.DialogCode.Accepted
+
+    def missing(self):
+        assert list(self.edits) == ["noizee"]
+        ok = self.buttons.button(self.buttons.StandardButton.Ok)
+        self.edits["noizee"].setText("N OY Q")                 # not ARPAbet: OK stays off
+        assert not ok.isEnabled() and "not ARPAbet: q" in self.message.text()
+        self.edits["noizee"].setText("N OY1 Z IY0")
+        assert ok.isEnabled()
+        return QDialog.DialogCode.Accepted
+
+    monkeypatch.setattr(SentenceDialog, "exec", sentence)
+    monkeypatch.setattr(MissingWordsDialog, "exec", missing)
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        win.action_open_audio.trigger()
+    utt = win.view.utterance
+    assert utt.label_source == "aligned" and "noizee" in [w.label for w in utt.words]
+
+
+def test_empty_sentence_recognizes_and_wrong_sentence_is_refused(window, qtbot, clip, monkeypatch):
+    win = window
+    monkeypatch.setattr(QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: (str(clip), "")))
+    monkeypatch.setattr(SentenceDialog, "exec", lambda self: QDialog.DialogCode.Accepted)
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        win.action_open_audio.trigger()
+    assert win.view.utterance.label_source == "recognized"
+    shown: list[str] = []
+    monkeypatch.setattr(QMessageBox, "critical", staticmethod(
+        lambda parent, title, text, *a, **k: shown.append(text)))
+    name = win.view.utterance.name
+    win.open_audio(clip, text="Tornadoes often destroy acres of farm land")
+    qtbot.waitUntil(lambda: bool(shown), timeout=WAIT_MS)
+    assert "recording.flac" in shown[0] and "does not match the audio" in shown[0]
+    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    assert win.view.utterance.name == name and win.view.utterance.label_source == "recognized"
+    # a transcript beside the audio is used without asking
+    clip.with_suffix(".txt").write_text(SENTENCE)
+    monkeypatch.setattr(SentenceDialog, "exec", lambda self: pytest.fail("asked"))
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        win.action_open_audio.trigger()
+    assert win.view.utterance.label_source == "aligned"
