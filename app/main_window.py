@@ -58,6 +58,7 @@ from PyQt6.QtWidgets import (
     QMessageBox,
     QProgressBar,
     QPushButton,
+    QSizePolicy,
     QSlider,
     QSplitter,
     QStyle,
@@ -159,6 +160,8 @@ class MainWindow(QMainWindow):
 
         self.title = QLabel("")
         self.title.setStyleSheet("font-size: 15px; font-weight: 600; padding: 2px 6px;")
+        self.title.setWordWrap(True)          # a long title wraps instead of widening the window
+        self.title.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
         top = QWidget()
         tl = QVBoxLayout(top)
         tl.setContentsMargins(0, 0, 0, 0)
@@ -736,7 +739,7 @@ class MainWindow(QMainWindow):
             name += "'"
         utt = Utterance(name=name, audio=audio, sample_rate=rate, phones=list(phones),
                         markers=None, marker_rate=self.model.marker_rate,
-                        marker_names=list(self.model.marker_names), text=str(audio_path))
+                        marker_names=list(self.model.marker_names), text="")
         self.external[name] = utt
         self.browser.add_external(name)
         self.set_utterance(name)
