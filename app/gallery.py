@@ -78,9 +78,14 @@ def app_figures(out: Path, scratch: Path) -> list[Path]:
     from engine.corpus import init_corpus, load_corpus
     from engine.formats import write_audio
 
+    from .main import WINDOW_SIZE
+
     written = []
     corpus = load_corpus(DEFAULT_CORPUS)
     test_utt = corpus.info.test[0]
+    win = _window(DEFAULT_CORPUS, WINDOW_SIZE, test_utt)     # what --screenshot shows
+    written.append(_shoot(win, out / "app.png", 2.38))
+    win.close()
     for name, size in SIZES.items():
         win = _window(DEFAULT_CORPUS, size, test_utt)
         written.append(_shoot(win, out / f"app_{name}.png", 2.38))
