@@ -112,6 +112,9 @@ def fill_table(table: QTableWidget, header: list[str], rows: list[list[QTableWid
     table.setSortingEnabled(sorting)
 
 
+MAX_TABLE_MIN_WIDTH = 720     # px: a table narrower than this shows all its columns
+
+
 class _ColumnStretcher(QObject):
     """Keeps a table's columns filling its width: each column gets its contents' width plus an
     equal share of the room left (never less than its contents, so nothing is cut short)."""
@@ -143,6 +146,11 @@ def stretch_columns(table: QTableWidget) -> None:
     stretcher = table.findChild(_ColumnStretcher) or _ColumnStretcher(table)
     stretcher.widths = [table.columnWidth(c) for c in range(table.columnCount())]
     table.horizontalHeader().setStretchLastSection(False)
+    # a table of a few columns asks for their whole width (a splitter or dock then shows them all);
+    # a wide one (the similarity matrix) scrolls instead
+    need = (sum(stretcher.widths) + 2 * table.frameWidth()
+            + table.verticalScrollBar().sizeHint().width())
+    table.setMinimumWidth(need if need <= MAX_TABLE_MIN_WIDTH else 0)
     stretcher.apply()
 
 

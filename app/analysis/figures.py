@@ -53,8 +53,10 @@ def shoot(widget: QWidget, path: Path) -> Path:
     return path
 
 
-def make_figures(corpus_dir: Path, out: Path, per_split: int = 6) -> list[Path]:
-    """Open the main window on ``corpus_dir`` with the analysis views and save their screenshots."""
+def make_figures(corpus_dir: Path, out: Path, per_split: int = 6,
+                 only: set[str] | None = None) -> list[Path]:
+    """Open the main window on ``corpus_dir`` with the analysis views and save their screenshots
+    (``only``: just these views, e.g. ``{"errors"}``; ``"window"`` is the panel stack)."""
     from app.main_window import MainWindow
     from engine.corpus import load_corpus
 
@@ -72,6 +74,8 @@ def make_figures(corpus_dir: Path, out: Path, per_split: int = 6) -> list[Path]:
     standalone = {"similarity": (1000, 900), "metrics": (1100, 850), "pc_modes": (1300, 750),
                   "inspector": (900, 950), "errors": (1000, 750), "kinematics": (600, 700)}
     for key, size in standalone.items():
+        if only is not None and key not in only:
+            continue
         w = views.open_view(key)
         dock = views.docks[key]
         dock.setFloating(True)
@@ -104,13 +108,14 @@ def make_figures(corpus_dir: Path, out: Path, per_split: int = 6) -> list[Path]:
             w.tabs.setCurrentIndex(1)
             written.append(shoot(dock, out / "analysis_errors_utterances.png"))
         dock.hide()
-    for key in ("aperture", "width", "protrusion", "velocity", "lip_error"):
-        views.panel_actions[key].setChecked(True)
-    win.resize(1600, 1400)
-    win.splitter.setSizes([300, 1100])
-    if info.test:
-        win.seek(0.0)
-    written.append(shoot(win, out / "analysis_window.png"))
+    if only is None or "window" in only:
+        for key in ("aperture", "width", "protrusion", "velocity", "lip_error"):
+            views.panel_actions[key].setChecked(True)
+        win.resize(1600, 1400)
+        win.splitter.setSizes([300, 1100])
+        if info.test:
+            win.seek(0.0)
+        written.append(shoot(win, out / "analysis_window.png"))
     views.close()
     win.close()
     return written
