@@ -46,6 +46,12 @@ def settle(ms: int = 300) -> None:
     loop.exec()
 
 
+def _finish(cond: Callable[[], bool], what: str, timeout_s: float = 1800.0) -> None:
+    """Wait for a view's background computation; a picture of an unfinished view is an error."""
+    if not wait_until(cond, timeout_s):
+        raise RuntimeError(f"{what} did not finish within {timeout_s:.0f} s: no picture taken")
+
+
 def shoot(widget: QWidget, path: Path) -> Path:
     settle()
     widget.grab().save(str(path))
@@ -86,15 +92,15 @@ def make_figures(corpus_dir: Path, out: Path, per_split: int = 6,
             w.per_split.setValue(per_split)
             w.max_n.setValue(6)
             w.start_table2()
-            wait_until(lambda w=w: w.table2_result is not None)
+            _finish(lambda w=w: w.table2_result is not None, "Table 2")
             w.start_sweep()
-            wait_until(lambda w=w: w.sweep_result is not None)
+            _finish(lambda w=w: w.sweep_result is not None, "the N sweep")
         if key == "pc_modes":
             w.set_sd_units(2.5)
         if key == "errors":
             w.per_split.setValue(per_split)
             w.start()
-            wait_until(lambda w=w: w.report is not None)
+            _finish(lambda w=w: w.report is not None, "the error analysis")
             w.tabs.setCurrentIndex(0)
         if key == "inspector":
             win.seek(min(1.0, win.view.duration / 2))
