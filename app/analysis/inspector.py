@@ -3,7 +3,7 @@
 The current phone and its context-phone, the top-N context-phones chosen with their n_j scores
 (eq 4), the 5N candidate codewords with their distances d_i (eq 5) and weights v_i (eq 6), the
 chosen gamma, and the input LSF vector w against its approximation w-hat (eq 7). Every number is
-from :func:`engine.analysis.inspect_frame`.
+from :func:`engine.analysis.inspector.inspect_frame`.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from PyQt6.QtWidgets import (
 )
 
 from app.style import ORIGINAL_COLOR, SYNTH_COLOR
-from engine.analysis import FrameInspection, inspect_frame
+from engine.analysis.inspector import FrameInspection, inspect_frame
 from engine.model import Model
 from engine.pipeline import Synthesis
 
