@@ -45,6 +45,12 @@ fuzz: $(VENV)/.installed-test
 corpus: $(VENV)/.installed-corpus
 	$(BIN)/facetraj corpus build data_samples
 
+# every screenshot of the docs (docs/figures/), on a screen big enough for the 1920x1080 window;
+# the results figures come from `make report`
+figures: $(VENV)/.installed-test
+	$(if $(DISPLAY),,xvfb-run -a -s "-screen 0 2000x1400x24") $(BIN)/python -m app.gallery docs/figures
+	$(BIN)/python docs/figures/make_corpus_figures.py
+
 report: $(VENV)/.installed-test
 	$(BIN)/facetraj report data_samples -o docs
 

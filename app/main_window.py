@@ -61,6 +61,7 @@ from PyQt6.QtWidgets import (
     QMainWindow,
     QMenu,
     QMessageBox,
+    QSizePolicy,
     QSplitter,
     QVBoxLayout,
     QWidget,
@@ -161,6 +162,8 @@ class MainWindow(QMainWindow):
         self.transport = self._build_transport()
         self.title = QLabel("")
         self.title.setStyleSheet("font-size: 15px; font-weight: 600; padding: 2px 6px;")
+        self.title.setWordWrap(True)          # a long title wraps instead of widening the window
+        self.title.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
         self.splitter = _split(_column([self.view_bar, self.face, self.transport], 2, stretch=self.face),
                                _column([self.title, self.timeline], 0, stretch=self.timeline))
         self.setCentralWidget(self.splitter)

@@ -165,7 +165,7 @@ class OpenedAudio:
                          phones=list(labels.phones) if labels else [],
                          words=list(labels.words) if labels else [], markers=None,
                          marker_rate=marker_rate, marker_names=list(marker_names),
-                         text=self.text or str(self.path),
+                         text=self.text or "",
                          label_source=labels.source if labels else "none")
 
 

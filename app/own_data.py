@@ -328,7 +328,7 @@ def export_video(window, path: Path) -> None:
     def work(progress):
         return render_video(model, view.synthesis, utt.audio, utt.sample_rate, path,
                             original=view.original, overwrite=True, progress=progress,
-                            title=utt.text or utt.name)
+                            title=utt.text or utt.name, phones=utt.phones)
 
     window.run_task(work, lambda p: window.show_status(f"wrote {p}"), f"rendering {path.name}")
 

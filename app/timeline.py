@@ -131,6 +131,9 @@ class PhoneTierPanel:
         tier = "words\nphones" if utt.words else "phones"
         source = f"\n({utt.label_source})" if utt.phones else ""
         ax.set_ylabel(tier + source, fontsize=8)
+        if not utt.phones:
+            ax.text(0.5, 0.5, "no phone labels: acoustic-only synthesis", transform=ax.transAxes,
+                    ha="center", va="center", fontsize=8, color="#777777")
         for seg in utt.phones:
             silent = seg.label in ("sil", "", "sp", "pau", "h#")
             if silent:
@@ -256,8 +259,10 @@ class Timeline(QWidget):
         if not self.panels or self.view is None:
             self.canvas.draw_idle()
             return
+        # the bottom margin in pixels: room for the tick labels and "time (s)" at any height
+        bottom = min(0.3, 40.0 / max(fig.get_figheight() * fig.dpi, 1.0))
         grid = fig.add_gridspec(len(self.panels), 1, height_ratios=[p.height for p in self.panels],
-                                left=0.075, right=0.99, top=0.985, bottom=0.075, hspace=0.09)
+                                left=0.075, right=0.99, top=0.985, bottom=bottom, hspace=0.09)
         first = None
         for i, panel in enumerate(self.panels):
             ax = fig.add_subplot(grid[i, 0], sharex=first)

@@ -204,6 +204,20 @@ def test_error_view_matches_engine_and_jumps(qtbot, model, corpus, view):
     assert cell_values(w.phone_table, 1) == pytest.approx([p.correlation for p in rep.phones], nan_ok=True)
     assert cell_values(w.phone_table, 2) == pytest.approx([p.rms for p in rep.phones])
     assert cell_values(w.utt_table, 5) == pytest.approx([u.rms for u in rep.utterances])
+    # beside the table: the per-phone correlations as bars, sorted, one per phone with a value
+    ax = w.phone_chart.figure.axes[0]
+    finite = sorted(p.correlation for p in rep.phones if p.correlation == p.correlation)
+    assert [b.get_width() for b in ax.patches] == pytest.approx(finite)
+    assert [t.get_text() for t in ax.get_yticklabels()][-1] == max(
+        (p for p in rep.phones if p.correlation == p.correlation), key=lambda p: p.correlation).phone
+    # the tables' columns fill the width, none narrower than its contents
+    w.resize(1400, 700)
+    w.tabs.setCurrentIndex(1)
+    qtbot.waitUntil(lambda: abs(sum(w.utt_table.columnWidth(c) for c in range(w.utt_table.columnCount()))
+                                - w.utt_table.viewport().width()) < w.utt_table.columnCount() + 1)
+    for c in range(w.utt_table.columnCount()):
+        assert w.utt_table.columnWidth(c) >= w.utt_table.sizeHintForColumn(c)
+    w.tabs.setCurrentIndex(0)
     with qtbot.waitSignal(w.jumpRequested) as sig:
         w.utt_table.cellClicked.emit(0, 0)
     u = w.utt_table.item(0, 0).text()

@@ -13,7 +13,7 @@ import numpy as np
 from matplotlib import colormaps
 from matplotlib.backends.backend_qtagg import FigureCanvasQTAgg
 from matplotlib.figure import Figure
-from PyQt6.QtCore import Qt
+from PyQt6.QtCore import QEvent, QObject, Qt, QTimer
 from PyQt6.QtGui import QColor
 from PyQt6.QtWidgets import (
     QFileDialog,
@@ -108,7 +108,50 @@ def fill_table(table: QTableWidget, header: list[str], rows: list[list[QTableWid
         for c, item in enumerate(row):
             table.setItem(r, c, item)
     table.resizeColumnsToContents()
+    stretch_columns(table)
     table.setSortingEnabled(sorting)
+
+
+MAX_TABLE_MIN_WIDTH = 720     # px: a table narrower than this shows all its columns
+
+
+class _ColumnStretcher(QObject):
+    """Keeps a table's columns filling its width: each column gets its contents' width plus an
+    equal share of the room left (never less than its contents, so nothing is cut short)."""
+
+    def __init__(self, table: QTableWidget):
+        super().__init__(table)
+        self.table = table
+        self.widths: list[int] = []
+        table.installEventFilter(self)
+
+    def apply(self) -> None:
+        t = self.table
+        if not self.widths or len(self.widths) != t.columnCount():
+            return
+        room = t.viewport().width() - sum(self.widths)
+        extra = max(room, 0) // len(self.widths)
+        for c, w in enumerate(self.widths):
+            t.setColumnWidth(c, w + extra)
+
+    def eventFilter(self, obj, event) -> bool:
+        if event.type() == QEvent.Type.Resize:
+            QTimer.singleShot(0, self.apply)      # after the viewport has its new size
+        return False
+
+
+def stretch_columns(table: QTableWidget) -> None:
+    """Columns share the table's width (no empty strip on the right), each at least as wide as
+    its contents (after ``resizeColumnsToContents``)."""
+    stretcher = table.findChild(_ColumnStretcher) or _ColumnStretcher(table)
+    stretcher.widths = [table.columnWidth(c) for c in range(table.columnCount())]
+    table.horizontalHeader().setStretchLastSection(False)
+    # a table of a few columns asks for their whole width (a splitter or dock then shows them all);
+    # a wide one (the similarity matrix) scrolls instead
+    need = (sum(stretcher.widths) + 2 * table.frameWidth()
+            + table.verticalScrollBar().sizeHint().width())
+    table.setMinimumWidth(need if need <= MAX_TABLE_MIN_WIDTH else 0)
+    stretcher.apply()
 
 
 def ask_save_path(parent: QWidget, title: str, default: str, filters: str) -> Path | None:

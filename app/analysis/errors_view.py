@@ -12,6 +12,8 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
+import numpy as np
+from matplotlib import colormaps
 from PyQt6.QtCore import pyqtSignal
 from PyQt6.QtWidgets import (
     QComboBox,
@@ -20,6 +22,7 @@ from PyQt6.QtWidgets import (
     QProgressBar,
     QPushButton,
     QSpinBox,
+    QSplitter,
     QTableWidget,
     QTabWidget,
     QVBoxLayout,
@@ -40,6 +43,7 @@ from engine.corpus import Corpus
 from engine.model import Model
 
 from .common import (
+    Canvas,
     NumberItem,
     export_with_dialog,
     fill_table,
@@ -100,7 +104,13 @@ class ErrorView(QWidget):
         self.utt_table.cellClicked.connect(self._utt_clicked)
         self.worst_table.cellClicked.connect(self._worst_clicked)
         self.tabs = QTabWidget()
-        self.tabs.addTab(self.phone_table, "Per phone")
+        self.phone_chart = Canvas(5, 5)
+        per_phone = QSplitter()
+        per_phone.addWidget(self.phone_table)
+        per_phone.addWidget(self.phone_chart)
+        per_phone.setStretchFactor(0, 3)
+        per_phone.setStretchFactor(1, 2)
+        self.tabs.addTab(per_phone, "Per phone")
         self.tabs.addTab(self.utt_table, "Per utterance")
         self.tabs.addTab(self.worst_table, "Worst segments")
         self.status = QLabel("Compute synthesizes every utterance of the split and compares it with "
@@ -147,6 +157,7 @@ class ErrorView(QWidget):
                  NumberItem(p.segments, "{:.0f}")] for p in report.phones]
         fill_table(self.phone_table, ["phone", "correlation (lips y)", "RMS error (mm)", "frames",
                                       "segments"], rows)
+        self._draw_phone_chart(report)
         finite = [u.rms for u in report.utterances if u.rms == u.rms]
         rms_ulo, rms_u = (min(finite), max(finite)) if finite else (0.0, 1.0)
         rows = [[text_item(u.utterance), text_item(u.split),
@@ -165,6 +176,33 @@ class ErrorView(QWidget):
                    rows)
         self.status.setText(f"{len(report.utterances)} utterances, {len(report.phones)} phones. "
                             "Click an utterance or a segment to go there.")
+
+    def _draw_phone_chart(self, report: ErrorReport) -> None:
+        """Per-phone correlation as horizontal bars, sorted (best at the top), coloured like the
+        table's cells."""
+        fig = self.phone_chart.figure
+        fig.clear()
+        ax = fig.add_subplot(111)
+        phones = sorted((p for p in report.phones if p.correlation == p.correlation),
+                        key=lambda p: p.correlation)
+        if not phones:
+            ax.text(0.5, 0.5, "no phone has enough frames for a correlation", ha="center",
+                    va="center", transform=ax.transAxes, color="#555555")
+            ax.set_axis_off()
+        else:
+            r = np.array([p.correlation for p in phones])
+            y = np.arange(len(phones))
+            ax.barh(y, r, color=colormaps["RdYlGn"](np.clip(r, 0.0, 1.0)), edgecolor="#555555",
+                    lw=0.4)
+            ax.set_yticks(y, [p.phone for p in phones], fontsize=max(5, min(9, 600 // len(phones))))
+            ax.set_ylim(-0.6, len(phones) - 0.4)
+            ax.set_xlim(min(0.0, float(r.min()) - 0.05), 1.0)
+            ax.axvline(0.0, color="k", lw=0.6)
+            ax.set_xlabel("correlation, original vs synthesized lip y")
+            ax.set_title("Per phone, sorted (best at the top)", fontsize=10)
+            ax.grid(axis="x", alpha=0.3)
+        fig.tight_layout()
+        self.phone_chart.draw_idle()
 
     def _utt_clicked(self, row: int, _col: int) -> None:
         utt = self.utt_table.item(row, 0).text()

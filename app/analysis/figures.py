@@ -46,6 +46,12 @@ def settle(ms: int = 300) -> None:
     loop.exec()
 
 
+def _finish(cond: Callable[[], bool], what: str, timeout_s: float = 1800.0) -> None:
+    """Wait for a view's background computation; a picture of an unfinished view is an error."""
+    if not wait_until(cond, timeout_s):
+        raise RuntimeError(f"{what} did not finish within {timeout_s:.0f} s: no picture taken")
+
+
 def shoot(widget: QWidget, path: Path) -> Path:
     settle()
     widget.grab().save(str(path))
@@ -53,8 +59,10 @@ def shoot(widget: QWidget, path: Path) -> Path:
     return path
 
 
-def make_figures(corpus_dir: Path, out: Path, per_split: int = 6) -> list[Path]:
-    """Open the main window on ``corpus_dir`` with the analysis views and save their screenshots."""
+def make_figures(corpus_dir: Path, out: Path, per_split: int = 6,
+                 only: set[str] | None = None) -> list[Path]:
+    """Open the main window on ``corpus_dir`` with the analysis views and save their screenshots
+    (``only``: just these views, e.g. ``{"errors"}``; ``"window"`` is the panel stack)."""
     from app.main_window import MainWindow
     from engine.corpus import load_corpus
 
@@ -72,6 +80,8 @@ def make_figures(corpus_dir: Path, out: Path, per_split: int = 6) -> list[Path]:
     standalone = {"similarity": (1000, 900), "metrics": (1100, 850), "pc_modes": (1300, 750),
                   "inspector": (900, 950), "errors": (1000, 750), "kinematics": (600, 700)}
     for key, size in standalone.items():
+        if only is not None and key not in only:
+            continue
         w = views.open_view(key)
         dock = views.docks[key]
         dock.setFloating(True)
@@ -82,15 +92,15 @@ def make_figures(corpus_dir: Path, out: Path, per_split: int = 6) -> list[Path]:
             w.per_split.setValue(per_split)
             w.max_n.setValue(6)
             w.start_table2()
-            wait_until(lambda w=w: w.table2_result is not None)
+            _finish(lambda w=w: w.table2_result is not None, "Table 2")
             w.start_sweep()
-            wait_until(lambda w=w: w.sweep_result is not None)
+            _finish(lambda w=w: w.sweep_result is not None, "the N sweep")
         if key == "pc_modes":
             w.set_sd_units(2.5)
         if key == "errors":
             w.per_split.setValue(per_split)
             w.start()
-            wait_until(lambda w=w: w.report is not None)
+            _finish(lambda w=w: w.report is not None, "the error analysis")
             w.tabs.setCurrentIndex(0)
         if key == "inspector":
             win.seek(min(1.0, win.view.duration / 2))
@@ -104,13 +114,14 @@ def make_figures(corpus_dir: Path, out: Path, per_split: int = 6) -> list[Path]:
             w.tabs.setCurrentIndex(1)
             written.append(shoot(dock, out / "analysis_errors_utterances.png"))
         dock.hide()
-    for key in ("aperture", "width", "protrusion", "velocity", "lip_error"):
-        views.panel_actions[key].setChecked(True)
-    win.resize(1600, 1400)
-    win.splitter.setSizes([300, 1100])
-    if info.test:
-        win.seek(0.0)
-    written.append(shoot(win, out / "analysis_window.png"))
+    if only is None or "window" in only:
+        for key in ("aperture", "width", "protrusion", "velocity", "lip_error"):
+            views.panel_actions[key].setChecked(True)
+        win.resize(1600, 1400)
+        win.splitter.setSizes([300, 1100])
+        if info.test:
+            win.seek(0.0)
+        written.append(shoot(win, out / "analysis_window.png"))
     views.close()
     win.close()
     return written

@@ -46,7 +46,7 @@ def cmd_video(args: argparse.Namespace) -> int:
     w, h = args.size
     render_video(model, res, audio, rate, args.output, original=original,
                  settings=VideoSettings(w, h, args.fps), overwrite=args.overwrite,
-                 progress=TerminalProgress("video"), title=title)
+                 progress=TerminalProgress("video"), title=title, phones=phones)
     print(args.output)
     return 0
 
