@@ -26,6 +26,7 @@ from engine.data import Utterance
 from engine.errors import FacetrajError
 from engine.evaluation import evaluate_utterance
 from engine.model import Model
+from engine.paper import FIGURE4_TEXT
 from engine.pipeline import mode_for
 from engine.progress import Progress
 
@@ -33,7 +34,8 @@ from .state import UtteranceView, build_view
 
 log = logging.getLogger(__name__)
 
-DEFAULT_SENTENCE = "Tornadoes often destroy acres of farm land"
+#: the sentence shown first: the held-out example of the paper's Figure 4
+DEFAULT_SENTENCE = FIGURE4_TEXT
 
 
 def normalise_text(text: str) -> str:
