@@ -61,6 +61,6 @@ def choose_warp(w: np.ndarray, cb_lsf: np.ndarray, alphas: np.ndarray | None = N
     for k, alpha in enumerate(alphas):
         ww = warp_lsf(w, float(alpha))
         best = nearest_codewords(ww, cb_lsf, 1)[:, 0]
-        d = lsf_distances(ww[:, None, :], cb_lsf[best][:, None, :])[:, 0]    # eq 5
+        d = lsf_distances(ww, cb_lsf[best][:, None, :])[:, 0]                # eq 5
         cost[k] = np.median(d)
     return float(alphas[int(np.argmin(cost))])
