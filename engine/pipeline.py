@@ -149,14 +149,16 @@ def normalise_speaker(model: Model, w: np.ndarray, config: SynthConfig) -> tuple
     return (w, 1.0) if alpha == 1.0 else (warp_lsf(w, alpha), float(alpha))
 
 
-def acoustic_candidates(model: Model, w: np.ndarray, config: SynthConfig) -> np.ndarray:
+def acoustic_candidates(model: Model, w: np.ndarray, config: SynthConfig,
+                        grouped: np.ndarray | None = None) -> np.ndarray:
     """Acoustic-only candidates ``(T, I)`` of frames ``w``: the ``config.acoustic_prefilter``
     codewords nearest by eq 5 through the model's LSF index (``acoustic_probe`` cells), or exactly,
-    or every codeword (``acoustic_prefilter=None``, as the paper does)."""
+    or every codeword (``acoustic_prefilter=None``, as the paper does). ``grouped``: the index's
+    :meth:`~engine.lsf_index.LsfIndex.grouped` codebook, when the caller keeps it."""
     cb = model.codebook
     if config.acoustic_prefilter is not None and config.acoustic_probe is not None:
         return model.lsf_index().nearest(w, cb.lsf, config.acoustic_prefilter,
-                                         config.acoustic_probe)
+                                         config.acoustic_probe, grouped=grouped)
     return nearest_codewords(w, cb.lsf, config.acoustic_prefilter)   # every one, or exact K
 
 

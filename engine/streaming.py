@@ -98,7 +98,7 @@ class StreamingSynthesizer:
         self._gammas = gamma_grid(cfg.gamma_min, cfg.gamma_max, cfg.gamma_steps)
         self._lsf: list[np.ndarray] = []
         self._raw: list[np.ndarray] = []
-        model.lsf_index()                   # built now, not in the first block
+        self._grouped = model.lsf_index().grouped(model.codebook.lsf)   # once, not per block
 
     @property
     def lookahead_s(self) -> float:
@@ -181,7 +181,7 @@ class StreamingSynthesizer:
         if self.synth.speaker_warp != 1.0:
             w = warp_lsf(w, self.synth.speaker_warp)
         cb = self.model.codebook
-        fw = weight_frames(w, acoustic_candidates(self.model, w, self.synth), cb.lsf, cb.pcs,
+        fw = weight_frames(w, acoustic_candidates(self.model, w, self.synth, self._grouped), cb.lsf, cb.pcs,
                            self._gammas)
         self._lsf.append(w)
         self._raw.append(fw.pcs)

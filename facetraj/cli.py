@@ -14,7 +14,7 @@ from collections.abc import Sequence
 
 from engine.errors import FacetrajError
 
-from .commands import corpus, evaluate, gui, render, synth, train
+from .commands import corpus, evaluate, gui, live, render, synth, train
 from .paths import default_corpus
 
 log = logging.getLogger("facetraj")
@@ -22,7 +22,7 @@ log = logging.getLogger("facetraj")
 EXIT_BAD_INPUT = 2
 
 #: The subcommand modules, in the order ``facetraj --help`` lists them.
-COMMANDS = (gui, train, synth, evaluate, render, corpus)
+COMMANDS = (gui, train, synth, evaluate, render, corpus, live)
 
 
 def build_parser() -> argparse.ArgumentParser:
