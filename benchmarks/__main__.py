@@ -22,7 +22,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from . import scaling, synth, train
+from . import live, scaling, synth, train
 from .common import (
     REPO,
     BenchContext,
@@ -37,7 +37,7 @@ from .common import (
 
 log = logging.getLogger("benchmarks")
 
-GROUPS = ("train", "synth", "scaling", "playback")
+GROUPS = ("train", "synth", "scaling", "playback", "live")
 DEFAULT_OUT = REPO / "docs" / "benchmarks.md"
 
 
@@ -85,6 +85,8 @@ def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS, factors: Sequence[i
         rows += scaling.run(ctx, factors, prefilters)
     if "playback" in only:
         rows += run_playback(ctx.smoke, ctx.corpus.root)
+    if "live" in only:
+        rows += live.run(ctx)
     return rows
 
 

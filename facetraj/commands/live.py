@@ -24,11 +24,6 @@ from ..paths import default_corpus
 
 log = logging.getLogger("facetraj")
 
-#: the message when live mode has no microphone (docs/app.md, tests/test_live_gui.py)
-NO_INPUT_DEVICE = ("no audio input device found (is a microphone connected and a sound server "
-                   "running?); use --from-file FILE to play a file through live mode")
-
-
 def load_model(args: argparse.Namespace):
     """The model of ``--model``, or the default corpus's (trained and cached on first use)."""
     from engine.model import Model
