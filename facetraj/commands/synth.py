@@ -24,7 +24,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
     cfg = mode_for(synth_config(args), phones)
     label_map = read_label_map(args.label_map) if args.label_map else None
     res = synthesize(model, audio, rate, phones, cfg, label_map=label_map,
-                     source=str(args.labels or args.audio))
+                     source=str(args.labels or args.audio), audio_source=str(args.audio))
     out = write_trajectories(args.output, res.markers, model, res, args.overwrite)
     log.info("%d frames (%.2f s) synthesized, %s mode, %s smoothing", len(res.times),
              res.times[-1], cfg.mode, cfg.smoothing)
