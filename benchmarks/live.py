@@ -2,9 +2,12 @@
 streaming path, and face updates per second of the Live window under Xvfb.
 
 Latency is simulated on the audio clock, without sleeping: blocks of ``BLOCK_S`` arrive at their
-last sample's time; a frame is out when the block that completes it has been processed, so its
-latency is ``(block end - frame time) + the feed() call's wall time`` (the algorithm's lookahead,
-the block wait and the compute; the render of the frame is the live fps row's business).
+last sample's time and queue up when the previous one is still being processed; a block's
+processing starts at ``max(its arrival, the previous block's end)`` and lasts its ``feed()`` call's
+measured wall time; a frame's latency is the end of the processing of the block that completes it
+minus the frame's time (the algorithm's lookahead, the block wait, the queue and the compute; a
+stream slower than real time shows as growing latency; the render of the frame is the live fps
+row's business).
 
 ``python -m benchmarks.live [--section docs/benchmarks.md]`` runs only these and writes them as
 a section of that file (``python -m benchmarks`` puts them in the main table).
@@ -40,13 +43,15 @@ def _stream(model, audio: np.ndarray, rate: int, block_s: float) -> tuple[list[f
     block = max(1, int(round(block_s * rate)))
     latencies: list[float] = []
     total = 0.0
+    busy_until = 0.0                                    # on the audio clock
     for a in range(0, len(audio), block):
-        end = min(a + block, len(audio)) / rate
+        arrival = min(a + block, len(audio)) / rate
         t0 = time.perf_counter()
         frames = stream.feed(audio[a:a + block])
         dt = time.perf_counter() - t0
         total += dt
-        latencies += [end - t + dt for t in frames.times]
+        busy_until = max(arrival, busy_until) + dt
+        latencies += [busy_until - t for t in frames.times]
     t0 = time.perf_counter()
     stream.flush()
     return latencies, total + time.perf_counter() - t0
