@@ -19,7 +19,7 @@ import numpy as np
 
 from engine.errors import FacetrajError
 
-from ..options import count_or_all, synth_config
+from ..options import count_or_all, real, synth_config
 from ..paths import default_corpus
 
 log = logging.getLogger("facetraj")
@@ -109,13 +109,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--model", type=Path, help="a trained model (default: the default corpus's)")
     p.add_argument("--corpus", type=Path, help="train on this corpus when no --model is given")
     p.add_argument("--device", help="input device (part of its name; default: the system's)")
-    p.add_argument("--block-ms", type=float, default=10.0,
+    p.add_argument("--block-ms", type=real(0.0625, 10000), default=10.0,
                    help="audio block size in ms (default 10)")
-    p.add_argument("--warp", type=float, default=1.0, metavar="ALPHA",
+    p.add_argument("--warp", type=real(0.5, 2.0), default=1.0, metavar="ALPHA",
                    help="speaker warp of the input LSFs (engine.speaker; 1 = none, below 1 for a "
                         "shorter vocal tract than the training voice)")
     p.add_argument("--screenshot", metavar="OUT.png", help=argparse.SUPPRESS)
-    p.add_argument("--quit-after", type=float, metavar="S", help=argparse.SUPPRESS)
+    p.add_argument("--quit-after", type=real(0, 1e6, lo_open=True), metavar="S",
+                   help=argparse.SUPPRESS)
     g = p.add_argument_group("synthesis (paper 2.3, acoustic-only)")
     g.add_argument("--smoothing", choices=["triangular", "none"])
     g.add_argument("--acoustic-prefilter", type=count_or_all, metavar="K|all",
