@@ -115,7 +115,10 @@ def write_section(path: Path, rows: Sequence[BenchRow]) -> None:
     body = "\n".join([SECTION[0], "", "## Live mode (benchmarks/live.py)", "",
                       f"Measured {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} by "
                       f"`python -m benchmarks.live`; the 2 cores were shared with other jobs "
-                      f"(load average {load} at the end), so these are pessimistic.", "",
+                      f"(load average {load} at the end), so these are pessimistic: the CPU-time "
+                      f"column is the speed the process would have with a core to itself; when "
+                      f"the wall-clock speed is below 1x real time the blocks queue up and the "
+                      f"latency grows with the length of the input.", "",
                       markdown_table(rows), "", SECTION[1]])
     text = path.read_text(encoding="utf-8") if path.exists() else ""
     pattern = re.escape(SECTION[0]) + ".*?" + re.escape(SECTION[1])
