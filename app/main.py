@@ -42,12 +42,12 @@ def build_window(corpus: Path | str | None, model: Path | None = None, utterance
 
     A view set that fails to install is logged and left out; the window still opens.
     """
-    from . import analysis, own_data
+    from . import analysis, live, own_data
     from .main_window import MainWindow
 
     window = MainWindow(None if corpus is None else Path(corpus), model_path=model, utterance=utterance,
                         start_time=time, use_audio=use_audio)
-    for extension in (own_data, analysis):
+    for extension in (own_data, analysis, live):
         try:
             extension.install(window)
         except Exception:

@@ -22,7 +22,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from . import labels, scaling, startup, synth, train
+from . import labels, live, scaling, startup, synth, train
 from .common import (
     REPO,
     BenchContext,
@@ -37,7 +37,7 @@ from .common import (
 
 log = logging.getLogger("benchmarks")
 
-GROUPS = ("train", "synth", "scaling", "eval", "labels", "playback", "startup")
+GROUPS = ("train", "synth", "scaling", "eval", "labels", "playback", "startup", "live")
 DEFAULT_OUT = REPO / "docs" / "benchmarks.md"
 #: hand-written profile notes (per stage, before and after a change), copied into the Markdown
 NOTES = REPO / "benchmarks" / "profile_notes.md"
@@ -94,6 +94,8 @@ def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS, factors: Sequence[i
     if "startup" in only:
         rows += startup.cold_start(ctx) if display_available()[0] else [BenchRow(
             "startup", "cold start", float("nan"), "", note="skipped: no display")]
+    if "live" in only:
+        rows += live.run(ctx)
     return rows
 
 

@@ -41,7 +41,7 @@ class BenchRow:
 
     Attributes
     ----------
-    group : ``train``, ``synth``, ``scaling``, ``labels`` or ``playback``.
+    group : ``train``, ``synth``, ``scaling``, ``eval``, ``labels``, ``playback``, ``startup`` or ``live``.
     name : what was measured.
     value : the number (NaN when it could not be measured).
     unit : ``s``, ``MiB``, ``x RT`` (times faster than real time), ``corr``, ``ms``...

@@ -81,6 +81,9 @@ class SynthConfig:
     acoustic_probe : how the K nearest are found: among the members of this many cells of the
         model's coarse LSF index (``engine.lsf_index``, fast, growth about sqrt(5L)); ``None``
         compares every codeword (exact, linear in 5L).
+    speaker_warp : speaker normalisation of the input LSFs (``engine.speaker``): a warp factor
+        alpha (1.0: none; below 1 lowers the frequencies, for a voice with a shorter vocal tract
+        than the training voice), or ``None`` to choose it per utterance (``choose_warp``).
     """
 
     n_context_phones: int = 3
@@ -96,6 +99,7 @@ class SynthConfig:
     spline_knot_s: float = 0.1
     acoustic_prefilter: int | None = 128
     acoustic_probe: int | None = 8
+    speaker_warp: float | None = 1.0
 
     def with_(self, **changes) -> SynthConfig:
         """A copy with some fields changed."""

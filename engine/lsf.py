@@ -171,19 +171,127 @@ def resample_audio(audio: np.ndarray, rate: int, target: int) -> np.ndarray:
     return resample_poly(np.asarray(audio, dtype=np.float64), target // g, rate // g)
 
 
+class ResampleStream:
+    """:func:`resample_audio` of a signal that arrives in blocks: the same polyphase filter
+    (``scipy.signal.resample_poly``'s Kaiser-windowed sinc, zero outside the signal), each output
+    sample computed as soon as the input it depends on has arrived (about ``10 max(up, down) / up``
+    input samples of lookahead). The concatenated output equals ``resample_audio`` of the whole
+    signal to rounding.
+
+    >>> x = np.sin(np.arange(1000) / 7.0)
+    >>> stream = ResampleStream(44100, 16000)
+    >>> y = np.concatenate([stream.feed(x[:333]), stream.feed(x[333:]), stream.flush()])
+    >>> bool(np.allclose(y, resample_audio(x, 44100, 16000), atol=1e-12))
+    True
+    """
+
+    def __init__(self, rate: int, target: int):
+        g = int(np.gcd(int(rate), int(target)))
+        self.up, self.down = int(target) // g, int(rate) // g
+        self._identity = self.up == self.down
+        #: input samples an output sample waits for beyond its own time
+        self.lookahead = 0.0
+        if not self._identity:
+            from scipy.signal import firwin
+            max_rate = max(self.up, self.down)
+            half_len = 10 * max_rate
+            h = firwin(2 * half_len + 1, 1.0 / max_rate, window=("kaiser", 5.0)) * self.up
+            pre = self.down - half_len % self.down
+            h = np.concatenate([np.zeros(pre), h])
+            self._offset = (half_len + pre) // self.down            # outputs dropped at the start
+            taps = -(-len(h) // self.up)
+            poly = np.zeros((self.up, taps))                        # poly[phase, m] = h[phase + up m]
+            for phase in range(self.up):
+                sub = h[phase::self.up]
+                poly[phase, :len(sub)] = sub
+            self._poly = poly
+            self._taps = taps
+            self.lookahead = self._offset * self.down / self.up
+        self._buffer = np.zeros(0)       # input samples from index self._first on
+        self._first = 0
+        self._received = 0
+        self._emitted = 0
+
+    def _outputs(self, stop: int, n_input: int) -> np.ndarray:
+        """Output samples ``self._emitted .. stop-1``, input beyond ``n_input`` taken as zero."""
+        i = np.arange(self._emitted, stop)
+        j = (i + self._offset) * self.down
+        phase, last = j % self.up, j // self.up                     # newest input sample used
+        idx = last[:, None] - np.arange(self._taps)[None, :]
+        valid = (idx >= 0) & (idx < n_input)
+        x = np.where(valid, self._buffer[np.clip(idx - self._first, 0, None)
+                                         .clip(max=max(len(self._buffer) - 1, 0))]
+                     if len(self._buffer) else 0.0, 0.0)
+        y = np.einsum("it,it->i", self._poly[phase], x)
+        self._emitted = stop
+        keep = max(0, (stop + self._offset) * self.down // self.up - self._taps + 1)
+        if keep > self._first:                                      # drop input no longer needed
+            self._buffer = self._buffer[keep - self._first:]
+            self._first = keep
+        return y
+
+    def feed(self, block: np.ndarray) -> np.ndarray:
+        """The output samples that ``block`` (the next input samples) completes."""
+        block = np.asarray(block, dtype=np.float64).ravel()
+        if self._identity:
+            self._received += len(block)
+            return block.copy()
+        self._buffer = np.concatenate([self._buffer, block])
+        self._received += len(block)
+        # output i is complete once its newest input sample (i + offset) down / up has arrived
+        stop = (self._received * self.up - 1) // self.down - self._offset + 1
+        stop = max(stop, self._emitted)
+        return self._outputs(stop, self._received) if stop > self._emitted else np.zeros(0)
+
+    def flush(self) -> np.ndarray:
+        """The remaining output samples, the input ended (``ceil(n up / down)`` in all)."""
+        if self._identity:
+            return np.zeros(0)
+        total = -(-self._received * self.up // self.down)
+        return self._outputs(total, self._received) if total > self._emitted else np.zeros(0)
+
+
+def frame_starts(times: np.ndarray, rate: int) -> np.ndarray:
+    """The first sample of the analysis frame centred on each of ``times``, as an index into the
+    signal preceded by half a window of zeros (:func:`analysis_frames`).
+
+    >>> frame_starts(np.array([0.0, 1 / 60, 0.5]), 16000).tolist()
+    [0, 267, 8000]
+    """
+    return np.round(np.asarray(times, dtype=np.float64) * rate).astype(int)
+
+
+def preemphasize(x: np.ndarray, coefficient: float, previous: float | None = None) -> np.ndarray:
+    """First-order pre-emphasis ``y[i] = x[i] - c x[i-1]``; the first sample is kept as it is, or
+    uses ``previous`` (the sample before ``x``, when a signal arrives in blocks).
+
+    >>> preemphasize(np.array([1.0, 2.0, 4.0]), 0.5).tolist()
+    [1.0, 1.5, 3.0]
+    >>> preemphasize(np.array([4.0]), 0.5, previous=2.0).tolist()
+    [3.0]
+    """
+    x = np.asarray(x, dtype=np.float64)
+    if not coefficient or len(x) == 0:
+        return x
+    before = x[:1] if previous is None else np.array([x[0] - coefficient * previous])
+    return np.concatenate([before, x[1:] - coefficient * x[:-1]])
+
+
 def analysis_frames(audio: np.ndarray, rate: int, times: np.ndarray, window_s: float,
                     preemphasis: float = 0.0) -> np.ndarray:
     """Hamming-windowed frames of ``window_s`` centred on ``times`` (zero outside the signal)."""
-    x = np.asarray(audio, dtype=np.float64)
-    if preemphasis:
-        x = np.concatenate([x[:1], x[1:] - preemphasis * x[:-1]])
+    x = preemphasize(audio, preemphasis)
     n = int(round(window_s * rate))
     half = n // 2
     pad = np.concatenate([np.zeros(half), x, np.zeros(n)])
-    starts = np.round(np.asarray(times) * rate).astype(int)
-    starts = np.clip(starts, 0, len(x))
+    starts = np.clip(frame_starts(times, rate), 0, len(x))
     idx = starts[:, None] + np.arange(n)[None, :]
     return pad[idx] * np.hamming(n)[None, :]
+
+
+def frame_lsf(frames: np.ndarray, order: int) -> np.ndarray:
+    """LSF vectors ``(..., order)`` of windowed analysis frames ``(..., n)`` (LPC, then LSF)."""
+    return poly2lsf(lpc(frames, order))
 
 
 def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
@@ -206,4 +314,4 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     x = resample_audio(x, rate, audio_rate)
     frames = analysis_frames(x, audio_rate, np.asarray(times, dtype=np.float64), window_s,
                              preemphasis)
-    return poly2lsf(lpc(frames, order))
+    return frame_lsf(frames, order)

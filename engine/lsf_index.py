@@ -97,8 +97,13 @@ class LsfIndex:
         total = np.cumsum(np.sort(self.sizes))
         return int(min(np.searchsorted(total, count) + 1, self.n_cells))
 
+    def grouped(self, cb_lsf: np.ndarray) -> np.ndarray:
+        """The codebook LSFs ``cb_lsf`` grouped by cell (``cb_lsf[order]``), for callers that
+        search a few frames at a time and pass it to :meth:`nearest` on every call."""
+        return np.asarray(cb_lsf, dtype=np.float64)[self.order]
+
     def nearest(self, w: np.ndarray, cb_lsf: np.ndarray, count: int, probe: int,
-                chunk: int | None = None) -> np.ndarray:
+                chunk: int | None = None, grouped: np.ndarray | None = None) -> np.ndarray:
         """The ``count`` codewords nearest to each frame by eq 5, among the members of the
         ``probe`` cells whose centroids are nearest by eq 5; ``(T, count)`` codebook indices.
 
@@ -106,6 +111,7 @@ class LsfIndex:
         is raised when the opened cells could hold fewer than ``count`` codewords; probing every
         cell finds the exact nearest. The distances are computed cell by cell, for all the frames
         of a chunk that open the cell at once, so the cell's codewords are a slice, not a gather.
+        ``grouped`` may pass :meth:`grouped` of ``cb_lsf``, computed once.
 
         Examples
         --------
@@ -122,7 +128,7 @@ class LsfIndex:
         count = min(count, self.n_codewords)
         probe = min(max(probe, self.min_probe(count)), self.n_cells)
         sizes = self.sizes
-        cell_lsf = np.asarray(cb_lsf, dtype=np.float64)[self.order]    # codewords grouped by cell
+        cell_lsf = self.grouped(cb_lsf) if grouped is None else grouped   # codewords by cell
         width_max = int(np.sort(sizes)[-probe:].sum())
         chunk = chunk or max(1, min(1024, int(4e6 // max(self.n_cells * order, width_max))))
         out = np.empty((n_frames, count), dtype=np.int64)

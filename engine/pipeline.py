@@ -21,6 +21,7 @@ from .model import Model
 from .phones import SILENCE, context_ids, map_labels, segment_index
 from .similarity import top_context_phones
 from .smoothing import smooth
+from .speaker import choose_warp, warp_lsf
 from .synthesis import FrameWeights, gamma_grid, nearest_codewords, weight_frames
 
 log = logging.getLogger(__name__)
@@ -57,12 +58,13 @@ class Synthesis:
     Attributes
     ----------
     times : ``(T,)`` frame times in seconds (frame t at ``t / marker_rate``).
-    lsf : ``(T, P)`` input LSF vectors w.
+    lsf : ``(T, P)`` input LSF vectors w (after the speaker warp, if any).
     raw_pcs : ``(T, K)`` unsmoothed p-hat(t) (eq 8).
     pcs : ``(T, K)`` smoothed PCs; ``markers`` ``(T, M, 3)`` rebuilt from them (head frame).
     frames : per-frame eq 5-8 details (gamma, weights, candidates, w-hat).
     segments : per input phone, the chosen context-phones (phonetic mode), else empty.
     frame_segment : ``(T,)`` index into ``segments`` (phonetic mode), else -1.
+    warp : the speaker warp factor applied to the input LSFs (``config.speaker_warp``).
     """
 
     times: np.ndarray
@@ -74,6 +76,7 @@ class Synthesis:
     config: SynthConfig
     segments: list[SegmentChoice] = field(default_factory=list)
     frame_segment: np.ndarray | None = None
+    warp: float = 1.0
 
 
 def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
@@ -110,6 +113,7 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         raise ValueError(f"lsf must be ({n_frames}, {mc.lpc_order}) for these frames, got {lsf.shape}")
     else:
         w = lsf
+    w, warp = normalise_speaker(model, w, config)
     cb = model.codebook
     segments: list[SegmentChoice] = []
     frame_seg = None
@@ -127,18 +131,38 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         frame_seg = segment_index(segs, times)
         candidates = cb.codewords_of(top)[frame_seg]
     elif config.mode == "acoustic":
-        if config.acoustic_prefilter is not None and config.acoustic_probe is not None:
-            candidates = model.lsf_index().nearest(w, cb.lsf, config.acoustic_prefilter,
-                                                   config.acoustic_probe)
-        else:                                   # every codeword, or the exact K nearest
-            candidates = nearest_codewords(w, cb.lsf, config.acoustic_prefilter)
+        candidates = acoustic_candidates(model, w, config)
     else:
         raise ValueError(f"unknown mode {config.mode!r} (phonetic or acoustic)")
     gammas = gamma_grid(config.gamma_min, config.gamma_max, config.gamma_steps)
     fw = weight_frames(w, candidates, cb.lsf, cb.pcs, gammas)
     pcs = smooth(fw.pcs, rate, config.smoothing, config.triangle_s, config.spline_knot_s)
     return Synthesis(times=times, lsf=w, raw_pcs=fw.pcs, pcs=pcs, markers=model.to_markers(pcs),
-                     frames=fw, config=config, segments=segments, frame_segment=frame_seg)
+                     frames=fw, config=config, segments=segments, frame_segment=frame_seg,
+                     warp=warp)
+
+
+def normalise_speaker(model: Model, w: np.ndarray, config: SynthConfig) -> tuple[np.ndarray, float]:
+    """The input LSFs ``w`` warped by ``config.speaker_warp`` (chosen here for these frames when
+    it is ``None``), and the warp factor (``engine.speaker``)."""
+    alpha = config.speaker_warp
+    if alpha is None:
+        alpha = choose_warp(w, model.codebook.lsf)
+        log.info("speaker warp %.2f chosen", alpha)
+    return (w, 1.0) if alpha == 1.0 else (warp_lsf(w, alpha), float(alpha))
+
+
+def acoustic_candidates(model: Model, w: np.ndarray, config: SynthConfig,
+                        grouped: np.ndarray | None = None) -> np.ndarray:
+    """Acoustic-only candidates ``(T, I)`` of frames ``w``: the ``config.acoustic_prefilter``
+    codewords nearest by eq 5 through the model's LSF index (``acoustic_probe`` cells), or exactly,
+    or every codeword (``acoustic_prefilter=None``, as the paper does). ``grouped``: the index's
+    :meth:`~engine.lsf_index.LsfIndex.grouped` codebook, when the caller keeps it."""
+    cb = model.codebook
+    if config.acoustic_prefilter is not None and config.acoustic_probe is not None:
+        return model.lsf_index().nearest(w, cb.lsf, config.acoustic_prefilter,
+                                         config.acoustic_probe, grouped=grouped)
+    return nearest_codewords(w, cb.lsf, config.acoustic_prefilter)   # every one, or exact K
 
 
 def resmooth(model: Model, result: Synthesis, method: str) -> np.ndarray:

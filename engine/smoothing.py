@@ -64,3 +64,56 @@ def smooth(x: np.ndarray, rate: float, method: str = "triangular", width_s: floa
     if method == "none":
         return np.asarray(x, dtype=np.float64).copy()
     raise ValueError(f"unknown smoothing {method!r} (triangular, spline or none)")
+
+
+class TriangularStream:
+    """:func:`triangular_smooth` of frames that arrive in blocks.
+
+    Smoothed frame t needs the raw frames up to ``t + lookahead`` (``lookahead`` = half the window
+    minus one: 3 frames, 50 ms, for 100 ms at 60 Hz). The edges are extended with the end values
+    as offline: the first frame is known when it arrives, the last one at :meth:`flush`. So the
+    concatenated output equals the offline smoothing of all the frames, only ``lookahead`` frames
+    later. ``width_s = 0`` (a one-tap window) passes frames through.
+
+    >>> x = np.arange(10.0)[:, None] ** 2
+    >>> s = TriangularStream(60.0)
+    >>> y = np.concatenate([s.feed(x[:4]), s.feed(x[4:5]), s.feed(x[5:]), s.flush()])
+    >>> bool(np.allclose(y, triangular_smooth(x, 60.0)))
+    True
+    """
+
+    def __init__(self, rate: float, width_s: float = 0.1):
+        self.window = triangular_window(rate, width_s) if width_s > 0 else np.ones(1)
+        self.lookahead = len(self.window) // 2
+        self._history: np.ndarray | None = None     # the last 2 * lookahead raw frames (padded)
+        self._received = 0
+        self._emitted = 0
+
+    def _convolve(self, padded: np.ndarray, count: int) -> np.ndarray:
+        n = len(self.window)
+        return sum(self.window[k] * padded[k:k + count] for k in range(n))
+
+    def feed(self, frames: np.ndarray) -> np.ndarray:
+        """The smoothed frames that ``frames`` (the next raw frames, ``(n, K)``) complete."""
+        frames = np.asarray(frames, dtype=np.float64)
+        if len(frames) == 0:
+            return frames.copy()
+        if self._history is None:                     # 'nearest' edge: repeat the first frame
+            self._history = np.repeat(frames[:1], self.lookahead, axis=0)
+        buf = np.concatenate([self._history, frames])
+        self._received += len(frames)
+        count = max(0, self._received - self.lookahead - self._emitted)
+        out = self._convolve(buf, count) if count else np.zeros((0, *frames.shape[1:]))
+        self._emitted += count
+        self._history = buf[max(0, len(buf) - 2 * self.lookahead):] if self.lookahead else buf[:0]
+        return out
+
+    def flush(self) -> np.ndarray:
+        """The last ``lookahead`` smoothed frames (the end extended with the last frame)."""
+        if self._history is None or self._emitted >= self._received:
+            return np.zeros((0,) if self._history is None else (0, *self._history.shape[1:]))
+        count = self._received - self._emitted
+        buf = self._history[len(self._history) - (count + self.lookahead):]
+        buf = np.concatenate([buf, np.repeat(buf[-1:], self.lookahead, axis=0)])
+        self._emitted = self._received
+        return self._convolve(buf, count)

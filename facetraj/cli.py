@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from engine.errors import FacetrajError
 from engine.formats import write_problem
 
-from .commands import align, corpus, evaluate, gui, render, synth, train
+from .commands import align, corpus, evaluate, gui, live, render, synth, train
 from .options import SECONDS
 from .paths import default_corpus
 
@@ -24,7 +24,7 @@ log = logging.getLogger("facetraj")
 EXIT_BAD_INPUT = 2
 
 #: The subcommand modules, in the order ``facetraj --help`` lists them.
-COMMANDS = (gui, train, synth, align, evaluate, render, corpus)
+COMMANDS = (gui, train, synth, align, evaluate, render, corpus, live)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,396 @@
+"""Live mode: the synthesized face follows a microphone (QtMultimedia ``QAudioSource``) or a file
+played in real time, through the streaming synthesizer (``engine.streaming``).
+
+The window shows the 3-D face (synthesized points only), an input level meter, and the upper and
+lower lip y of the last few seconds scrolling, with speech/silence dots computed live (the
+energy of the 20 ms before each frame against the take's running floor and peak). Stop keeps the
+take: its audio and trajectories can be saved (WAV + C3D/TSV) and opened like any utterance.
+"""
+
+from __future__ import annotations
+
+import logging
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+from matplotlib.backends.backend_qtagg import FigureCanvasQTAgg
+from matplotlib.figure import Figure
+from PyQt6.QtCore import QTimer, pyqtSignal
+from PyQt6.QtWidgets import (
+    QApplication,
+    QComboBox,
+    QFileDialog,
+    QHBoxLayout,
+    QLabel,
+    QMainWindow,
+    QProgressBar,
+    QToolBar,
+    QVBoxLayout,
+    QWidget,
+)
+
+from engine.config import SynthConfig
+from engine.errors import FacetrajError
+from engine.export import write_trajectories
+from engine.formats import write_audio
+from engine.model import Model
+from engine.streaming import StreamConfig, StreamingSynthesizer
+
+from .view3d import FaceView
+
+log = logging.getLogger(__name__)
+
+#: shown (and raised by ``facetraj live``) when there is no microphone
+NO_INPUT_DEVICE = ("no audio input device found (is a microphone connected and a sound server "
+                   "running?); use --from-file FILE to play a file through live mode")
+MIC_RATE = 16000
+SHOWN_S = 4.0
+TICK_MS = 15
+PLOT_EVERY_S = 0.1
+
+
+def input_devices() -> list:
+    """The audio input devices QtMultimedia sees (``QAudioDevice``), default first."""
+    from PyQt6.QtMultimedia import QMediaDevices
+
+    devices = list(QMediaDevices.audioInputs())
+    default = QMediaDevices.defaultAudioInput()
+    devices.sort(key=lambda d: d.id() != default.id())
+    return devices
+
+
+class FileFeeder:
+    """Blocks of a file as the audio clock reaches them (``fast``: the next block every poll)."""
+
+    def __init__(self, audio: np.ndarray, rate: int, block_s: float, fast: bool = False):
+        self.audio, self.rate, self.fast = audio, rate, fast
+        self.block = max(1, int(round(block_s * rate)))
+        self.pos = 0
+        self.t0 = time.perf_counter()
+
+    def poll(self) -> np.ndarray | None:
+        """The samples due now (possibly none); ``None`` once the file has been played."""
+        if self.pos >= len(self.audio):
+            return None
+        due = self.pos + self.block if self.fast else \
+            int((time.perf_counter() - self.t0) * self.rate) // self.block * self.block
+        due = min(max(due, self.pos), len(self.audio))
+        out, self.pos = self.audio[self.pos:due], due
+        return out
+
+    def stop(self) -> None:
+        self.pos = len(self.audio)
+
+
+class MicFeeder:
+    """16 kHz mono 16-bit blocks from a ``QAudioSource`` (pull mode: read what has arrived)."""
+
+    def __init__(self, device):
+        from PyQt6.QtMultimedia import QAudioFormat, QAudioSource
+
+        fmt = QAudioFormat()
+        fmt.setSampleRate(MIC_RATE)
+        fmt.setChannelCount(1)
+        fmt.setSampleFormat(QAudioFormat.SampleFormat.Int16)
+        self.rate = MIC_RATE
+        self.source = QAudioSource(device, fmt)
+        self.io = self.source.start()
+
+    def poll(self) -> np.ndarray | None:
+        data = bytes(self.io.readAll()) if self.io is not None else b""
+        data = data[: len(data) // 2 * 2]
+        return np.frombuffer(data, dtype="<i2").astype(np.float64) / 32768.0
+
+    def stop(self) -> None:
+        self.source.stop()
+
+
+class LiveWindow(QMainWindow):
+    """The Live window. ``start()`` begins a take from the chosen device (or ``from_file``),
+    ``stop()`` ends it; ``save_take(path)`` writes ``path`` (.c3d/.tsv/...) and the WAV beside it.
+    """
+
+    takeFinished = pyqtSignal()
+
+    def __init__(self, model: Model, config: SynthConfig | None = None,
+                 from_file: tuple[np.ndarray, int] | None = None, block_s: float = 0.01,
+                 fast: bool = False, device: str | None = None):
+        super().__init__()
+        self.setWindowTitle("facetraj - live")
+        self.model = model
+        self.config = (config or SynthConfig()).with_(mode="acoustic")
+        self.from_file, self.block_s, self.fast = from_file, block_s, fast
+        self.stream: StreamingSynthesizer | None = None
+        self.feeder: FileFeeder | MicFeeder | None = None
+        self.audio: list[np.ndarray] = []
+        self.markers: list[np.ndarray] = []
+        self.speech: list[bool] = []
+        self.rate = MIC_RATE
+        self.updates = 0
+        self._t_start = 0.0
+        self._last_plot = 0.0
+        self._timer = QTimer(self)
+        self._timer.setInterval(TICK_MS)
+        self._timer.timeout.connect(self._tick)
+
+        bar = QToolBar("Live")
+        self.addToolBar(bar)
+        self.device_box = QComboBox()
+        self.devices = [] if from_file is not None else input_devices()
+        if from_file is not None:
+            self.device_box.addItem("file")
+        for d in self.devices:
+            self.device_box.addItem(d.description())
+        if device:
+            names = [d.description() for d in self.devices]
+            match = [i for i, n in enumerate(names) if device.lower() in n.lower()]
+            if match:
+                self.device_box.setCurrentIndex(match[0])
+        bar.addWidget(QLabel(" input: "))
+        bar.addWidget(self.device_box)
+        self.start_action = bar.addAction("Start", self.start)
+        self.stop_action = bar.addAction("Stop", self.stop)
+        self.save_action = bar.addAction("Save take...", self._save_dialog)
+        self.stop_action.setEnabled(False)
+        self.save_action.setEnabled(False)
+
+        central = QWidget()
+        lay = QHBoxLayout(central)
+        self.face = FaceView(central)
+        self.face.set_model(model)
+        self.face.set_sets_visible(False, True)
+        lay.addWidget(self.face, 3)
+        right = QVBoxLayout()
+        self.level = QProgressBar()
+        self.level.setRange(-60, 0)
+        self.level.setValue(-60)
+        self.level.setFormat("input %v dB")
+        right.addWidget(self.level)
+        self.figure = Figure(figsize=(5, 4), tight_layout=True)
+        self.canvas = FigureCanvasQTAgg(self.figure)
+        self.axes = [self.figure.add_subplot(2, 1, k + 1) for k in range(2)]
+        self.lines, self.dots = [], []
+        for ax, which in zip(self.axes, ("upper", "lower"), strict=True):
+            ax.set_ylabel(f"{which} lip y (mm)", fontsize=8)
+            ax.set_xlim(-SHOWN_S, 0.0)
+            (line,) = ax.plot([], [], color="#d62728", lw=1.5)
+            (dots,) = ax.plot([], [], ls="none", marker=".", ms=3, color="#2ca02c")
+            self.lines.append(line)
+            self.dots.append(dots)
+        self.axes[1].set_xlabel("time (s, 0 = now)", fontsize=8)
+        right.addWidget(self.canvas, 1)
+        lay.addLayout(right, 2)
+        self.setCentralWidget(central)
+        self.message = QLabel()
+        self.statusBar().addWidget(self.message, 1)
+        if from_file is None and not self.devices:
+            self.message.setText(NO_INPUT_DEVICE)
+            self.start_action.setEnabled(False)
+        else:
+            self.message.setText("press Start")
+
+    # ------------------------------------------------------------------ a take
+    def start(self) -> None:
+        """Begin a take (the previous one is dropped)."""
+        if self.from_file is not None:
+            audio, rate = self.from_file
+            self.feeder = FileFeeder(audio, rate, self.block_s, self.fast)
+        elif self.devices:
+            self.feeder = MicFeeder(self.devices[self.device_box.currentIndex()])
+        else:
+            self.message.setText(NO_INPUT_DEVICE)
+            return
+        self.rate = self.feeder.rate
+        self.stream = StreamingSynthesizer(self.model, StreamConfig(self.rate, self.config))
+        self.audio, self.markers, self.speech = [], [], []
+        self._energy: list[float] = []
+        self.updates = 0
+        self._t_start = time.perf_counter()
+        self.start_action.setEnabled(False)
+        self.stop_action.setEnabled(True)
+        self.save_action.setEnabled(False)
+        self.message.setText("live")
+        self._timer.start()
+
+    def stop(self) -> None:
+        """End the take: the last frames come out (the smoothing's lookahead) and it is kept."""
+        if self.stream is None:
+            return
+        self._timer.stop()
+        self.feeder.stop()
+        self._consume(self.stream.flush())
+        self.stream = None
+        self.start_action.setEnabled(True)
+        self.stop_action.setEnabled(False)
+        self.save_action.setEnabled(self.n_frames > 0)
+        self.message.setText(f"take: {self.take_seconds:.1f} s, {self.n_frames} frames, "
+                             f"{self.fps:.0f} face updates/s")
+        self.takeFinished.emit()
+
+    @property
+    def n_frames(self) -> int:
+        return sum(len(m) for m in self.markers)
+
+    @property
+    def take_seconds(self) -> float:
+        return sum(len(a) for a in self.audio) / float(self.rate)
+
+    @property
+    def fps(self) -> float:
+        """Face updates per second of the take so far."""
+        return self.updates / max(time.perf_counter() - self._t_start, 1e-9)
+
+    def take(self) -> tuple[np.ndarray, int, np.ndarray]:
+        """The take's audio, its rate and its synthesized markers ``(T, M, 3)``."""
+        audio = np.concatenate(self.audio) if self.audio else np.zeros(0)
+        markers = (np.concatenate(self.markers) if self.markers
+                   else np.zeros((0, self.model.n_markers, 3)))
+        return audio, self.rate, markers
+
+    def save_take(self, path: str | Path, overwrite: bool = False) -> tuple[Path, Path]:
+        """Write the take's trajectories to ``path`` (.c3d, .tsv, .csv or .npz) and its audio to
+        the WAV of the same name; both paths."""
+        audio, rate, markers = self.take()
+        path = Path(path)
+        wav = path.with_suffix(".wav")
+        write_audio(wav, audio, rate, overwrite)
+        out = write_trajectories(path, markers, self.model, None, overwrite)
+        self.message.setText(f"take saved: {out} and {wav.name}")
+        return out, wav
+
+    def _save_dialog(self) -> None:
+        name, _ = QFileDialog.getSaveFileName(self, "Save take", "take.c3d",
+                                              "C3D (*.c3d);;TSV (*.tsv)")
+        if name:
+            try:
+                self.save_take(name, overwrite=True)
+            except (OSError, FacetrajError) as exc:
+                self.message.setText(f"could not save: {exc}")
+
+    # ------------------------------------------------------------------ the clock
+    def _tick(self) -> None:
+        block = self.feeder.poll()
+        if block is None:
+            self.stop()
+            return
+        if len(block):
+            self.audio.append(block)
+            rms = float(np.sqrt(np.mean(block**2)) + 1e-12)
+            self.level.setValue(int(np.clip(20 * np.log10(rms), -60, 0)))
+            self._consume(self.stream.feed(block))
+
+    def _consume(self, frames) -> None:
+        if len(frames) == 0:
+            return
+        self.markers.append(frames.markers)
+        self._mark_speech(frames.times)
+        self.face.synth.set_points(frames.markers[-1])
+        self.face.plotter.update()
+        self.updates += 1
+        now = time.perf_counter()
+        if now - self._last_plot >= PLOT_EVERY_S or self.stream is None:
+            self._last_plot = now
+            self._plot()
+
+    def _mark_speech(self, times: np.ndarray) -> None:
+        """Speech/silence of each new frame: the energy (dB) of the 20 ms of audio before it
+        against the take's floor and peak so far (5th and 99th percentiles), 30 % up."""
+        audio = np.concatenate(self.audio[-20:]) if self.audio else np.zeros(0)
+        end_of_audio = self.take_seconds
+        n = int(0.02 * self.rate)
+        for t in times:
+            stop = len(audio) - int(round((end_of_audio - t) * self.rate))
+            seg = audio[max(0, stop - n):max(0, stop)]
+            self._energy.append(10 * np.log10(np.mean(seg**2) + 1e-12) if len(seg) else -120.0)
+        e = np.asarray(self._energy)
+        floor, peak = np.percentile(e, [5, 99])
+        threshold = floor + 0.3 * (peak - floor)
+        self.speech.extend(bool(v > threshold and peak - floor > 6.0) for v in e[-len(times):])
+
+    def _plot(self) -> None:
+        markers = np.concatenate(self.markers)
+        n = min(len(markers), int(SHOWN_S * self.model.marker_rate))
+        t = (np.arange(len(markers) - n, len(markers)) - (len(markers) - 1)) / self.model.marker_rate
+        speech = np.asarray(self.speech[-n:])
+        for ax, line, dots, k in zip(self.axes, self.lines, self.dots,
+                                     (self.model.upper_lip, self.model.lower_lip), strict=True):
+            y = markers[-n:, k, 1]
+            line.set_data(t, y)
+            mid = float(np.median(y))
+            dots.set_data(t[speech], np.full(int(speech.sum()), mid))
+            lo, hi = float(y.min()), float(y.max())
+            pad = 0.15 * max(hi - lo, 0.5)
+            ax.set_ylim(lo - pad, hi + pad)
+        self.canvas.draw_idle()
+
+
+def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = None,
+             from_file: Path | None = None, block_s: float = 0.01, fast: bool = False,
+             device: str | None = None, screenshot: str | None = None,
+             quit_after: float | None = None) -> int:
+    """Open the Live window (``facetraj live``) and start a take. No input device and no file:
+    :class:`FacetrajError` with :data:`NO_INPUT_DEVICE`. With ``screenshot``, the window is saved
+    to that PNG when the file has been played (or after ``quit_after`` seconds) and closes."""
+    from engine.formats import read_audio
+
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    audio = read_audio(from_file) if from_file is not None else None
+    if audio is None and not input_devices():
+        raise FacetrajError(NO_INPUT_DEVICE)
+    window = LiveWindow(model_loader(), config, audio, block_s, fast, device)
+    window.resize(1400, 800)
+    window.show()
+
+    def finish() -> None:
+        if screenshot:
+            window.grab().save(str(screenshot))
+            print(screenshot)
+        app.quit()
+
+    if screenshot or quit_after:
+        window.takeFinished.connect(finish)
+        if quit_after:
+            QTimer.singleShot(int(quit_after * 1000), window.stop)
+    QTimer.singleShot(0, window.start)
+    app.exec()
+    return 0
+
+
+class LiveToggle:
+    """The window extension of live mode: a "Live" toggle in a toolbar that opens the Live window
+    on the main window's model (the microphone; no device: the window says so) and closes it."""
+
+    def __init__(self, window):
+        self.window = window
+        self.live: LiveWindow | None = None
+        bar = window.addToolBar("Live")
+        bar.setObjectName("live-toolbar")
+        self.action = bar.addAction("Live")
+        self.action.setCheckable(True)
+        self.action.setToolTip("the face follows the microphone (live mode)")
+        self.action.toggled.connect(self.toggled)
+
+    def toggled(self, on: bool) -> None:
+        if on and self.live is None:
+            if self.window.model is None:
+                self.window.show_error("live mode needs a model: wait for training to finish")
+                self.action.setChecked(False)
+                return
+            self.live = LiveWindow(self.window.model)
+            self.live.destroyed.connect(lambda *_: self.action.setChecked(False))
+            self.live.resize(1400, 800)
+            self.live.show()
+        elif not on and self.live is not None:
+            live, self.live = self.live, None
+            live.stop()
+            live.close()
+
+
+def install(window) -> LiveToggle:
+    """Add live mode to the main window (as the extension ``live``)."""
+    toggle = LiveToggle(window)
+    window.add_extension("live", toggle)
+    return toggle

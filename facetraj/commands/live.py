@@ -1,0 +1,127 @@
+"""``facetraj live``: the face follows a microphone, or a file played through the same streaming
+path (``engine.streaming``).
+
+* ``facetraj live``: the app's Live mode (input device, level meter, scrolling lip panels).
+* ``facetraj live --from-file speech.wav``: the same window, fed from the file in real time.
+* ``facetraj live --from-file speech.wav [--as-fast-as-possible] -o take.tsv``: no window; the
+  file goes through the streaming path (in real time, or as fast as it runs) and the take is
+  written in any ``synth`` output format.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import time
+from pathlib import Path
+
+import numpy as np
+
+from engine.errors import FacetrajError
+
+from ..options import count_or_all, real, synth_config
+from ..paths import default_corpus
+
+log = logging.getLogger("facetraj")
+
+def load_model(args: argparse.Namespace):
+    """The model of ``--model``, or the default corpus's (trained and cached on first use)."""
+    from engine.model import Model
+
+    if args.model is not None:
+        return Model.load(args.model)
+    from app.cache import load_or_train
+    from engine.corpus import load_corpus
+
+    return load_or_train(load_corpus(args.corpus or default_corpus()))
+
+
+def live_config(args: argparse.Namespace):
+    """The synthesis settings of a stream: acoustic-only, ``--warp`` as the speaker warp."""
+    cfg = synth_config(args).with_(mode="acoustic")
+    if args.smoothing == "spline":
+        raise FacetrajError("live mode smooths with the triangular window or not at all "
+                            "(--smoothing triangular or none)")
+    return cfg.with_(speaker_warp=args.warp)
+
+
+def stream_file(model, audio: np.ndarray, rate: int, cfg, block_s: float,
+                real_time: bool) -> tuple[np.ndarray, float]:
+    """Markers ``(T, M, 3)`` of ``audio`` streamed in blocks of ``block_s`` seconds, paced to the
+    audio clock when ``real_time``; and the wall time it took."""
+    from engine.streaming import StreamConfig, StreamingSynthesizer
+
+    stream = StreamingSynthesizer(model, StreamConfig(rate, cfg))
+    block = max(1, int(round(block_s * rate)))
+    parts = []
+    t0 = time.perf_counter()
+    for a in range(0, len(audio), block):
+        if real_time:                                   # the block's last sample "arrives" now
+            delay = t0 + min(a + block, len(audio)) / rate - time.perf_counter()
+            if delay > 0:
+                time.sleep(delay)
+        parts.append(stream.feed(audio[a:a + block]).markers)
+    parts.append(stream.flush().markers)
+    return np.concatenate(parts), time.perf_counter() - t0
+
+
+def cmd_live(args: argparse.Namespace) -> int:
+    from engine.formats import read_audio
+
+    cfg = live_config(args)
+    if args.output is not None:
+        if args.from_file is None:
+            raise FacetrajError("-o writes a take played from a file: add --from-file FILE "
+                                "(a microphone take is saved from the Live window)")
+        from engine.export import write_trajectories
+
+        if args.output.exists() and not args.overwrite:
+            raise FileExistsError(f"{args.output} exists (use --overwrite to replace it)")
+        audio, rate = read_audio(args.from_file)
+        model = load_model(args)
+        markers, wall = stream_file(model, audio, rate, cfg, args.block_ms / 1000.0,
+                                    not args.as_fast_as_possible)
+        if len(markers) == 0:
+            raise FacetrajError(f"{args.from_file}: the audio is too short to synthesize")
+        out = write_trajectories(args.output, markers, model, None, args.overwrite)
+        log.info("%d frames streamed in %.2f s (%.1f x real time)", len(markers), wall,
+                 len(audio) / rate / max(wall, 1e-9))
+        print(out)
+        return 0
+    try:
+        from app.live import run_live
+    except ImportError as exc:
+        raise FacetrajError(f"the app cannot start: {exc}") from exc
+    return run_live(model_loader=lambda: load_model(args), config=cfg, from_file=args.from_file,
+                    block_s=args.block_ms / 1000.0, fast=args.as_fast_as_possible,
+                    device=args.device, screenshot=args.screenshot, quit_after=args.quit_after)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("live", help="the face follows a microphone (or a file) in real time")
+    p.add_argument("--from-file", type=Path, metavar="AUDIO",
+                   help="play a WAV/FLAC file through the streaming path instead of a microphone")
+    p.add_argument("--as-fast-as-possible", action="store_true",
+                   help="with --from-file: do not wait for the audio clock (benchmarks)")
+    p.add_argument("-o", "--output", type=Path,
+                   help="with --from-file: no window; write the take (.c3d, .tsv, .csv or .npz)")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing output file")
+    p.add_argument("--model", type=Path, help="a trained model (default: the default corpus's)")
+    p.add_argument("--corpus", type=Path, help="train on this corpus when no --model is given")
+    p.add_argument("--device", help="input device (part of its name; default: the system's)")
+    p.add_argument("--block-ms", type=real(0.0625, 10000), default=10.0,
+                   help="audio block size in ms (default 10)")
+    p.add_argument("--warp", type=real(0.5, 2.0), default=1.0, metavar="ALPHA",
+                   help="speaker warp of the input LSFs (engine.speaker; 1 = none, below 1 for a "
+                        "shorter vocal tract than the training voice)")
+    p.add_argument("--screenshot", metavar="OUT.png", help=argparse.SUPPRESS)
+    p.add_argument("--quit-after", type=real(0, 1e6, lo_open=True), metavar="S",
+                   help=argparse.SUPPRESS)
+    g = p.add_argument_group("synthesis (paper 2.3, acoustic-only)")
+    g.add_argument("--smoothing", choices=["triangular", "none"])
+    g.add_argument("--acoustic-prefilter", type=count_or_all, metavar="K|all",
+                   help="weight the K codewords nearest to each frame (default 128)")
+    g.add_argument("--acoustic-probe", type=count_or_all, metavar="P|all",
+                   help="find them in P cells of the model's LSF index (default 8)")
+    p.set_defaults(func=cmd_live)
+

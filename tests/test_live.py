@@ -1,0 +1,65 @@
+"""``facetraj live`` without a window: a file through the streaming path, written as a take."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from engine.config import SynthConfig
+from engine.formats import read_audio, read_marker_table
+from engine.pipeline import synthesize
+from facetraj.cli import main
+
+
+@pytest.fixture(scope="module")
+def model_file(default_model, tmp_path_factory):
+    return default_model.save(tmp_path_factory.mktemp("live") / "model.npz")
+
+
+def test_live_from_file_writes_the_offline_synthesis(model_file, default_model, default_corpus,
+                                                     tmp_path, capsys):
+    wav = default_corpus.root / f"{default_corpus.info.test[0]}.flac"
+    out = tmp_path / "take.tsv"
+    assert main(["-q", "live", "--model", str(model_file), "--from-file", str(wav),
+                 "--as-fast-as-possible", "-o", str(out)]) == 0
+    assert capsys.readouterr().out.strip() == str(out)
+    take = read_marker_table(out)
+    audio, rate = read_audio(wav)
+    offline = synthesize(default_model, audio, rate, None, SynthConfig(mode="acoustic"))
+    assert take.markers.shape == offline.markers.shape
+    np.testing.assert_allclose(take.markers, offline.markers, atol=0.006)   # TSV: 3 decimals
+    # the take exists: not replaced without --overwrite
+    assert main(["-q", "live", "--model", str(model_file), "--from-file", str(wav),
+                 "--as-fast-as-possible", "-o", str(out)]) != 0
+
+
+@pytest.mark.parametrize("args, message", [
+    (["-o", "x.tsv"], "add --from-file"),
+    (["--from-file", "nothing.wav", "-o", "x.tsv"], "nothing.wav: no such audio file"),
+    (["--smoothing", "none", "--from-file", "nothing.wav", "-o", "x.tsv"], "no such audio file"),
+])
+def test_live_bad_input_exit_2(args, message, model_file, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["-q", "live", "--model", str(model_file), *args]) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_live_benchmark_rows_and_section(toy_corpus_dir, tmp_path, monkeypatch):
+    from benchmarks import live as bench
+    from benchmarks.common import load_context
+
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    rows = bench.run(load_context(toy_corpus_dir, smoke=True))
+    names = [r.name for r in rows]
+    assert names[:2] == ["latency sample -> face frame, median",
+                         "latency sample -> face frame, 95th percentile"]
+    assert all(r.value > 0 for r in rows[:5])
+    assert rows[0].value <= rows[1].value
+    assert "skipped" in rows[-1].note                    # no display: no Live window
+    doc = tmp_path / "bench.md"
+    doc.write_text("# Benchmarks\n\ntable\n")
+    bench.write_section(doc, rows)
+    bench.write_section(doc, rows)                       # replaced, not appended twice
+    text = doc.read_text()
+    assert text.startswith("# Benchmarks\n\ntable\n") and text.count("## Live mode") == 1

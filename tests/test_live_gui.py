@@ -1,0 +1,93 @@
+"""The Live window in a real window (Xvfb): a file played through live mode, its take saved and
+reopened; no input device gives the documented message, not a crash."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pytestqt")
+pytest.importorskip("pyvistaqt")
+
+from PyQt6.QtWidgets import QMainWindow
+
+from app import live
+from engine.config import SynthConfig
+from engine.errors import FacetrajError
+from engine.formats import read_audio, read_c3d
+from engine.pipeline import synthesize
+from facetraj.cli import main
+
+
+@pytest.fixture
+def utterance(default_corpus):
+    utt = default_corpus.utterance(default_corpus.info.test[0])
+    return utt.audio[: utt.sample_rate * 2], utt.sample_rate          # 2 s
+
+
+def _image_std(image) -> float:
+    ptr = image.constBits()
+    ptr.setsize(image.sizeInBytes())
+    return float(np.frombuffer(ptr, np.uint8).std())
+
+
+def test_live_window_plays_a_file_and_its_take_reopens(qtbot, default_model, utterance, tmp_path):
+    audio, rate = utterance
+    window = live.LiveWindow(default_model, None, (audio, rate), block_s=0.05, fast=True)
+    qtbot.addWidget(window)
+    window.resize(1200, 700)
+    window.show()
+    qtbot.waitExposed(window)
+    with qtbot.waitSignal(window.takeFinished, timeout=120_000):
+        window.start()
+    offline = synthesize(default_model, audio, rate, None, SynthConfig(mode="acoustic"))
+    take_audio, take_rate, markers = window.take()
+    assert take_rate == rate and len(take_audio) == len(audio)
+    np.testing.assert_allclose(markers, offline.markers, atol=1e-9)       # streamed = offline
+    assert window.updates > 1 and len(window.speech) == len(markers)
+    assert 0 < sum(window.speech) < len(markers)                        # speech and pauses
+    assert window.save_action.isEnabled() and "take:" in window.message.text()
+    # the face moved to the last frame and the window shows something
+    np.testing.assert_allclose(window.face.synth.current, offline.markers[-1])
+    window.face.rerender()
+    assert np.asarray(window.face.plotter.screenshot()).std() > 10
+    assert _image_std(window.grab().toImage()) > 10
+    # the take: WAV + C3D, reopened like any utterance's files
+    path, wav = window.save_take(tmp_path / "take.c3d")
+    back, back_rate = read_audio(wav)
+    assert back_rate == rate and len(back) == len(audio)
+    np.testing.assert_allclose(back, audio, atol=1 / 32767 + 1e-9)
+    c3d = read_c3d(path)
+    assert c3d.markers.shape == offline.markers.shape and c3d.rate == default_model.marker_rate
+    np.testing.assert_allclose(c3d.markers, offline.markers, atol=0.05)
+
+
+def test_no_input_device_gives_the_message(qtbot, default_model, monkeypatch, capsys, tmp_path):
+    monkeypatch.setattr(live, "input_devices", lambda: [])
+    window = live.LiveWindow(default_model)
+    qtbot.addWidget(window)
+    window.show()
+    assert window.message.text() == live.NO_INPUT_DEVICE
+    assert not window.start_action.isEnabled()
+    window.start()                                      # nothing to start: still the message
+    assert window.message.text() == live.NO_INPUT_DEVICE and window.stream is None
+    with pytest.raises(FacetrajError, match="no audio input device"):
+        live.run_live(lambda: default_model)
+    model_file = default_model.save(tmp_path / "m.npz")
+    assert main(["-q", "live", "--model", str(model_file)]) == 2
+    assert live.NO_INPUT_DEVICE in capsys.readouterr().err
+
+
+def test_live_toggle_in_the_main_window(qtbot, default_model, monkeypatch):
+    monkeypatch.setattr(live, "input_devices", lambda: [])
+    window = QMainWindow()
+    window.model = default_model
+    window.show_error = lambda message: None
+    qtbot.addWidget(window)
+    live.install(window)
+    window.extension("live").action.setChecked(True)
+    opened = [w for w in window.findChildren(live.LiveWindow)] or \
+        [w for w in live.QApplication.topLevelWidgets() if isinstance(w, live.LiveWindow)]
+    assert opened and opened[-1].isVisible()
+    window.extension("live").action.setChecked(False)
+    assert not opened[-1].isVisible()
