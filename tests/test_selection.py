@@ -5,14 +5,21 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from conftest import edited_model_file
+
 from engine.config import SynthConfig
 from engine.data import PhoneSegment
 from engine.model import Model
 from engine.pipeline import frame_confidence, mode_for, synthesize
-from engine.selection import (candidate_union, context_distances, context_frames, label_penalty,
-                              mean_normalise, robust_frames, weight_costs)
+from engine.selection import (
+    candidate_union,
+    context_distances,
+    context_frames,
+    label_penalty,
+    mean_normalise,
+    robust_frames,
+    weight_costs,
+)
 from engine.synthesis import gamma_grid, perceptual_weights, weight_frames
 
 
