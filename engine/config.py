@@ -107,8 +107,8 @@ class SynthConfig:
     spline_knot_s: float = 0.1
     acoustic_prefilter: int | None = 128
     acoustic_probe: int | None = 8
-    robust_candidates: int = 64
-    label_weight: float = 4.0
+    robust_candidates: int = 32
+    label_weight: float = 16.0
     context_weight: float = 1.0
     mean_normalise: bool = False
 

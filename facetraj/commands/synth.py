@@ -19,21 +19,24 @@ def cmd_synth(args: argparse.Namespace) -> int:
     from engine.labelmap import read_label_map
     from engine.model import Model
     from engine.pipeline import mode_for, synthesize
+    from engine.tuning import tuned_config
 
     model = Model.load(args.model)
     audio, rate = read_audio(args.audio)
     cfg = synth_config(args)
     labels = None
-    if cfg.mode == "phonetic":
+    if cfg.mode in ("phonetic", "robust"):
         labels = labels_for_audio(args.audio, audio, rate, labels=args.labels, text=args.text,
                                   transcript=args.transcript, recognize=args.recognize,
                                   extra_dict=extra_dictionary(args))
     phones = labels.phones if labels else None
-    cfg = mode_for(cfg, phones)
+    cfg = tuned_config(mode_for(cfg, phones, labels.source if labels else None,
+                                explicit=args.mode == "phonetic"), model.tuned)
+    confidence = labels.confidence if labels and labels.source != "file" else None
     label_map = read_label_map(args.label_map) if args.label_map and labels and \
         labels.source == "file" else None
     res = synthesize(model, audio, rate, phones, cfg, label_map=label_map,
-                     source=str(args.labels or args.audio))
+                     source=str(args.labels or args.audio), confidence=confidence)
     out = write_trajectories(args.output, res.markers, model, res, args.overwrite)
     log.info("%d frames (%.2f s) synthesized, %s mode (labels: %s), %s smoothing", len(res.times),
              res.times[-1], cfg.mode, labels.source if labels else "none", cfg.smoothing)

@@ -1,0 +1,195 @@
+"""Evaluation with automatic labels (issue 16): every mode and baseline on held-out sentences,
+trained and tested with the corpus's exact labels, or with labels from the aligner or the
+recognizer (``engine.labelling``) -- the setting of a real user, who has no hand-checked labels.
+
+For each label kind: a model trained on the training split with those labels; its robust-mode
+settings cross-validated on the training split (``engine.tuning``); then on the test split, with
+the same kind of labels, the paper's phonetic mode (N = 3), acoustic-only (default index search),
+the robust mode, and the two baselines of ``engine.baselines`` (viseme lookup, ridge regression),
+all scored as Table 2 (triangular smoothing, speech frames).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from .baselines import evaluate_baselines, fit_baselines, frame_data
+from .config import SynthConfig, TrainConfig
+from .corpus import Corpus
+from .evaluation import METRICS, UtteranceScore, evaluate_utterance, speech_mask
+from .labelling import RelabelledCorpus, relabelled
+from .model import Model
+from .training import train
+from .tuning import Tuning, cross_validate, tuned_config
+
+log = logging.getLogger(__name__)
+
+#: Label kinds: the corpus's own (exact) labels, and the two automatic ones.
+LABEL_KINDS = ("exact", "aligned", "recognized")
+#: Methods compared, in table order.
+METHODS = ("robust", "phonetic", "acoustic", "ridge", "viseme")
+#: One line per method for the reader.
+METHOD_NOTES = {
+    "robust": "eq 4 and acoustic candidates, label confidence weighting, acoustic context "
+              "(cross-validated settings)",
+    "phonetic": "the paper's method, N = 3",
+    "acoustic": "acoustic-only, default index search",
+    "ridge": "ridge regression on +-5 stacked LSF frames (no labels)",
+    "viseme": "mean face per phone label",
+}
+
+
+@dataclass
+class LabelEval:
+    """Per-utterance test scores of every method under each label kind, and the tunings."""
+
+    scores: dict[str, list[UtteranceScore]] = field(default_factory=dict)
+    tunings: dict[str, dict] = field(default_factory=dict)
+    label_quality: dict[str, dict] = field(default_factory=dict)
+
+    def rows(self, kind: str, method: str) -> list[UtteranceScore]:
+        return [s for s in self.scores.get(kind, []) if s.mode == method]
+
+    def summary(self, kind: str, method: str) -> dict[str, tuple[float, float]]:
+        """Mean and standard deviation over test utterances of each measure."""
+        rows = self.rows(kind, method)
+        out = {}
+        for m in METRICS:
+            v = np.array([getattr(r, m) for r in rows], dtype=float)
+            out[m] = (float(np.nanmean(v)), float(np.nanstd(v))) if len(v) else (np.nan, np.nan)
+        return out
+
+    def best(self, kind: str) -> str:
+        """The method with the highest mean of the three measures under ``kind`` labels."""
+        return max((m for m in METHODS if self.rows(kind, m)),
+                   key=lambda m: np.mean([v[0] for v in self.summary(kind, m).values()]))
+
+    def beats_all(self, kind: str, method: str = "robust") -> bool:
+        """Whether ``method`` is above every other method on all three measures."""
+        mine = self.summary(kind, method)
+        return all(mine[m][0] > self.summary(kind, o)[m][0] for o in METHODS if o != method
+                   and self.rows(kind, o) for m in METRICS)
+
+    def to_json(self) -> dict:
+        return {"summary": {k: {m: self.summary(k, m) for m in METHODS if self.rows(k, m)}
+                            for k in self.scores},
+                "tunings": self.tunings, "label_quality": self.label_quality,
+                "utterances": {k: [asdict(s) for s in v] for k, v in self.scores.items()}}
+
+
+def labelled_corpus(corpus: Corpus, kind: str,
+                    progress: Callable[[float, str], None] | None = None) -> Corpus:
+    """``corpus`` itself (``exact``), or relabelled by the aligner or the recognizer (cached)."""
+    if kind == "exact":
+        return corpus
+    return relabelled(corpus, kind, progress=progress)
+
+
+def confidences(corpus: Corpus) -> dict[str, np.ndarray] | None:
+    """Per utterance, its labels' per-phone confidence (automatic labels), else ``None``."""
+    if not isinstance(corpus, RelabelledCorpus):
+        return None
+    return {u: lab.confidence for u, lab in corpus.auto.labels.items()}
+
+
+def evaluate_kind(corpus: Corpus, kind: str, train_config: TrainConfig | None = None,
+                  model: Model | None = None, tune: bool = True, max_test: int | None = None,
+                  progress: Callable[[float, str], None] | None = None
+                  ) -> tuple[list[UtteranceScore], Tuning | None]:
+    """Train (unless ``model`` is given), cross-validate and score every method on the test split
+    of ``corpus`` labelled by ``kind``."""
+    lab = labelled_corpus(corpus, kind)
+    conf = confidences(lab)
+    if model is None:
+        if progress:
+            progress(0.0, f"{kind}: training")
+        model = train(lab, config=train_config)
+    tuning = cross_validate(lab, train_config, conf) if tune else None
+    robust = tuned_config(SynthConfig(mode="robust"), tuning.to_json() if tuning else model.tuned)
+    configs = [robust, SynthConfig(mode="phonetic"), SynthConfig(mode="acoustic")]
+    test = list(lab.info.test)
+    if max_test is not None and len(test) > max_test:
+        test = [test[int(i)] for i in np.linspace(0, len(test) - 1, max_test)]
+    scores: list[UtteranceScore] = []
+    train_frames = [frame_data(model, lab.utterance(u)) for u in lab.info.train]
+    baselines = fit_baselines(model, train_frames)
+    test_frames = []
+    for j, utt_id in enumerate(test):
+        if progress:
+            progress(j / max(len(test), 1), f"{kind}: {utt_id}")
+        utt = lab.utterance(utt_id)
+        original = model.normalise_markers(utt.markers)
+        speech = speech_mask(utt.audio, utt.sample_rate, utt.frame_times())
+        lsf = model.input_lsf(utt.audio, utt.sample_rate, np.arange(utt.n_frames) / model.marker_rate)
+        c = None if conf is None else conf.get(utt_id)
+        for cfg in configs:
+            from .pipeline import synthesize
+
+            res = synthesize(model, utt.audio, utt.sample_rate, utt.phones, cfg,
+                             n_frames=utt.n_frames, source=utt.name, lsf=lsf, confidence=c)
+            scores.extend(evaluate_utterance(model, utt, "test", cfg, ("triangular",),
+                                             synthesis=res, original=original, speech=speech))
+        test_frames.append(frame_data(model, utt))
+    scores.extend(evaluate_baselines(model, baselines, {"test": test_frames}, ("triangular",)))
+    return scores, tuning
+
+
+def evaluate_labels(corpus: Corpus, kinds: Sequence[str] = LABEL_KINDS,
+                    train_config: TrainConfig | None = None, exact_model: Model | None = None,
+                    tune: bool = True, max_test: int | None = None,
+                    progress: Callable[[float, str], None] | None = None) -> LabelEval:
+    """:func:`evaluate_kind` for every label kind (``exact_model``: an already trained model for
+    the exact labels)."""
+    out = LabelEval()
+    for k, kind in enumerate(kinds):
+        if progress:
+            progress(k / len(kinds), f"{kind} labels")
+        scores, tuning = evaluate_kind(corpus, kind, train_config,
+                                       exact_model if kind == "exact" else None, tune, max_test)
+        out.scores[kind] = scores
+        if tuning is not None:
+            out.tunings[kind] = tuning.to_json()
+    if progress:
+        progress(1.0, "done")
+    return out
+
+
+def _cell(v: tuple[float, float]) -> str:
+    return f"{v[0]:.4f} ± {v[1]:.2f}"
+
+
+def format_markdown(result: LabelEval) -> str:
+    """The results.md section: one table per label kind and a plain recommendation."""
+    lines = []
+    for kind in result.scores:
+        lines += ["", f"**{kind.title()} labels** (train and test labelled the same way)", "",
+                  "| Method | Whole face | Lower lip | Upper lip | Utterances |",
+                  "|---|---:|---:|---:|---:|"]
+        for m in METHODS:
+            rows = result.rows(kind, m)
+            if not rows:
+                continue
+            s = result.summary(kind, m)
+            lines.append(f"| {m} ({METHOD_NOTES[m]}) | {_cell(s['whole_face'])} | "
+                         f"{_cell(s['lower_lip'])} | {_cell(s['upper_lip'])} | {len(rows)} |")
+        tuned = result.tunings.get(kind, {}).get("settings")
+        if tuned:
+            lines += ["", "Robust settings chosen by cross-validation on the training split: "
+                      + ", ".join(f"{k} = {v:g}" for k, v in tuned.items()) + "."]
+    lines += ["", recommendation(result)]
+    return "\n".join(lines)
+
+
+def recommendation(result: LabelEval) -> str:
+    """Which mode to pick for which labels, said from the numbers."""
+    parts = []
+    for kind in result.scores:
+        best = result.best(kind)
+        beats = result.beats_all(kind)
+        parts.append(f"with {kind} labels the best is **{best}**"
+                     + (" (robust above every other method on all three measures)" if beats else ""))
+    return "Which mode to pick: " + "; ".join(parts) + "."
