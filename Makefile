@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 XVFB   := $(if $(DISPLAY),,xvfb-run -a -s "-screen 0 1600x1200x24")
 
-.PHONY: run test lint bench corpus report clean
+.PHONY: run test lint bench fuzz corpus report clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -34,6 +34,13 @@ test: lint
 
 bench: $(VENV)/.installed-test
 	$(XVFB) $(BIN)/python -m benchmarks
+
+# the long bad-input fuzz run (tests/fuzzing.py): thousands of mutated inputs, each in a forked
+# child with a memory limit and a timeout; prints a table per category (docs/bad-input.md)
+FUZZ_CASES ?= 2100
+FUZZ_SEED  ?= 14
+fuzz: $(VENV)/.installed-test
+	$(BIN)/python tests/fuzzing.py --cases $(FUZZ_CASES) --seed $(FUZZ_SEED)
 
 corpus: $(VENV)/.installed-corpus
 	$(BIN)/facetraj corpus build data_samples

@@ -8,6 +8,7 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+import math
 import os
 from collections.abc import Iterator
 from dataclasses import asdict, dataclass, field
@@ -20,6 +21,7 @@ from .errors import InputError
 from .formats import (
     MARKER_SUFFIXES,
     atomic_write,
+    check_output_path,
     read_audio,
     read_labels,
     read_markers,
@@ -32,6 +34,7 @@ log = logging.getLogger(__name__)
 
 CORPUS_FORMAT = "facetraj-corpus"
 CORPUS_VERSION = 1
+MAX_DESCRIPTION_BYTES = 64 << 20
 
 
 @dataclass
@@ -91,9 +94,17 @@ class CorpusInfo:
 
     @classmethod
     def from_json(cls, obj: dict, path: str | os.PathLike[str] | None = None) -> CorpusInfo:
+        """The description in ``obj`` (parsed JSON), its schema (:data:`SCHEMA`) and its marker
+        roles checked; any problem is an :class:`InputError` naming ``path``."""
+        if not isinstance(obj, dict):
+            raise InputError(path, f"not a facetraj corpus description (a JSON "
+                                   f"{type(obj).__name__}, not an object)")
         if obj.get("format") != CORPUS_FORMAT:
             raise InputError(path, f"not a facetraj corpus description (format {obj.get('format')!r})")
-        if int(obj.get("version", 0)) > CORPUS_VERSION:
+        version = obj.get("version", 1)
+        if not isinstance(version, int) or isinstance(version, bool) or version < 1:
+            raise InputError(path, f"'version' is {version!r:.40}, not a whole number")
+        if version > CORPUS_VERSION:
             raise InputError(path, f"corpus format version {obj['version']} is newer than this "
                                    f"facetraj understands ({CORPUS_VERSION})")
         known = set(cls.__dataclass_fields__)
@@ -102,7 +113,16 @@ class CorpusInfo:
                                "lower_lip", "train", "test") if k not in kwargs]
         if missing:
             raise InputError(path, f"missing entries: {', '.join(missing)}")
+        for key, value in kwargs.items():
+            check, what = SCHEMA[key]
+            if not check(value):
+                raise InputError(path, f"{key!r} is {json.dumps(value)[:60]}, not {what}")
         info = cls(**kwargs)
+        if len(set(info.marker_names)) != len(info.marker_names):
+            raise InputError(path, "marker_names lists a marker twice")
+        if set(info.train) & set(info.test):
+            raise InputError(path, f"utterances in both train and test: "
+                                   f"{' '.join(sorted(set(info.train) & set(info.test))[:5])}")
         for m in [*info.fixed_markers, info.upper_lip, info.lower_lip, *info.lip_corners]:
             if m not in info.marker_names:
                 raise InputError(path, f"marker {m!r} is not among marker_names")
@@ -113,15 +133,56 @@ class CorpusInfo:
         return info
 
 
+def _names(v) -> bool:
+    return isinstance(v, list) and all(isinstance(x, str) and x.strip() for x in v)
+
+
+def _ids(v) -> bool:
+    """Utterance ids: plain file stems (no folders, nothing hidden)."""
+    return _names(v) and all("/" not in x and "\\" not in x and not x.startswith(".") for x in v)
+
+
+def _text(v) -> bool:
+    return isinstance(v, str)
+
+
+def _rate(v) -> bool:
+    return (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+            and 1 <= v <= 10000)
+
+
+#: corpus.json fields: a check of the value and what it must be (for the message).
+SCHEMA: dict[str, tuple] = {
+    "marker_names": (lambda v: _names(v) and len(v) >= 2, "a list of at least 2 marker names"),
+    "marker_rate": (_rate, "a number of frames per second from 1 to 10000"),
+    "fixed_markers": (_names, "a list of marker names"),
+    "upper_lip": (lambda v: isinstance(v, str) and bool(v), "a marker name"),
+    "lower_lip": (lambda v: isinstance(v, str) and bool(v), "a marker name"),
+    "train": (lambda v: _ids(v) and len(v) >= 1, "a list of at least one utterance id (file stem)"),
+    "test": (_ids, "a list of utterance ids (file stems)"),
+    "lip_corners": (lambda v: _names(v) and len(v) in (0, 2), "a list of 2 marker names (or [])"),
+    "units": (lambda v: v == "mm", '"mm"'),
+    "axes": (lambda v: isinstance(v, dict) and all(isinstance(x, str) for x in v.values()),
+             "an object of axis names"),
+    "label_set": (_text, "text"),
+    "label_map": (_text, "text (\"\", \"mocha\" or a label map file)"),
+    "data_dir": (_text, "text (a folder relative to the description)"),
+    "dimensions": (lambda v: v in (2, 3) and not isinstance(v, bool), "2 or 3"),
+    "name": (_text, "text"),
+    "description": (_text, "text"),
+}
+
+
 def _json_path(root: str | os.PathLike[str]) -> Path:
     root = Path(root)
     return root if root.suffix.lower() == ".json" else root / "corpus.json"
 
 
-def save_corpus_info(root: str | os.PathLike[str], info: CorpusInfo) -> Path:
+def save_corpus_info(root: str | os.PathLike[str], info: CorpusInfo,
+                     overwrite: bool = True) -> Path:
     """Write ``root/corpus.json`` (or ``root`` itself when it names a ``.json`` file)."""
     path = _json_path(root)
-    with atomic_write(path) as tmp:
+    with atomic_write(path, overwrite) as tmp:
         tmp.write_text(json.dumps(info.to_json(), indent=2) + "\n", encoding="utf-8")
     return path
 
@@ -132,10 +193,16 @@ def load_corpus_info(root: str | os.PathLike[str]) -> CorpusInfo:
     if not path.exists():
         raise InputError(path, "no corpus.json in this folder" if path.name == "corpus.json"
                          else "no such corpus description")
+    if path.is_dir():
+        raise InputError(path, "is a folder, not a corpus description")
+    if path.stat().st_size > MAX_DESCRIPTION_BYTES:
+        raise InputError(path, f"is {path.stat().st_size} bytes, too large for a corpus description")
     try:
         obj = json.loads(path.read_text(encoding="utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise InputError(path, f"not valid JSON ({exc})") from exc
+    except RecursionError:
+        raise InputError(path, "not valid JSON (nested too deeply)") from None
     return CorpusInfo.from_json(obj, path)
 
 
@@ -218,10 +285,15 @@ def load_corpus(root: str | os.PathLike[str]) -> Corpus:
     """Open a corpus folder, or a corpus description ``.json`` (utterances load on demand)."""
     root = Path(root)
     if root.suffix.lower() == ".json" and root.is_file():
-        return Corpus(root.parent, load_corpus_info(root))
-    if not root.is_dir():
+        corpus = Corpus(root.parent, load_corpus_info(root))
+    elif not root.is_dir():
         raise InputError(root, "not a folder")
-    return Corpus(root, load_corpus_info(root))
+    else:
+        corpus = Corpus(root, load_corpus_info(root))
+    if not corpus.data_root.is_dir():
+        raise InputError(_json_path(root), f"its data folder {corpus.info.data_dir!r} "
+                                           f"({corpus.data_root}) is not a folder")
+    return corpus
 
 
 def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
@@ -252,7 +324,7 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
     mdata = read_markers(mpath, info.marker_rate)
     if mdata.names != info.marker_names:
         raise InputError(mpath, f"marker set differs from the corpus description "
-                                f"({len(mdata.names)} markers, {len(info.marker_names)} expected)")
+                                f"({marker_set_difference(mdata.names, info.marker_names)})")
     markers = mdata.markers
     n_audio = int(np.floor(len(audio) / rate * info.marker_rate + 1e-9)) + 1
     if markers.shape[0] < n_audio - 1:
@@ -268,8 +340,11 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
                     "%.0f ms are left out of training and evaluation", mpath, 100 * seen, 100)
     text = ""
     txt = root / f"{utt_id}.txt"
-    if txt.exists():
-        text = txt.read_text(encoding="utf-8").strip()
+    if txt.is_file():
+        try:
+            text = txt.read_text(encoding="utf-8").strip()
+        except UnicodeDecodeError:
+            raise InputError(txt, "the transcript is not UTF-8 text") from None
     return Utterance(name=utt_id, audio=audio, sample_rate=rate, phones=phones,
                      markers=markers, marker_rate=info.marker_rate,
                      marker_names=list(mdata.names), words=words, text=text)
@@ -323,16 +398,20 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
                 fixed: list[str] | None = None, upper_lip: str = "", lower_lip: str = "",
                 lip_corners: list[str] | None = None, label_map: str = "",
                 marker_rate: float = 60.0, test: list[str] | None = None,
-                test_fraction: float = 1 / 3, name: str = "") -> tuple[Path, CorpusInfo]:
+                test_fraction: float = 1 / 3, name: str = "",
+                overwrite: bool = True) -> tuple[Path, CorpusInfo]:
     """Describe a folder of someone's own recordings as a corpus and write the description.
 
     Utterances are the file stems that have audio, labels and markers. The marker roles (fixed
     references, lip centres) are given by name; the test split is ``test`` or every
     ``round(1 / test_fraction)``-th utterance. ``output`` defaults to ``data_dir/corpus.json``;
     when it lies elsewhere (a read-only data folder), the description records ``data_dir``
-    relative to it.
+    relative to it. An existing description is replaced only with ``overwrite``.
     """
     data_dir = Path(data_dir).resolve()
+    out = Path(output) if output else data_dir / "corpus.json"
+    out = out if out.suffix.lower() == ".json" else out / "corpus.json"
+    check_output_path(out, overwrite)
     scan = scan_folder(data_dir)
     ids, names, planar = scan.ids, scan.marker_names, scan.dimensions == 2
     for role in [*(fixed or []), upper_lip, lower_lip, *(lip_corners or [])]:
@@ -345,16 +424,34 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
     train_ids = [u for u in ids if u not in test]
     if not train_ids:
         train_ids, test = ids, [u for u in test if u in ids]
-    out = Path(output) if output else data_dir / "corpus.json"
-    out = out if out.suffix.lower() == ".json" else out / "corpus.json"
     rel = "" if out.parent.resolve() == data_dir else os.path.relpath(data_dir, out.parent.resolve())
     info = CorpusInfo(marker_names=names, marker_rate=float(marker_rate), fixed_markers=list(fixed or []),
                       upper_lip=upper_lip, lower_lip=lower_lip, train=train_ids, test=list(test),
                       lip_corners=list(lip_corners or []), label_map=label_map, data_dir=rel,
                       dimensions=2 if planar else 3, name=name or data_dir.name)
     CorpusInfo.from_json(info.to_json(), out)  # the same checks as on loading
-    save_corpus_info(out, info)
+    save_corpus_info(out, info, overwrite)
     return out, info
+
+
+def marker_set_difference(found: list[str], expected: list[str]) -> str:
+    """How a marker set differs from the expected one, in words (for error messages).
+
+    >>> marker_set_difference(["a", "b", "x"], ["a", "b", "c"])
+    "3 markers, 3 expected; 'c' missing; 'x' not expected"
+    >>> marker_set_difference(["b", "a"], ["a", "b"])
+    '2 markers, 2 expected; the same names in another order'
+    """
+    parts = [f"{len(found)} markers, {len(expected)} expected"]
+    missing = [n for n in expected if n not in found]
+    extra = [n for n in found if n not in expected]
+    if missing:
+        parts.append(f"{', '.join(map(repr, missing[:5]))}{' ...' if len(missing) > 5 else ''} missing")
+    if extra:
+        parts.append(f"{', '.join(map(repr, extra[:5]))}{' ...' if len(extra) > 5 else ''} not expected")
+    if not missing and not extra and found != expected:
+        parts.append("the same names in another order")
+    return "; ".join(parts)
 
 
 def marker_coverage(markers: np.ndarray) -> float:

@@ -23,8 +23,12 @@ class InputError(FacetrajError):
 
     def __init__(self, path: str | PathLike[str] | None, problem: str):
         self.path = None if path is None else str(path)
-        self.problem = problem
-        super().__init__(f"{self.path}: {problem}" if self.path else problem)
+        self.problem = " ".join(str(problem).split())  # always one line (library texts may wrap)
+        super().__init__(f"{self.path}: {self.problem}" if self.path else self.problem)
+
+
+class OutputExistsError(InputError, FileExistsError):
+    """The output file exists and replacing it was not asked for (``--overwrite``)."""
 
 
 class ModelFileError(InputError):

@@ -113,8 +113,9 @@ def trajectory_correlations(original: np.ndarray, synthesized: np.ndarray, mask:
     lip y and upper lip y. ``original`` and ``synthesized`` are ``(T, M, 3)`` head-normalised."""
     config = config or EvalConfig()
     ok = mask & np.isfinite(original).all(axis=(1, 2)) & np.isfinite(synthesized).all(axis=(1, 2))
-    o = original[ok].reshape(int(ok.sum()), -1)
-    s = synthesized[ok].reshape(int(ok.sum()), -1)
+    width = int(np.prod(original.shape[1:]))    # explicit: no frame at all may be left
+    o = original[ok].reshape(int(ok.sum()), width)
+    s = synthesized[ok].reshape(int(ok.sum()), width)
     coords = moving_coordinates(model, config.moving_fraction)
     per = np.array([pearson(o[:, c], s[:, c]) for c in coords])
     y = 1

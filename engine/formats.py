@@ -8,10 +8,14 @@ where the user's file was.
 from __future__ import annotations
 
 import contextlib
+import errno
 import io
 import logging
 import os
+import signal
+import stat
 import tempfile
+import threading
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,22 +23,98 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import resample_poly
 
+from .c3d_check import MAX_RATE as MAX_C3D_RATE
+from .c3d_check import MIN_RATE as MIN_C3D_RATE
+from .c3d_check import check_c3d
 from .data import PhoneSegment
-from .errors import InputError
+from .errors import InputError, OutputExistsError
 
 log = logging.getLogger(__name__)
 
 MIN_SAMPLE_RATE = 8000
 AUDIO_SUFFIXES = (".wav", ".flac")
 LABEL_SUFFIXES = (".textgrid", ".lab", ".phn")
+_NAME_MAX = 255  # bytes in one file name on the usual file systems
 
 
 # --------------------------------------------------------------------------- writing safely
+#: What an OS error while writing means, in words (instead of the raw errno text).
+_WRITE_PROBLEMS = {
+    errno.EACCES: "permission denied", errno.EPERM: "permission denied",
+    errno.EROFS: "the file system is read-only", errno.ENOSPC: "no space left on the device",
+    errno.EDQUOT: "the disk quota is exceeded", errno.ENAMETOOLONG: "the name is too long",
+    errno.EISDIR: "it is a folder", errno.ENOTDIR: "a folder in the path is a file",
+    errno.ENOENT: "the folder does not exist", errno.EFBIG: "the file would be too large",
+}
+
+
+def write_problem(exc: OSError) -> str:
+    """The reason an output cannot be written, in words."""
+    return _WRITE_PROBLEMS.get(exc.errno, exc.strerror or type(exc).__name__)
+
+
+def check_output_path(path: str | os.PathLike[str], overwrite: bool = True) -> Path:
+    """Refuse an output path that cannot be written, before any work is done: an existing file
+    without ``overwrite`` (:class:`~engine.errors.OutputExistsError`), a folder at the path, a
+    parent that is a regular file, a name too long, a folder we may not write in.
+    Raises :class:`InputError` naming the path; returns it as a :class:`Path`."""
+    path = Path(path)
+    if len(os.fsencode(path.name)) > _NAME_MAX:
+        raise InputError(path, f"the file name is too long ({len(os.fsencode(path.name))} bytes; "
+                               f"at most {_NAME_MAX})")
+    if path.is_dir():
+        raise InputError(path, "a folder is at this path; give a file name")
+    if path.exists() and not overwrite:
+        raise OutputExistsError(path, "already exists; choose to overwrite it (--overwrite) or "
+                                      "give another name")
+    folder = path.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if folder.exists() and not folder.is_dir():
+        raise InputError(path, f"cannot be written: {folder} is a file, not a folder")
+    if folder.is_dir() and not os.access(folder, os.W_OK | os.X_OK):
+        raise InputError(path, f"cannot be written: no permission to write in {folder}")
+    return path
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+class _TermToExit:
+    """While a write is under way in the main thread, SIGTERM raises ``SystemExit(143)`` (as
+    SIGINT raises KeyboardInterrupt), so the temporary file is removed; the previous handler is
+    restored afterwards."""
+
+    def __enter__(self):
+        self.previous = None
+        if threading.current_thread() is threading.main_thread():
+            try:
+                self.previous = signal.signal(signal.SIGTERM, self._raise)
+            except ValueError:  # not the main interpreter
+                self.previous = None
+        return self
+
+    @staticmethod
+    def _raise(signum, frame):
+        raise SystemExit(128 + signum)
+
+    def __exit__(self, *exc):
+        if self.previous is not None:
+            signal.signal(signal.SIGTERM, self.previous)
+        return False
+
+
 @contextlib.contextmanager
 def atomic_write(path: str | os.PathLike[str], overwrite: bool = True) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; rename it into place only if the block succeeds.
 
-    Raises :class:`FileExistsError` when ``path`` exists and ``overwrite`` is false.
+    The file gets the mode of the file it replaces, or the user's umask for a new one. The
+    temporary file is removed when the block fails, on Ctrl-C and on SIGTERM. Raises
+    :class:`~engine.errors.OutputExistsError` when ``path`` exists and ``overwrite`` is false, and
+    :class:`InputError` naming ``path`` when it cannot be written (see :func:`check_output_path`).
 
     Examples
     --------
@@ -45,20 +125,30 @@ def atomic_write(path: str | os.PathLike[str], overwrite: bool = True) -> Iterat
     >>> out.read_text()
     'done'
     """
-    path = Path(path)
-    if path.exists() and not overwrite:
-        raise FileExistsError(f"{path}: already exists; choose to overwrite it (--overwrite) "
-                              "or give another name")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.part-", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
+    path = check_output_path(path, overwrite)
+    try:
+        mode = stat.S_IMODE(path.stat().st_mode) if path.exists() else 0o666 & ~_umask()
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem[:40]}.part-", suffix=path.suffix[:20],
+                                   dir=path.parent)
+        os.close(fd)
+    except OSError as exc:
+        raise InputError(path, f"cannot be written ({write_problem(exc)})") from exc
     tmp_path = Path(tmp)
     try:
-        yield tmp_path
-        os.replace(tmp_path, path)
+        with _TermToExit():
+            try:
+                yield tmp_path
+                os.chmod(tmp_path, mode)
+                os.replace(tmp_path, path)
+            except OSError as exc:
+                if isinstance(exc, FileExistsError) and isinstance(exc, InputError):
+                    raise
+                raise InputError(path, f"cannot be written ({write_problem(exc)})") from exc
     finally:
-        if tmp_path.exists():
-            tmp_path.unlink()
+        with contextlib.suppress(OSError):
+            if tmp_path.exists():
+                tmp_path.unlink()
 
 
 # --------------------------------------------------------------------------- audio
@@ -106,6 +196,8 @@ def write_audio(path: str | os.PathLike[str], samples: np.ndarray, rate: int,
 def _read_text(path: Path) -> str:
     if not path.exists():
         raise InputError(path, "no such label file")
+    if path.is_dir():
+        raise InputError(path, "is a folder, not a file")
     raw = path.read_bytes()
     try:
         if raw.startswith((b"\xff\xfe", b"\xfe\xff")):  # UTF-16 (Praat writes it) only with a BOM
@@ -120,7 +212,7 @@ def read_textgrid_tiers(path: str | os.PathLike[str]) -> dict[str, list[PhoneSeg
     from praatio import textgrid
 
     path = Path(path)
-    _read_text(path)  # existence and encoding, with our own message
+    _check_interval_order(path, _read_text(path))  # our own messages, before praatio's
     try:
         tg = textgrid.openTextgrid(str(path), includeEmptyIntervals=True)
     except Exception as exc:
@@ -133,6 +225,35 @@ def read_textgrid_tiers(path: str | os.PathLike[str]) -> dict[str, list[PhoneSeg
         tiers[name] = [PhoneSegment(float(s), float(e), str(lab).strip())
                        for s, e, lab in tier.entries]
     return tiers
+
+
+def _check_interval_order(path: Path, text: str) -> None:
+    """Refuse interval tiers whose intervals are out of order, overlap or are not numbers (praatio
+    would sort them silently, or fail with its own text)."""
+    from praatio.utilities import textgrid_io
+
+    try:
+        parsed = textgrid_io.parseTextgridStr(text, includeEmptyIntervals=True)
+    except Exception as exc:  # praatio raises several types for malformed text
+        raise InputError(path, f"not a readable TextGrid ({exc})") from exc
+    for tier in parsed.get("tiers", []):
+        if tier.get("class") != "IntervalTier":
+            continue
+        prev_end = -np.inf
+        for i, (start, end, label) in enumerate(tier["entries"]):
+            try:
+                start, end = float(start), float(end)
+            except ValueError:
+                raise InputError(path, f"tier {tier['name']!r}: interval {i + 1} has a time that "
+                                       f"is not a number ({start} {end})") from None
+            if not (np.isfinite(start) and np.isfinite(end)):
+                raise InputError(path, f"tier {tier['name']!r}: interval {i + 1} has a time that "
+                                       f"is not a finite number ({start} {end})")
+            if start < prev_end - 1e-6:
+                raise InputError(path, f"tier {tier['name']!r}: interval {i + 1} ({label!r}) at "
+                                       f"{start:.3f} s overlaps or precedes the one before, "
+                                       f"ending {prev_end:.3f} s")
+            prev_end = max(prev_end, end)
 
 
 def read_textgrid(path: str | os.PathLike[str], tier: str = "phones") -> list[PhoneSegment]:
@@ -182,6 +303,10 @@ def read_lab(path: str | os.PathLike[str]) -> list[PhoneSegment]:
         times = np.array([[float(r[0]), float(r[1])] for r in rows])
     except ValueError as exc:
         raise InputError(path, f"a start or end time is not a number ({exc})") from exc
+    if times.size and not np.all(np.isfinite(times)):
+        row = int(np.flatnonzero(~np.isfinite(times).all(axis=1))[0])
+        raise InputError(path, f"segment {row + 1} has a time that is not a finite number "
+                               f"({rows[row][0]} {rows[row][1]})")
     scale = 1e-7 if times.size and times.max() > 1e4 else 1.0
     return [PhoneSegment(a * scale, b * scale, r[2]) for (a, b), r in zip(times, rows, strict=True)]
 
@@ -206,12 +331,16 @@ def read_labels(path: str | os.PathLike[str], sample_rate: int = 16000,
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".textgrid":
-        return read_textgrid(path, tier)
-    if suffix == ".lab":
-        return read_lab(path)
-    if suffix == ".phn":
-        return read_phn(path, sample_rate)
-    raise InputError(path, f"unknown label format {suffix!r} (use .TextGrid, .lab or .phn)")
+        segs = read_textgrid(path, tier)
+    elif suffix == ".lab":
+        segs = read_lab(path)
+    elif suffix == ".phn":
+        segs = read_phn(path, sample_rate)
+    else:
+        raise InputError(path, f"unknown label format {suffix!r} (use .TextGrid, .lab or .phn)")
+    if not segs:
+        raise InputError(path, "the label file holds no segments")
+    return segs
 
 
 def validate_phones(phones: Sequence[PhoneSegment], duration: float,
@@ -269,23 +398,38 @@ def read_c3d(path: str | os.PathLike[str]) -> MarkerData:
     path = Path(path)
     if not path.exists():
         raise InputError(path, "no such C3D file")
+    if path.is_dir():
+        raise InputError(path, "is a folder, not a C3D file")
+    check_c3d(path)
     try:
         c3d = ezc3d.c3d(str(path))
     except Exception as exc:
-        raise InputError(path, f"not a readable C3D file ({exc})") from exc
-    point = c3d["parameters"]["POINT"]
+        reason = str(exc).split(". ")[0].split("\n")[0]  # not ezc3d's advice to set options
+        raise InputError(path, f"not a readable C3D file ({reason})") from exc
+    point = c3d["parameters"].get("POINT", {})
+
+    def values(name: str) -> list:
+        return list(point.get(name, {}).get("value", []))
+
     pts = np.asarray(c3d["data"]["points"], dtype=np.float64)[:3]  # (3, M, T)
     if pts.ndim != 3 or pts.shape[1] == 0 or pts.shape[2] == 0:
         raise InputError(path, "the C3D file holds no points")
-    names = [str(n).strip() for n in point["LABELS"]["value"]][: pts.shape[1]]
-    unit = str(point.get("UNITS", {}).get("value", ["mm"])[0]).strip().lower() or "mm"
+    names = [str(n).strip() for n in values("LABELS")][: pts.shape[1]]
+    if len(names) != pts.shape[1]:
+        raise InputError(path, f"the C3D file names {len(names)} of its {pts.shape[1]} points "
+                               f"(POINT:LABELS)")
+    unit = str((values("UNITS") or ["mm"])[0]).strip().lower() or "mm"
     scale = _UNIT_TO_MM.get(unit)
     if scale is None:
         raise InputError(path, f"unknown point unit {unit!r}")
+    rate = float((values("RATE") or [c3d["header"]["points"]["frame_rate"]])[0])
+    if not MIN_C3D_RATE <= rate <= MAX_C3D_RATE:  # NaN fails too
+        raise InputError(path, f"the C3D frame rate {rate:g} Hz is outside {MIN_C3D_RATE:g}-"
+                               f"{MAX_C3D_RATE:g} Hz")
     residuals = np.asarray(c3d["data"]["meta_points"]["residuals"])[0]  # (M, T)
     markers = np.transpose(pts, (2, 1, 0)) * scale
     markers[residuals.T < 0] = np.nan
-    return MarkerData(markers, float(point["RATE"]["value"][0]), names)
+    return MarkerData(markers, rate, names)
 
 
 C3D_INT_SCALE = 0.01  # mm per integer step in integer C3D files
@@ -343,6 +487,18 @@ def write_marker_tsv(path: str | os.PathLike[str], markers: np.ndarray, rate: fl
                    fmt=["%.6f"] + ["%.4f"] * (table.shape[1] - 1))
 
 
+def _rate_of(path: Path, times: np.ndarray) -> float:
+    """The frame rate of a time column: (frames - 1) / span, refused unless the span is finite and
+    positive and the rate within the marker rates facetraj reads."""
+    span = float(times[-1] - times[0])
+    rate = (len(times) - 1) / span if np.isfinite(span) and span > 0 else np.nan
+    if not MIN_C3D_RATE <= rate <= MAX_C3D_RATE:  # NaN fails too
+        raise InputError(path, f"its times ({times[0]:g} to {times[-1]:g} s over {len(times)} "
+                               f"frames) give no marker rate within {MIN_C3D_RATE:g}-"
+                               f"{MAX_C3D_RATE:g} Hz")
+    return rate
+
+
 def read_marker_table(path: str | os.PathLike[str], rate: float | None = None) -> MarkerData:
     """Read TSV/CSV trajectories with a header ``[time] name_x name_y name_z ...`` (mm).
 
@@ -378,7 +534,7 @@ def read_marker_table(path: str | os.PathLike[str], rate: float | None = None) -
         base, _, axis = h.rpartition("_")
         markers[:, names.index(base), "xyz".index(axis.lower())] = table[:, col]
     if times is not None and len(times) > 1:
-        rate = (len(times) - 1) / (times[-1] - times[0])
+        rate = _rate_of(path, times)
         rate = float(round(rate)) if abs(rate - round(rate)) < 1e-3 * rate else float(rate)
     if rate is None:
         raise InputError(path, "no time column: give the marker rate")
@@ -476,7 +632,7 @@ def read_mocha_ema(path: str | os.PathLike[str]) -> MarkerData:
     markers = np.stack([_midsagittal(chans[:, cx], chans[:, cy]) for cx, cy in cols], axis=1)
     rate = MOCHA_RATE
     if len(times) > 1:
-        rate = float(round((len(times) - 1) / (times[-1] - times[0])))
+        rate = float(round(_rate_of(path, times)))
     return MarkerData(markers, rate, names)
 
 
@@ -521,6 +677,11 @@ def read_markers(path: str | os.PathLike[str], rate: float | None = None) -> Mar
         data = read_mocha_ema(path)
     else:
         raise InputError(path, f"unknown marker format {suffix!r} (use .c3d, .tsv, .csv or .ema)")
+    if not MIN_C3D_RATE <= data.rate <= MAX_C3D_RATE:  # NaN fails too
+        raise InputError(path, f"the marker rate {data.rate:g} Hz (from the file's times) is "
+                               f"outside {MIN_C3D_RATE:g}-{MAX_C3D_RATE:g} Hz")
+    if data.markers.shape[0] == 0 or data.markers.shape[1] == 0:
+        raise InputError(path, "the marker file holds no frames or no markers")
     if rate is not None and abs(data.rate - rate) > 1e-6:
         log.info("%s: markers resampled from %g Hz to %g Hz", path, data.rate, rate)
         data = MarkerData(resample_markers(data.markers, data.rate, rate), float(rate), data.names)

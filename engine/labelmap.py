@@ -24,14 +24,25 @@ MOCHA_TO_ARPABET: dict[str, str] = {
 }
 
 
-def read_label_map(path: str | os.PathLike[str]) -> dict[str, str]:
+class LabelMap(dict):
+    """A label map (label -> ARPAbet) that remembers where it was read from, so that a label it
+    maps to an unknown phone is blamed on it, not on the label file."""
+
+    def __init__(self, table: dict[str, str], source: str):
+        super().__init__(table)
+        self.source = source
+
+
+def read_label_map(path: str | os.PathLike[str]) -> LabelMap:
     """Read a ``label<TAB>arpabet`` file (whitespace also separates); ``mocha`` names the built-in
     MOCHA map."""
     if str(path).lower() == "mocha":
-        return dict(MOCHA_TO_ARPABET)
+        return LabelMap(MOCHA_TO_ARPABET, "the built-in MOCHA label map")
     path = Path(path)
     if not path.exists():
         raise InputError(path, "no such label map")
+    if path.is_dir():
+        raise InputError(path, "is a folder, not a label map file")
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError as exc:
@@ -45,7 +56,7 @@ def read_label_map(path: str | os.PathLike[str]) -> dict[str, str]:
         if len(parts) != 2:
             raise InputError(path, f"line {lineno}: expected 'label arpabet', got {line!r}")
         table[parts[0]] = parts[1]
-    return table
+    return LabelMap(table, str(path))
 
 
 def write_label_map(path: str | os.PathLike[str], table: dict[str, str]) -> None:

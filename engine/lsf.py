@@ -198,7 +198,11 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     >>> lsf_at(rng.standard_normal(16000), 16000, np.array([0.5]), order=10).shape
     (1, 10)
     """
-    x = resample_audio(audio, rate, audio_rate)
+    x = np.asarray(audio, dtype=np.float64)
+    peak = float(np.max(np.abs(x))) if x.size else 0.0
+    if 0 < peak < np.inf:  # to a peak in [0.5, 1) by a power of 2: exact, and LPC is scale-free,
+        x = np.ldexp(x, -int(np.frexp(peak)[1]))  # so huge samples cannot overflow to inf
+    x = resample_audio(x, rate, audio_rate)
     frames = analysis_frames(x, audio_rate, np.asarray(times, dtype=np.float64), window_s,
                              preemphasis)
     return poly2lsf(lpc(frames, order))

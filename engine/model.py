@@ -9,7 +9,6 @@ from __future__ import annotations
 import json
 import logging
 import os
-import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -23,6 +22,7 @@ from .formats import atomic_write
 from .lsf import lsf_at
 from .lsf_index import LsfIndex, build_index
 from .markers import fill_gaps, remove_head_motion
+from .model_file import read_model_file
 from .pca import PCA
 from .similarity import similarity_matrix
 
@@ -181,35 +181,16 @@ class Model:
 
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> Model:
-        """Read a model written by :meth:`save`; a wrong, truncated or newer file is refused."""
+        """Read a model written by :meth:`save`; a wrong, truncated, damaged or newer file is
+        refused (:func:`engine.model_file.read_model_file` checks every entry first)."""
         path = Path(path)
-        if not path.exists():
-            raise ModelFileError(path, "no such model file")
-        if not zipfile.is_zipfile(path):
-            raise ModelFileError(path, "not a facetraj model (not an .npz archive, or truncated)")
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                if "meta" not in z.files:
-                    raise ModelFileError(path, "not a facetraj model (no metadata entry)")
-                meta = json.loads(str(z["meta"]))
-                if meta.get("format") != MODEL_FORMAT:
-                    raise ModelFileError(path, "not a facetraj model")
-                if int(meta.get("version", 0)) > MODEL_VERSION:
-                    raise ModelFileError(path, f"model format {meta['version']} is newer than this "
-                                               f"facetraj reads ({MODEL_VERSION}); upgrade facetraj")
-                a = {k: z[k] for k in z.files if k != "meta"}
-        except ModelFileError:
-            raise
-        except (zipfile.BadZipFile, OSError, ValueError, EOFError, KeyError) as exc:
-            raise ModelFileError(path, f"not a readable facetraj model ({exc})") from exc
+        meta, a = read_model_file(path, MODEL_VERSION, MODEL_FORMAT)
         try:
             pca = PCA(a["pca_mean"], a["pca_components"], a["pca_variances"],
                       float(meta["pca_total_variance"]))
             cb = Codebook(a["cb_contexts"], a["cb_lsf"], a["cb_pcs"], a["cb_token_utt"],
                           a["cb_token_start"], a["cb_token_end"], int(meta["n_per_phone"]),
                           a.get("cb_lsf_context"))
-            if cb.lsf_context is not None and cb.lsf_context.shape[0] != cb.lsf.shape[0]:
-                raise ModelFileError(path, "its codeword LSF context does not match its codebook")
             index = (LsfIndex(a["ix_centroids"], a["ix_order"], a["ix_offsets"])
                      if "ix_centroids" in a else None)
             if index is not None and not _index_fits(index, cb.lsf):

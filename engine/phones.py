@@ -81,6 +81,11 @@ def map_labels(phones: Sequence[PhoneSegment], known: Sequence[str],
                                 lab, alt)
                     warned.add(lab)
                 lab = alt
+            elif table and (raw in table or normalise_label(raw) in table):
+                raise InputError(getattr(table, "source", None) or "the label map",
+                                 f"maps {raw!r} (at {seg.start:.3f} s in {path or 'the labels'}) "
+                                 f"to {lab!r}, which is not in the model; known phones: "
+                                 f"{' '.join(sorted(known_set))}")
             else:
                 raise InputError(path, f"phone {raw!r} at {seg.start:.3f} s is not in the model; "
                                        f"known phones: {' '.join(sorted(known_set))}")

@@ -100,6 +100,7 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                phones: Sequence[PhoneSegment] | None = None, config: SynthConfig | None = None,
                n_frames: int | None = None, label_map: Mapping[str, str] | None = None,
                source: str | None = None, lsf: np.ndarray | None = None,
+               audio_source: str | None = None,
                confidence: Sequence[float] | np.ndarray | None = None) -> Synthesis:
     """Synthesize face point trajectories from speech (paper section 2.3).
 
@@ -113,8 +114,9 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     e.g. :attr:`engine.alignment.Labels.confidence`; ``None``: 1, hand-checked) for codewords eq 4
     did not choose. Then smoothing, and the PCs back to ``(T, M, 3)`` markers.
 
-    ``n_frames`` defaults to every marker frame inside the audio. ``source`` names the input in
-    error messages. ``lsf`` may pass the input LSFs already computed by :meth:`Model.input_lsf`
+    ``n_frames`` defaults to every marker frame inside the audio. ``source`` names the input (the
+    labels) in error messages, ``audio_source`` the audio (default ``source``).
+    ``lsf`` may pass the input LSFs already computed by :meth:`Model.input_lsf`
     for these frames (when one utterance is synthesized under several configs).
     """
     config = config or SynthConfig()
@@ -123,7 +125,8 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     if n_frames is None:
         n_frames = int(np.floor(duration * rate + 1e-9)) + 1
     if n_frames < 2 or duration < 2.0 / rate:
-        raise InputError(source, f"the audio is too short ({duration * 1000:.1f} ms) to synthesize")
+        raise InputError(audio_source or source,
+                         f"the audio is too short ({duration * 1000:.1f} ms) to synthesize")
     times = np.arange(n_frames) / rate
     mc = model.config
     if lsf is None:

@@ -13,8 +13,10 @@ import sys
 from collections.abc import Sequence
 
 from engine.errors import FacetrajError
+from engine.formats import write_problem
 
 from .commands import align, corpus, evaluate, gui, render, synth, train
+from .options import SECONDS
 from .paths import default_corpus
 
 log = logging.getLogger("facetraj")
@@ -35,11 +37,32 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--screenshot", metavar="OUT.png",
                         help="render the app window to a PNG and exit")
     parser.add_argument("--utterance", help="utterance shown first")
-    parser.add_argument("--time", type=float, help="cursor time in seconds")
+    parser.add_argument("--time", type=SECONDS, help="cursor time in seconds")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for module in COMMANDS:
         module.register(sub)
+    for subparser in subcommand_parsers(parser):
+        _add_verbosity(subparser)
     return parser
+
+
+def subcommand_parsers(parser: argparse.ArgumentParser) -> list[argparse.ArgumentParser]:
+    """Every (nested) subcommand parser under ``parser``, each once, in registration order."""
+    found: list[argparse.ArgumentParser] = []
+    for action in parser._actions:  # argparse offers no public walk over subparsers
+        if isinstance(action, argparse._SubParsersAction):
+            for child in dict.fromkeys(action.choices.values()):
+                found.append(child)
+                found.extend(subcommand_parsers(child))
+    return found
+
+
+def _add_verbosity(p: argparse.ArgumentParser) -> None:
+    """``-v``/``-q`` after the subcommand too; SUPPRESS keeps the value given before it."""
+    p.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS,
+                   help="log details")
+    p.add_argument("-q", "--quiet", action="store_true", default=argparse.SUPPRESS,
+                   help="log only errors")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -57,8 +80,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except FacetrajError as exc:
         print(f"facetraj: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    except FileExistsError as exc:
-        print(f"facetraj: error: {exc}", file=sys.stderr)
+    except OSError as exc:  # a file the commands did not check themselves: still one line
+        where = exc.filename or exc.filename2
+        problem = write_problem(exc) if exc.strerror else str(exc)
+        print(f"facetraj: error: {where + ': ' if where else ''}{problem}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         return 130

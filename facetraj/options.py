@@ -1,13 +1,72 @@
-"""The training and synthesis options shared by several subcommands, and the configurations
-(:class:`~engine.config.TrainConfig`, :class:`~engine.config.SynthConfig`) built from them."""
+"""The training and synthesis options shared by several subcommands, the range-checked option
+types every subcommand uses, and the configurations (:class:`~engine.config.TrainConfig`,
+:class:`~engine.config.SynthConfig`) built from them.
+
+A value out of range is refused by argparse with the valid range (exit status 2), e.g.
+``argument -N/--n-context-phones: expected a whole number from 1 to 1000, got '0'``.
+"""
 
 from __future__ import annotations
 
 import argparse
+import math
+from collections.abc import Callable
 
 from engine.config import SynthConfig, TrainConfig
 
 ALL = -1
+
+
+def _fmt(x: float) -> str:
+    return f"{x:g}"
+
+
+def integer(lo: int, hi: int) -> Callable[[str], int]:
+    """An argparse type: a whole number in ``[lo, hi]``.
+
+    >>> integer(1, 10)("3")
+    3
+    >>> integer(1, 10)("0")
+    Traceback (most recent call last):
+    argparse.ArgumentTypeError: expected a whole number from 1 to 10, got '0'
+    """
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = None
+        if value is None or not lo <= value <= hi:
+            raise argparse.ArgumentTypeError(f"expected a whole number from {lo} to {hi}, "
+                                             f"got {text!r}")
+        return value
+    parse.__name__ = f"integer({lo}..{hi})"
+    return parse
+
+
+def real(lo: float, hi: float, lo_open: bool = False, hi_open: bool = False) -> Callable[[str], float]:
+    """An argparse type: a finite number in the interval from ``lo`` to ``hi`` (each end open or
+    closed).
+
+    >>> real(0, 1, lo_open=True)("0.5")
+    0.5
+    >>> real(0, 1, lo_open=True)("nan")
+    Traceback (most recent call last):
+    argparse.ArgumentTypeError: expected a number in (0, 1], got 'nan'
+    """
+    interval = f"{'(' if lo_open else '['}{_fmt(lo)}, {_fmt(hi)}{')' if hi_open else ']'}"
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        ok = (math.isfinite(value) and (value > lo if lo_open else value >= lo)
+              and (value < hi if hi_open else value <= hi))
+        if not ok:
+            raise argparse.ArgumentTypeError(f"expected a number in {interval}, got {text!r}")
+        return value
+    parse.__name__ = f"number{interval}"
+    return parse
 
 
 def count_or_all(text: str) -> int:
@@ -22,35 +81,71 @@ def count_or_all(text: str) -> int:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a positive whole number or 'all', got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a positive whole number or 'all', got {text!r}")
+    if not 1 <= value <= MAX_COUNT:
+        raise argparse.ArgumentTypeError(f"expected a whole number from 1 to {MAX_COUNT} or 'all', "
+                                         f"got {text!r}")
     return value
+
+
+#: Largest count any option accepts (codewords, cells, top-N ...).
+MAX_COUNT = 1_000_000
+PCS = integer(0, 1000)
+VARIANCE = real(0, 1, lo_open=True)
+LPC_ORDER = integer(2, 64)
+CONTEXT = integer(0, 10)
+POSITIVE = real(0, 1e6, lo_open=True)
+CODEWORDS = integer(1, 100)
+MAX_GAP_S = real(0, 10)
+CELLS = integer(1, MAX_COUNT)
+TOP_N = integer(1, MAX_COUNT)
+XI = real(1, 1e6)
+FPS = real(1, 240)
+SECONDS = real(0, 1e6)
+RATE = real(1, 100000)
+FRACTION = real(0, 1, hi_open=True)
+
+
+def video_size(text: str) -> tuple[int, int]:
+    """An argparse type: ``WIDTHxHEIGHT`` in pixels, each from 16 to 7680.
+
+    >>> video_size("640x480")
+    (640, 480)
+    """
+    parts = text.lower().split("x")
+    try:
+        w, h = (int(v) for v in parts)
+    except ValueError:
+        w = h = 0
+    if not (16 <= w <= 7680 and 16 <= h <= 7680):
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT, each from 16 to 7680 pixels, "
+                                         f"got {text!r}")
+    return w, h
 
 
 def add_train_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("training (paper 2.1-2.2)")
-    g.add_argument("--pcs", type=int, help="PCs kept (default 20; 0 = as many as reach "
+    g.add_argument("--pcs", type=PCS, help="PCs kept (default 20; 0 = as many as reach "
                                            "--variance-target)")
-    g.add_argument("--variance-target", type=float, help="variance fraction (default 0.99)")
-    g.add_argument("--lpc-order", type=int, help="LPC order P (default 18)")
-    g.add_argument("--context", type=int, help="phones of context C each side (default 3)")
-    g.add_argument("--nu", type=float, help="eq 3 constant (default 10)")
-    g.add_argument("--codewords-per-phone", type=int, help="codewords per phone (default 5)")
+    g.add_argument("--variance-target", type=VARIANCE, help="variance fraction (default 0.99)")
+    g.add_argument("--lpc-order", type=LPC_ORDER, help="LPC order P (default 18)")
+    g.add_argument("--context", type=CONTEXT, help="phones of context C each side (default 3)")
+    g.add_argument("--nu", type=POSITIVE, help="eq 3 constant (default 10)")
+    g.add_argument("--codewords-per-phone", type=CODEWORDS, help="codewords per phone (default 5)")
     g.add_argument("--placement", choices=["centres", "edges"], help="codeword placement")
     g.add_argument("--distance-scale", choices=["max", "median", "none"],
                    help="normalisation of D before eq 3 (default max)")
-    g.add_argument("--max-gap-s", type=float, help="longest marker gap filled (default 0.1 s)")
-    g.add_argument("--index-cells", type=int,
+    g.add_argument("--max-gap-s", type=MAX_GAP_S, help="longest marker gap filled (default 0.1 s)")
+    g.add_argument("--index-cells", type=CELLS,
                    help="cells of the LSF index for acoustic-only synthesis (default sqrt(5L))")
 
 
 def add_synth_options(p: argparse.ArgumentParser, nu: bool = True) -> None:
     g = p.add_argument_group("synthesis (paper 2.3)")
-    g.add_argument("-N", "--n-context-phones", type=int, help="top-N context-phones (default 3)")
-    g.add_argument("--xi", type=float, help="eq 4 constant (default 20)")
+    g.add_argument("-N", "--n-context-phones", type=TOP_N, help="top-N context-phones (default 3)")
+    g.add_argument("--xi", type=XI, help="eq 4 constant (default 20)")
     if nu:
-        g.add_argument("--nu", type=float, help="override eq 3's constant")
-    g.add_argument("--synth-context", type=int, help="context C used in eq 4 (default 3)")
+        g.add_argument("--nu", type=POSITIVE, help="override eq 3's constant")
+    g.add_argument("--synth-context", type=CONTEXT, help="context C used in eq 4 (default 3)")
     g.add_argument("--mode", choices=["phonetic", "acoustic", "robust"],
                    help="phonetic: the paper's eq 4, labels trusted (default for label files); "
                         "robust: eq 4 and acoustic candidates weighted by label confidence "

@@ -1,8 +1,13 @@
 """Every row of docs/bad-input.md, produced for real: the documented message is the one given."""
 
+import errno
 import json
 import logging
+import os
 import re
+import struct
+import tempfile
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -10,6 +15,7 @@ import pytest
 import soundfile as sf
 from alignment_cases import alignment_cases
 from conftest import edited_model_file
+from fuzzing import _c3d_rate
 
 from engine.config import SynthConfig
 from engine.corpus import CorpusInfo, load_corpus, save_corpus_info
@@ -23,6 +29,7 @@ from engine.formats import (
     read_labels,
     read_markers,
     read_mocha_ema,
+    read_textgrid,
     validate_phones,
     write_c3d,
 )
@@ -74,6 +81,7 @@ def produce(case: str, tmp: Path, toy_dir: Path, model: Model, caplog) -> str:
     def with_phone(label: str):
         return [PhoneSegment(s.start, s.end, label if i == 1 else s.label) for i, s in enumerate(phones)]
 
+    lab1 = next(s.label for s in phones if s.label != "sil")
     gappy = toy_markers.copy()
     gappy[20:40] = np.nan
     sparse = np.where(np.arange(len(toy_markers))[:, None, None] % 3 == 0, toy_markers, np.nan)
@@ -134,6 +142,58 @@ def produce(case: str, tmp: Path, toy_dir: Path, model: Model, caplog) -> str:
         "a MOCHA EMA file with the wrong column count": lambda: read_mocha_ema(
             write("x.ema", "0 1 2 3\n1 1 2 3\n")),
         "a label map line that is not a pair": lambda: read_label_map(write("map.txt", "a b c\n")),
+        "a label map that maps a label to a phone the model does not know": lambda: synthesize(
+            model, audio, rate, phones, label_map=read_label_map(write("m.tsv", f"{lab1}\tzz\n"))),
+        "a label file or label map given as a folder": lambda: (
+            (tmp / "f.lab").mkdir(), read_labels(tmp / "f.lab")),
+        "TextGrid intervals out of order or overlapping": lambda: read_textgrid(write(
+            "o.TextGrid", (toy_dir / "toy030.TextGrid").read_text().replace(
+                "xmin = 0.25", "xmin = 0.001", 1))),
+        "a .lab time that is not a finite number (`inf`, `nan`)": lambda: read_lab(
+            write("i.lab", "0 0.5 a\n0.5 inf b\n")),
+        "an empty phone tier": lambda: read_labels(write("e.lab", "# nothing\n")),
+        "a transcript (`<id>.txt`) that is not UTF-8": lambda: (
+            write("u.txt", b"caf\xe9"), corpus_with()),
+        "markers whose names differ from the corpus (same count)": lambda: corpus_with(
+            toy_markers, [n + "_X" if i == 3 else n for i, n in enumerate(names)]),
+        "marker table or EMA times that give no sane rate": lambda: read_markers(write(
+            "t.tsv", "time\ta_x\ta_y\ta_z\n0\t1\t2\t3\n0\t1\t2\t3\n")),
+        "a C3D whose header or parameters ask for more than the file holds": lambda: read_c3d(
+            write("h.c3d", (toy_dir / "toy030.c3d").read_bytes()[:3000])),
+        "a C3D whose parameter section is damaged": lambda: read_c3d(write(
+            "p.c3d", _damaged_parameter((toy_dir / "toy030.c3d").read_bytes()))),
+        "a C3D frame rate outside 1-10000 Hz": lambda: read_c3d(write(
+            "r.c3d", _c3d_rate((toy_dir / "toy030.c3d").read_bytes(), 1e6))),
+        "a model whose metadata has wrong types or values": lambda: Model.load(edited_model_file(
+            model.save(tmp / "full.npz"), tmp / "m.npz", meta=np.array(json.dumps(
+                {**_meta(tmp / "full.npz"), "marker_rate": "60"})))),
+        "a model array of the wrong shape or data type": lambda: Model.load(edited_model_file(
+            model.save(tmp / "full.npz"), tmp / "m.npz", cb_lsf=model.codebook.lsf[:, 1:])),
+        "a model array holding NaN or infinite values": lambda: Model.load(edited_model_file(
+            model.save(tmp / "full.npz"), tmp / "m.npz", means=model.means * np.nan)),
+        "a model entry whose .npy header asks for too much memory": lambda: Model.load(
+            _forged_header(model.save(tmp / "full.npz"), tmp / "m.npz")),
+        "a model entry with an unsupported zip compression method": lambda: Model.load(
+            _bzip2(model.save(tmp / "full.npz"), tmp / "m.npz")),
+        "a corpus.json that is not an object": lambda: (write("corpus.json", "[]"), load_corpus(tmp)),
+        "a corpus.json entry of the wrong type or range": lambda: (write("corpus.json", json.dumps(
+            {**info.to_json(), "marker_rate": 0})), load_corpus(tmp)),
+        "a corpus.json nested too deeply": lambda: (write("corpus.json", "[" * 10**5 + "]" * 10**5),
+                                                    load_corpus(tmp)),
+        "a corpus.json whose data folder is missing": lambda: (write("corpus.json", json.dumps(
+            {**info.to_json(), "data_dir": "gone"})), load_corpus(tmp)),
+        "an option value out of its range (`-N 0`, `--xi nan`, `--lpc-order 0`)": lambda: _parse(
+            ["synth", "m.npz", "a.wav", "-o", "o.tsv", "-N", "0"]),
+        "a folder at the output path (even with `--overwrite`)": lambda: (
+            (tmp / "o.tsv").mkdir(), atomic_write(tmp / "o.tsv").__enter__()),
+        "an output whose parent is a regular file": lambda: (
+            write("f", "x"), atomic_write(tmp / "f" / "o.tsv").__enter__()),
+        "an output name too long for the file system": lambda: atomic_write(
+            tmp / ("x" * 300)).__enter__(),
+        "an output folder without write permission": lambda: _patched(
+            os, "access", lambda *a: False, lambda: atomic_write(tmp / "o.tsv").__enter__()),
+        "an output on a read-only file system": lambda: _patched(
+            tempfile, "mkstemp", _erofs, lambda: atomic_write(tmp / "o.tsv").__enter__()),
     }
     cases.update(alignment_cases(tmp))
     caplog.clear()
@@ -143,6 +203,65 @@ def produce(case: str, tmp: Path, toy_dir: Path, model: Model, caplog) -> str:
     except (FacetrajError, FileExistsError) as exc:
         return str(exc) + "\n" + caplog.text
     return caplog.text
+
+
+def _meta(path: Path) -> dict:
+    with np.load(path) as z:
+        return json.loads(str(z["meta"]))
+
+
+def _forged_header(src: Path, dst: Path) -> Path:
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w") as zout:
+        for item in zin.infolist():
+            data = zin.read(item)
+            if item.filename == "cb_lsf.npy":
+                hdr = "{'descr': '<f8', 'fortran_order': False, 'shape': (1099511627776, 18), }"
+                hdr = hdr.ljust(117) + "\n"
+                data = b"\x93NUMPY\x01\x00" + struct.pack("<H", len(hdr)) + hdr.encode()
+            zout.writestr(item.filename, data)
+    return dst
+
+
+def _bzip2(src: Path, dst: Path) -> Path:
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w", zipfile.ZIP_BZIP2) as zout:
+        for item in zin.infolist():
+            zout.writestr(item.filename, zin.read(item))
+    return dst
+
+
+def _damaged_parameter(c3d: bytes) -> bytes:
+    """The C3D with POINT:USED's offset to the next entry pointing far past the section."""
+    i = c3d.find(b"USED", 512)
+    return c3d[: i + 4] + b"\xff\x7f" + c3d[i + 6:]
+
+
+def _parse(argv: list[str]) -> None:
+    """Parse a command line; the option parser's error (exit 2) becomes the message."""
+    import contextlib
+    import io
+
+    from facetraj.cli import build_parser
+
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        try:
+            build_parser().parse_args(argv)
+        except SystemExit as exc:
+            assert exc.code == 2
+            raise FacetrajError(err.getvalue().splitlines()[-1]) from None
+
+
+def _patched(module, name: str, value, action):
+    old = getattr(module, name)
+    setattr(module, name, value)
+    try:
+        return action()
+    finally:
+        setattr(module, name, old)
+
+
+def _erofs(*args, **kwargs):
+    raise OSError(errno.EROFS, "Read-only file system")
 
 
 @pytest.mark.parametrize("case, phrases", _rows(), ids=[r[0] for r in _rows()])

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from engine.errors import FacetrajError
 
+from ..options import FRACTION, RATE, integer
 from ..progress import TerminalProgress
 
 log = logging.getLogger("facetraj")
@@ -35,7 +36,8 @@ def cmd_corpus_init(args: argparse.Namespace) -> int:
 
     out, info = init_corpus(args.data_dir, args.output, args.fixed, args.upper_lip,
                             args.lower_lip, args.lip_corners, args.label_map or "", args.rate,
-                            args.test, args.test_fraction, args.name or "")
+                            args.test, args.test_fraction, args.name or "",
+                            overwrite=args.overwrite)
     log.info("%d train and %d test utterances, %d markers (%d-D)", len(info.train),
              len(info.test), len(info.marker_names), info.dimensions)
     print(out)
@@ -80,7 +82,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     csub = p.add_subparsers(dest="corpus_command", metavar="ACTION", required=True)
     b = csub.add_parser("build", help="synthesize the default corpus into a folder")
     b.add_argument("output", type=Path)
-    b.add_argument("--sentences", type=int, help="number of sentences")
+    b.add_argument("--sentences", type=integer(1, 100000), help="number of sentences")
     b.add_argument("--seed", type=int, help="random seed")
     b.set_defaults(func=cmd_corpus_build)
     i = csub.add_parser("init", help="describe a folder of your own recordings as a corpus")
@@ -93,10 +95,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     i.add_argument("--lower-lip", required=True, metavar="MARKER")
     i.add_argument("--lip-corners", nargs=2, metavar=("RIGHT", "LEFT"))
     i.add_argument("--label-map", help="'mocha' or a label map file (label<TAB>arpabet)")
-    i.add_argument("--rate", type=float, default=60.0, help="marker rate to resample to (60 Hz)")
+    i.add_argument("--rate", type=RATE, default=60.0, help="marker rate to resample to (60 Hz)")
     i.add_argument("--test", nargs="+", metavar="ID", help="test utterances")
-    i.add_argument("--test-fraction", type=float, default=1 / 3)
+    i.add_argument("--test-fraction", type=FRACTION, default=1 / 3)
     i.add_argument("--name")
+    i.add_argument("--overwrite", action="store_true", help="replace an existing description")
     i.set_defaults(func=cmd_corpus_init)
     sh = csub.add_parser("show", help="list a corpus's utterances")
     sh.add_argument("corpus", type=Path, help="corpus folder or description .json")

@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from ..options import add_synth_options, synth_config
+from ..options import POSITIVE, TOP_N, add_synth_options, integer, synth_config
 from ..progress import TerminalProgress
 
 
@@ -75,14 +75,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("sweep", help="correlation against N (Figure 5)")
     p.add_argument("model", type=Path)
     p.add_argument("corpus", type=Path)
-    p.add_argument("--max-n", type=int, default=10)
+    p.add_argument("--max-n", type=integer(1, 100), default=10)
     p.add_argument("--split", choices=["train", "test", "all"], default="all")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_sweep)
 
     p = sub.add_parser("similarity", help="visual phoneme similarity (Table 1)")
     p.add_argument("model", type=Path)
-    p.add_argument("--nu", type=float, help="eq 3 constant (default: the model's)")
-    p.add_argument("--top", type=int, default=3)
+    p.add_argument("--nu", type=POSITIVE, help="eq 3 constant (default: the model's)")
+    p.add_argument("--top", type=TOP_N, default=3)
     p.add_argument("--csv", action="store_true", help="the full K x K matrix as CSV")
     p.set_defaults(func=cmd_similarity)

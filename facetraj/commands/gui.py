@@ -7,6 +7,8 @@ from pathlib import Path
 
 from engine.errors import FacetrajError
 
+from ..options import SECONDS
+
 
 def cmd_gui(args: argparse.Namespace) -> int:
     try:
@@ -23,5 +25,5 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--model", type=Path, help="a trained model (default: train and cache)")
     p.add_argument("--screenshot", metavar="OUT.png", help="render to a PNG and exit")
     p.add_argument("--utterance", help="utterance shown first")
-    p.add_argument("--time", type=float, help="cursor time in seconds")
+    p.add_argument("--time", type=SECONDS, help="cursor time in seconds")
     p.set_defaults(func=cmd_gui)

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from engine.errors import FacetrajError
 
-from ..options import add_synth_options, synth_config
+from ..options import FPS, add_synth_options, integer, synth_config, video_size
 from ..progress import TerminalProgress
 
 
@@ -41,8 +41,9 @@ def cmd_video(args: argparse.Namespace) -> int:
     else:
         raise FacetrajError("give an AUDIO file, or --corpus and --utterance")
     cfg = mode_for(synth_config(args), phones)
-    res = synthesize(model, audio, rate, phones, cfg, n_frames=n_frames, source=source)
-    w, h = (int(v) for v in args.size.lower().split("x"))
+    res = synthesize(model, audio, rate, phones, cfg, n_frames=n_frames, source=source,
+                     audio_source=str(args.audio or source))
+    w, h = args.size
     render_video(model, res, audio, rate, args.output, original=original,
                  settings=VideoSettings(w, h, args.fps), overwrite=args.overwrite,
                  progress=TerminalProgress("video"), title=title)
@@ -70,7 +71,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", type=Path, default=Path("docs"),
                    help="folder of results.md, results.json and figures/ (default docs)")
     p.add_argument("--model", type=Path, help="a trained model (default: train on the corpus)")
-    p.add_argument("--max-n", type=int, default=10, help="the N sweep runs 1..MAX_N")
+    p.add_argument("--max-n", type=integer(1, 100), default=10, help="the N sweep runs 1..MAX_N")
     p.set_defaults(func=cmd_report)
 
     p = sub.add_parser("video", help="an MP4 of the face points and lip panels with the sound")
@@ -81,7 +82,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--utterance", help="utterance id in --corpus")
     p.add_argument("-o", "--output", type=Path, required=True, help="an .mp4 file")
     p.add_argument("--overwrite", action="store_true", help="replace an existing file")
-    p.add_argument("--fps", type=float, default=30.0)
-    p.add_argument("--size", default="1280x544", help="WIDTHxHEIGHT")
+    p.add_argument("--fps", type=FPS, default=30.0)
+    p.add_argument("--size", type=video_size, default=(1280, 544),
+                   help="WIDTHxHEIGHT (16 to 7680 pixels each)")
     add_synth_options(p)
     p.set_defaults(func=cmd_video)

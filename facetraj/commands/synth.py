@@ -36,7 +36,8 @@ def cmd_synth(args: argparse.Namespace) -> int:
     label_map = read_label_map(args.label_map) if args.label_map and labels and \
         labels.source == "file" else None
     res = synthesize(model, audio, rate, phones, cfg, label_map=label_map,
-                     source=str(args.labels or args.audio), confidence=confidence)
+                     source=str(args.labels or args.audio), audio_source=str(args.audio),
+                     confidence=confidence)
     out = write_trajectories(args.output, res.markers, model, res, args.overwrite)
     log.info("%d frames (%.2f s) synthesized, %s mode (labels: %s), %s smoothing", len(res.times),
              res.times[-1], cfg.mode, labels.source if labels else "none", cfg.smoothing)

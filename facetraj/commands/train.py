@@ -14,8 +14,10 @@ log = logging.getLogger("facetraj")
 
 def cmd_train(args: argparse.Namespace) -> int:
     from engine.corpus import load_corpus
+    from engine.formats import check_output_path
     from engine.training import train
 
+    check_output_path(args.output, args.overwrite)  # before training, not after
     corpus = load_corpus(args.corpus)
     model = train(corpus, config=train_config(args), progress=TerminalProgress("train"))
     if args.tune:

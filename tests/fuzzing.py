@@ -1,0 +1,939 @@
+"""The bad-input fuzz suite: seeded, mutated inputs run through the ``facetraj`` command line.
+
+Each case mutates one input (audio, labels, a model file, corpus.json, a C3D file, an option
+value, an output path) of a command that works on the unmutated inputs, runs the command and
+checks the README's promise: no traceback, exit status 0 or 2, an error as one line
+``facetraj: error: <file>: <problem>``, no output left at the output path after a failure, no
+``.part`` file, nothing the user had is changed without ``--overwrite``, no NaN in a written
+trajectory, no hang, no run above :data:`MEMORY_LIMIT`.
+
+``tests/test_fuzz.py`` runs a few hundred cases in-process (``facetraj.cli.main``) under a
+minute; ``make fuzz`` (``python tests/fuzzing.py``) runs thousands, each in a forked child with
+an address-space limit (``resource.setrlimit``) and a timeout, and prints a table per category.
+Option cases are built from the parser itself (every option of every subcommand with a
+``type``), so new commands are covered as they are added.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import hashlib
+import io
+import json
+import os
+import random
+import resource
+import shutil
+import signal
+import struct
+import sys
+import time
+import traceback
+import zipfile
+from collections import Counter, defaultdict
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+#: Address-space limit above the parent's own size for each forked run, and the RSS ceiling.
+MEMORY_LIMIT = 2 << 30
+#: Seconds a forked run may take before it counts as a hang.
+TIMEOUT_S = 60.0
+#: Commands whose runs open windows or render (only their option parsing is fuzzed).
+PARSE_ONLY = {"gui", "report", "video", "build", None}
+BAD_NUMBERS = ["0", "-1", "-20", "nan", "inf", "-inf", "1e309", "1e-320", "abc", "", "3.5",
+               "99999999999999999999", "0x10", "1e6", "-0", "1e-9", "2"]
+
+CATEGORIES = ("audio", "labels", "model", "corpus", "c3d", "markers", "options", "output")
+
+
+@dataclass
+class Case:
+    """One fuzz run: ``argv`` for ``facetraj``, the files it must not change, its output path."""
+
+    category: str
+    name: str
+    argv: list[str]
+    protected: dict[Path, tuple[str, int]] = field(default_factory=dict)  # sha256, mode
+    output: Path | None = None
+    parse_only: bool = False
+    keep_mode: int | None = None   # the mode an overwritten output must keep
+
+
+@dataclass
+class Outcome:
+    case: Case
+    status: str          # ok (exit 0), refused (exit 2), or a failure: traceback, hang, ...
+    code: int
+    detail: str = ""
+    seconds: float = 0.0
+    max_rss: int = 0
+
+    @property
+    def failed(self) -> bool:
+        return self.status not in ("ok", "refused")
+
+
+# --------------------------------------------------------------------------- the workspace
+@dataclass
+class Workspace:
+    """Valid inputs every case starts from: a small corpus, a model trained on it, audio, labels."""
+
+    root: Path
+    corpus: Path
+    model: Path
+    wav: Path
+    textgrid: Path
+    lab: Path
+    c3d: Path
+    n: int = 0
+
+    def fresh(self, name: str) -> Path:
+        """A new empty folder for one case."""
+        self.n += 1
+        d = self.root / "cases" / f"{self.n:05d}-{name}"
+        d.mkdir(parents=True)
+        return d
+
+
+def make_workspace(root: Path, toy_dir: Path | None = None, model_path: Path | None = None
+                   ) -> Workspace:
+    """A small corpus (3 utterances of the toy corpus) and a model trained on it, in ``root``."""
+    from engine.corpus import CorpusInfo, load_corpus, save_corpus_info
+    from engine.formats import read_labels
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    if toy_dir is None:
+        from toycorpus import build_toy_corpus
+
+        toy_dir = build_toy_corpus(root / "toy")
+    corpus = root / "corpus"
+    corpus.mkdir(parents=True, exist_ok=True)
+    ids = ["toy000", "toy001", "toy030"]
+    for utt in ids:
+        for ext in ("wav", "TextGrid", "c3d"):
+            shutil.copy(toy_dir / f"{utt}.{ext}", corpus / f"{utt}.{ext}")
+    info = load_corpus(toy_dir).info
+    save_corpus_info(corpus, CorpusInfo(**{**info.__dict__, "train": ids[:2], "test": ids[2:]}))
+    model = root / "model.npz"
+    if model_path is not None:
+        shutil.copy(model_path, model)
+    else:
+        from engine.training import train
+
+        train(load_corpus(toy_dir)).save(model)
+    lab = root / "toy030.lab"
+    segs = read_labels(corpus / "toy030.TextGrid")
+    lab.write_text("".join(f"{s.start:.4f} {s.end:.4f} {s.label}\n" for s in segs))
+    (root / "toy030.phn").write_text("".join(f"{round(s.start * 16000)} {round(s.end * 16000)} "
+                                             f"{s.label}\n" for s in segs))
+    return Workspace(root, corpus, model, corpus / "toy030.wav", corpus / "toy030.TextGrid", lab,
+                     corpus / "toy030.c3d")
+
+
+# --------------------------------------------------------------------------- byte mutations
+def mutate_bytes(rng: random.Random, data: bytes, start: int = 0,
+                 end: int | None = None) -> tuple[bytes, str]:
+    """A random damage: truncation, bit flips, random bytes, a zeroed or repeated block."""
+    end = len(data) if end is None else min(end, len(data))
+    start = min(start, max(end - 1, 0))
+    d = bytearray(data)
+    kind = rng.choice(["truncate", "flip", "bytes", "zero", "ff", "insert", "delete", "empty"])
+    if kind == "truncate":
+        d = d[: rng.randrange(0, max(len(d), 1))]
+    elif kind == "empty":
+        d = bytearray()
+    elif kind in ("flip", "bytes"):
+        for _ in range(rng.choice([1, 2, 4, 8, 32])):
+            i = rng.randrange(start, max(end, start + 1))
+            if i < len(d):
+                d[i] = d[i] ^ (1 << rng.randrange(8)) if kind == "flip" else rng.randrange(256)
+    elif kind in ("zero", "ff"):
+        i = rng.randrange(start, max(end, start + 1))
+        n = rng.choice([2, 4, 16, 128])
+        d[i:i + n] = (b"\0" if kind == "zero" else b"\xff") * len(d[i:i + n])
+    elif kind == "insert":
+        i = rng.randrange(start, max(end, start + 1))
+        d[i:i] = bytes(rng.randrange(256) for _ in range(rng.choice([1, 3, 64])))
+    else:
+        i = rng.randrange(start, max(end, start + 1))
+        del d[i:i + rng.choice([1, 4, 100])]
+    return bytes(d), kind
+
+
+def _digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _protect(*paths: Path) -> dict[Path, tuple[str, int]]:
+    """Files a case must leave as they are: their digests and modes."""
+    return {p: (_digest(p), p.stat().st_mode) for p in paths if p.is_file()}
+
+
+def _synth_argv(ws: Workspace, model: Path, audio: Path, out: Path, labels: Path | None = None,
+                extra: list[str] | None = None) -> list[str]:
+    argv = ["synth", str(model), str(audio), "-o", str(out), "-q"]
+    if labels is not None:
+        argv += ["--labels", str(labels)]
+    return argv + (extra or [])
+
+
+# --------------------------------------------------------------------------- audio
+def audio_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
+    import numpy as np
+    import soundfile as sf
+
+    samples, rate = sf.read(str(ws.wav), dtype="float64")
+    while True:
+        d = ws.fresh("audio")
+        kind = rng.choice(["bytes", "bytes", "huge", "nan", "rate", "channels", "format", "short",
+                           "silence", "clip"])
+        path = d / "in.wav"
+        if kind == "bytes":
+            data, how = mutate_bytes(rng, ws.wav.read_bytes(), 0, rng.choice([64, 2000, None]))
+            path.write_bytes(data)
+            name = f"damaged ({how})"
+        elif kind == "huge":
+            scale = 10.0 ** rng.choice([10, 100, 154, 200, 300, 307, 308])
+            x = samples * scale if rng.random() < 0.5 else np.where(
+                np.arange(len(samples)) == rng.randrange(len(samples)), scale, samples)
+            sf.write(str(path), x, rate, subtype="DOUBLE")
+            name = f"huge samples {scale:.0e}"
+        elif kind == "nan":
+            x = samples.copy()
+            x[rng.randrange(len(x))] = rng.choice([np.nan, np.inf, -np.inf])
+            sf.write(str(path), x, rate, subtype="FLOAT")
+            name = "NaN or inf sample"
+        elif kind == "rate":
+            r = rng.choice([1, 100, 7999, 8000, 11025, 44100, 96000, 192000, 384000, 655350])
+            sf.write(str(path), samples[: rng.choice([10, 1000, len(samples)])], r)
+            name = f"rate {r} Hz"
+        elif kind == "channels":
+            ch = rng.choice([2, 6, 64])
+            sf.write(str(path), np.repeat(samples[:, None], ch, axis=1), rate)
+            name = f"{ch} channels"
+        elif kind == "format":
+            path = d / rng.choice(["in.flac", "in.WAV", "in.ogg", "in.txt", "in"])
+            sf.write(str(path), samples, rate, format="FLAC") if path.suffix == ".flac" else \
+                path.write_bytes(ws.wav.read_bytes())
+            name = f"file named {path.name}"
+        elif kind == "short":
+            n = rng.choice([0, 1, 10, 100, 500, 1000])
+            sf.write(str(path), samples[:n], rate)
+            name = f"{n} samples"
+        elif kind == "silence":
+            sf.write(str(path), np.zeros(len(samples)), rate)
+            name = "silence"
+        else:
+            sf.write(str(path), np.clip(samples * 1e4, -1, 1), rate)
+            name = "clipped"
+        labels = ws.textgrid if rng.random() < 0.3 and kind not in ("short", "rate") else None
+        out = d / "out.tsv"
+        yield Case("audio", name, _synth_argv(ws, ws.model, path, out, labels),
+                   _protect(ws.model, ws.textgrid), out)
+
+
+# --------------------------------------------------------------------------- labels
+_NUMBERS = ["nan", "inf", "-inf", "-1", "0", "1e300", "1e-300", "99999", "x", "", "1,5", "2.0e5"]
+
+
+def _mutate_text(rng: random.Random, text: str) -> tuple[str, str]:
+    lines = text.splitlines()
+    kind = rng.choice(["number", "number", "swap", "delete", "dup", "empty", "garbage", "blank",
+                       "label"])
+    if not lines:
+        return "", "empty"
+    i = rng.randrange(len(lines))
+    if kind == "number":
+        toks = lines[i].split()
+        nums = [k for k, t in enumerate(toks) if t.replace(".", "", 1).replace("-", "", 1).isdigit()]
+        if nums:
+            k = rng.choice(nums)
+            toks[k] = rng.choice(_NUMBERS)
+            lead = lines[i][: len(lines[i]) - len(lines[i].lstrip())]
+            lines[i] = lead + " ".join(toks)
+    elif kind == "swap":
+        j = rng.randrange(len(lines))
+        lines[i], lines[j] = lines[j], lines[i]
+    elif kind == "delete":
+        del lines[i:i + rng.choice([1, 3, 10])]
+    elif kind == "dup":
+        lines[i:i] = lines[i:i + rng.choice([1, 4])]
+    elif kind == "empty":
+        lines = []
+    elif kind == "garbage":
+        lines[i] = "".join(rng.choice("\"=[]{}<>ab 01.\t\\") for _ in range(rng.randrange(1, 30)))
+    elif kind == "blank":
+        lines = [ln for ln in lines if "text" not in ln] if rng.random() < 0.5 else lines[:12]
+    else:
+        lines[i] = lines[i].replace('"', '"zz', 1) if '"' in lines[i] else lines[i] + " zz"
+    return "\n".join(lines) + "\n", kind
+
+
+def label_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
+    while True:
+        d = ws.fresh("labels")
+        src = rng.choice([ws.textgrid, ws.textgrid, ws.lab, ws.lab.with_suffix(".phn")])
+        path = d / src.name
+        kind = rng.random()
+        if kind < 0.7:
+            text, how = _mutate_text(rng, src.read_text())
+            path.write_text(text)
+            name = f"{src.suffix} {how}"
+        elif kind < 0.8:
+            path.write_bytes(src.read_bytes().replace(b"a", b"\xe9\xff", 3))
+            name = f"{src.suffix} not UTF-8"
+        elif kind < 0.9:
+            data, how = mutate_bytes(rng, src.read_bytes())
+            path.write_bytes(data)
+            name = f"{src.suffix} bytes {how}"
+        else:
+            path = d / rng.choice(["l.seg", "l.TextGrid", "l.lab"])
+            path.mkdir()
+            name = "labels given as a folder"
+        extra = []
+        if rng.random() < 0.15:
+            lm = d / "map.tsv"
+            choice = rng.choice(["unknown", "folder", "bad", "utf"])
+            if choice == "folder":
+                lm.mkdir()
+            elif choice == "bad":
+                lm.write_text("a b c\n")
+            elif choice == "utf":
+                lm.write_bytes(b"\xff\xfe\x00a")
+            else:
+                lm.write_text("aa\tzz\niy\tqq\n")
+            extra = ["--label-map", str(lm)]
+            name += f", label map {choice}"
+        out = d / "out.tsv"
+        yield Case("labels", name, _synth_argv(ws, ws.model, ws.wav, out, path, extra),
+                   _protect(ws.model, ws.wav), out)
+
+
+# --------------------------------------------------------------------------- models
+def _npz_members(path: Path) -> dict[str, bytes]:
+    with zipfile.ZipFile(path) as zf:
+        return {i.filename: zf.read(i) for i in zf.infolist()}
+
+
+def _write_npz(path: Path, members: dict[str, bytes], compression=zipfile.ZIP_STORED) -> None:
+    with zipfile.ZipFile(path, "w", compression) as zf:
+        for name, data in members.items():
+            zf.writestr(name, data)
+
+
+def _npy(arr) -> bytes:
+    import numpy as np
+
+    buf = io.BytesIO()
+    np.lib.format.write_array(buf, np.asarray(arr), allow_pickle=False)
+    return buf.getvalue()
+
+
+def _model_variant(rng: random.Random, src: Path, dst: Path) -> str:
+    import numpy as np
+
+    members = _npz_members(src)
+    with np.load(src, allow_pickle=False) as z:
+        arrays = {k: z[k] for k in z.files}
+    meta = json.loads(str(arrays["meta"]))
+    kind = rng.choice(["meta", "meta", "array", "array", "header", "compression", "deflate",
+                       "bytes", "missing", "pickle"])
+    if kind == "meta":
+        field_ = rng.choice([*list(meta), "config"])
+        value = rng.choice([None, [], {}, "x", -1, 0, 1e309, True, 3.5, [1, 2], "nan", 10**30])
+        if rng.random() < 0.15:
+            meta = rng.choice([[], "text", 5, None])
+            desc = f"meta is {meta!r}"
+        elif field_ == "config" and isinstance(meta.get("config"), dict) and rng.random() < 0.7:
+            key = rng.choice(list(meta["config"]))
+            meta["config"][key] = value
+            desc = f"config {key} = {value!r}"
+        else:
+            meta[field_] = value
+            desc = f"meta {field_} = {value!r}"
+        members["meta.npy"] = _npy(np.array(json.dumps(meta).replace("Infinity", "1e999")))
+        _write_npz(dst, members)
+        return desc
+    if kind == "array":
+        name = rng.choice([k for k in arrays if k != "meta"])
+        a = arrays[name]
+        how = rng.choice(["nan", "dtype", "shape", "empty", "big", "str", "transpose", "neg"])
+        if how == "nan":
+            b = a.astype(float)
+            if b.size:
+                b.flat[rng.randrange(b.size)] = rng.choice([np.nan, np.inf])
+        elif how == "dtype":
+            b = a.astype(rng.choice([np.int8, np.float32, np.complex64, np.bool_, np.uint64]))
+        elif how == "shape":
+            b = a.reshape(-1)[: max(a.size - 1, 0)]
+        elif how == "empty":
+            b = np.zeros((0, *a.shape[1:]), a.dtype)
+        elif how == "big":
+            b = np.concatenate([a, a]) if a.ndim else a
+        elif how == "str":
+            b = np.array(["x"] * max(a.size, 1))
+        elif how == "transpose":
+            b = a.T.copy()
+        else:
+            b = -np.abs(a) - 1 if a.dtype.kind in "iuf" else a
+        members[f"{name}.npy"] = _npy(b)
+        _write_npz(dst, members)
+        return f"{name} {how}"
+    if kind == "header":
+        name = rng.choice(list(members))
+        shape = rng.choice([(2**40,), (2**20, 2**20), (-1,), (10**12, 20), (3, 0, 2**62)])
+        descr = rng.choice(["<f8", "|O", "<U100000", "<f8", "|V8"])
+        hdr = f"{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape!r}, }}"
+        hdr = hdr.ljust(118) + "\n"
+        members[name] = b"\x93NUMPY\x01\x00" + struct.pack("<H", len(hdr)) + hdr.encode() + b"\0" * 64
+        _write_npz(dst, members)
+        return f"{name} header asks for {shape} of {descr}"
+    if kind == "compression":
+        _write_npz(dst, members, zipfile.ZIP_DEFLATED)
+        data = bytearray(dst.read_bytes())
+        method = rng.choice([12, 14, 99, 8, 1, 93])
+        for sig, off in ((b"PK\x03\x04", 8), (b"PK\x01\x02", 10)):
+            i = data.find(sig)
+            while i >= 0:
+                data[i + off:i + off + 2] = struct.pack("<H", method)
+                i = data.find(sig, i + 4)
+        dst.write_bytes(bytes(data))
+        return f"compression method {method}"
+    if kind == "deflate":
+        _write_npz(dst, members, zipfile.ZIP_DEFLATED)
+        data, how = mutate_bytes(rng, dst.read_bytes(), 40, len(dst.read_bytes()) - 200)
+        dst.write_bytes(data)
+        return f"deflate stream {how}"
+    if kind == "missing":
+        name = rng.choice(list(members))
+        del members[name]
+        _write_npz(dst, members)
+        return f"{name} missing"
+    if kind == "pickle":
+        name = rng.choice(list(members))
+        members[name] = b"\x93NUMPY\x01\x00" + struct.pack("<H", 118) + \
+            "{'descr': '|O', 'fortran_order': False, 'shape': (1,), }".ljust(117).encode() + \
+            b"\n" + b"\x80\x04\x95cos\nsystem\n."
+        _write_npz(dst, members)
+        return f"{name} pickled"
+    data, how = mutate_bytes(rng, src.read_bytes())
+    dst.write_bytes(data)
+    return f"bytes {how}"
+
+
+def model_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
+    while True:
+        d = ws.fresh("model")
+        path = d / "model.npz"
+        name = _model_variant(rng, ws.model, path)
+        out = d / "out.tsv"
+        if rng.random() < 0.8:
+            argv = _synth_argv(ws, path, ws.wav, out, ws.textgrid if rng.random() < 0.5 else None)
+        else:
+            argv, out = ["similarity", str(path), "-q"], None
+        yield Case("model", name, argv, _protect(ws.wav), out)
+
+
+# --------------------------------------------------------------------------- corpus.json
+_VALUES = [None, [], {}, "", "x", -1, 0, 0.001, 1e6, 1e309, True, [1], ["x"], {"a": 1}, "mocha",
+           "../nowhere", [""], ["a/b"], 2, 3, 4]
+
+
+def corpus_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
+    info = json.loads((ws.corpus / "corpus.json").read_text())
+    while True:
+        d = ws.fresh("corpus")
+        corpus = d / "corpus"
+        shutil.copytree(ws.corpus, corpus)
+        obj = json.loads(json.dumps(info))
+        kind = rng.random()
+        if kind < 0.6:
+            key = rng.choice([*list(obj), "data_dir", "label_map"])
+            obj[key] = rng.choice(_VALUES)
+            text = json.dumps(obj).replace("Infinity", "1e999")
+            name = f"{key} = {json.dumps(obj[key])[:30]}"
+        elif kind < 0.7:
+            text = json.dumps(rng.choice([[], "x", 5, None, [obj]]))
+            name = f"top level {text[:20]}"
+        elif kind < 0.75:
+            depth = rng.choice([100, 10000, 100000])
+            text = "[" * depth + "]" * depth
+            name = f"nested {depth} deep"
+        elif kind < 0.85:
+            text, how = _mutate_text(rng, json.dumps(obj, indent=1))
+            name = f"text {how}"
+        elif kind < 0.9:
+            text = json.dumps(obj)
+            (corpus / "toy030.txt").write_bytes(b"caf\xe9 \xff")
+            name = "transcript not UTF-8"
+        elif kind < 0.95:
+            text = json.dumps(obj)
+            victim = corpus / f"toy030.{rng.choice(['wav', 'TextGrid', 'c3d'])}"
+            victim.unlink()
+            if rng.random() < 0.5:
+                victim.mkdir()
+            name = f"{victim.suffix} missing or a folder"
+        else:
+            text = json.dumps(obj)
+            (corpus / "corpus.json").unlink()
+            (corpus / "corpus.json").mkdir()
+            name = "corpus.json is a folder"
+        if (corpus / "corpus.json").is_file():
+            (corpus / "corpus.json").write_text(text)
+        out = d / "model.npz"
+        r = rng.random()
+        if r < 0.5:
+            argv, out = ["corpus", "show", str(corpus), "-q"], None
+        elif r < 0.8:
+            argv = ["train", str(corpus), "-o", str(out), "-q"]
+        else:
+            argv, out = ["eval", str(ws.model), str(corpus), "--split", "test", "-q"], None
+        yield Case("corpus", name, argv, _protect(ws.model), out)
+
+
+# --------------------------------------------------------------------------- C3D
+def _c3d_rate(data: bytes, rate: float) -> bytes:
+    """The C3D with POINT:RATE and the header rate set to ``rate`` (Intel float32)."""
+    d = bytearray(data)
+    d[20:24] = struct.pack("<f", rate)
+    i = d.find(b"RATE", 512)
+    while i > 0:
+        body = i + 4 + 2
+        if d[body] == 4 and d[body + 1] == 0:  # float scalar
+            d[body + 2:body + 6] = struct.pack("<f", rate)
+        i = d.find(b"RATE", i + 4)
+    return bytes(d)
+
+
+def c3d_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
+    src = ws.c3d.read_bytes()
+    data_start = struct.unpack("<H", src[16:18])[0]
+    while True:
+        d = ws.fresh("c3d")
+        corpus = d / "corpus"
+        shutil.copytree(ws.corpus, corpus)
+        kind = rng.choice(["params", "params", "header", "data", "any", "rate", "frames"])
+        if kind == "params":
+            data, how = mutate_bytes(rng, src, 512, (data_start - 1) * 512)
+        elif kind == "header":
+            data, how = mutate_bytes(rng, src, 0, 512)
+        elif kind == "data":
+            data, how = mutate_bytes(rng, src, (data_start - 1) * 512)
+        elif kind == "rate":
+            rate = rng.choice([1e6, 0.001, 0.0, -60.0, float("nan"), 1e30, 59.9, 240.0])
+            data, how = _c3d_rate(src, rate), f"{rate:g} Hz"
+        elif kind == "frames":
+            from engine.formats import read_c3d, write_c3d
+
+            m = read_c3d(ws.c3d)
+            n = rng.choice([0, 1, 2, 3])
+            if n == 0:
+                data, how = src[: (data_start - 1) * 512], "no frames"
+            else:
+                write_c3d(d / "t.c3d", m.markers[:n], m.rate, m.names)
+                data, how = (d / "t.c3d").read_bytes(), f"{n} frames"
+        else:
+            data, how = mutate_bytes(rng, src)
+        (corpus / "toy030.c3d").write_bytes(data)
+        out = d / "model.npz"
+        r = rng.random()
+        if r < 0.5:
+            argv, out = ["corpus", "show", str(corpus), "-q"], None
+        elif r < 0.7:
+            argv, out = ["eval", str(ws.model), str(corpus), "--split", "test", "-q"], None
+        elif r < 0.85:
+            shutil.copy(corpus / "toy030.c3d", corpus / "toy000.c3d")
+            argv = ["train", str(corpus), "-o", str(out), "-q"]
+        else:  # describing the folder reads the first marker file
+            shutil.copy(corpus / "toy030.c3d", corpus / "toy000.c3d")
+            out = d / "described.json"
+            argv = ["corpus", "init", str(corpus), "-o", str(out), "--fixed", "FH_L", "FH_R", "NB",
+                    "NT", "--upper-lip", "UL_C", "--lower-lip", "LL_C", "-q"]
+        yield Case("c3d", f"{kind} {how}", argv, _protect(ws.model), out)
+
+
+# --------------------------------------------------------------------------- TSV / EMA markers
+def marker_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
+    """Marker tables (TSV/CSV) and MOCHA EMA text in place of the C3D, damaged as text."""
+    from engine.formats import read_c3d, write_marker_tsv
+
+    m = read_c3d(ws.c3d)
+    while True:
+        d = ws.fresh("markers")
+        corpus = d / "corpus"
+        shutil.copytree(ws.corpus, corpus)
+        (corpus / "toy030.c3d").unlink()
+        kind = rng.choice(["tsv", "tsv", "csv", "ema", "folder"])
+        if kind in ("tsv", "csv"):
+            path = corpus / f"toy030.{kind}"
+            write_marker_tsv(path, m.markers, m.rate, m.names)
+            text, how = _mutate_text(rng, path.read_text())
+            if rng.random() < 0.3:  # equal, reversed or absurd times
+                lines = text.splitlines()
+                t = rng.choice(["0", "1e300", "nan", "-1", "1e-300"])
+                text = "\n".join(lines[:1] + [t + ln[ln.find("\t"):] for ln in lines[1:]]) + "\n"
+                how += f", times {t}"
+            path.write_text(text)
+        elif kind == "ema":
+            path = corpus / "toy030.ema"
+            rows = ["0.0 1 " + " ".join(["100"] * 20)] * 3
+            text, how = _mutate_text(rng, "\n".join(rows))
+            path.write_text(text)
+        else:
+            path = corpus / "toy030.tsv"
+            path.mkdir()
+            how = "a folder"
+        if rng.random() < 0.5:
+            argv, out = ["corpus", "show", str(corpus), "-q"], None
+        else:
+            argv, out = ["eval", str(ws.model), str(corpus), "--split", "test", "-q"], None
+        yield Case("markers", f"{kind} {how}", argv, _protect(ws.model), out)
+
+
+# --------------------------------------------------------------------------- options
+def _positional_value(ws: Workspace, dest: str, d: Path) -> str:
+    return {"model": str(ws.model), "audio": str(ws.wav), "corpus": str(ws.corpus),
+            "data_dir": str(ws.corpus), "output": str(d / "out")}.get(dest, str(d / dest))
+
+
+def option_targets() -> list[tuple[tuple[str, ...], argparse.ArgumentParser, argparse.Action]]:
+    """Every (command path, parser, option with a value type) of the ``facetraj`` parser."""
+    from facetraj.cli import build_parser
+
+    top = build_parser()
+    out = []
+
+    def walk(parser: argparse.ArgumentParser, path: tuple[str, ...]) -> None:
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                seen = set()
+                for name, child in action.choices.items():
+                    if id(child) not in seen:
+                        seen.add(id(child))
+                        walk(child, (*path, name))
+            elif action.option_strings and (action.type is not None or action.choices):
+                out.append((path, parser, action))
+
+    walk(top, ())
+    return out
+
+
+def option_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
+    targets = option_targets()
+    while True:
+        path, parser, action = rng.choice(targets)
+        d = ws.fresh("options")
+        value = rng.choice(BAD_NUMBERS + ([*list(action.choices or [])[:1], "bogus"]
+                                          if action.choices else []))
+        argv = list(path)
+        for pos in parser._actions:
+            if not pos.option_strings and pos.nargs not in ("?", "*") and \
+                    not isinstance(pos, argparse._SubParsersAction):
+                argv.append(_positional_value(ws, pos.dest, d))
+        out = None
+        for req in parser._actions:
+            if req.option_strings and req.required and req is not action:
+                if req.dest == "output":
+                    out = d / ("out.npz" if "train" in path else "out.tsv")
+                    argv += [req.option_strings[0], str(out)]
+                elif req.nargs == "+" and req.dest == "fixed":
+                    argv += [req.option_strings[0], "FH_L", "FH_R", "NB", "NT"]
+                elif req.dest == "upper_lip":
+                    argv += [req.option_strings[0], "UL_C"]
+                elif req.dest == "lower_lip":
+                    argv += [req.option_strings[0], "LL_C"]
+                else:
+                    argv += [req.option_strings[0], "x"]
+        if path[-1:] == ("init",):
+            out = d / "corpus.json"
+            argv += ["-o", str(out)]
+        if path[:1] == ("eval",) or path[:1] == ("sweep",):
+            argv += ["--split", "test"]
+        argv += [action.option_strings[-1] + "=" + value, "-q"]
+        parse_only = (not path or path[0] in PARSE_ONLY or path[-1] in PARSE_ONLY
+                      or path[0] == "sweep")
+        yield Case("options", f"{' '.join(path) or '(none)'} {action.option_strings[-1]}={value!r}",
+                   argv, _protect(ws.model, ws.wav, ws.corpus / "corpus.json"), out, parse_only)
+
+
+# --------------------------------------------------------------------------- outputs
+def output_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
+    while True:
+        d = ws.fresh("output")
+        kind = rng.choice(["exists", "exists-overwrite", "folder", "parent-file", "long",
+                           "no-permission", "deep", "suffix", "init-exists", "train-exists"])
+        extra: list[str] = []
+        keep_mode = None
+        protected = _protect(ws.model, ws.wav)
+        out = d / "out.tsv"
+        argv_of = None
+        if kind in ("exists", "exists-overwrite"):
+            out.write_text("the user's file\n")
+            keep_mode = rng.choice([0o644, 0o600, 0o664])
+            os.chmod(out, keep_mode)
+            if kind == "exists":
+                protected.update(_protect(out))
+            else:
+                extra = ["--overwrite"]
+        elif kind == "folder":
+            out.mkdir()
+            (out / "keep.txt").write_text("x")
+            protected.update(_protect(out / "keep.txt"))
+            extra = ["--overwrite"] if rng.random() < 0.5 else []
+        elif kind == "parent-file":
+            (d / "file").write_text("x")
+            protected.update(_protect(d / "file"))
+            out = d / "file" / rng.choice(["out.tsv", "sub/out.tsv"])
+        elif kind == "long":
+            out = d / ("x" * rng.choice([250, 256, 300, 5000]) + ".tsv")
+        elif kind == "no-permission":
+            out = Path(rng.choice(["/sys/facetraj-fuzz.tsv", "/proc/facetraj-fuzz.tsv",
+                                   "/proc/self/facetraj/out.tsv"]))
+        elif kind == "deep":
+            out = d / "a" / "b" / "c" / "out.tsv"
+        elif kind == "suffix":
+            out = d / rng.choice(["out.xyz", "out", "out.C3D", "out.csv", "out.npz", ".tsv"])
+        elif kind == "init-exists":
+            corpus = d / "corpus"
+            shutil.copytree(ws.corpus, corpus)
+            protected.update(_protect(corpus / "corpus.json"))
+            out = corpus / "corpus.json"
+            argv_of = ["corpus", "init", str(corpus), "--fixed", "FH_L", "FH_R", "NB", "NT",
+                       "--upper-lip", "UL_C", "--lower-lip", "LL_C", "-q"]
+        else:
+            out = d / "model.npz"
+            out.write_bytes(b"the user's model")
+            protected.update(_protect(out))
+            argv_of = ["train", str(ws.corpus), "-o", str(out), "-q"]
+        argv = argv_of or _synth_argv(ws, ws.model, ws.wav, out, extra=extra)
+        yield Case("output", f"{kind} {out.name[:40]}", argv, protected, out, keep_mode=keep_mode)
+
+
+GENERATORS: dict[str, Callable[[Workspace, random.Random], Iterator[Case]]] = {
+    "audio": audio_cases, "labels": label_cases, "model": model_cases, "corpus": corpus_cases,
+    "c3d": c3d_cases, "markers": marker_cases, "options": option_cases, "output": output_cases,
+}
+
+
+def cases(ws: Workspace, n: int, seed: int) -> Iterator[Case]:
+    """``n`` cases, spread evenly over :data:`CATEGORIES`, reproducible from ``seed``."""
+    gens = {c: GENERATORS[c](ws, random.Random(f"{seed}-{c}")) for c in CATEGORIES}
+    for i in range(n):
+        yield next(gens[CATEGORIES[i % len(CATEGORIES)]])
+
+
+# --------------------------------------------------------------------------- running a case
+def _invoke(case: Case) -> int:
+    """Run the command as ``facetraj`` would; parse-only cases stop after argparse."""
+    from facetraj.cli import build_parser, main
+
+    if case.parse_only:
+        build_parser().parse_args(case.argv)
+        return 0
+    return main(case.argv)
+
+
+def _judge(case: Case, code: int, err: str, status: str | None = None) -> Outcome:
+    """The outcome of a finished run: its exit status, messages and files checked."""
+    if status is not None:
+        return Outcome(case, status, code, err[-300:])
+    if "Traceback (most recent call last)" in err or code == 1:
+        return Outcome(case, "traceback", code, err.strip().splitlines()[-1][:300] if err.strip()
+                       else "")
+    if code not in (0, 2):
+        return Outcome(case, f"exit {code}", code, err[-300:])
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    if code == 2:
+        errors = [ln for ln in lines if ln.startswith("facetraj") and ": error: " in ln]
+        if len(errors) != 1:
+            return Outcome(case, "unclear message", code, err[-300:])
+    for path, (data, mode) in case.protected.items():
+        if not path.is_file() or _digest(path) != data:
+            return Outcome(case, "clobbered", code, f"{path} changed")
+        if path.stat().st_mode != mode:
+            return Outcome(case, "clobbered", code, f"{path} mode changed")
+    out = case.output
+    if out is not None:
+        with contextlib.suppress(OSError):
+            folder = out.parent
+            if folder.is_dir() and any(".part-" in p.name for p in folder.iterdir()):
+                return Outcome(case, "partial", code, f".part file left in {folder}")
+            if code != 0 and out.is_file() and out not in case.protected and \
+                    b"the user's file" not in out.read_bytes():
+                return Outcome(case, "partial", code, f"{out} written by a failed run")
+            if code == 0 and case.keep_mode is not None and \
+                    (out.stat().st_mode & 0o7777) != case.keep_mode:
+                return Outcome(case, "clobbered", code, f"{out} mode {out.stat().st_mode:o}, "
+                                                        f"{case.keep_mode:o} before")
+            if code == 0 and out.is_file() and out.suffix in (".tsv", ".csv") and \
+                    b"nan" in out.read_bytes().lower():
+                return Outcome(case, "nan output", code, f"{out} holds NaN")
+    return Outcome(case, "ok" if code == 0 else "refused", code, lines[-1][:200] if lines else "")
+
+
+def run_in_process(case: Case) -> Outcome:
+    """Run a case in this process (stdout and stderr captured)."""
+    import logging
+
+    err, out = io.StringIO(), io.StringIO()
+    t0 = time.perf_counter()
+    handlers = logging.getLogger().handlers[:]
+    try:
+        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(out):
+            try:
+                code = _invoke(case)
+            except SystemExit as exc:
+                code = exc.code if isinstance(exc.code, int) else 2
+            except BaseException:
+                traceback.print_exc()
+                code = 1
+    finally:
+        logging.getLogger().handlers[:] = handlers
+    outcome = _judge(case, code, err.getvalue())
+    outcome.seconds = time.perf_counter() - t0
+    return outcome
+
+
+def run_forked(case: Case, timeout: float = TIMEOUT_S, memory: int = MEMORY_LIMIT) -> Outcome:
+    """Run a case in a forked child with an address-space limit and a timeout."""
+    err_path = case_workdir(case) / ".stderr"
+    t0 = time.perf_counter()
+    pid = os.fork()
+    if pid == 0:  # the child: never returns
+        code = 1
+        try:
+            fd = os.open(err_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+            os.dup2(fd, 2)
+            null = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(null, 1)
+            sys.stderr = os.fdopen(2, "w", buffering=1)
+            sys.stdout = os.fdopen(1, "w")
+            limit = _vm_size() + memory
+            resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+            try:
+                code = _invoke(case)
+            except SystemExit as exc:
+                code = exc.code if isinstance(exc.code, int) else 2
+            except BaseException:
+                traceback.print_exc()
+                code = 1
+            sys.stderr.flush()
+            sys.stdout.flush()
+        finally:
+            os._exit(code)
+    status = None
+    while True:
+        done, wstatus, usage = os.wait4(pid, os.WNOHANG)
+        if done:
+            break
+        if time.perf_counter() - t0 > timeout:
+            os.kill(pid, signal.SIGKILL)
+            _, wstatus, usage = os.wait4(pid, 0)
+            status = "hang"
+            break
+        time.sleep(0.005)
+    code = os.waitstatus_to_exitcode(wstatus)
+    err = err_path.read_text(errors="replace") if err_path.exists() else ""
+    if status is None and code < 0:
+        status = f"signal {-code}"
+    outcome = _judge(case, code, err, status)
+    outcome.seconds = time.perf_counter() - t0
+    outcome.max_rss = usage.ru_maxrss * 1024
+    if outcome.max_rss > memory and not outcome.failed:
+        outcome.status, outcome.detail = "memory", f"{outcome.max_rss / 2**30:.2f} GiB"
+    return outcome
+
+
+def case_workdir(case: Case) -> Path:
+    """A folder of the case (where the forked run's stderr is kept)."""
+    for p in case.argv:
+        if "/cases/" in p:
+            q = Path(p)
+            while q.parent.name != "cases":
+                q = q.parent
+            return q
+    return Path(os.environ.get("TMPDIR", "/tmp"))
+
+
+def _vm_size() -> int:
+    with open("/proc/self/status") as fh:
+        for line in fh:
+            if line.startswith("VmSize:"):
+                return int(line.split()[1]) * 1024
+    return 0
+
+
+# --------------------------------------------------------------------------- the table
+def table(outcomes: list[Outcome]) -> str:
+    """Markdown table: per category the cases and their outcomes."""
+    by_cat: dict[str, Counter] = defaultdict(Counter)
+    rss: dict[str, int] = defaultdict(int)
+    slow: dict[str, float] = defaultdict(float)
+    for o in outcomes:
+        by_cat[o.case.category][o.status] += 1
+        rss[o.case.category] = max(rss[o.case.category], o.max_rss)
+        slow[o.case.category] = max(slow[o.case.category], o.seconds)
+    failures = sorted({o.status for o in outcomes if o.failed})
+    head = ["category", "cases", "exit 0", "exit 2 (refused)", "tracebacks", "hangs",
+            "partial or clobbered", *[f for f in failures if f not in
+                                      ("traceback", "hang", "partial", "clobbered")],
+            "slowest run (s)", "peak memory (MiB)"]
+    rows = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    total: Counter = Counter()
+    for cat in CATEGORIES:
+        c = by_cat.get(cat)
+        if not c:
+            continue
+        total.update(c)
+        extra = [str(c[f]) for f in failures if f not in ("traceback", "hang", "partial",
+                                                          "clobbered")]
+        rows.append(f"| {cat} | {sum(c.values())} | {c['ok']} | {c['refused']} | {c['traceback']} "
+                    f"| {c['hang']} | {c['partial'] + c['clobbered']} | " + "".join(
+                        f"{x} | " for x in extra) + f"{slow[cat]:.1f} | {rss[cat] / 2**20:.0f} |")
+    extra = [str(total[f]) for f in failures if f not in ("traceback", "hang", "partial",
+                                                          "clobbered")]
+    rows.append(f"| **all** | {sum(total.values())} | {total['ok']} | {total['refused']} | "
+                f"{total['traceback']} | {total['hang']} | {total['partial'] + total['clobbered']} "
+                f"| " + "".join(f"{x} | " for x in extra)
+                + f"{max(slow.values(), default=0):.1f} | {max(rss.values(), default=0) / 2**20:.0f} |")
+    return "\n".join(rows)
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description="the long bad-input fuzz run (make fuzz)")
+    p.add_argument("--cases", type=int, default=2100)
+    p.add_argument("--seed", type=int, default=14)
+    p.add_argument("--workdir", type=Path, help="keep the cases here (default a temporary folder)")
+    p.add_argument("--timeout", type=float, default=TIMEOUT_S)
+    args = p.parse_args(argv)
+    import tempfile
+
+    root = args.workdir or Path(tempfile.mkdtemp(prefix="facetraj-fuzz-"))
+    root.mkdir(parents=True, exist_ok=True)
+    ws = make_workspace(root)
+    outcomes = []
+    t0 = time.perf_counter()
+    for i, case in enumerate(cases(ws, args.cases, args.seed), 1):
+        o = run_forked(case, args.timeout)
+        outcomes.append(o)
+        if o.failed:
+            print(f"FAIL {o.status}: [{case.category}] {case.name}: facetraj {' '.join(case.argv)}"
+                  f"\n    {o.detail}", flush=True)
+        if i % 100 == 0:
+            print(f"{i} cases, {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
+    print(f"\n{len(outcomes)} cases (seed {args.seed}) in {time.perf_counter() - t0:.0f} s; "
+          f"memory limit {MEMORY_LIMIT >> 20} MiB above the parent, timeout {args.timeout:g} s "
+          f"per run\n")
+    print(table(outcomes))
+    if args.workdir is None:
+        shutil.rmtree(root, ignore_errors=True)
+    return 1 if any(o.failed for o in outcomes) else 0
+
+
+if __name__ == "__main__":
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+    sys.exit(main())
