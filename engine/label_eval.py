@@ -11,9 +11,12 @@ all scored as Table 2 (triangular smoothing, speech frames).
 
 from __future__ import annotations
 
+import json
 import logging
+import os
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -21,6 +24,7 @@ from .baselines import evaluate_baselines, fit_baselines, frame_data
 from .config import SynthConfig, TrainConfig
 from .corpus import Corpus
 from .evaluation import METRICS, UtteranceScore, evaluate_utterance, speech_mask
+from .formats import atomic_write
 from .labelling import RelabelledCorpus, relabelled
 from .model import Model
 from .training import train
@@ -28,6 +32,8 @@ from .tuning import Tuning, cross_validate, tuned_config
 
 log = logging.getLogger(__name__)
 
+#: The file of a saved evaluation, beside the report (``engine.report``).
+LABEL_EVAL_FILE = "label_eval.json"
 #: Label kinds: the corpus's own (exact) labels, and the two automatic ones.
 LABEL_KINDS = ("exact", "aligned", "recognized")
 #: Methods compared, in table order.
@@ -73,6 +79,12 @@ class LabelEval:
         mine = self.summary(kind, method)
         return all(mine[m][0] > self.summary(kind, o)[m][0] for o in METHODS if o != method
                    and self.rows(kind, o) for m in METRICS)
+
+    @classmethod
+    def from_json(cls, obj: dict) -> LabelEval:
+        """Read what :meth:`to_json` wrote."""
+        return cls({k: [UtteranceScore(**r) for r in v] for k, v in obj["utterances"].items()},
+                   dict(obj.get("tunings", {})), dict(obj.get("label_quality", {})))
 
     def to_json(self) -> dict:
         return {"summary": {k: {m: self.summary(k, m) for m in METHODS if self.rows(k, m)}
@@ -158,13 +170,37 @@ def evaluate_labels(corpus: Corpus, kinds: Sequence[str] = LABEL_KINDS,
     return out
 
 
+def write_label_eval(path: str | os.PathLike[str], result: LabelEval) -> Path:
+    """Save ``result`` as JSON (read by the report generator, ``engine.report``)."""
+    path = Path(path)
+    with atomic_write(path) as tmp:
+        tmp.write_text(json.dumps(result.to_json(), indent=1) + "\n", encoding="utf-8")
+    path.chmod(0o644)
+    return path
+
+
+def read_label_eval(path: str | os.PathLike[str]) -> LabelEval | None:
+    """The saved evaluation at ``path``, or ``None`` when there is none."""
+    path = Path(path)
+    if not path.is_file():
+        return None
+    return LabelEval.from_json(json.loads(path.read_text(encoding="utf-8")))
+
+
 def _cell(v: tuple[float, float]) -> str:
     return f"{v[0]:.4f} ± {v[1]:.2f}"
 
 
 def format_markdown(result: LabelEval) -> str:
     """The results.md section: one table per label kind and a plain recommendation."""
-    lines = []
+    lines = ["Held-out (test) sentences only. Exact labels are the corpus's own; aligned labels come "
+             "from PocketSphinx forced alignment of each sentence's text, recognized ones from its "
+             "phone recognizer without text (`engine.labelling`, cached). For each kind of labels "
+             "the model is trained on the training split labelled the same way, the robust mode's "
+             "settings are cross-validated on the training split (`engine.tuning`), and every "
+             "method is scored on the test split as in Table 2 (triangular smoothing, speech "
+             "frames), mean ± one standard deviation over utterances (the corpus has one speaker, "
+             "so the spread is over utterances). Computed by `engine.label_eval`."]
     for kind in result.scores:
         lines += ["", f"**{kind.title()} labels** (train and test labelled the same way)", "",
                   "| Method | Whole face | Lower lip | Upper lip | Utterances |",

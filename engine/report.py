@@ -40,6 +40,7 @@ from .evaluation import (
     trajectory_correlations,
 )
 from .formats import atomic_write
+from .label_eval import LABEL_EVAL_FILE, LabelEval, format_markdown, read_label_eval
 from .model import Model
 from .pipeline import resmooth, synthesize
 from .progress import Progress
@@ -136,6 +137,7 @@ class ReportData:
     figure4 : the Figure-4 example (``None`` when the corpus has no test utterance).
     figures : figure name -> path relative to the report folder (filled by the figures callable).
     timings : seconds per stage.
+    labels : the evaluation with automatic labels (``engine.label_eval``), when one was saved.
     """
 
     corpus: dict
@@ -149,6 +151,7 @@ class ReportData:
     timings: dict[str, float] = field(default_factory=dict)
     figures: dict[str, str] = field(default_factory=dict)
     created: str = ""
+    labels: LabelEval | None = None
 
     def row(self, mode: str, split: str = "test", smoothing: str = "triangular") -> dict | None:
         """The comparison row of one mode (``phonetic``, ``acoustic``, ``acoustic-indexed``,
@@ -178,6 +181,7 @@ class ReportData:
             "table1_agreement": table1_agreement(self.table1, self.paper_table1),
             "at_a_glance": at_a_glance(self),
             "timings_s": self.timings, "figures": self.figures,
+            "automatic_labels": self.labels.to_json()["summary"] if self.labels else None,
         })
 
 
@@ -668,6 +672,9 @@ def render_markdown(data: ReportData) -> str:
         ours = [f"{p} {v:.2f}" for p, v in r.neighbours] + [""] * (3 - len(r.neighbours))
         paper = [f"{p} {v:.2f}" for p, v in data.paper_table1.get(r.phone, [])] or ["", "", ""]
         lines.append(f"| {r.phone} | " + " | ".join(ours + paper) + " |")
+    if data.labels is not None:
+        lines += ["", "## Beyond the paper: automatic labels on held-out sentences", "",
+                  format_markdown(data.labels)]
     lines += ["", "## Discussion: where and why we differ from the paper", ""]
     for para in discussion(data):
         lines += [para, ""]
@@ -684,10 +691,13 @@ def write_report(corpus_dir: str | os.PathLike[str], out_dir: str | os.PathLike[
                  ns: Iterable[int] = range(1, 11), figures: FigureMaker | None = None) -> Path:
     """Compute the report on ``corpus_dir`` and write ``out_dir/results.md``, ``results.json`` and
     (through ``figures``, drawn into ``out_dir/figures/``) its figures. Returns the ``.md`` path.
+    The evaluation with automatic labels is read from ``out_dir/label_eval.json`` (written by
+    ``facetraj report --automatic-labels``, which takes about half an hour) when present.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     data = compute_report(corpus_dir, model, progress, ns)
+    data.labels = read_label_eval(out / LABEL_EVAL_FILE)
     if figures is not None:
         fig_dir = out / "figures"
         fig_dir.mkdir(exist_ok=True)

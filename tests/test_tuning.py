@@ -63,3 +63,15 @@ def test_evaluate_kind_on_toy_corpus(toy_corpus, toy_model):
     assert methods == {"robust", "phonetic", "acoustic", "ridge", "viseme"}
     assert all(len([s for s in scores if s.mode == m]) == 2 for m in methods)
     assert all(-1 <= s.whole_face <= 1 for s in scores)
+
+
+def test_label_eval_file_round_trip(tmp_path):
+    from engine.label_eval import read_label_eval, write_label_eval
+
+    assert read_label_eval(tmp_path / "absent.json") is None
+    res = LabelEval(scores={"recognized": [_score("robust", 0.7), _score("phonetic", 0.5)]},
+                    tunings={"recognized": {"settings": {"label_weight": 4.0}}})
+    back = read_label_eval(write_label_eval(tmp_path / "label_eval.json", res))
+    assert back.summary("recognized", "robust") == res.summary("recognized", "robust")
+    assert back.tunings == res.tunings
+    assert "label_weight = 4" in format_markdown(back)
