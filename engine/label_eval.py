@@ -15,7 +15,7 @@ import json
 import logging
 import os
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +27,7 @@ from .evaluation import METRICS, UtteranceScore, evaluate_utterance, speech_mask
 from .formats import atomic_write
 from .labelling import RelabelledCorpus, relabelled
 from .model import Model
+from .pipeline import synthesize
 from .training import train
 from .tuning import Tuning, cross_validate, tuned_config
 
@@ -37,12 +38,14 @@ LABEL_EVAL_FILE = "label_eval.json"
 #: Label kinds: the corpus's own (exact) labels, and the two automatic ones.
 LABEL_KINDS = ("exact", "aligned", "recognized")
 #: Methods compared, in table order.
-METHODS = ("robust", "phonetic", "acoustic", "ridge", "viseme")
+METHODS = ("robust", "phonetic", "phonetic-tuned", "acoustic", "ridge", "viseme")
 #: One line per method for the reader.
 METHOD_NOTES = {
     "robust": "eq 4 and acoustic candidates, label confidence weighting, acoustic context "
               "(cross-validated settings)",
     "phonetic": "the paper's method, N = 3",
+    "phonetic-tuned": "the paper's method with the robust mode's cross-validated N and smoothing "
+                      "width: what the rest of the robust mode adds",
     "acoustic": "acoustic-only, default index search",
     "ridge": "ridge regression on +-5 stacked LSF frames (no labels)",
     "viseme": "mean face per phone label",
@@ -122,7 +125,8 @@ def evaluate_kind(corpus: Corpus, kind: str, train_config: TrainConfig | None = 
         model = train(lab, config=train_config)
     tuning = cross_validate(lab, train_config, conf) if tune else None
     robust = tuned_config(SynthConfig(mode="robust"), tuning.to_json() if tuning else model.tuned)
-    configs = [robust, SynthConfig(mode="phonetic"), SynthConfig(mode="acoustic")]
+    configs = {"robust": robust, "phonetic": SynthConfig(mode="phonetic"),
+               "acoustic": SynthConfig(mode="acoustic"), "phonetic-tuned": phonetic_tuned(robust)}
     test = list(lab.info.test)
     if max_test is not None and len(test) > max_test:
         test = [test[int(i)] for i in np.linspace(0, len(test) - 1, max_test)]
@@ -138,16 +142,27 @@ def evaluate_kind(corpus: Corpus, kind: str, train_config: TrainConfig | None = 
         speech = speech_mask(utt.audio, utt.sample_rate, utt.frame_times())
         lsf = model.input_lsf(utt.audio, utt.sample_rate, np.arange(utt.n_frames) / model.marker_rate)
         c = None if conf is None else conf.get(utt_id)
-        for cfg in configs:
-            from .pipeline import synthesize
-
+        for name, cfg in configs.items():
             res = synthesize(model, utt.audio, utt.sample_rate, utt.phones, cfg,
                              n_frames=utt.n_frames, source=utt.name, lsf=lsf, confidence=c)
-            scores.extend(evaluate_utterance(model, utt, "test", cfg, ("triangular",),
-                                             synthesis=res, original=original, speech=speech))
+            scores.extend(replace(r, mode=name) for r in evaluate_utterance(
+                model, utt, "test", cfg, ("triangular",), synthesis=res, original=original,
+                speech=speech))
         test_frames.append(frame_data(model, utt))
     scores.extend(evaluate_baselines(model, baselines, {"test": test_frames}, ("triangular",)))
     return scores, tuning
+
+
+def phonetic_tuned(robust: SynthConfig) -> SynthConfig:
+    """The paper's phonetic mode with the robust config's N and smoothing width (the ablation that
+    separates what cross-validating N and the width gives from what the robust search gives).
+
+    >>> c = phonetic_tuned(SynthConfig(mode="robust", n_context_phones=6, triangle_s=0.067))
+    >>> (c.mode, c.n_context_phones, c.triangle_s, c.xi)
+    ('phonetic', 6, 0.067, 20.0)
+    """
+    return SynthConfig(mode="phonetic", n_context_phones=robust.n_context_phones,
+                       triangle_s=robust.triangle_s, xi=robust.xi, gamma_max=robust.gamma_max)
 
 
 def evaluate_labels(corpus: Corpus, kinds: Sequence[str] = LABEL_KINDS,

@@ -60,7 +60,7 @@ def test_evaluate_kind_on_toy_corpus(toy_corpus, toy_model):
     scores, tuning = evaluate_kind(toy_corpus, "exact", model=toy_model, tune=False, max_test=2)
     assert tuning is None
     methods = {s.mode for s in scores}
-    assert methods == {"robust", "phonetic", "acoustic", "ridge", "viseme"}
+    assert methods == {"robust", "phonetic", "phonetic-tuned", "acoustic", "ridge", "viseme"}
     assert all(len([s for s in scores if s.mode == m]) == 2 for m in methods)
     assert all(-1 <= s.whole_face <= 1 for s in scores)
 
