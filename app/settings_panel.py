@@ -121,6 +121,9 @@ class SynthSettingsPanel(QWidget):
 
     def _show_mode_note(self, *_args) -> None:
         self.mode_note.setText(MODE_NOTES.get(self.mode.currentData(), ""))
+        n = self._tuned.get("settings", {}).get("n_context_phones")
+        if self.mode.currentData() == "robust" and n is not None:
+            self.n.setValue(int(n))                  # the cross-validated N, still editable
 
     def set_limits(self, max_context: int, default_nu: float, tuned: dict | None = None) -> None:
         """Fit the controls to a model: C up to its trained context, ν's default, and the robust

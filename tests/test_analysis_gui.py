@@ -237,8 +237,11 @@ def test_settings_panel_explains_modes_and_shows_tuned(qtbot):
     p.set_limits(3, 10.0, {"settings": {"label_weight": 4.0, "triangle_s": 0.133,
                                         "n_context_phones": 6}, "folds": 2})
     assert "κ (label weight) = 4" in p.tuned_label.text() and "2 folds" in p.tuned_label.text()
+    p.mode.setCurrentIndex(p.mode.findData("phonetic"))
+    p.mode.setCurrentIndex(p.mode.findData("robust"))          # picks up the tuned N
     cfg = p.config()
     assert cfg.mode == "robust" and cfg.label_weight == 4.0 and cfg.triangle_s == 0.133
+    assert cfg.n_context_phones == 6
     p.mode.setCurrentIndex(p.mode.findData("phonetic"))
     assert p.config().label_weight == SynthConfig().label_weight
 
