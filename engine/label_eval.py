@@ -41,11 +41,11 @@ LABEL_KINDS = ("exact", "aligned", "recognized")
 METHODS = ("robust", "phonetic", "phonetic-tuned", "acoustic", "ridge", "viseme")
 #: One line per method for the reader.
 METHOD_NOTES = {
-    "robust": "eq 4 and acoustic candidates, label confidence weighting, acoustic context "
-              "(cross-validated settings)",
+    "robust": "eq 4 and acoustic candidates, label confidence weighting, acoustic context, "
+              "cross-validated settings",
     "phonetic": "the paper's method, N = 3",
     "phonetic-tuned": "the paper's method with the robust mode's cross-validated N and smoothing "
-                      "width: what the rest of the robust mode adds",
+                      "width",
     "acoustic": "acoustic-only, default index search",
     "ridge": "ridge regression on +-5 stacked LSF frames (no labels)",
     "viseme": "mean face per phone label",
