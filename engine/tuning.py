@@ -52,18 +52,22 @@ class Tuning:
                 "utterances": self.utterances, "split": "train"}
 
 
-def tuned_config(config: SynthConfig, tuned: Mapping) -> SynthConfig:
+def tuned_config(config: SynthConfig, tuned: Mapping, keep: Sequence[str] = ()) -> SynthConfig:
     """``config`` with a model's cross-validated settings (robust mode only; fields unknown to
-    this facetraj are ignored).
+    this facetraj, and the fields in ``keep`` -- set by the user -- are left alone).
 
     >>> tuned_config(SynthConfig(mode="robust"), {"settings": {"label_weight": 2.0}}).label_weight
     2.0
     >>> tuned_config(SynthConfig(), {"settings": {"label_weight": 2.0}}).label_weight
-    4.0
+    16.0
+    >>> tuned_config(SynthConfig(mode="robust"), {"settings": {"label_weight": 2.0}},
+    ...              keep=("label_weight",)).label_weight
+    16.0
     """
     if config.mode != "robust" or not tuned:
         return config
-    kw = {k: v for k, v in dict(tuned.get("settings", {})).items() if k in TUNED_FIELDS}
+    kw = {k: v for k, v in dict(tuned.get("settings", {})).items()
+          if k in TUNED_FIELDS and k not in keep}
     return config.with_(**kw)
 
 

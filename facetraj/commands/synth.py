@@ -19,7 +19,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
     from engine.labelmap import read_label_map
     from engine.model import Model
     from engine.pipeline import mode_for, synthesize
-    from engine.tuning import tuned_config
+    from engine.tuning import TUNED_FIELDS, tuned_config
 
     model = Model.load(args.model)
     audio, rate = read_audio(args.audio)
@@ -31,7 +31,8 @@ def cmd_synth(args: argparse.Namespace) -> int:
                                   extra_dict=extra_dictionary(args))
     phones = labels.phones if labels else None
     cfg = tuned_config(mode_for(cfg, phones, labels.source if labels else None,
-                                explicit=args.mode == "phonetic"), model.tuned)
+                                explicit=args.mode == "phonetic"), model.tuned,
+                       keep=[f for f in TUNED_FIELDS if getattr(args, f, None) is not None])
     confidence = labels.confidence if labels and labels.source != "file" else None
     label_map = read_label_map(args.label_map) if args.label_map and labels and \
         labels.source == "file" else None
