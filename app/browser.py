@@ -5,19 +5,17 @@ from __future__ import annotations
 
 import logging
 import math
-import re
 
 from PyQt6.QtCore import Qt, pyqtSignal
 from PyQt6.QtWidgets import QHeaderView, QLineEdit, QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget
 
+from .viewer_model import normalise_text
+
 log = logging.getLogger(__name__)
 
+__all__ = ["UtteranceBrowser", "normalise_text"]
+
 ID_ROLE = Qt.ItemDataRole.UserRole
-
-
-def normalise_text(text: str) -> str:
-    """Lower case, letters and single spaces only (for matching sentences)."""
-    return " ".join(re.sub(r"[^a-z' ]+", " ", text.lower()).split())
 
 
 class UtteranceBrowser(QWidget):

@@ -80,7 +80,7 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
             status["code"] = 2
             app.quit()
 
-        window.show_error = fail           # no dialogs in screenshot mode
+        window.set_error_handler(fail)     # no dialogs in screenshot mode
 
         def shoot() -> None:
             if window.view is None:

@@ -1,67 +1,67 @@
-"""The facetraj main window.
+"""The facetraj main window: it lays out the widgets and wires their signals.
 
-Window contract (used by the analysis views, ``app.analysis.install(window)``)
-==============================================================================
+Architecture
+============
+``state: ViewerModel`` (``app/viewer_model.py``, no Qt) holds the corpus, the model, the synthesis
+settings, the current view and the latest synthesis request with its generation number (stale
+results are dropped there); ``tasks: TaskRunner`` (``app/workers.py``) runs all background work;
+``playback: PlaybackScheduler`` (``app/playback.py``) paces the frames while the sound of ``clock``
+plays. Extensions (``app/own_data.py: OwnData``, ``app/analysis: AnalysisViews``) are objects that
+take the window and use only the contract below; ``app/main.py: build_window`` installs them.
 
-``MainWindow(QMainWindow)`` exposes
-
+Window contract
+===============
 Attributes
-    ``model: Model`` (``None`` until the first model is loaded or trained),
-    ``corpus: Corpus | None``,
-    ``view: UtteranceView | None`` (the current utterance, its synthesis and derived tracks; see
-    ``app/state.py``), ``synth_config: SynthConfig`` (the settings the view was synthesized with),
-    ``plotter`` (the pyvistaqt ``QtInteractor`` of the 3-D view), ``timeline`` (the time-aligned
-    panel stack, ``app/timeline.py``) and ``analysis_menu`` (the ``QMenu`` "Analysis").
+    ``model``, ``corpus``, ``view`` (``UtteranceView``, ``app/state.py``), ``synth_config`` (read
+    from ``state``), ``plotter`` (the pyvistaqt ``QtInteractor``), ``face`` (``FaceView``),
+    ``timeline`` (``app/timeline.py``), ``analysis_menu``, ``marker_panels`` (``MarkerPanels``),
+    ``action_screenshot`` (File-menu entries of extensions go before it).
 
 Signals
     ``utteranceChanged(str)`` after a new utterance is shown (``view`` already updated);
     ``cursorMoved(float)`` the cursor time in seconds, at most once per displayed frame;
-    ``synthesisChanged()`` after every (re)synthesis, once ``view`` is updated.
+    ``synthesisChanged()`` after every (re)synthesis; ``modelReady()`` after a model is loaded;
+    ``busyChanged(bool)``.
 
 Methods
-    ``set_utterance(utt_id)``, ``seek(t)``, ``current_time() -> float``,
-    ``add_dock(widget, title, area=Qt.DockWidgetArea.RightDockWidgetArea) -> QDockWidget``,
-    ``run_in_background(fn, on_done, progress_label, on_error=None, on_partial=None) -> Task``:
-    runs ``fn(progress)`` in a worker thread (``progress(fraction, message)`` drives the status
-    bar's progress bar; ``progress.partial(obj)`` delivers ``on_partial(obj)``), then calls
-    ``on_done(result)`` on the GUI thread; an exception goes to ``on_error(exc)`` or an error
-    dialog.
+    ``menu(name) -> QMenu``: the menu "File", "View", "Analysis", "Help", or a new one (added
+    before Help); ``add_dock(widget, title, area=Right) -> QDockWidget`` (listed in View);
+    ``run_task(fn, on_done, label, *, on_error=None, on_partial=None, on_progress=None,
+    background=False) -> Task``: ``fn(progress)`` in a worker thread, the status bar shows its
+    progress, the callbacks run on the GUI thread, an error goes to ``on_error`` or
+    ``report_error``; ``report_error(exc)`` and ``show_error(message)`` (a dialog, or the handler
+    set with ``set_error_handler(fn)``); ``show_status(text, timeout_ms=0)``;
+    ``add_extension(name, obj)`` / ``extension(name)``; ``set_utterance(utt_id)``, ``seek(t)``,
+    ``current_time()``, ``open_corpus(path)``, ``open_audio(path, labels)``.
+
+Adding a feature
+    Write an object that takes the window (like ``OwnData``): its menu entries go into
+    ``menu(...)`` (File entries before ``action_screenshot``), a toggle can live in a
+    ``QToolBar`` added with ``addToolBar``, its work goes through ``run_task`` and its errors through
+    ``report_error``; it follows the window through the signals above. Install it in
+    ``app/main.py: build_window`` with ``add_extension``.
 
 Timeline panels
     ``timeline.add_panel(panel)`` / ``timeline.remove_panel(panel)``; a panel is any object with
     ``title: str``, ``height: float`` (relative) and ``draw(ax, view: UtteranceView) -> None``.
-    The timeline re-lays out its figure (shared time axis, blitted cursor) and redraws every panel
-    whenever the view changes.
 """
 
 from __future__ import annotations
 
 import logging
-import math
-import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-from PyQt6.QtCore import QEvent, QPoint, Qt, QTimer, pyqtSignal
-from PyQt6.QtGui import QAction, QImage, QKeySequence, QPainter, QShortcut
+from PyQt6.QtCore import QEvent, Qt, QTimer, pyqtSignal
+from PyQt6.QtGui import QAction, QKeySequence
 from PyQt6.QtWidgets import (
-    QCheckBox,
-    QComboBox,
     QDockWidget,
-    QFileDialog,
-    QHBoxLayout,
     QLabel,
     QMainWindow,
     QMenu,
     QMessageBox,
-    QProgressBar,
-    QPushButton,
-    QSlider,
     QSplitter,
-    QStyle,
-    QToolButton,
     QVBoxLayout,
     QWidget,
 )
@@ -70,34 +70,36 @@ from engine.config import SynthConfig
 from engine.corpus import Corpus, load_corpus
 from engine.data import Utterance
 from engine.errors import FacetrajError
-from engine.evaluation import evaluate_utterance, trajectory_correlations
 from engine.formats import read_audio, read_labels
 from engine.model import Model
 
-from .browser import UtteranceBrowser, normalise_text
+from .browser import UtteranceBrowser
 from .cache import load_or_train
+from .controls import (
+    SPEEDS,
+    LoopRange,
+    TransportBar,
+    ViewBar,
+    add_shortcuts,
+    ask_audio_and_labels,
+    ask_corpus_folder,
+    ask_screenshot_path,
+)
+from .correlations import BrowserScores
+from .marker_panels import MarkerPanels
+from .playback import PlaybackScheduler
 from .settings_panel import SynthSettingsPanel
-from .state import UtteranceView, build_view
-from .style import ORIGINAL_COLOR, SYNTH_COLOR
+from .state import UtteranceView
+from .status import StatusArea
 from .timeline import LipPanel, PhoneTierPanel, SpectrogramPanel, Timeline, WaveformPanel
 from .transport import PlaybackClock
-from .view3d import CAMERA_PRESETS, FaceView
-from .workers import Progress, Task
+from .view3d import FaceView
+from .viewer_model import DEFAULT_SENTENCE, SynthRequest, ViewerModel, load_model, view_summary, view_title
+from .workers import Progress, Task, TaskRunner
+
+__all__ = ["DEFAULT_SENTENCE", "SPEEDS", "MainWindow"]
 
 log = logging.getLogger(__name__)
-
-DEFAULT_SENTENCE = "Tornadoes often destroy acres of farm land"
-SPEEDS = (1.0, 0.5, 0.25)
-
-
-def _phone_at(view: UtteranceView | None, t: float) -> str:
-    if view is None:
-        return ""
-    for seg in view.utterance.phones:
-        if seg.start <= t < seg.end:
-            return seg.label
-    return ""
-
 
 class MainWindow(QMainWindow):
     """Speech plays while original and synthesized face points move, with the lip trajectories."""
@@ -114,36 +116,33 @@ class MainWindow(QMainWindow):
                  use_audio: bool | None = None, parent: QWidget | None = None):
         super().__init__(parent)
         self.setWindowTitle("facetraj — speech-driven 3-D face point trajectories")
-        self.model: Model | None = None
-        self.corpus: Corpus | None = None
-        self.view: UtteranceView | None = None
-        self.synth_config = SynthConfig()
-        self.texts: dict[str, str] = {}
-        self.external: dict[str, Utterance] = {}
-        self._pending_utterance = utterance
-        self._pending_time = start_time
-        self._tasks: list[Task] = []
-        self._synth_generation = 0
-        # the latest utterance asked for: (loader, split, is it a new utterance not shown yet)
-        self._request: tuple[Callable[[], Utterance], str, bool] | None = None
-        self._corr_task: Task | None = None
-        self._latency = 0.0          # running estimate of one frame update (s)
-        self.stats: list[tuple[float, int, float, float]] | None = None   # benchmark hook
-        self.displayed_frame = -1
-        self._closing = False
-        self._frame_pending: tuple[float, int] | None = None   # (tick time, frame) until flushed
+        self.state = ViewerModel(pending_utterance=utterance, pending_time=start_time)
+        self.tasks = TaskRunner(self, error_handler=self.report_error)
+        self.tasks.busyChanged.connect(self.busyChanged)
         self.clock = PlaybackClock(self, use_audio=use_audio)
+        self.playback = PlaybackScheduler(self.clock, self)
+        self.playback.frameDue.connect(lambda t: self._show_time(t, force=True))
         self.clock.playingChanged.connect(self._on_playing_changed)
-
+        self._error_handler: Callable[[str], None] | None = None
+        self._extensions: dict[str, object] = {}
+        self._menus: dict[str, QMenu] = {}
         self._build_widgets()
         self._build_menus()
         self._build_shortcuts()
-        self._timer = QTimer(self)
-        self._timer.setTimerType(Qt.TimerType.PreciseTimer)
-        self._timer.setInterval(5)
-        self._timer.timeout.connect(self._tick)
         if corpus_path is not None:
             QTimer.singleShot(0, lambda: self.open_corpus(Path(corpus_path), model_path))
+
+    # ================================================================== state (read-only views)
+    model = property(lambda self: self.state.model, doc="The model (None until one is loaded).")
+    corpus = property(lambda self: self.state.corpus, doc="The corpus (None until one is opened).")
+    view = property(lambda self: self.state.view, doc="The utterance shown (``UtteranceView``).")
+    synth_config = property(lambda self: self.state.synth_config, doc="The synthesis settings.")
+    displayed_frame = property(lambda self: self.playback.displayed_frame, doc="The frame on screen.")
+    busy = property(lambda self: self.tasks.busy, doc="Whether foreground work (model, synthesis) runs.")
+    correlations_running = property(lambda self: self.scores.running,
+                                    doc="Whether the background lip-correlation sweep runs.")
+    stats = property(lambda self: self.playback.stats, lambda self, v: setattr(self.playback, "stats", v),
+                     doc="The playback benchmark's hook (see :class:`PlaybackScheduler`).")
 
     # ================================================================== construction
     def _build_widgets(self) -> None:
@@ -154,36 +153,16 @@ class MainWindow(QMainWindow):
         for panel in (WaveformPanel(), SpectrogramPanel(), PhoneTierPanel(),
                       LipPanel(self, "upper"), LipPanel(self, "lower")):
             self.timeline.panels.append(panel)
-        self.timeline.seekRequested.connect(self._on_timeline_seek)
-        self.timeline.loopSelected.connect(self._on_loop_selected)
-
+        self.timeline.seekRequested.connect(self.seek)
+        self.marker_panels = MarkerPanels(self.timeline)
+        self.view_bar = ViewBar(self.face)
+        self.camera_buttons = self.view_bar.camera_buttons
+        self.transport = self._build_transport()
         self.title = QLabel("")
         self.title.setStyleSheet("font-size: 15px; font-weight: 600; padding: 2px 6px;")
-        top = QWidget()
-        tl = QVBoxLayout(top)
-        tl.setContentsMargins(0, 0, 0, 0)
-        tl.setSpacing(2)
-        tl.addWidget(self._build_view_bar())
-        tl.addWidget(self.face, 1)
-        tl.addWidget(self._build_transport())
-
-        bottom = QWidget()
-        bl = QVBoxLayout(bottom)
-        bl.setContentsMargins(0, 0, 0, 0)
-        bl.setSpacing(0)
-        bl.addWidget(self.title)
-        bl.addWidget(self.timeline, 1)
-
-        split = QSplitter(Qt.Orientation.Vertical)
-        split.addWidget(top)
-        split.addWidget(bottom)
-        split.setStretchFactor(0, 1)
-        split.setStretchFactor(1, 1)
-        split.setSizes([480, 520])
-        split.setChildrenCollapsible(False)
-        self.splitter = split
-        self.setCentralWidget(split)
-
+        self.splitter = _split(_column([self.view_bar, self.face, self.transport], 2, stretch=self.face),
+                               _column([self.title, self.timeline], 0, stretch=self.timeline))
+        self.setCentralWidget(self.splitter)
         self.browser = UtteranceBrowser(self)
         self.browser.utteranceSelected.connect(self.set_utterance)
         self.browser_dock = self._dock(self.browser, "Utterances", Qt.DockWidgetArea.LeftDockWidgetArea)
@@ -193,95 +172,20 @@ class MainWindow(QMainWindow):
                                         Qt.DockWidgetArea.LeftDockWidgetArea)
         self.resizeDocks([self.browser_dock], [400], Qt.Orientation.Horizontal)
         self._extra_docks: dict[Qt.DockWidgetArea, QDockWidget] = {}
+        self.status = StatusArea(self.statusBar(), self.tasks)
+        self.status_label, self.progress = self.status.label, self.status.progress
+        self.dimensions_label = self.status.dimensions_label
+        self.scores = BrowserScores(self.browser, self.tasks, self.playback.idle)
 
-        self.status_label = QLabel("")
-        self.progress = QProgressBar()
-        self.progress.setRange(0, 1000)
-        self.progress.setFixedWidth(300)
-        self.progress.setVisible(False)
-        self.statusBar().addWidget(self.status_label, 1)
-        self.statusBar().addPermanentWidget(self.progress)
-
-    def _build_view_bar(self) -> QWidget:
-        bar = QWidget()
-        lay = QHBoxLayout(bar)
-        lay.setContentsMargins(4, 0, 4, 0)
-        lay.addWidget(QLabel("camera:"))
-        self.camera_buttons: dict[str, QToolButton] = {}
-        for name in CAMERA_PRESETS:
-            b = QToolButton()
-            b.setText(name)
-            b.setCheckable(True)
-            b.setAutoExclusive(True)
-            b.clicked.connect(lambda _c=False, n=name: self.face.set_camera(n))
-            lay.addWidget(b)
-            self.camera_buttons[name] = b
-        self.camera_buttons[self.face.preset].setChecked(True)
-        lay.addSpacing(16)
-        legend = QLabel(f'<span style="color:{ORIGINAL_COLOR}; font-size:16px">●</span> original &nbsp; '
-                        f'<span style="color:{SYNTH_COLOR}; font-size:16px">●</span> synthesized')
-        legend.setToolTip("marker colours in the 3-D view (lines: lip contours; surface: the "
-                          "synthesized face)")
-        lay.addWidget(legend)
-        lay.addSpacing(16)
-        self.side_by_side = QCheckBox("side by side")
-        self.side_by_side.toggled.connect(self.face.set_side_by_side)
-        self.show_original = QCheckBox("show original")
-        self.show_original.setChecked(True)
-        self.show_synth = QCheckBox("show synthesized")
-        self.show_synth.setChecked(True)
-        for cb in (self.show_original, self.show_synth):
-            cb.toggled.connect(lambda _c: self.face.set_sets_visible(self.show_original.isChecked(),
-                                                                     self.show_synth.isChecked()))
-        self.surface = QCheckBox("face surface")
-        self.surface.setChecked(True)
-        self.surface.toggled.connect(self.face.set_surface)
-        for w in (self.show_original, self.show_synth, self.side_by_side, self.surface):
-            w.setFocusPolicy(Qt.FocusPolicy.NoFocus)
-            lay.addWidget(w)
-        lay.addStretch(1)
-        return bar
-
-    def _build_transport(self) -> QWidget:
-        bar = QWidget()
-        lay = QHBoxLayout(bar)
-        lay.setContentsMargins(4, 0, 4, 0)
-        st = self.style()
-
-        def button(icon: QStyle.StandardPixmap, tip: str, slot: Callable[[], None]) -> QPushButton:
-            b = QPushButton(st.standardIcon(icon), "")
-            b.setToolTip(tip)
-            b.setFocusPolicy(Qt.FocusPolicy.NoFocus)
-            b.clicked.connect(lambda _c=False: slot())
-            lay.addWidget(b)
-            return b
-
-        self.play_button = button(QStyle.StandardPixmap.SP_MediaPlay, "play / pause (space)",
-                                  self.toggle_play)
-        button(QStyle.StandardPixmap.SP_MediaStop, "stop", self.stop)
-        button(QStyle.StandardPixmap.SP_MediaSeekBackward, "previous frame (left)",
-               lambda: self.step_frames(-1))
-        button(QStyle.StandardPixmap.SP_MediaSeekForward, "next frame (right)", lambda: self.step_frames(1))
-        self.slider = QSlider(Qt.Orientation.Horizontal)
-        self.slider.setFocusPolicy(Qt.FocusPolicy.NoFocus)
-        self.slider.valueChanged.connect(self._on_slider)
-        lay.addWidget(self.slider, 1)
-        self.time_label = QLabel("0.000 s")
-        self.time_label.setMinimumWidth(300)
-        self.time_label.setStyleSheet("font-family: monospace;")
-        lay.addWidget(self.time_label)
-        self.speed = QComboBox()
-        for s in SPEEDS:
-            self.speed.addItem(f"{s:g}x", s)
-        self.speed.setFocusPolicy(Qt.FocusPolicy.NoFocus)
-        self.speed.setToolTip("playback speed")
-        self.speed.currentIndexChanged.connect(lambda _i: self.clock.set_speed(self.speed.currentData()))
-        lay.addWidget(self.speed)
-        self.loop_box = QCheckBox("loop")
-        self.loop_box.setFocusPolicy(Qt.FocusPolicy.NoFocus)
-        self.loop_box.setToolTip("loop the selected range (drag on the panels to select; Esc clears)")
-        self.loop_box.toggled.connect(self._on_loop_toggled)
-        lay.addWidget(self.loop_box)
+    def _build_transport(self) -> TransportBar:
+        bar = TransportBar()
+        bar.playClicked.connect(self.toggle_play)
+        bar.stopClicked.connect(self.stop)
+        bar.stepClicked.connect(self.step_frames)
+        bar.speedChanged.connect(self.clock.set_speed)
+        bar.slider.valueChanged.connect(self._on_slider)
+        self.slider, self.speed, self.loop_box = bar.slider, bar.speed, bar.loop_box
+        self.loop = LoopRange(self.clock, self.timeline, bar.loop_box, self.seek)
         return bar
 
     def _dock(self, widget: QWidget, title: str, area: Qt.DockWidgetArea) -> QDockWidget:
@@ -294,34 +198,38 @@ class MainWindow(QMainWindow):
         self.addDockWidget(area, dock)
         return dock
 
+    def _action(self, menu: str, text: str, slot: Callable[[], Any]) -> QAction:
+        """A menu entry; an engine error its slot raises is reported, never raised."""
+        def run(_checked: bool = False) -> None:
+            try:
+                slot()
+            except FacetrajError as exc:
+                self.report_error(exc)
+
+        action = QAction(text, self)
+        action.triggered.connect(run)
+        self.menu(menu).addAction(action)
+        return action
+
     def _build_menus(self) -> None:
-        mb = self.menuBar()
-        file_menu = mb.addMenu("&File")
-        self.action_open_corpus = QAction("Open &corpus folder…", self)
-        self.action_open_corpus.triggered.connect(self._menu_open_corpus)
-        self.action_open_audio = QAction("Open &audio (+ labels) for synthesis…", self)
-        self.action_open_audio.triggered.connect(self._menu_open_audio)
-        self.action_screenshot = QAction("Save &screenshot…", self)
-        self.action_screenshot.triggered.connect(self._menu_screenshot)
-        quit_action = QAction("&Quit", self)
-        quit_action.setShortcut(QKeySequence.StandardKey.Quit)
-        quit_action.triggered.connect(self.close)
-        for a in (self.action_open_corpus, self.action_open_audio, self.action_screenshot):
-            file_menu.addAction(a)
-        file_menu.addSeparator()
-        file_menu.addAction(quit_action)
-        view_menu = mb.addMenu("&View")
-        view_menu.addAction(self.browser_dock.toggleViewAction())
-        view_menu.addAction(self.settings_dock.toggleViewAction())
-        reset = QAction("Show the whole utterance", self)
-        reset.triggered.connect(self.timeline.reset_zoom)
-        view_menu.addAction(reset)
-        self.view_menu = view_menu
-        self.analysis_menu: QMenu = mb.addMenu("&Analysis")
-        help_menu = mb.addMenu("&Help")
-        keys = QAction("Keys", self)
-        keys.triggered.connect(lambda: QMessageBox.information(self, "Keys", KEYS_HELP))
-        help_menu.addAction(keys)
+        self.action_open_corpus = self._action("File", "Open &corpus folder…",
+                                               lambda: _given(ask_corpus_folder(self), self.open_corpus))
+        self.action_open_audio = self._action("File", "Open &audio (+ labels) for synthesis…",
+                                              lambda: _given(ask_audio_and_labels(self), self.open_audio))
+        self.action_screenshot = self._action("File", "Save &screenshot…",
+                                              lambda: _given(ask_screenshot_path(self), self.save_screenshot))
+        self.menu("File").addSeparator()
+        self._action("File", "&Quit", self.close).setShortcut(QKeySequence.StandardKey.Quit)
+        self.view_menu = self.menu("View")
+        self.view_menu.addAction(self.browser_dock.toggleViewAction())
+        self.view_menu.addAction(self.settings_dock.toggleViewAction())
+        self._action("View", "Show the whole utterance", self.timeline.reset_zoom)
+        self.view_menu.addSeparator()
+        self.action_add_marker_panel = self._action("View", "Add a marker trajectory panel…",
+                                                    lambda: self.marker_panels.ask(self.model, self))
+        self._action("View", "Remove the marker trajectory panels", self.marker_panels.clear)
+        self.analysis_menu = self.menu("Analysis")
+        self._action("Help", "Keys", lambda: QMessageBox.information(self, "Keys", KEYS_HELP))
 
     def _build_shortcuts(self) -> None:
         K, M = Qt.Key, Qt.KeyboardModifier
@@ -333,16 +241,22 @@ class MainWindow(QMainWindow):
             (QKeySequence(M.ShiftModifier | K.Key_Right), lambda: self.step_phone(1)),
             (QKeySequence(K.Key_Home), lambda: self.seek(0.0)),
             (QKeySequence(K.Key_End), lambda: self.seek(self.clock.duration)),
-            (QKeySequence(K.Key_Escape), self.clear_loop),
+            (QKeySequence(K.Key_Escape), self.loop.clear),
         ]
-        self._shortcuts = []
-        for seq, slot in bindings:
-            sc = QShortcut(seq, self)
-            sc.setContext(Qt.ShortcutContext.WindowShortcut)
-            sc.activated.connect(slot)
-            self._shortcuts.append(sc)
+        self._shortcuts = add_shortcuts(self, bindings)
 
-    # ================================================================== public API (contract)
+    # ================================================================== public contract
+    def menu(self, name: str) -> QMenu:
+        """The menu ``name`` ("File", "View", "Analysis", "Help"; another name: a new menu)."""
+        if name not in self._menus:
+            help_menu = self._menus.get("Help")
+            if help_menu is None:
+                self._menus[name] = self.menuBar().addMenu(f"&{name}")
+            else:
+                self._menus[name] = QMenu(f"&{name}", self)
+                self.menuBar().insertMenu(help_menu.menuAction(), self._menus[name])
+        return self._menus[name]
+
     def add_dock(self, widget: QWidget, title: str,
                  area: Qt.DockWidgetArea = Qt.DockWidgetArea.RightDockWidgetArea) -> QDockWidget:
         """Add ``widget`` as a dock; docks added to the same area are tabbed together."""
@@ -354,43 +268,49 @@ class MainWindow(QMainWindow):
         self.view_menu.addAction(dock.toggleViewAction())
         return dock
 
-    def run_in_background(self, fn: Callable[[Progress], Any], on_done: Callable[[Any], None],
-                          progress_label: str, on_error: Callable[[BaseException], None] | None = None,
-                          on_partial: Callable[[Any], None] | None = None) -> Task:
-        """Run ``fn(progress)`` in a worker thread; ``on_done(result)`` on the GUI thread."""
-        task = Task(fn, progress_label, self)
-        if self._closing:            # never start work once the window is closing
-            return task
-        task.progress.connect(lambda f, m: self._on_task_progress(task, f, m))
-        task.succeeded.connect(lambda r: self._safe(on_done, r))
-        task.failed.connect(lambda e: self._safe(on_error, e) if on_error else self._report_error(e))
-        if on_partial is not None:
-            task.partial.connect(lambda obj: self._safe(on_partial, obj))
-        task.finished.connect(lambda: self._on_task_finished(task))
-        self._tasks.append(task)
-        self._update_busy(progress_label)
-        task.start()
-        return task
+    def run_task(self, fn: Callable[[Progress], Any], on_done: Callable[[Any], None] | None, label: str,
+                 **options: Any) -> Task:
+        """Run ``fn(progress)`` in a worker thread (see :meth:`TaskRunner.run` for ``options``)."""
+        return self.tasks.run(fn, on_done, label, **options)
+
+    def report_error(self, exc: BaseException) -> None:
+        """Show an error (:func:`error_message`) with :meth:`show_error`."""
+        self.show_error(error_message(exc))
+
+    def show_error(self, message: str) -> None:
+        """An error message: in the status bar, and a dialog (or the ``set_error_handler`` one)."""
+        self.status_label.setText(message)
+        log.error("%s", message)
+        if self._error_handler is not None:
+            self._error_handler(message)
+        else:
+            QMessageBox.critical(self, "facetraj", message)
+
+    def set_error_handler(self, handler: Callable[[str], None] | None) -> None:
+        """Route error messages to ``handler`` instead of a dialog (None: dialogs again)."""
+        self._error_handler = handler
+
+    def show_status(self, text: str, timeout_ms: int = 0) -> None:
+        """A message in the status bar (a temporary one with ``timeout_ms``)."""
+        self.status.show(text, timeout_ms)
+
+    def add_extension(self, name: str, extension: object) -> None:
+        self._extensions[name] = extension
+
+    def extension(self, name: str) -> Any:
+        """The extension installed under ``name`` (KeyError if none)."""
+        return self._extensions[name]
 
     def set_utterance(self, utt_id: str) -> None:
         """Show utterance ``utt_id`` (of the corpus, or opened from files): loaded and synthesized in
         the background; ``utteranceChanged`` follows."""
-        if self.model is None:
-            self._pending_utterance = utt_id
+        try:
+            request = self.state.request_utterance(utt_id)
+        except FacetrajError as exc:
+            self.report_error(exc)
             return
-        if utt_id in self.external:
-            utt, split = self.external[utt_id], "external"
-            self._synthesize(lambda: utt, split, new_utterance=True)
-            return
-        if self.corpus is None:
-            return
-        info = self.corpus.info
-        if utt_id not in info.ids:
-            self._report_error(FacetrajError(f"{utt_id}: no such utterance in {self.corpus.root}"))
-            return
-        split = "test" if utt_id in info.test else "train"
-        corpus = self.corpus
-        self._synthesize(lambda: corpus.utterance(utt_id), split, new_utterance=True)
+        if request is not None:
+            self._synthesize(request)
 
     def seek(self, t: float) -> None:
         """Move the clock, the cursor and the 3-D frame to ``t`` seconds."""
@@ -406,95 +326,53 @@ class MainWindow(QMainWindow):
         try:
             corpus = load_corpus(path)
         except FacetrajError as exc:
-            self._report_error(exc)
+            self.report_error(exc)
             return
-
-        def work(progress: Progress) -> tuple[Model, dict[str, str]]:
-            texts = {}
-            for utt_id in corpus.info.ids:
-                p = corpus.data_root / f"{utt_id}.txt"
-                if p.exists():
-                    texts[utt_id] = p.read_text(encoding="utf-8", errors="replace").strip()
-            if model_path is not None:
-                progress(0.5, f"loading {model_path}")
-                model = Model.load(model_path)
-            else:
-                model = load_or_train(corpus, progress=progress)
-            if model.marker_names != corpus.info.marker_names:
-                raise FacetrajError(f"{model_path or corpus.root}: the model's marker set differs from "
-                                    "the corpus")
-            return model, texts
-
         self.status_label.setText(f"opening {corpus.root} …")
-        self.run_in_background(work, lambda r: self._on_model_ready(corpus, *r),
-                               "preparing the model (first run trains it)")
+        self.run_task(lambda p: load_model(corpus, model_path, p, load_or_train),
+                      lambda r: self._on_model_ready(corpus, *r), "preparing the model (first run trains it)")
 
     def _on_model_ready(self, corpus: Corpus, model: Model, texts: dict[str, str]) -> None:
         self.stop()
-        self.corpus, self.model, self.texts = corpus, model, texts
-        self.external.clear()
-        self.view = None
-        self._request = None
+        first = self.state.set_model(corpus, model, texts)
         self.face.set_model(model)
         self.settings.set_limits(model.config.context, model.config.nu, model.tuned)
         info = corpus.info
         self.browser.populate({"test": list(info.test), "train": list(info.train)}, texts)
         self.status_label.setText(f"{corpus.root}: {len(info.train)} training and {len(info.test)} test "
                                   f"utterances, {model.n_markers} markers, {model.pca.n_components} PCs")
+        self._show_planar(model.is_planar)
+        self.marker_panels.set_model(model)
         self.modelReady.emit()
-        first = self._pending_utterance or self.default_utterance()
-        self._pending_utterance = None
         if first:
             self.set_utterance(first)
-        self._start_correlations()
+        self.scores.start(self.state, lambda _r: self.correlationsDone.emit())
 
-    def default_utterance(self) -> str | None:
-        """The test sentence "Tornadoes often destroy acres of farm land" (paper Figure 4), else
-        the first test utterance."""
-        if self.corpus is None:
-            return None
-        info = self.corpus.info
-        want = normalise_text(DEFAULT_SENTENCE)
-        for utt_id in [*info.test, *info.train]:
-            if normalise_text(self.texts.get(utt_id, "")) == want:
-                return utt_id
-        return (info.test or info.train or [None])[0]
+    def _show_planar(self, planar: bool) -> None:
+        """Midsagittal (2-D) data is shown as such: the profile camera and a status-bar note."""
+        self.dimensions_label.setVisible(planar)
+        if planar:
+            self.view_bar.set_camera("profile")
 
     # ================================================================== synthesis
     def set_synth_config(self, cfg: SynthConfig) -> None:
         """Use new synthesis settings: re-synthesize the current utterance and the correlations."""
-        if cfg == self.synth_config:
+        changed, request = self.state.set_config(cfg)
+        if not changed:
             return
-        self.synth_config = cfg
         self.settings.set_config(cfg)
-        if self._request is not None:
-            # the utterance asked for last (it may still be on its way)
-            get_utterance, split, new_utterance = self._request
-            self._synthesize(get_utterance, split, new_utterance)
-        self._start_correlations()
+        if request is not None:
+            self._synthesize(request)
+        self.scores.start(self.state, lambda _r: self.correlationsDone.emit())
 
-    def _synthesize(self, get_utterance: Callable[[], Utterance], split: str, new_utterance: bool) -> None:
-        model = self.model
-        cfg = self.synth_config
-        self._request = (get_utterance, split, new_utterance)
-        self._synth_generation += 1
-        gen = self._synth_generation
-
-        def work(progress: Progress) -> UtteranceView:
-            utt = get_utterance()
-            progress(0.3, f"synthesizing {utt.name}")
-            c = cfg if (utt.phones or cfg.mode == "acoustic") else cfg.with_(mode="acoustic")
-            return build_view(model, utt, split, c)
-
+    def _synthesize(self, request: SynthRequest) -> None:
         def done(view: UtteranceView) -> None:
-            if gen == self._synth_generation and model is self.model:
-                self._apply_view(view, new_utterance)
+            if self.state.accept(request, view):
+                self._apply_view(view, request.new_utterance)
 
-        self.run_in_background(work, done, "synthesizing")
+        self.run_task(request.run, done, "synthesizing")
 
     def _apply_view(self, view: UtteranceView, new_utterance: bool) -> None:
-        utt_now = view.utterance
-        self._request = (lambda: utt_now, view.split, False)
         t = 0.0 if new_utterance else self.clock.time()
         was_playing = self.clock.playing and not new_utterance
         if new_utterance:
@@ -502,82 +380,30 @@ class MainWindow(QMainWindow):
             self.clock.load(view.utterance.audio, view.utterance.sample_rate)
             self.loop_box.setChecked(False)
             self.timeline.loop = None
-            if self._pending_time is not None:
-                t, self._pending_time = float(self._pending_time), None
-        self.view = view
+            t = self.state.take_pending_time(t)
+        self.playback.set_frames(view.n_frames, view.rate)
         self.face.set_view(view)
         self.timeline.set_view(view, keep_zoom=not new_utterance)
-        self.slider.blockSignals(True)
-        self.slider.setRange(0, view.n_frames - 1)
-        self.slider.blockSignals(False)
-        utt = view.utterance
-        text = f" — “{utt.text}”" if utt.text else ""
-        cfg = view.synthesis.config
-        shown = {"triangular": "triangular", "spline": "spline", "none": "unsmoothed"}[cfg.smoothing]
-        self.title.setText(f"{utt.name} ({view.split}){text}    ·    3-D: {shown} synthesis, "
-                           f"{cfg.mode}, N={cfg.n_context_phones}")
-        self.browser.set_current(utt.name)
-        self._score_current()
-        self.status_label.setText(f"{utt.name}: {view.n_frames} frames at {view.rate:g} Hz, "
-                                  f"{int(view.speech.sum())} speech frames")
+        self.transport.set_frames(view.n_frames)
+        self._show_titles(view)
         self.clock.seek(t)
         self._show_time(t, force=True)
         if was_playing and not self.clock.playing:
             self.clock.play()
         if new_utterance:
-            self.utteranceChanged.emit(utt.name)
+            self.utteranceChanged.emit(view.utterance.name)
         self.synthesisChanged.emit()
 
-    def _score_current(self) -> None:
-        v = self.view
-        if v is None or v.original is None or self.model is None:
-            return
-        try:
-            c = trajectory_correlations(v.original, v.shown, v.speech, self.model)
-            self.browser.set_scores(v.utterance.name, c["lower_lip"], c["upper_lip"])
-        except Exception:
-            log.debug("scoring the current utterance failed", exc_info=True)
-
-    def _start_correlations(self) -> None:
-        """Lip correlations of every corpus utterance under the current settings, in the background."""
-        if self._corr_task is not None:
-            self._corr_task.cancel()
-        if self.corpus is None or self.model is None:
-            return
-        self.browser.clear_scores()
-        corpus, model, cfg = self.corpus, self.model, self.synth_config
-        ids = [(s, u) for s in ("test", "train") for u in getattr(corpus.info, s)]
-        smoothing = cfg.smoothing
-
-        clock = self.clock
-
-        def work(progress: Progress) -> None:
-            for k, (split, utt_id) in enumerate(ids):
-                while clock.playing and not progress.cancelled:
-                    time.sleep(0.05)    # playback first: resume when the sound stops
-                progress(k / max(len(ids), 1), f"lip correlations: {utt_id}")
-                try:
-                    utt = corpus.utterance(utt_id)
-                    score = evaluate_utterance(model, utt, split, cfg, (smoothing,))[0]
-                    progress.partial((utt_id, score.lower_lip, score.upper_lip))
-                except FacetrajError as exc:
-                    log.warning("%s", exc)
-                    progress.partial((utt_id, math.nan, math.nan))
-                time.sleep(0.002)   # let the GUI thread have the interpreter
-
-        def partial(obj: tuple[str, float, float]) -> None:
-            self.browser.set_scores(*obj)
-
-        self._corr_task = self.run_in_background(work, lambda _r: self.correlationsDone.emit(),
-                                                 "lip correlations", on_partial=partial)
-        if self._corr_task.isRunning():
-            self._corr_task.setPriority(Task.Priority.LowPriority)
+    def _show_titles(self, view: UtteranceView) -> None:
+        self.title.setText(view_title(view))
+        self.browser.set_current(view.utterance.name)
+        self.scores.score(view, self.model)
+        self.status_label.setText(view_summary(view))
 
     # ================================================================== playback
     def toggle_play(self) -> None:
-        if self.view is None:
-            return
-        self.clock.toggle()
+        if self.view is not None:
+            self.clock.toggle()
 
     def play(self) -> None:
         if self.view is not None:
@@ -588,98 +414,35 @@ class MainWindow(QMainWindow):
 
     def stop(self) -> None:
         self.clock.stop()
-        if self.view is not None:
-            self._show_time(self.clock.time(), force=True)
+        self._show_time(self.clock.time(), force=True)      # nothing without a view
 
     def step_frames(self, n: int) -> None:
-        if self.view is None:
-            return
-        self.clock.pause()
-        rate = self.view.rate
-        k = int(np.clip(round(self.clock.time() * rate) + n, 0, self.view.n_frames - 1))
-        self.seek(k / rate)
+        if self.view is not None:
+            self.clock.pause()
+            self.seek(self.state.step_frames_target(self.clock.time(), n))
 
     def step_phone(self, direction: int) -> None:
         """Jump to the start of the next (or previous) phone."""
-        if self.view is None:
-            return
-        self.clock.pause()
-        t = self.clock.time()
-        starts = [s.start for s in self.view.utterance.phones] or [0.0]
-        if direction > 0:
-            later = [s for s in starts if s > t + 1e-6]
-            target = later[0] if later else self.clock.duration
-        else:
-            earlier = [s for s in starts if s < t - 1e-3]
-            target = earlier[-1] if earlier else 0.0
-        self.seek(target)
-
-    def clear_loop(self) -> None:
-        self.loop_box.setChecked(False)
-        self.clock.set_loop(None)
-        self.timeline.set_loop(None)
-
-    def _on_loop_selected(self, a: float, b: float) -> None:
-        self.clock.set_loop(a, b)
-        self.loop_box.setChecked(True)
-        self.seek(a)
-
-    def _on_loop_toggled(self, on: bool) -> None:
-        self.clock.looping = bool(on)
-        if not on:
-            self.timeline.set_loop(None)
-        elif self.clock.loop is not None:
-            self.timeline.set_loop(self.clock.loop)
-
-    def _on_timeline_seek(self, t: float) -> None:
-        self.seek(t)
+        if self.view is not None:
+            self.clock.pause()
+            self.seek(self.state.step_phone_target(self.clock.time(), direction))
 
     def _on_slider(self, value: int) -> None:
         if self.view is not None:
             self.seek(value / self.view.rate)
 
     def _on_playing_changed(self, playing: bool) -> None:
-        icon = QStyle.StandardPixmap.SP_MediaPause if playing else QStyle.StandardPixmap.SP_MediaPlay
-        self.play_button.setIcon(self.style().standardIcon(icon))
-        if playing:
-            self._timer.start()
-        else:
-            self._timer.stop()
-            if self.view is not None:
-                self._show_time(self.clock.time(), force=True)
-
-    def _tick(self) -> None:
-        """One timer tick: show the frame at the audio clock (skip frames, never drift)."""
-        if self.view is None:
-            return
-        t = self.clock.poll()
-        if not self.clock.playing:
-            self._show_time(t, force=True)
-            return
-        # aim at the clock time when this update reaches the screen
-        end = self.clock.loop[1] if (self.clock.looping and self.clock.loop) else self.clock.duration
-        target = min(t + self._latency * self.clock.speed, end)
-        k = int(np.clip(round(target * self.view.rate), 0, self.view.n_frames - 1))
-        if self._frame_pending is not None:
-            if time.perf_counter() - self._frame_pending[0] < 0.25:
-                return
-            self._frame_pending = None    # no flush came (window hidden?): do not stall
-        if k == self.displayed_frame:
-            return
-        self._frame_pending = (time.perf_counter(), k)
-        self._show_time(target, force=True)
+        self.transport.set_playing(playing)
+        if not playing:
+            self._show_time(self.clock.time(), force=True)
 
     def event(self, e: QEvent) -> bool:
-        """The window's flush (UpdateRequest) is when a frame reaches the screen: time it."""
-        if e.type() != QEvent.Type.UpdateRequest or self._frame_pending is None:
+        """The window's flush (UpdateRequest) is when a frame reaches the screen: the scheduler
+        times it."""
+        if e.type() != QEvent.Type.UpdateRequest or not self.playback.pending:
             return super().event(e)
         result = super().event(e)
-        start, k = self._frame_pending
-        self._frame_pending = None
-        spent = time.perf_counter() - start
-        self._latency = min(0.8 * self._latency + 0.2 * spent, 0.08) if self._latency else spent
-        if self.stats is not None:
-            self.stats.append((start, k, spent, self.clock.time()))
+        self.playback.flushed()
         return result
 
     def _show_time(self, t: float, force: bool = False) -> None:
@@ -687,151 +450,94 @@ class MainWindow(QMainWindow):
         view = self.view
         if view is None:
             return
-        rate = view.rate
-        k = int(np.clip(round(t * rate), 0, view.n_frames - 1))
+        k = view.frame_at(t)
         if not force and k == self.displayed_frame:
             return
-        phone = _phone_at(view, t)
+        phone = self.state.phone_at(t)
         # everything is only marked dirty here: the window's next flush puts the 3-D frame, the
         # cursor and the widgets on screen together (one composition per frame)
         self.face.show_frame(k)
-        self.displayed_frame = k
-        self.slider.blockSignals(True)
-        self.slider.setValue(k)
-        self.slider.blockSignals(False)
-        self.time_label.setText(f"{t:6.3f} / {view.duration:.3f} s  frame {k:4d}  "
-                                f"{('/' + phone + '/') if phone else ''}")
+        self.playback.shown(k)
+        self.transport.show_frame(k, f"{t:6.3f} / {view.duration:.3f} s  frame {k:4d}  "
+                                     f"{('/' + phone + '/') if phone else ''}")
         self.timeline.set_cursor(t, follow=self.clock.playing)
         self.cursorMoved.emit(float(t))
 
     # ================================================================== files
-    def _menu_open_corpus(self) -> None:
-        path = QFileDialog.getExistingDirectory(self, "Open a corpus folder")
-        if path:
-            self.open_corpus(Path(path))
-
-    def _menu_open_audio(self) -> None:
-        audio, _ = QFileDialog.getOpenFileName(self, "Open audio for synthesis", "",
-                                               "Audio (*.wav *.flac);;All files (*)")
-        if not audio:
-            return
-        labels, _ = QFileDialog.getOpenFileName(
-            self, "Phone labels (Cancel: acoustic-only synthesis)", str(Path(audio).parent),
-            "Labels (*.TextGrid *.lab *.phn);;All files (*)")
-        self.open_audio(Path(audio), Path(labels) if labels else None)
-
     def open_audio(self, audio_path: Path, labels_path: Path | None = None) -> None:
         """Synthesize from an audio file (and phone labels) that has no original markers."""
-        if self.model is None:
-            self._report_error(FacetrajError("no model yet: open a corpus first"))
+        model = self.model
+        if model is None:
+            self.report_error(FacetrajError("no model yet: open a corpus first"))
             return
         try:
             audio, rate = read_audio(audio_path)
             phones = read_labels(labels_path, rate) if labels_path else []
         except FacetrajError as exc:
-            self._report_error(exc)
+            self.report_error(exc)
             return
-        name = audio_path.stem
-        while name in (self.corpus.info.ids if self.corpus else []):
-            name += "'"
-        utt = Utterance(name=name, audio=audio, sample_rate=rate, phones=list(phones),
-                        markers=None, marker_rate=self.model.marker_rate,
-                        marker_names=list(self.model.marker_names), text=str(audio_path))
-        self.external[name] = utt
+        name = self.state.add_external(Utterance(
+            name=audio_path.stem, audio=audio, sample_rate=rate, phones=list(phones), markers=None,
+            marker_rate=model.marker_rate, marker_names=list(model.marker_names), text=str(audio_path)))
         self.browser.add_external(name)
         self.set_utterance(name)
-
-    def _menu_screenshot(self) -> None:
-        path, _ = QFileDialog.getSaveFileName(self, "Save a screenshot", "facetraj.png", "PNG (*.png)")
-        if path:
-            self.save_screenshot(Path(path))
 
     def save_screenshot(self, path: Path) -> Path:
         """Render the whole window (with the 3-D view) to a PNG."""
         self.face.rerender()
         self.timeline.canvas.draw()
         pix = self.grab()
-        img = self.plotter.screenshot(return_img=True)
-        if img is not None and img.size:
-            h, w = img.shape[:2]
-            rgb = np.ascontiguousarray(img[:, :, :3])
-            qimg = QImage(rgb.data, w, h, 3 * w, QImage.Format.Format_RGB888)
-            painter = QPainter(pix)
-            target = self.face.plotter.interactor.mapTo(self, QPoint(0, 0))
-            dpr = pix.devicePixelRatio()
-            size = self.face.plotter.interactor.size()
-            painter.drawImage(target.x(), target.y(), qimg.scaled(int(size.width() * dpr),
-                                                                  int(size.height() * dpr)))
-            painter.end()
+        self.face.paint_into(pix, self)
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         if not pix.save(str(path), "PNG"):
             raise FacetrajError(f"{path}: cannot write the screenshot")
         return path
 
-    # ================================================================== tasks and errors
-    def _safe(self, fn: Callable[[Any], None] | None, arg: Any) -> None:
-        """Call a completion handler; an exception becomes an error dialog (never a crash)."""
-        if fn is None:
-            return
-        try:
-            fn(arg)
-        except Exception as exc:
-            log.exception("handler failed")
-            self._report_error(exc)
-
-    def _report_error(self, exc: BaseException) -> None:
-        if isinstance(exc, FacetrajError):
-            msg = str(exc)
-        else:
-            log.error("unexpected error", exc_info=exc)
-            msg = f"internal error: {type(exc).__name__}: {exc}"
-        self.status_label.setText(msg)
-        self.show_error(msg)
-
-    def show_error(self, message: str) -> None:
-        log.error("%s", message)
-        QMessageBox.critical(self, "facetraj", message)
-
-    def _on_task_progress(self, task: Task, fraction: float, message: str) -> None:
-        if task is self._corr_task and len(self._tasks) > 1:
-            return   # foreground work owns the bar
-        self.progress.setValue(int(1000 * fraction))
-        self.progress.setFormat(f"{task.label}: %p%")
-        if message and task is not self._corr_task:
-            self.status_label.setText(message)
-
-    def _on_task_finished(self, task: Task) -> None:
-        if task in self._tasks:
-            self._tasks.remove(task)
-        if task is self._corr_task:
-            self._corr_task = None
-        task.deleteLater()
-        self._update_busy()
-
-    def _update_busy(self, label: str = "") -> None:
-        busy = bool(self._tasks)
-        self.progress.setVisible(busy)
-        if busy and label:
-            self.progress.setValue(0)
-            self.progress.setFormat(f"{label}: %p%")
-        self.busyChanged.emit(busy)
-
-    @property
-    def busy(self) -> bool:
-        """Whether foreground work (model, synthesis) is running (background correlations aside)."""
-        return any(t is not self._corr_task for t in self._tasks)
-
     def closeEvent(self, event) -> None:
-        self._closing = True
-        self._timer.stop()
+        self.playback.stop()
         self.clock.close()
-        for task in list(self._tasks):
-            task.cancel()
-        for task in list(self._tasks):
-            task.wait(5000)
+        self.tasks.close()
         self.face.close_view()
         super().closeEvent(event)
+
+
+def error_message(exc: BaseException) -> str:
+    """The engine's own errors as they are (they name the file), anything else as an internal one
+    (logged with its traceback)."""
+    if isinstance(exc, FacetrajError):
+        return str(exc)
+    log.error("unexpected error", exc_info=exc)
+    return f"internal error: {type(exc).__name__}: {exc}"
+
+
+def _given(args: tuple | None, fn: Callable[..., Any]) -> None:
+    """``fn(*args)`` unless a dialog was cancelled (``args`` None)."""
+    if args is not None:
+        fn(*args)
+
+
+def _split(top: QWidget, bottom: QWidget) -> QSplitter:
+    """Two widgets one above the other, sharing the height, neither collapsible."""
+    split = QSplitter(Qt.Orientation.Vertical)
+    split.addWidget(top)
+    split.addWidget(bottom)
+    split.setStretchFactor(0, 1)
+    split.setStretchFactor(1, 1)
+    split.setSizes([480, 520])
+    split.setChildrenCollapsible(False)
+    return split
+
+
+def _column(widgets: list[QWidget], spacing: int, stretch: QWidget) -> QWidget:
+    """Widgets stacked vertically without margins; ``stretch`` takes the spare height."""
+    box = QWidget()
+    lay = QVBoxLayout(box)
+    lay.setContentsMargins(0, 0, 0, 0)
+    lay.setSpacing(spacing)
+    for w in widgets:
+        lay.addWidget(w, 1 if w is stretch else 0)
+    return box
 
 
 KEYS_HELP = """space\tplay / pause

@@ -294,72 +294,6 @@ class ImportDialog(QDialog):
         self.accept()
 
 
-# ---------------------------------------------------------------------- marker panels
-JAW_NAMES = ("LI", "JAW", "JAW_C", "CN_C", "CHIN", "CN")
-
-
-class MarkerPanel:
-    """A time-aligned panel of one marker coordinate: original (dashed) and the triangular and
-    spline syntheses, like the lip panels (e.g. the jaw of MOCHA-TIMIT's lower incisor coil)."""
-
-    height = 1.0
-
-    def __init__(self, marker: str, axis: str = "y"):
-        self.marker = marker
-        self.axis = axis
-        self.title = f"{marker} {axis}"
-
-    def draw(self, ax, view) -> None:
-        from .style import ORIGINAL_COLOR, SPLINE_COLOR, TRIANGULAR_COLOR
-
-        names = view.utterance.marker_names or []
-        if self.marker not in names:
-            ax.text(0.5, 0.5, f"no marker {self.marker}", transform=ax.transAxes, ha="center")
-            return
-        k, a = names.index(self.marker), "xyz".index(self.axis)
-        t = view.times
-        ax.plot(t, view.triangular[:, k, a], color=TRIANGULAR_COLOR, lw=1.6)
-        ax.plot(t, view.spline[:, k, a], color=SPLINE_COLOR, lw=1.3)
-        if view.original is not None:
-            ax.plot(t, view.original[:, k, a], color=ORIGINAL_COLOR, lw=1.5, ls=(0, (2, 1.5)))
-        ax.set_ylabel(f"{self.marker}\n{self.axis} (mm)", fontsize=8)
-
-
-def jaw_marker(names: list[str]) -> str | None:
-    """The jaw marker among ``names`` (MOCHA's lower incisor LI, or a chin/jaw marker), if any."""
-    upper = [n.upper() for n in names]
-    for cand in JAW_NAMES:
-        if cand in upper:
-            return names[upper.index(cand)]
-    return None
-
-
-class MarkerPanelDialog(QDialog):
-    """Choose a marker and an axis for a new time-aligned panel."""
-
-    def __init__(self, names: list[str], parent: QWidget | None = None):
-        super().__init__(parent)
-        self.setWindowTitle("Add a marker trajectory panel")
-        form = QFormLayout(self)
-        self.marker = QComboBox()
-        self.marker.addItems(names)
-        jaw = jaw_marker(names)
-        if jaw:
-            self.marker.setCurrentText(jaw)
-        self.axis = QComboBox()
-        self.axis.addItems(["y (up)", "z (forward)", "x (right)"])
-        form.addRow("Marker", self.marker)
-        form.addRow("Coordinate", self.axis)
-        buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Ok
-                                   | QDialogButtonBox.StandardButton.Cancel)
-        buttons.accepted.connect(self.accept)
-        buttons.rejected.connect(self.reject)
-        form.addRow(buttons)
-
-    def panel(self) -> MarkerPanel:
-        return MarkerPanel(self.marker.currentText(), self.axis.currentText()[0])
-
-
 # ---------------------------------------------------------------------- exports
 def export_trajectories(window, path: Path, which: str = "synthesized") -> Path:
     """Write the current utterance's ``synthesized`` or ``original`` markers (C3D, TSV or NPZ)."""
@@ -396,123 +330,88 @@ def export_video(window, path: Path) -> None:
                             original=view.original, overwrite=True, progress=progress,
                             title=utt.text or utt.name)
 
-    window.run_in_background(work, lambda p: window.status_label.setText(f"wrote {p}"),
-                             f"rendering {path.name}")
+    window.run_task(work, lambda p: window.show_status(f"wrote {p}"), f"rendering {path.name}")
 
 
-def install(window) -> None:
-    """Add import and export entries to the window's File menu."""
-    file_menu = window.menuBar().actions()[0].menu()
-    first = file_menu.actions()[2] if len(file_menu.actions()) > 2 else None
+class OwnData:
+    """The File-menu entries to bring one's own recordings in and to export results (an extension:
+    it uses only the window contract of ``app/main_window.py``)."""
 
-    def guarded(fn):
+    ENTRIES = (
+        ("&Import your own recordings…", "do_import"),
+        ("Export &synthesized trajectories…", "export_synthesized"),
+        ("Export &original trajectories…", "export_original"),
+        ("Export the panels as a &figure…", "do_figure"),
+        ("Save the &model…", "do_model"),
+        ("Export a &video…", "do_video"),
+    )
+
+    def __init__(self, window):
+        self.window = window
+        self.actions: dict[str, QAction] = {}
+        file_menu = window.menu("File")
+        for text, method in self.ENTRIES:
+            action = QAction(text, window)
+            action.triggered.connect(self._guarded(getattr(self, method)))
+            file_menu.insertAction(window.action_screenshot, action)
+            self.actions[text.replace("&", "").rstrip("…")] = action
+
+    def _guarded(self, fn):
+        """A menu slot: a bad file or an engine error is reported, never raised."""
         def run(*_):
             try:
                 fn()
             except (FacetrajError, OSError) as exc:
-                window._report_error(exc if isinstance(exc, FacetrajError) else FacetrajError(str(exc)))
+                self.window.report_error(exc if isinstance(exc, FacetrajError) else FacetrajError(str(exc)))
         return run
 
-    def do_import():
-        dlg = ImportDialog(window)
+    def _wrote(self, path: Path) -> None:
+        self.window.show_status(f"wrote {path}")
+
+    def do_import(self) -> None:
+        dlg = ImportDialog(self.window)
         if dlg.exec() == QDialog.DialogCode.Accepted and dlg.result_path:
-            window.open_corpus(dlg.result_path)
+            self.window.open_corpus(dlg.result_path)
 
-    def do_traj(which: str):
-        name = window.view.utterance.name if window.view else "trajectories"
-        p = ask_save_path(window, f"Export {which} trajectories", f"{name}_{which}.c3d",
-                     "C3D (*.c3d);;TSV (*.tsv);;NumPy (*.npz)")
+    def export_synthesized(self) -> None:
+        self._export_trajectories("synthesized")
+
+    def export_original(self) -> None:
+        self._export_trajectories("original")
+
+    def _export_trajectories(self, which: str) -> None:
+        w = self.window
+        name = w.view.utterance.name if w.view else "trajectories"
+        p = ask_save_path(w, f"Export {which} trajectories", f"{name}_{which}.c3d",
+                          "C3D (*.c3d);;TSV (*.tsv);;NumPy (*.npz)")
         if p:
-            export_trajectories(window, p, which)
-            window.status_label.setText(f"wrote {p}")
+            self._wrote(export_trajectories(w, p, which))
 
-    def do_figure():
-        p = ask_save_path(window, "Export the panels as a figure", "panels.png",
+    def do_figure(self) -> None:
+        p = ask_save_path(self.window, "Export the panels as a figure", "panels.png",
                           "PNG (*.png);;SVG (*.svg);;PDF (*.pdf)")
         if p:
-            export_figure(window, p)
-            window.status_label.setText(f"wrote {p}")
+            self._wrote(export_figure(self.window, p))
 
-    def do_model():
-        if window.model is None:
+    def do_model(self) -> None:
+        model = self.window.model
+        if model is None:
             raise FacetrajError("no model yet")
-        p = ask_save_path(window, "Save the model", "model.npz", "facetraj model (*.npz)")
+        p = ask_save_path(self.window, "Save the model", "model.npz", "facetraj model (*.npz)")
         if p:
-            window.model.save(p)
-            window.status_label.setText(f"wrote {p}")
+            model.save(p)
+            self._wrote(p)
 
-    def do_video():
-        name = window.view.utterance.name if window.view else "facetraj"
-        p = ask_save_path(window, "Export a video", f"{name}.mp4", "MP4 (*.mp4)")
+    def do_video(self) -> None:
+        w = self.window
+        name = w.view.utterance.name if w.view else "facetraj"
+        p = ask_save_path(w, "Export a video", f"{name}.mp4", "MP4 (*.mp4)")
         if p:
-            export_video(window, p)
+            export_video(w, p)
 
-    entries = [
-        ("&Import your own recordings…", do_import),
-        ("Export &synthesized trajectories…", lambda: do_traj("synthesized")),
-        ("Export &original trajectories…", lambda: do_traj("original")),
-        ("Export the panels as a &figure…", do_figure),
-        ("Save the &model…", do_model),
-        ("Export a &video…", do_video),
-    ]
-    window.own_data_actions = {}
-    for text, fn in entries:
-        action = QAction(text, window)
-        action.triggered.connect(guarded(fn))
-        if first is not None:
-            file_menu.insertAction(first, action)
-        else:
-            file_menu.addAction(action)
-        window.own_data_actions[text.replace("&", "").rstrip("…")] = action
 
-    window.dimensions_label = QLabel("midsagittal (2-D) data: profile view, y up, z forward")
-    window.dimensions_label.setStyleSheet("font-weight: 600; padding: 0 8px;")
-    window.statusBar().addPermanentWidget(window.dimensions_label)
-    window.dimensions_label.hide()
-
-    def on_model():
-        model = window.model
-        planar = model is not None and not model.neutral_face()[:, 0].any()
-        window.dimensions_label.setVisible(planar)
-        if planar:
-            window.face.set_camera("profile")          # midsagittal data: shown as such
-            if "profile" in getattr(window, "camera_buttons", {}):
-                window.camera_buttons["profile"].setChecked(True)
-
-    window.marker_panels = []
-
-    def add_marker_panel(panel: MarkerPanel) -> None:
-        window.marker_panels.append(panel)
-        window.timeline.add_panel(panel)
-
-    def ask_marker_panel():
-        if window.model is None:
-            raise FacetrajError("no model yet")
-        dlg = MarkerPanelDialog(list(window.model.marker_names), window)
-        if dlg.exec() == QDialog.DialogCode.Accepted:
-            add_marker_panel(dlg.panel())
-
-    def remove_marker_panels():
-        for panel in window.marker_panels:
-            window.timeline.remove_panel(panel)
-        window.marker_panels.clear()
-
-    add = QAction("Add a marker trajectory panel…", window)
-    add.triggered.connect(guarded(ask_marker_panel))
-    remove = QAction("Remove the marker trajectory panels", window)
-    remove.triggered.connect(guarded(remove_marker_panels))
-    window.view_menu.addSeparator()
-    window.view_menu.addAction(add)
-    window.view_menu.addAction(remove)
-    window.own_data_actions["Add a marker trajectory panel"] = add
-
-    def on_model_panels():
-        remove_marker_panels()
-        model = window.model
-        if model is not None and not model.neutral_face()[:, 0].any():
-            jaw = jaw_marker(list(model.marker_names))     # midsagittal EMA: the jaw beside the lips
-            if jaw:
-                add_marker_panel(MarkerPanel(jaw, "y"))
-
-    window.modelReady.connect(on_model)
-    window.modelReady.connect(on_model_panels)
+def install(window) -> OwnData:
+    """Add the import and export entries to ``window``; also ``window.extension("own_data")``."""
+    own = OwnData(window)
+    window.add_extension("own_data", own)
+    return own

@@ -23,7 +23,8 @@ from matplotlib.figure import Figure
 
 from engine.evaluation import METRICS
 from engine.model import Model
-from engine.report import PAPER_TABLE2, ReportData, write_report
+from engine.paper import PAPER_TABLE2, TABLE2_N
+from engine.report import ComparisonRow, ReportData, write_report
 
 log = logging.getLogger(__name__)
 
@@ -46,17 +47,18 @@ def figure5(data: ReportData, path: Path) -> Path:
     """Correlation (triangular smoothing) against N, train and test, whole face solid and lips
     thin; the paper's N = 3 figures as markers."""
     sw = data.sweep
-    ns = sw["ns"]
+    ns = sw.ns
     fig = Figure(figsize=(9.0, 4.2))
     ax = fig.add_subplot()
     for split, colour in (("train", TRAIN_C), ("test", TEST_C)):
-        ax.plot(ns, sw[split]["whole_face"], "-o", color=colour, lw=2, ms=4,
+        curves = sw.curves[split]
+        ax.plot(ns, curves["whole_face"], "-o", color=colour, lw=2, ms=4,
                 label=f"{split}, whole face")
-        ax.plot(ns, sw[split]["lower_lip"], "--", color=colour, lw=1, label=f"{split}, lower lip")
-        ax.plot(ns, sw[split]["upper_lip"], ":", color=colour, lw=1, label=f"{split}, upper lip")
+        ax.plot(ns, curves["lower_lip"], "--", color=colour, lw=1, label=f"{split}, lower lip")
+        ax.plot(ns, curves["upper_lip"], ":", color=colour, lw=1, label=f"{split}, upper lip")
         paper = PAPER_TABLE2[(split, "triangular")][0]
-        ax.plot([3], [paper], "*", color=colour, ms=12, mec="k", mew=0.5,
-                label=f"paper, {split} whole face (N = 3)")
+        ax.plot([TABLE2_N], [paper], "*", color=colour, ms=12, mec="k", mew=0.5,
+                label=f"paper, {split} whole face (N = {TABLE2_N})")
     ax.set_xlabel("N, visually most similar context-phones searched")
     ax.set_ylabel("correlation, original vs synthesized")
     ax.set_xticks(ns)
@@ -111,7 +113,7 @@ def figure4(data: ReportData, path: Path) -> Path | None:
 def comparison(data: ReportData, path: Path) -> Path:
     """Grouped bars: whole face / lower lip / upper lip on test (triangular) for the paper's
     numbers, ours, acoustic-only and the two baselines; train shown as thin outlines."""
-    methods: list[tuple[str, dict | None]] = []
+    methods: list[tuple[str, ComparisonRow | None]] = []
     names = {"phonetic": "ours, N = 3", "acoustic": "acoustic-only", "viseme": "viseme lookup",
              "ridge": "ridge (LSF)"}
     for mode, label in names.items():
@@ -126,13 +128,14 @@ def comparison(data: ReportData, path: Path) -> Path:
     for k, (label, row) in enumerate(methods):
         if row is None:
             continue
-        vals = [row[m] for m in METRICS]
-        err = [row.get(f"{m}_std") or 0.0 for m in METRICS]
+        vals = [getattr(row, m) for m in METRICS]
+        err = [row.std(m) or 0.0 for m in METRICS]
         ax.bar(x - 0.4 + width * (k + 1.5), vals, width, yerr=err, capsize=2,
                color=colours[k % len(colours)], label=label, error_kw={"lw": 0.6})
     ax.set_xticks(x, [LABELS[m] for m in METRICS])
     ax.set_ylabel("correlation on test (triangular)")
-    lo = min(0.0, *(r[m] for _, r in methods if r for m in METRICS if np.isfinite(r[m])))
+    lo = min(0.0, *(v for _, r in methods if r for v in (getattr(r, m) for m in METRICS)
+                    if np.isfinite(v)))
     ax.set_ylim(lo, 1.05)
     ax.axhline(0, color="k", lw=0.5)
     ax.grid(axis="y", alpha=0.3)

@@ -17,6 +17,16 @@ from engine.model import Model
 from engine.pipeline import Synthesis, resmooth, synthesize
 
 
+def frame_index(t: float, rate: float, n_frames: int, step: int = 0) -> int:
+    """The frame at ``t`` seconds (``round(t * rate)``), moved by ``step`` frames, clipped to
+    ``[0, n_frames - 1]``.
+
+    >>> frame_index(0.51, 60.0, 100), frame_index(0.51, 60.0, 100, step=-1), frame_index(9.0, 60.0, 100)
+    (31, 30, 99)
+    """
+    return int(np.clip(round(t * rate) + step, 0, max(n_frames - 1, 0)))
+
+
 @dataclass
 class UtteranceView:
     """The current utterance and everything derived from it.
@@ -58,6 +68,10 @@ class UtteranceView:
     def rate(self) -> float:
         """Marker frames per second."""
         return float(1.0 / (self.times[1] - self.times[0])) if len(self.times) > 1 else 60.0
+
+    def frame_at(self, t: float, step: int = 0) -> int:
+        """The frame shown at ``t`` seconds (moved by ``step`` frames), within the utterance."""
+        return frame_index(t, self.rate, self.n_frames, step)
 
 
 def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig) -> UtteranceView:

@@ -19,7 +19,6 @@ from matplotlib.figure import Figure
 from matplotlib.transforms import Bbox
 from PyQt6.QtCore import pyqtSignal
 from PyQt6.QtWidgets import QSizePolicy, QVBoxLayout, QWidget
-from scipy.signal import spectrogram
 
 from .state import UtteranceView
 from .style import (
@@ -76,6 +75,27 @@ class WaveformPanel:
         ax.set_ylabel("speech", fontsize=8)
 
 
+def spectrogram(x: np.ndarray, rate: float, nperseg: int, hop: int,
+                nfft: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Frequencies, segment-centre times and power spectral density ``(freqs, segments)`` of
+    ``x``: periodic Hamming window, each segment's mean removed, one-sided density scaling.
+
+    The same values as ``scipy.signal.spectrogram(x, rate, window="hamming", nperseg=nperseg,
+    noverlap=nperseg - hop, nfft=nfft, mode="psd")`` (tested), without importing scipy.signal,
+    which takes 1-2 s and would delay the window's first frame.
+    """
+    x = np.asarray(x, dtype=np.float64)
+    n_seg = (len(x) - nperseg) // hop + 1
+    win = np.hamming(nperseg + 1)[:-1]
+    seg = np.lib.stride_tricks.sliding_window_view(x, nperseg)[::hop][:n_seg]
+    seg = (seg - seg.mean(axis=1, keepdims=True)) * win
+    psd = np.abs(np.fft.rfft(seg, nfft, axis=1)) ** 2 / (rate * np.sum(win ** 2))
+    psd[:, 1:-1 if nfft % 2 == 0 else None] *= 2.0
+    freqs = np.fft.rfftfreq(nfft, 1.0 / rate)
+    times = (nperseg / 2 + hop * np.arange(n_seg)) / rate
+    return freqs, times, psd.T
+
+
 class SpectrogramPanel:
     """A wide-band spectrogram (grey scale, 0 to 8 kHz)."""
 
@@ -88,8 +108,7 @@ class SpectrogramPanel:
         rate = view.utterance.sample_rate
         nper = max(16, int(0.006 * rate))
         hop = max(1, int(0.002 * rate))
-        f, t, s = spectrogram(x, rate, window="hamming", nperseg=nper, noverlap=nper - hop,
-                              nfft=max(256, 2 ** int(np.ceil(np.log2(nper)))), mode="psd")
+        f, t, s = spectrogram(x, rate, nper, hop, max(256, 2 ** int(np.ceil(np.log2(nper)))))
         keep = f <= self.max_freq
         db = 10 * np.log10(s[keep] + 1e-14)
         top = float(db.max())

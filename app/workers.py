@@ -1,9 +1,16 @@
-"""Background work off the GUI thread: a :class:`Task` runs ``fn(progress)`` in a QThread and
-reports progress, partial results, the result or the error back on the GUI thread."""
+"""Background work off the GUI thread.
+
+A :class:`Task` runs ``fn(progress)`` in a QThread and reports progress, partial results, the
+result or the error back on the GUI thread. A :class:`TaskRunner` is the one place that starts,
+tracks and stops tasks: the main window has one (``window.tasks``, behind ``window.run_task``); a
+view used on its own, without a window, makes its own. A :class:`Gate` is what a worker waits on
+(e.g. "no sound is playing") without polling: opening it, or cancelling the task, wakes it.
+"""
 
 from __future__ import annotations
 
 import logging
+import threading
 import traceback
 from collections.abc import Callable
 from typing import Any
@@ -15,6 +22,34 @@ log = logging.getLogger(__name__)
 
 class Cancelled(Exception):
     """Raised inside a task's function by :meth:`Progress.__call__` once the task is cancelled."""
+
+
+class Gate:
+    """An open/closed flag worker threads can wait on (a condition variable, no polling)."""
+
+    def __init__(self, is_open: bool = True):
+        self._cond = threading.Condition()
+        self._open = is_open
+
+    @property
+    def is_open(self) -> bool:
+        return self._open
+
+    def set_open(self, is_open: bool) -> None:
+        with self._cond:
+            self._open = bool(is_open)
+            self._cond.notify_all()
+
+    def wake(self) -> None:
+        """Wake the waiters so that they look at their stop condition again."""
+        with self._cond:
+            self._cond.notify_all()
+
+    def wait_open(self, stop: Callable[[], bool] = lambda: False) -> bool:
+        """Block until the gate is open or ``stop()`` is true (after a :meth:`wake`); whether open."""
+        with self._cond:
+            self._cond.wait_for(lambda: self._open or stop())
+            return self._open
 
 
 class Progress:
@@ -38,23 +73,45 @@ class Progress:
             raise Cancelled
         self._task.partial.emit(obj)
 
+    def wait_open(self, gate: Gate) -> None:
+        """Wait until ``gate`` is open; raises Cancelled if the task is cancelled meanwhile."""
+        self._task.wait_open(gate)
+
 
 class Task(QThread):
-    """One background job. Signals arrive on the GUI thread (queued)."""
+    """One background job. Signals arrive on the GUI thread (queued).
+
+    A ``background`` task runs at low priority and its progress gives way to foreground work."""
 
     progress = pyqtSignal(float, str)
     partial = pyqtSignal(object)
     succeeded = pyqtSignal(object)
     failed = pyqtSignal(object)        # the exception
 
-    def __init__(self, fn: Callable[[Progress], Any], label: str = "", parent: QObject | None = None):
+    def __init__(self, fn: Callable[[Progress], Any], label: str = "", parent: QObject | None = None,
+                 background: bool = False):
         super().__init__(parent)
         self.fn = fn
         self.label = label
+        self.background = background
         self.is_cancelled = False
+        self._gate: Gate | None = None      # what the task waits on, if anything
 
     def cancel(self) -> None:
         self.is_cancelled = True
+        gate = self._gate
+        if gate is not None:
+            gate.wake()
+
+    def wait_open(self, gate: Gate) -> None:
+        """(In the task's thread) wait until ``gate`` opens; Cancelled when cancelled first."""
+        self._gate = gate
+        try:
+            gate.wait_open(lambda: self.is_cancelled)
+        finally:
+            self._gate = None
+        if self.is_cancelled:
+            raise Cancelled
 
     def run(self) -> None:
         try:
@@ -69,3 +126,101 @@ class Task(QThread):
             return
         if not self.is_cancelled:
             self.succeeded.emit(result)
+
+
+_DETACHED: list[Task] = []     # cancelled tasks that outlived their runner's close (see close)
+
+
+class TaskRunner(QObject):
+    """Starts tasks, keeps them until they finish, routes their results and errors, stops them.
+
+    ``error_handler(exc)`` receives the errors of tasks started without ``on_error`` and the
+    exceptions raised by completion handlers (a handler never crashes the app).
+    """
+
+    started = pyqtSignal(object)                 # the task
+    progressed = pyqtSignal(object, float, str)  # (task, fraction, message)
+    finished = pyqtSignal(object)                # the task (succeeded, failed or cancelled)
+    busyChanged = pyqtSignal(bool)               # whether any task runs
+
+    def __init__(self, parent: QObject | None = None,
+                 error_handler: Callable[[BaseException], None] | None = None):
+        super().__init__(parent)
+        self.error_handler = error_handler
+        self.tasks: list[Task] = []
+        self.closed = False
+
+    def run(self, fn: Callable[[Progress], Any], on_done: Callable[[Any], None] | None, label: str, *,
+            on_error: Callable[[BaseException], None] | None = None,
+            on_partial: Callable[[Any], None] | None = None,
+            on_progress: Callable[[float, str], None] | None = None,
+            background: bool = False) -> Task:
+        """Run ``fn(progress)`` in a worker thread; the callbacks arrive on the GUI thread.
+
+        Once the runner is closed the task is returned without being started."""
+        task = Task(fn, label, self, background=background)
+        if self.closed:
+            return task
+        task.progress.connect(lambda f, m: self.progressed.emit(task, f, m))
+        if on_progress is not None:
+            task.progress.connect(on_progress)
+        task.succeeded.connect(lambda r: self._safe(on_done, r))
+        task.failed.connect(lambda e: self._safe(on_error, e) if on_error else self._error(e))
+        if on_partial is not None:
+            task.partial.connect(lambda obj: self._safe(on_partial, obj))
+        task.finished.connect(lambda: self._finished(task))
+        self.tasks.append(task)
+        task.start()
+        if background and task.isRunning():
+            task.setPriority(Task.Priority.LowPriority)
+        self.started.emit(task)
+        self.busyChanged.emit(True)
+        return task
+
+    @property
+    def busy(self) -> bool:
+        """Whether foreground work is running (background tasks aside)."""
+        return any(not t.background for t in self.tasks)
+
+    def running(self, task: Task | None) -> bool:
+        return task is not None and task in self.tasks
+
+    def close(self, timeout_ms: int = 5000) -> None:
+        """Start nothing more; cancel every task and wait for it (before the owner closes).
+
+        A task still running after ``timeout_ms`` (a long synthesis notices the cancellation only
+        at its next progress call) is detached from the owner and kept alive until it ends, so
+        that closing the owner never destroys a running thread (Qt aborts the process then)."""
+        self.closed = True
+        for task in list(self.tasks):
+            task.cancel()
+        for task in list(self.tasks):
+            if not task.wait(timeout_ms):
+                log.warning("task %r still running after %d ms: detached", task.label, timeout_ms)
+                for signal in (task.finished, task.progress, task.partial):
+                    signal.disconnect()     # its receivers close with the owner
+                task.setParent(None)
+                _DETACHED.append(task)
+
+    def _safe(self, fn: Callable[[Any], None] | None, arg: Any) -> None:
+        """Call a completion handler; its exception goes to the error handler (never a crash)."""
+        if fn is None:
+            return
+        try:
+            fn(arg)
+        except Exception as exc:
+            log.exception("handler failed")
+            self._error(exc)
+
+    def _error(self, exc: BaseException) -> None:
+        if self.error_handler is not None:
+            self.error_handler(exc)
+        else:
+            log.error("background task failed", exc_info=exc)
+
+    def _finished(self, task: Task) -> None:
+        if task in self.tasks:
+            self.tasks.remove(task)
+        task.deleteLater()
+        self.finished.emit(task)
+        self.busyChanged.emit(bool(self.tasks))

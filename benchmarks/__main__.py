@@ -22,7 +22,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from . import scaling, synth, train
+from . import scaling, startup, synth, train
 from .common import (
     REPO,
     BenchContext,
@@ -37,8 +37,10 @@ from .common import (
 
 log = logging.getLogger("benchmarks")
 
-GROUPS = ("train", "synth", "scaling", "playback")
+GROUPS = ("train", "synth", "scaling", "eval", "playback", "startup")
 DEFAULT_OUT = REPO / "docs" / "benchmarks.md"
+#: hand-written profile notes (per stage, before and after a change), copied into the Markdown
+NOTES = REPO / "benchmarks" / "profile_notes.md"
 
 
 def display_available() -> tuple[bool, str]:
@@ -83,8 +85,13 @@ def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS, factors: Sequence[i
         rows += synth.run(ctx)
     if "scaling" in only:
         rows += scaling.run(ctx, factors, prefilters)
+    if "eval" in only:
+        rows += startup.evaluation(ctx)
     if "playback" in only:
         rows += run_playback(ctx.smoke, ctx.corpus.root)
+    if "startup" in only:
+        rows += startup.cold_start(ctx) if display_available()[0] else [BenchRow(
+            "startup", "cold start", float("nan"), "", note="skipped: no display")]
     return rows
 
 
@@ -137,6 +144,7 @@ def write_markdown(path: Path, rows: Sequence[BenchRow], ctx: BenchContext, elap
         *[line for name, top in (prof or {}).items() for line in (
             f"{name}:", "", "| function | s | share |", "|---|---:|---:|",
             *[f"| `{f}` | {t:.3f} | {100 * sh:.0f} % |" for f, t, sh in top], "")],
+        *(NOTES.read_text(encoding="utf-8").splitlines() if NOTES.exists() else []),
         "## How to read it",
         "",
         "- `value (CPU time)` is the same figure computed from this process's CPU time: on a shared "

@@ -59,7 +59,7 @@ def measure(corpus: Path, seconds: float, utterance: str | None = None, during_c
     startup = time.monotonic() - t0
     correlations = float("nan")
     if not during_correlations:
-        wait_for(lambda: win._corr_task is None, 900)
+        wait_for(lambda: not win.correlations_running, 900)
         correlations = time.monotonic() - t0 - startup
     view = win.view
     rate = view.rate

@@ -262,8 +262,8 @@ def score_baseline(model: Model, fd: FrameData, pcs: np.ndarray, split: str, nam
     """
     markers = model.to_markers(smooth(pcs, model.marker_rate, smoothing, triangle_s, knot_s))
     c = trajectory_correlations(fd.original, markers, fd.speech, model, eval_config)
-    return UtteranceScore(fd.name, split, name, smoothing, 0, c["whole_face"], c["lower_lip"],
-                          c["upper_lip"], int(fd.speech.sum()))
+    return UtteranceScore(split=split, mode=name, smoothing=smoothing, n_context_phones=0, **c,
+                          utterance=fd.name, speech_frames=int(fd.speech.sum()))
 
 
 def evaluate_baselines(model: Model, baselines: Baselines,

@@ -62,7 +62,7 @@ def read_c3d_parameters(path: Path, data: bytes) -> tuple[str, bool, dict[tuple[
         name_end = pos + 2 + name_len
         if name_end + 2 > end:
             raise bad("a parameter name runs past the parameter section")
-        name = "".join(c if c.isprintable() else "?" for c in
+        name = "".join(c if c.isascii() and c.isprintable() else "?" for c in
                        data[pos + 2:name_end].decode("ascii", errors="replace")).strip().upper()[:32]
         offset = struct.unpack(order + "h", data[name_end:name_end + 2])[0]
         nxt = name_end + offset

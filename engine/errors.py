@@ -27,7 +27,12 @@ class InputError(FacetrajError):
         super().__init__(f"{self.path}: {self.problem}" if self.path else self.problem)
 
 
-class OutputExistsError(InputError, FileExistsError):
+class OutputError(InputError, OSError):
+    """An output path that cannot be written (also an :class:`OSError`, for callers that catch
+    those around a save)."""
+
+
+class OutputExistsError(OutputError, FileExistsError):
     """The output file exists and replacing it was not asked for (``--overwrite``)."""
 
 

@@ -5,11 +5,13 @@ between original and synthesized trajectories (Table 2, Figure 5).
 from __future__ import annotations
 
 import logging
+import multiprocessing as mp
+import os
 from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
-from scipy.signal import medfilt
 
 from .config import SynthConfig
 from .corpus import Corpus
@@ -59,6 +61,22 @@ def short_time_energy_db(audio: np.ndarray, rate: int, window_s: float = 0.02,
     return 10 * np.log10(energy + 1e-12), np.arange(count) * hop / rate
 
 
+def median_filter(x: np.ndarray, k: int) -> np.ndarray:
+    """Running median of odd length ``k``, zero-padded at both ends (the values of
+    ``scipy.signal.medfilt``, tested; here so that the app's first frame does not wait 1-2 s for
+    scipy.signal to import).
+
+    >>> median_filter(np.array([3.0, 1.0, 2.0, 5.0, 4.0]), 3).tolist()
+    [1.0, 2.0, 2.0, 4.0, 4.0]
+    """
+    if k % 2 == 0:
+        raise ValueError("the median filter length must be odd")
+    x = np.asarray(x, dtype=np.float64)
+    half = k // 2
+    padded = np.concatenate([np.zeros(half), x, np.zeros(half)])
+    return np.median(np.lib.stride_tricks.sliding_window_view(padded, k), axis=1)
+
+
 def speech_mask(audio: np.ndarray, rate: int, times: np.ndarray,
                 config: EvalConfig | None = None) -> np.ndarray:
     """Speech (True) or silence per time in ``times``: energy, 112 ms median filter, threshold.
@@ -75,7 +93,7 @@ def speech_mask(audio: np.ndarray, rate: int, times: np.ndarray,
     e_db, _e_t = short_time_energy_db(audio, rate, config.energy_window_s, config.energy_hop_s)
     k = int(round(config.median_s / config.energy_hop_s))
     k = k + 1 if k % 2 == 0 else k
-    filtered = medfilt(e_db, k) if len(e_db) >= k else e_db
+    filtered = median_filter(e_db, k) if len(e_db) >= k else e_db
     floor, peak = np.percentile(filtered, [5, 99])
     threshold = floor + config.threshold_fraction * (peak - floor)
     idx = np.clip(np.round(np.asarray(times) / config.energy_hop_s).astype(int), 0, len(e_db) - 1)
@@ -127,10 +145,11 @@ def trajectory_correlations(original: np.ndarray, synthesized: np.ndarray, mask:
 
 
 @dataclass
-class UtteranceScore:
-    """Correlations of one utterance under one condition."""
+class ConditionScores:
+    """The three correlations of section 3 (whole face, lower lip, upper lip) under one condition:
+    split, synthesis mode, smoothing and N. One utterance's scores (:class:`UtteranceScore`) and a
+    mean over utterances (a Table 2 row) share these fields."""
 
-    utterance: str
     split: str
     mode: str
     smoothing: str
@@ -138,7 +157,22 @@ class UtteranceScore:
     whole_face: float
     lower_lip: float
     upper_lip: float
+
+
+@dataclass(kw_only=True)
+class UtteranceScore(ConditionScores):
+    """Correlations of one utterance under one condition, on its ``speech_frames`` frames."""
+
+    utterance: str
     speech_frames: int
+
+
+def _nanmean(values: Sequence[float]) -> float:
+    """Mean of the finite values; NaN (without numpy's warning) when there are none, e.g. an
+    utterance whose markers have no complete frame."""
+    v = np.asarray(values, dtype=np.float64)
+    v = v[np.isfinite(v)]
+    return float(v.mean()) if v.size else float("nan")
 
 
 @dataclass
@@ -152,8 +186,7 @@ class EvalResult:
         """Mean correlation over utterances of one condition (the paper averages utterances)."""
         rows = [r for r in self.scores if r.split == split and r.smoothing == smoothing
                 and r.mode == mode and (n is None or r.n_context_phones == n)]
-        return {m: float(np.nanmean([getattr(r, m) for r in rows])) if rows else float("nan")
-                for m in METRICS}
+        return {m: _nanmean([getattr(r, m) for r in rows]) for m in METRICS}
 
     def conditions(self) -> list[tuple[str, str, str, int]]:
         seen: dict[tuple[str, str, str, int], None] = {}
@@ -167,7 +200,9 @@ class EvalResult:
                  **self.mean(sp, sm, mo, n)} for sp, mo, sm, n in self.conditions()]
 
     def to_json(self) -> dict:
-        return {"table": self.table(), "utterances": [asdict(r) for r in self.scores]}
+        # the utterance first, as it reads
+        return {"table": self.table(),
+                "utterances": [{"utterance": r.utterance, **asdict(r)} for r in self.scores]}
 
 
 def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
@@ -196,32 +231,82 @@ def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
     for sm in smoothings:
         markers = resmooth(model, res, sm)
         c = trajectory_correlations(original, markers, mask, model, eval_config)
-        out.append(UtteranceScore(utt.name, split, config.mode, sm, config.n_context_phones,
-                                  c["whole_face"], c["lower_lip"], c["upper_lip"], int(mask.sum())))
+        out.append(UtteranceScore(split=split, mode=config.mode, smoothing=sm,
+                                  n_context_phones=config.n_context_phones, **c,
+                                  utterance=utt.name, speech_frames=int(mask.sum())))
     return out
+
+
+def _score_utterance(model: Model, corpus: Corpus, split: str, utt_id: str,
+                     configs: Sequence[SynthConfig], smoothings: Sequence[str],
+                     eval_config: EvalConfig | None) -> list[UtteranceScore]:
+    """Every config's scores of one corpus utterance (its audio, markers and LSFs read once)."""
+    utt = corpus.utterance(utt_id)
+    original = model.normalise_markers(utt.markers)
+    speech = speech_mask(utt.audio, utt.sample_rate, utt.frame_times(), eval_config)
+    lsf = model.input_lsf(utt.audio, utt.sample_rate,                 # synthesize()'s frames
+                          np.arange(utt.n_frames) / model.marker_rate)
+    out: list[UtteranceScore] = []
+    for cfg in configs:
+        out.extend(evaluate_utterance(model, utt, split, cfg, smoothings, eval_config,
+                                      original=original, speech=speech, lsf=lsf))
+    return out
+
+
+#: what a worker process of :func:`evaluate` scores with, inherited by fork (not pickled)
+_WORKER_STATE: tuple | None = None
+
+
+def _worker_init(state: tuple) -> None:
+    global _WORKER_STATE
+    _WORKER_STATE = state
+
+
+def _worker_score(split: str, utt_id: str) -> list[UtteranceScore]:
+    assert _WORKER_STATE is not None
+    return _score_utterance(*_WORKER_STATE[:2], split, utt_id, *_WORKER_STATE[2:])
+
+
+def default_workers() -> int:
+    """Worker processes for :func:`evaluate` by default: the cores this process may use."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:                          # not on Linux
+        return max(1, os.cpu_count() or 1)
 
 
 def evaluate(model: Model, corpus: Corpus, splits: Iterable[str] = ("train", "test"),
              configs: Sequence[SynthConfig] | None = None,
              smoothings: Sequence[str] = ("triangular", "spline"),
              eval_config: EvalConfig | None = None,
-             progress: Callable[[float, str], None] | None = None) -> EvalResult:
-    """Score every utterance of ``splits`` under each synthesis config (Table 2 and more)."""
+             progress: Callable[[float, str], None] | None = None,
+             workers: int = 1) -> EvalResult:
+    """Score every utterance of ``splits`` under each synthesis config (Table 2 and more).
+
+    With ``workers > 1`` the utterances are scored in that many processes (forked, so the model
+    is shared, not copied through pickle); each utterance is independent, and the scores come
+    back in corpus order, equal to the serial run's.
+    """
     configs = list(configs or [SynthConfig()])
     splits = list(splits)
     ids = [(sp, u) for sp in splits for u in getattr(corpus.info, sp)]
     result = EvalResult()
-    for k, (sp, utt_id) in enumerate(ids):
-        if progress:
-            progress(k / max(len(ids), 1), f"{sp}: {utt_id}")
-        utt = corpus.utterance(utt_id)
-        original = model.normalise_markers(utt.markers)
-        speech = speech_mask(utt.audio, utt.sample_rate, utt.frame_times(), eval_config)
-        lsf = model.input_lsf(utt.audio, utt.sample_rate,                 # synthesize()'s frames
-                              np.arange(utt.n_frames) / model.marker_rate)
-        for cfg in configs:
-            result.scores.extend(evaluate_utterance(model, utt, sp, cfg, smoothings, eval_config,
-                                                    original=original, speech=speech, lsf=lsf))
+    workers = min(workers, len(ids))
+    if workers > 1 and "fork" in mp.get_all_start_methods():
+        state = (model, corpus, configs, list(smoothings), eval_config)
+        with ProcessPoolExecutor(workers, mp.get_context("fork"), initializer=_worker_init,
+                                 initargs=(state,)) as pool:
+            futures = [pool.submit(_worker_score, sp, u) for sp, u in ids]
+            for k, (fut, (sp, utt_id)) in enumerate(zip(futures, ids, strict=True)):
+                if progress:
+                    progress(k / len(ids), f"{sp}: {utt_id}")
+                result.scores.extend(fut.result())
+    else:
+        for k, (sp, utt_id) in enumerate(ids):
+            if progress:
+                progress(k / max(len(ids), 1), f"{sp}: {utt_id}")
+            result.scores.extend(_score_utterance(model, corpus, sp, utt_id, configs, smoothings,
+                                                  eval_config))
     if progress:
         progress(1.0, "done")
     return result
@@ -229,22 +314,23 @@ def evaluate(model: Model, corpus: Corpus, splits: Iterable[str] = ("train", "te
 
 def table2(model: Model, corpus: Corpus, acoustic: bool = True,
            eval_config: EvalConfig | None = None,
-           progress: Callable[[float, str], None] | None = None) -> EvalResult:
+           progress: Callable[[float, str], None] | None = None, workers: int = 1) -> EvalResult:
     """The paper's Table 2 (train/test x triangular/spline, N = 3), plus acoustic-only rows
     (the paper's whole-codebook search, ``acoustic_prefilter=None``)."""
     configs = [SynthConfig(mode="phonetic")]
     if acoustic:
         configs.append(SynthConfig(mode="acoustic", acoustic_prefilter=None))
     return evaluate(model, corpus, ("train", "test"), configs, ("triangular", "spline"),
-                    eval_config, progress)
+                    eval_config, progress, workers)
 
 
 def sweep_n(model: Model, corpus: Corpus, ns: Sequence[int] = tuple(range(1, 11)),
             splits: Sequence[str] = ("train", "test"), eval_config: EvalConfig | None = None,
-            progress: Callable[[float, str], None] | None = None) -> EvalResult:
+            progress: Callable[[float, str], None] | None = None, workers: int = 1) -> EvalResult:
     """Correlation against N (the paper's Figure 5), triangular smoothing."""
     configs = [SynthConfig(n_context_phones=n) for n in ns]
-    return evaluate(model, corpus, splits, configs, ("triangular",), eval_config, progress)
+    return evaluate(model, corpus, splits, configs, ("triangular",), eval_config, progress,
+                    workers)
 
 
 def format_table2(result: EvalResult) -> str:

@@ -21,13 +21,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.signal import resample_poly
 
 from .c3d_check import MAX_RATE as MAX_C3D_RATE
 from .c3d_check import MIN_RATE as MIN_C3D_RATE
 from .c3d_check import check_c3d
 from .data import PhoneSegment
-from .errors import InputError, OutputExistsError
+from .errors import InputError, OutputError, OutputExistsError
 
 log = logging.getLogger(__name__)
 
@@ -60,10 +59,10 @@ def check_output_path(path: str | os.PathLike[str], overwrite: bool = True) -> P
     Raises :class:`InputError` naming the path; returns it as a :class:`Path`."""
     path = Path(path)
     if len(os.fsencode(path.name)) > _NAME_MAX:
-        raise InputError(path, f"the file name is too long ({len(os.fsencode(path.name))} bytes; "
+        raise OutputError(path, f"the file name is too long ({len(os.fsencode(path.name))} bytes; "
                                f"at most {_NAME_MAX})")
     if path.is_dir():
-        raise InputError(path, "a folder is at this path; give a file name")
+        raise OutputError(path, "a folder is at this path; give a file name")
     if path.exists() and not overwrite:
         raise OutputExistsError(path, "already exists; choose to overwrite it (--overwrite) or "
                                       "give another name")
@@ -71,9 +70,9 @@ def check_output_path(path: str | os.PathLike[str], overwrite: bool = True) -> P
     while not folder.exists() and folder != folder.parent:
         folder = folder.parent
     if folder.exists() and not folder.is_dir():
-        raise InputError(path, f"cannot be written: {folder} is a file, not a folder")
+        raise OutputError(path, f"cannot be written: {folder} is a file, not a folder")
     if folder.is_dir() and not os.access(folder, os.W_OK | os.X_OK):
-        raise InputError(path, f"cannot be written: no permission to write in {folder}")
+        raise OutputError(path, f"cannot be written: no permission to write in {folder}")
     return path
 
 
@@ -133,7 +132,7 @@ def atomic_write(path: str | os.PathLike[str], overwrite: bool = True) -> Iterat
                                    dir=path.parent)
         os.close(fd)
     except OSError as exc:
-        raise InputError(path, f"cannot be written ({write_problem(exc)})") from exc
+        raise OutputError(path, f"cannot be written ({write_problem(exc)})") from exc
     tmp_path = Path(tmp)
     try:
         with _TermToExit():
@@ -142,9 +141,9 @@ def atomic_write(path: str | os.PathLike[str], overwrite: bool = True) -> Iterat
                 os.chmod(tmp_path, mode)
                 os.replace(tmp_path, path)
             except OSError as exc:
-                if isinstance(exc, FileExistsError) and isinstance(exc, InputError):
+                if isinstance(exc, InputError):
                     raise
-                raise InputError(path, f"cannot be written ({write_problem(exc)})") from exc
+                raise OutputError(path, f"cannot be written ({write_problem(exc)})") from exc
     finally:
         with contextlib.suppress(OSError):
             if tmp_path.exists():
@@ -650,6 +649,8 @@ def resample_markers(markers: np.ndarray, rate: float, target: float) -> np.ndar
         from fractions import Fraction
 
         frac = Fraction(target / rate).limit_denominator(1000)
+        from scipy.signal import resample_poly  # here: scipy.signal takes 1-2 s to import
+
         out = resample_poly(markers, frac.numerator, frac.denominator, axis=0, padtype="line")
         if out.shape[0] >= n_out:
             return out[:n_out]

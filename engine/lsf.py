@@ -5,7 +5,6 @@ from the roots of the sum and difference polynomials.
 from __future__ import annotations
 
 import numpy as np
-from scipy.signal import resample_poly
 
 #: white-noise correction added to r[0] (a -40 dB noise floor) so that LPC of near-silent or
 #: perfectly periodic frames stays well conditioned.
@@ -167,6 +166,8 @@ def resample_audio(audio: np.ndarray, rate: int, target: int) -> np.ndarray:
     if rate == target:
         return np.asarray(audio, dtype=np.float64)
     g = np.gcd(int(rate), int(target))
+    from scipy.signal import resample_poly  # here: scipy.signal takes 1-2 s to import
+
     return resample_poly(np.asarray(audio, dtype=np.float64), target // g, rate // g)
 
 

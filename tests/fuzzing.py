@@ -59,6 +59,7 @@ class Case:
     output: Path | None = None
     parse_only: bool = False
     keep_mode: int | None = None   # the mode an overwritten output must keep
+    cwd: Path | None = None        # where it runs (relative output paths land there)
 
 
 @dataclass
@@ -88,12 +89,14 @@ class Workspace:
     lab: Path
     c3d: Path
     n: int = 0
+    current: Path | None = None    # the folder of the case being made
 
     def fresh(self, name: str) -> Path:
         """A new empty folder for one case."""
         self.n += 1
         d = self.root / "cases" / f"{self.n:05d}-{name}"
         d.mkdir(parents=True)
+        self.current = d
         return d
 
 
@@ -655,7 +658,8 @@ def option_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
         parse_only = (not path or path[0] in PARSE_ONLY or path[-1] in PARSE_ONLY
                       or path[0] == "sweep")
         yield Case("options", f"{' '.join(path) or '(none)'} {action.option_strings[-1]}={value!r}",
-                   argv, _protect(ws.model, ws.wav, ws.corpus / "corpus.json"), out, parse_only)
+                   argv, _protect(ws.model, ws.wav, ws.corpus / "corpus.json"), out, parse_only,
+                   cwd=d)
 
 
 # --------------------------------------------------------------------------- outputs
@@ -721,7 +725,9 @@ def cases(ws: Workspace, n: int, seed: int) -> Iterator[Case]:
     """``n`` cases, spread evenly over :data:`CATEGORIES`, reproducible from ``seed``."""
     gens = {c: GENERATORS[c](ws, random.Random(f"{seed}-{c}")) for c in CATEGORIES}
     for i in range(n):
-        yield next(gens[CATEGORIES[i % len(CATEGORIES)]])
+        case = next(gens[CATEGORIES[i % len(CATEGORIES)]])
+        case.cwd = case.cwd or ws.current   # relative paths land in the case's own folder
+        yield case
 
 
 # --------------------------------------------------------------------------- running a case
@@ -780,6 +786,8 @@ def run_in_process(case: Case) -> Outcome:
     err, out = io.StringIO(), io.StringIO()
     t0 = time.perf_counter()
     handlers = logging.getLogger().handlers[:]
+    cwd = os.getcwd()
+    os.chdir(case_workdir(case))
     try:
         with contextlib.redirect_stderr(err), contextlib.redirect_stdout(out):
             try:
@@ -791,6 +799,7 @@ def run_in_process(case: Case) -> Outcome:
                 code = 1
     finally:
         logging.getLogger().handlers[:] = handlers
+        os.chdir(cwd)
     outcome = _judge(case, code, err.getvalue())
     outcome.seconds = time.perf_counter() - t0
     return outcome
@@ -810,6 +819,7 @@ def run_forked(case: Case, timeout: float = TIMEOUT_S, memory: int = MEMORY_LIMI
             os.dup2(null, 1)
             sys.stderr = os.fdopen(2, "w", buffering=1)
             sys.stdout = os.fdopen(1, "w")
+            os.chdir(case_workdir(case))
             limit = _vm_size() + memory
             resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
             try:
@@ -847,14 +857,10 @@ def run_forked(case: Case, timeout: float = TIMEOUT_S, memory: int = MEMORY_LIMI
 
 
 def case_workdir(case: Case) -> Path:
-    """A folder of the case (where the forked run's stderr is kept)."""
-    for p in case.argv:
-        if "/cases/" in p:
-            q = Path(p)
-            while q.parent.name != "cases":
-                q = q.parent
-            return q
-    return Path(os.environ.get("TMPDIR", "/tmp"))
+    """The folder of the case: where it runs and the forked run's stderr is kept."""
+    if case.cwd is None:
+        raise ValueError(f"case {case.name!r} has no folder of its own")
+    return case.cwd
 
 
 def _vm_size() -> int:

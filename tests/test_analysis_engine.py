@@ -1,4 +1,4 @@
-"""Analysis helpers (engine/analysis.py): clustering, CSV export, Table 2 / N sweep rows, errors,
+"""Analysis helpers (the engine/analysis/ package): clustering, CSV export, Table 2 / N sweep rows, errors,
 the codebook inspector and PC modes; hand-checked where possible, else against the engine."""
 
 from __future__ import annotations
@@ -9,28 +9,30 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from engine.analysis import (
+from engine.analysis.errors import (
     SegmentError,
     analyse_utterance,
-    cluster_phones,
-    condition_name,
-    dendrogram,
-    describe_mode,
     error_report,
-    inspect_frame,
     lip_error,
-    mode_displacement,
-    mode_sd,
     phone_errors,
     segment_errors,
-    similarity_in_order,
-    sweep_curves,
-    table2_rows,
     worst_segments,
     write_error_csv,
-    write_similarity_csv,
+)
+from engine.analysis.inspector import inspect_frame
+from engine.analysis.metrics import (
+    condition_name,
+    sweep_curves,
+    table2_rows,
     write_sweep_csv,
     write_table2_csv,
+)
+from engine.analysis.pc_modes import describe_mode, mode_displacement, mode_sd
+from engine.analysis.similarity import (
+    cluster_phones,
+    dendrogram,
+    similarity_in_order,
+    write_similarity_csv,
 )
 from engine.data import PhoneSegment
 from engine.evaluation import EvalResult, UtteranceScore, evaluate_utterance
@@ -38,7 +40,8 @@ from engine.pipeline import synthesize
 
 
 def score(split, smoothing, n, wf, lo, up, mode="phonetic", utt="u"):
-    return UtteranceScore(utt, split, mode, smoothing, n, wf, lo, up, 10)
+    return UtteranceScore(split=split, mode=mode, smoothing=smoothing, n_context_phones=n,
+                          whole_face=wf, lower_lip=lo, upper_lip=up, utterance=utt, speech_frames=10)
 
 
 def test_cluster_groups_visemes():

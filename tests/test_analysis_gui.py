@@ -22,14 +22,11 @@ pytest.importorskip("pyvistaqt")
 if not os.environ.get("DISPLAY"):
     pytest.skip("the GUI tests need an X display (run under xvfb-run)", allow_module_level=True)
 
-from engine.analysis import (
-    cluster_phones,
-    describe_mode,
-    error_report,
-    subset_corpus,
-    sweep_curves,
-    table2_rows,
-)
+from engine.analysis.common import subset_corpus
+from engine.analysis.errors import error_report
+from engine.analysis.metrics import sweep_curves, table2_rows
+from engine.analysis.pc_modes import describe_mode
+from engine.analysis.similarity import cluster_phones
 from engine.config import SynthConfig
 from engine.data import PhoneSegment
 from engine.evaluation import sweep_n, table2
@@ -384,3 +381,35 @@ def test_installed_in_main_window(qtbot, corpus, model):
     assert win.view.utterance.name == other
     views.close()
     win.close()
+
+
+# ---------------------------------------------------------------------- export buttons
+def test_export_buttons_write_or_report(qtbot, model, corpus, tmp_path, monkeypatch):
+    """Every view's export goes through one dialog helper: the chosen file is written, a cancelled
+    dialog writes nothing, and a failure is shown in a message box instead of raised."""
+    from PyQt6.QtWidgets import QFileDialog, QMessageBox
+
+    from app.analysis.metrics_view import MetricsView
+    from app.analysis.similarity_view import SimilarityView
+
+    chosen: list[str] = []
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (chosen.pop(0), ""))
+    shown: list[tuple[str, str]] = []
+    monkeypatch.setattr(QMessageBox, "warning", lambda parent, title, text: shown.append((title, text)))
+
+    sim = SimilarityView(model)
+    qtbot.addWidget(sim)
+    chosen.append(str(tmp_path / "sim.csv"))
+    sim._export_csv()
+    header = (tmp_path / "sim.csv").read_text().splitlines()[0].split(",")
+    assert header[0] == "phone" and sorted(header[1:]) == sorted(model.phones)
+    chosen.append("")                                    # cancelled
+    sim._export_png()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["sim.csv"] and not shown
+
+    metrics = MetricsView(model, corpus)
+    qtbot.addWidget(metrics)
+    chosen.append(str(tmp_path / "t2.csv"))
+    metrics._export_table2()                             # nothing computed yet: a ValueError
+    assert shown == [("Export failed", "compute Table 2 first")]
+    assert not (tmp_path / "t2.csv").exists()

@@ -69,3 +69,14 @@ def test_playback_skipped_without_module(monkeypatch) -> None:
                         lambda name, *a: None if name == "benchmarks.playback" else real(name, *a))
     rows = run_playback(smoke=True)
     assert len(rows) == 1 and rows[0].group == "playback" and "skipped" in rows[0].note
+
+
+def test_smoke_eval_rows(toy: Path) -> None:
+    """The whole-corpus evaluation benchmark: serial and parallel wall times, results equal."""
+    from benchmarks.__main__ import run_all
+    from benchmarks.common import load_context
+
+    rows = run_all(load_context(toy, smoke=True), ("eval",))
+    assert [r.group for r in rows] == ["eval", "eval"]
+    assert all(math.isfinite(r.value) and r.value > 0 for r in rows)
+    assert "scores equal to the serial run: True" in rows[1].note

@@ -115,7 +115,7 @@ def test_midsagittal_corpus_shown_and_exported(mocha_window, tmp_path, qtbot):
 
 def test_file_menu_entries_and_errors(mocha_window, monkeypatch, tmp_path):
     win = mocha_window
-    acts = win.own_data_actions
+    acts = win.extension("own_data").actions
     assert {"Import your own recordings", "Export synthesized trajectories", "Export a video",
             "Export the panels as a figure", "Save the model"} <= set(acts)
     shown = []

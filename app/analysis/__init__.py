@@ -33,7 +33,7 @@ class AnalysisViews:
         self.panels: dict[str, object] = {}
         self.controls = None        # KinematicsControls (owns the velocity panel)
         self._batch = False
-        menu = window.analysis_menu
+        menu = window.menu("Analysis")
         self.view_actions: dict[str, QAction] = {}
         for key, text in VIEWS.items():
             act = QAction(text, window)
@@ -73,7 +73,7 @@ class AnalysisViews:
         """Show view ``key`` (created on first use); None while no model is loaded."""
         w = self.window
         if w.model is None:
-            w.statusBar().showMessage("the model is not ready yet", 4000)
+            w.show_status("the model is not ready yet", 4000)
             return None
         if key not in self.docks:
             widget = self._factories()[key]()
@@ -207,7 +207,7 @@ PANELS = {
 
 
 def install(window) -> AnalysisViews:
-    """Add the analysis views to ``window``; the returned object is also ``window.analysis``."""
+    """Add the analysis views to ``window``; also ``window.extension("analysis")``."""
     views = AnalysisViews(window)
-    window.analysis = views
+    window.add_extension("analysis", views)
     return views

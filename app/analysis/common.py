@@ -1,5 +1,5 @@
 """Shared pieces of the analysis views: a matplotlib canvas, heat-coloured numeric table cells,
-file dialogs for export, and background work (through the window when there is one)."""
+file dialogs for export, and the task runner of a view (the window's when there is one)."""
 
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from app.workers import Progress, Task
+from app.workers import TaskRunner
 
 log = logging.getLogger(__name__)
 
@@ -121,46 +121,27 @@ def report_error(parent: QWidget, title: str, exc: BaseException) -> None:
     QMessageBox.warning(parent, title, str(exc))
 
 
-def run_background(owner: QWidget, fn: Callable[[Progress], Any], on_done: Callable[[Any], None],
-                   on_progress: Callable[[float, str], None] | None = None,
-                   on_error: Callable[[BaseException], None] | None = None, label: str = "",
-                   window: Any = None) -> Task:
-    """Run ``fn(progress)`` in a worker thread; callbacks arrive on the GUI thread.
-
-    With a main ``window`` the work goes through ``window.run_in_background`` (its status bar shows
-    it and closing the window stops it); otherwise a :class:`~app.workers.Task` owned by ``owner``
-    is kept on the owner so it is not garbage collected while running."""
-
-    def failed(exc: BaseException) -> None:
-        if on_error is not None:
-            on_error(exc)
-        else:
-            report_error(owner, label or "background task", exc)
-
-    if window is not None and hasattr(window, "run_in_background"):
-        task = window.run_in_background(fn, on_done, label or "analysis", on_error=failed)
-        if on_progress is not None:
-            task.progress.connect(on_progress)
-        return task
-    task = Task(fn, label, owner)
-    tasks = owner.__dict__.setdefault("_analysis_tasks", [])
-    tasks.append(task)
-
-    def finished() -> None:
-        if task in tasks:
-            tasks.remove(task)
-
-    task.succeeded.connect(on_done)
-    task.failed.connect(failed)
-    if on_progress is not None:
-        task.progress.connect(on_progress)
-    task.finished.connect(finished)
-    task.start()
-    return task
+def export_with_dialog(parent: QWidget, title: str, default: str, filters: str,
+                       write: Callable[[Path], Any]) -> None:
+    """Ask for a file name and ``write(path)``; a failure (``OSError``, ``ValueError``) is shown,
+    not raised. The export buttons of every view go through here."""
+    path = ask_save_path(parent, title, default, filters)
+    if path:
+        try:
+            write(path)
+        except (OSError, ValueError) as exc:
+            report_error(parent, "Export failed", exc)
 
 
-def stop_tasks(owner: QWidget, timeout_ms: int = 5000) -> None:
-    """Cancel and join the owner's running tasks (before it closes)."""
-    for task in list(owner.__dict__.get("_analysis_tasks", [])):
-        task.cancel()
-        task.wait(timeout_ms)
+def task_runner(owner: QWidget, window: Any = None) -> TaskRunner:
+    """Where a view runs its background work: the main window's task runner (its status bar shows
+    the work and closing the window stops it), or, for a view used on its own, a runner owned by
+    the view (stop it with :func:`stop_own_tasks` when the view closes)."""
+    tasks = getattr(window, "tasks", None)
+    return tasks if isinstance(tasks, TaskRunner) else TaskRunner(owner)
+
+
+def stop_own_tasks(owner: QWidget, tasks: TaskRunner) -> None:
+    """Cancel and join the tasks of a runner the view owns (a window's runner is left alone)."""
+    if tasks.parent() is owner:
+        tasks.close()

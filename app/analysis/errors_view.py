@@ -1,6 +1,6 @@
 """Error analysis: which phones synthesize worst, which utterances, which segments.
 
-The view runs :func:`engine.analysis.error_report` in a background worker and shows correlation
+The view runs :func:`engine.analysis.errors.error_report` in a background worker and shows correlation
 and RMS lip error per phone, a sortable per-utterance list and the worst segments; a click on an
 utterance or a segment jumps there (utterance and time). :class:`LipErrorPanel` adds
 ``|original - synthesized|`` of the lips to the time-aligned stack with the worst segments of
@@ -27,12 +27,12 @@ from PyQt6.QtWidgets import (
 )
 
 from app.style import ORIGINAL_COLOR, SYNTH_COLOR
-from engine.analysis import (
+from engine.analysis.common import subset_corpus
+from engine.analysis.errors import (
     ErrorReport,
     error_report,
     lip_error,
     segment_errors,
-    subset_corpus,
     worst_segments,
     write_error_csv,
 )
@@ -41,12 +41,12 @@ from engine.model import Model
 
 from .common import (
     NumberItem,
-    ask_save_path,
+    export_with_dialog,
     fill_table,
     heat_item,
     report_error,
-    run_background,
-    stop_tasks,
+    stop_own_tasks,
+    task_runner,
     text_item,
 )
 
@@ -66,6 +66,7 @@ class ErrorView(QWidget):
         self.model = model
         self.corpus = corpus
         self.window_ = window
+        self.tasks = task_runner(self, window)
         self.report: ErrorReport | None = None
         self._pending_seek: tuple[str, float] | None = None
 
@@ -120,8 +121,8 @@ class ErrorView(QWidget):
         splits = SPLITS[self.splits.currentText()]
         config = getattr(self.window_, "synth_config", None)
         self.run_btn.setEnabled(False)
-        run_background(self, lambda p: error_report(model, corpus, splits, config, progress=p),
-                       self._done, self._on_progress, self._failed, "Error analysis", self.window_)
+        self.tasks.run(lambda p: error_report(model, corpus, splits, config, progress=p),
+                       self._done, "Error analysis", on_progress=self._on_progress, on_error=self._failed)
 
     def _on_progress(self, fraction: float, message: str) -> None:
         self.progress.setValue(int(1000 * fraction))
@@ -197,7 +198,7 @@ class ErrorView(QWidget):
             self.window_.seek(t)
 
     def closeEvent(self, event) -> None:
-        stop_tasks(self)
+        stop_own_tasks(self, self.tasks)
         super().closeEvent(event)
 
     # ------------------------------------------------------------------ export
@@ -207,12 +208,8 @@ class ErrorView(QWidget):
         return write_error_csv(path, self.report)
 
     def _export_csv(self) -> None:
-        path = ask_save_path(self, "Export per-utterance errors", "errors.csv", "CSV (*.csv)")
-        if path:
-            try:
-                self.export_csv(path)
-            except (OSError, ValueError) as exc:
-                report_error(self, "Export failed", exc)
+        export_with_dialog(self, "Export per-utterance errors", "errors.csv", "CSV (*.csv)",
+                           self.export_csv)
 
 
 class LipErrorPanel:

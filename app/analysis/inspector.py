@@ -6,7 +6,7 @@ chosen gamma, and the input LSF vector w against its approximation w-hat (eq 7).
 mode (``engine.selection``) each candidate also shows why it was chosen: its target cost (eq 5
 with acoustic context), its label cost (kappa times the label's confidence, when eq 4 did not
 choose it) and whether eq 4 chose it; the frame's label confidence is shown above. Every number is
-from :func:`engine.analysis.inspect_frame`.
+from :func:`engine.analysis.inspector.inspect_frame`.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from PyQt6.QtWidgets import (
 )
 
 from app.style import ORIGINAL_COLOR, SYNTH_COLOR
-from engine.analysis import FrameInspection, inspect_frame
+from engine.analysis.inspector import FrameInspection, inspect_frame
 from engine.model import Model
 from engine.pipeline import Synthesis
 

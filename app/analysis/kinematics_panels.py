@@ -42,7 +42,7 @@ from engine.kinematics import (
 )
 from engine.model import Model
 
-from .common import NumberItem, ask_save_path, fill_table, report_error, text_item
+from .common import NumberItem, export_with_dialog, fill_table, text_item
 
 log = logging.getLogger(__name__)
 
@@ -229,12 +229,7 @@ class KinematicsControls(QWidget):
 
     def _export(self, title: str, default: str, filters: str, fn) -> None:
         name = self.view.utterance.name if self.view is not None else "landmarks"
-        path = ask_save_path(self, title, f"{name}_{default}", filters)
-        if path:
-            try:
-                fn(path)
-            except (OSError, ValueError) as exc:
-                report_error(self, "Export failed", exc)
+        export_with_dialog(self, title, f"{name}_{default}", filters, fn)
 
     def _export_tsv(self) -> None:
         self._export("Export landmarks", "landmarks.tsv", "TSV (*.tsv)", self.export_tsv)

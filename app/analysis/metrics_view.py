@@ -25,10 +25,10 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from engine.analysis import (
+from engine.analysis.common import subset_corpus
+from engine.analysis.metrics import (
     SweepCurve,
     Table2Row,
-    subset_corpus,
     sweep_curves,
     table2_rows,
     write_sweep_csv,
@@ -37,17 +37,17 @@ from engine.analysis import (
 from engine.corpus import Corpus
 from engine.evaluation import METRICS, EvalResult, sweep_n, table2
 from engine.model import Model
-from engine.report import PAPER_TABLE2
+from engine.paper import TABLE2_N, table2_value
 
 from .common import (
     Canvas,
     NumberItem,
-    ask_save_path,
+    export_with_dialog,
     fill_table,
     heat_item,
     report_error,
-    run_background,
-    stop_tasks,
+    stop_own_tasks,
+    task_runner,
     text_item,
 )
 
@@ -58,9 +58,9 @@ METRIC_NAMES = {"whole_face": "Whole Face", "lower_lip": "Lower Lip", "upper_lip
 
 def _paper(row: Table2Row) -> tuple[float, float, float]:
     """The paper's Table 2 value of this condition (phonetic, N = 3), else NaN."""
-    if row.mode != "phonetic" or row.n_context_phones != 3:
+    if row.mode != "phonetic" or row.n_context_phones != TABLE2_N:
         return (float("nan"),) * 3
-    return PAPER_TABLE2.get((row.split, row.smoothing), (float("nan"),) * 3)
+    return table2_value(row.split, row.smoothing)
 
 
 def _short(row: Table2Row) -> str:
@@ -80,6 +80,7 @@ class MetricsView(QWidget):
         self.model = model
         self.corpus = corpus
         self.window_ = window
+        self.tasks = task_runner(self, window)
         self.table2_result: EvalResult | None = None
         self.sweep_result: EvalResult | None = None
         self.rows: list[Table2Row] = []
@@ -156,15 +157,15 @@ class MetricsView(QWidget):
     def start_table2(self) -> None:
         corpus, model, acoustic = self._subset(), self.model, self.acoustic.isChecked()
         self._busy(True)
-        run_background(self, lambda p: table2(model, corpus, acoustic=acoustic, progress=p),
-                       self._table2_done, self._on_progress, self._failed, "Table 2", self.window_)
+        self.tasks.run(lambda p: table2(model, corpus, acoustic=acoustic, progress=p),
+                       self._table2_done, "Table 2", on_progress=self._on_progress, on_error=self._failed)
 
     def start_sweep(self) -> None:
         corpus, model = self._subset(), self.model
         ns = tuple(range(1, int(self.max_n.value()) + 1))
         self._busy(True)
-        run_background(self, lambda p: sweep_n(model, corpus, ns, progress=p),
-                       self._sweep_done, self._on_progress, self._failed, "N sweep", self.window_)
+        self.tasks.run(lambda p: sweep_n(model, corpus, ns, progress=p),
+                       self._sweep_done, "N sweep", on_progress=self._on_progress, on_error=self._failed)
 
     def _table2_done(self, result: EvalResult) -> None:
         self._busy(False)
@@ -233,7 +234,7 @@ class MetricsView(QWidget):
         self.canvas.draw_idle()
 
     def closeEvent(self, event) -> None:
-        stop_tasks(self)
+        stop_own_tasks(self, self.tasks)
         super().closeEvent(event)
 
     # ------------------------------------------------------------------ export
@@ -251,19 +252,11 @@ class MetricsView(QWidget):
         self.canvas.draw()
         return self.canvas.save_png(path)
 
-    def _export(self, title: str, default: str, filters: str, fn) -> None:
-        path = ask_save_path(self, title, default, filters)
-        if path:
-            try:
-                fn(path)
-            except (OSError, ValueError) as exc:
-                report_error(self, "Export failed", exc)
-
     def _export_table2(self) -> None:
-        self._export("Export Table 2", "table2.csv", "CSV (*.csv)", self.export_table2_csv)
+        export_with_dialog(self, "Export Table 2", "table2.csv", "CSV (*.csv)", self.export_table2_csv)
 
     def _export_sweep(self) -> None:
-        self._export("Export N sweep", "n_sweep.csv", "CSV (*.csv)", self.export_sweep_csv)
+        export_with_dialog(self, "Export N sweep", "n_sweep.csv", "CSV (*.csv)", self.export_sweep_csv)
 
     def _export_png(self) -> None:
-        self._export("Export plots", "metrics.png", "PNG image (*.png)", self.export_png)
+        export_with_dialog(self, "Export plots", "metrics.png", "PNG image (*.png)", self.export_png)

@@ -29,7 +29,7 @@ from pyvistaqt import QtInteractor
 
 from app.style import BACKGROUND, SURFACE_COLOR, SYNTH_COLOR
 from app.view3d import face_triangles, lip_contours
-from engine.analysis import describe_mode, mode_displacement, mode_sd, variance_shares
+from engine.analysis.pc_modes import describe_mode, mode_displacement, mode_sd, variance_shares
 from engine.model import Model
 
 from .common import Canvas

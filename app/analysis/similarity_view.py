@@ -23,12 +23,17 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from engine.analysis import cluster_phones, dendrogram, similarity_in_order, write_similarity_csv
+from engine.analysis.similarity import (
+    cluster_phones,
+    dendrogram,
+    similarity_in_order,
+    write_similarity_csv,
+)
 from engine.model import Model
-from engine.report import paper_table1
+from engine.paper import paper_table1
 from engine.similarity import top_similar
 
-from .common import Canvas, ask_save_path, fill_table, heat_item, report_error, text_item
+from .common import Canvas, export_with_dialog, fill_table, heat_item, text_item
 
 log = logging.getLogger(__name__)
 
@@ -149,17 +154,9 @@ class SimilarityView(QWidget):
         return self.canvas.save_png(path)
 
     def _export_csv(self) -> None:
-        path = ask_save_path(self, "Export similarity matrix", "similarity.csv", "CSV (*.csv)")
-        if path:
-            try:
-                self.export_csv(path)
-            except OSError as exc:
-                report_error(self, "Export failed", exc)
+        export_with_dialog(self, "Export similarity matrix", "similarity.csv", "CSV (*.csv)",
+                           self.export_csv)
 
     def _export_png(self) -> None:
-        path = ask_save_path(self, "Export heat map", "similarity.png", "PNG image (*.png)")
-        if path:
-            try:
-                self.export_png(path)
-            except OSError as exc:
-                report_error(self, "Export failed", exc)
+        export_with_dialog(self, "Export heat map", "similarity.png", "PNG image (*.png)",
+                           self.export_png)

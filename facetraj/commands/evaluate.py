@@ -12,7 +12,7 @@ from ..progress import TerminalProgress
 
 def cmd_eval(args: argparse.Namespace) -> int:
     from engine.corpus import load_corpus
-    from engine.evaluation import evaluate, format_table2
+    from engine.evaluation import default_workers, evaluate, format_table2
     from engine.model import Model
 
     model = Model.load(args.model)
@@ -22,21 +22,22 @@ def cmd_eval(args: argparse.Namespace) -> int:
     if args.acoustic and configs[0].mode != "acoustic":
         configs.append(configs[0].with_(mode="acoustic"))
     res = evaluate(model, corpus, splits, configs, ("triangular", "spline"),
-                   progress=TerminalProgress("eval"))
+                   progress=TerminalProgress("eval"), workers=args.jobs or default_workers())
     print(json.dumps(res.to_json(), indent=2) if args.json else format_table2(res))
     return 0
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
     from engine.corpus import load_corpus
-    from engine.evaluation import sweep_n
+    from engine.evaluation import default_workers, sweep_n
     from engine.model import Model
 
     model = Model.load(args.model)
     corpus = load_corpus(args.corpus)
     ns = list(range(1, args.max_n + 1))
     splits = ("train", "test") if args.split == "all" else (args.split,)
-    res = sweep_n(model, corpus, ns, splits, progress=TerminalProgress("sweep"))
+    res = sweep_n(model, corpus, ns, splits, progress=TerminalProgress("sweep"),
+                  workers=args.jobs or default_workers())
     curve = {sp: [res.mean(sp, "triangular", n=n)["whole_face"] for n in ns] for sp in splits}
     if args.json:
         print(json.dumps({"n": ns, "whole_face": curve, "table": res.table()}, indent=2))
@@ -69,6 +70,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--split", choices=["train", "test", "all"], default="all")
     p.add_argument("--acoustic", action="store_true", help="add acoustic-only rows")
     p.add_argument("--json", action="store_true", help="JSON output with per-utterance scores")
+    p.add_argument("--jobs", "-j", type=integer(1, 256), metavar="N",
+                   help="utterances scored in N processes (default: every core)")
     add_synth_options(p)
     p.set_defaults(func=cmd_eval)
 
@@ -78,6 +81,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--max-n", type=integer(1, 100), default=10)
     p.add_argument("--split", choices=["train", "test", "all"], default="all")
     p.add_argument("--json", action="store_true")
+    p.add_argument("--jobs", "-j", type=integer(1, 256), metavar="N",
+                   help="utterances scored in N processes (default: every core)")
     p.set_defaults(func=cmd_sweep)
 
     p = sub.add_parser("similarity", help="visual phoneme similarity (Table 1)")

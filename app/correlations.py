@@ -1,0 +1,61 @@
+"""The browser's lip-correlation columns: the current utterance scored at once, every corpus
+utterance in a low-priority background sweep that waits while sound plays (playback first)."""
+
+from __future__ import annotations
+
+import logging
+
+from engine.evaluation import trajectory_correlations
+from engine.model import Model
+
+from .browser import UtteranceBrowser
+from .state import UtteranceView
+from .viewer_model import ViewerModel, correlation_sweep
+from .workers import Gate, Progress, Task, TaskRunner
+
+log = logging.getLogger(__name__)
+
+
+class BrowserScores:
+    """Fills ``browser``'s score columns; the sweep runs on ``tasks`` and waits on ``idle``."""
+
+    def __init__(self, browser: UtteranceBrowser, tasks: TaskRunner, idle: Gate):
+        self.browser = browser
+        self.tasks = tasks
+        self.idle = idle
+        self.task: Task | None = None
+
+    @property
+    def running(self) -> bool:
+        return self.tasks.running(self.task)
+
+    def score(self, view: UtteranceView | None, model: Model | None) -> None:
+        """Score the utterance shown (when it has original markers)."""
+        if view is None or view.original is None or model is None:
+            return
+        try:
+            c = trajectory_correlations(view.original, view.shown, view.speech, model)
+            self.browser.set_scores(view.utterance.name, c["lower_lip"], c["upper_lip"])
+        except Exception:
+            log.debug("scoring the current utterance failed", exc_info=True)
+
+    def start(self, state: ViewerModel, on_done=None) -> None:
+        """(Re)start the sweep of every corpus utterance under the current settings."""
+        if self.task is not None:
+            self.task.cancel()
+        if state.corpus is None or state.model is None:
+            return
+        self.browser.clear_scores()
+        corpus, model, cfg, ids = state.corpus, state.model, state.synth_config, state.correlation_ids()
+        idle = self.idle
+
+        def work(progress: Progress) -> None:
+            def before(k: int, utt_id: str) -> None:
+                progress.wait_open(idle)
+                progress(k / max(len(ids), 1), f"lip correlations: {utt_id}")
+
+            for _k, utt_id, lower, upper in correlation_sweep(model, corpus, ids, cfg, before):
+                progress.partial((utt_id, lower, upper))
+
+        self.task = self.tasks.run(work, on_done, "lip correlations",
+                                   on_partial=lambda obj: self.browser.set_scores(*obj), background=True)

@@ -1,0 +1,271 @@
+"""What the main window shows, without Qt: the viewer's state and its request/stale-result logic.
+
+:class:`ViewerModel` holds the corpus, the model, the synthesis settings, the utterances opened
+from files, the current :class:`~app.state.UtteranceView` and the latest synthesis request. Every
+new request (another utterance, other settings) gets a higher generation number; a result that
+arrives for an older generation, or for a model that has since been replaced, is stale and is
+dropped (:meth:`ViewerModel.accept`). The slow parts (:func:`load_model`, :meth:`SynthRequest.run`,
+:func:`correlation_sweep`) are plain functions meant for a worker thread; the window
+(``app/main_window.py``) runs them with its task runner and lays the results out. Nothing here
+imports Qt, so the logic is tested without a display (tests/test_viewer_model.py), in the way
+napari's ``ViewerModel`` sits under its Qt viewer.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import re
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from engine.config import SynthConfig
+from engine.corpus import Corpus
+from engine.data import Utterance
+from engine.errors import FacetrajError
+from engine.evaluation import evaluate_utterance
+from engine.model import Model
+from engine.pipeline import mode_for
+from engine.progress import Progress
+
+from .state import UtteranceView, build_view
+
+log = logging.getLogger(__name__)
+
+DEFAULT_SENTENCE = "Tornadoes often destroy acres of farm land"
+
+
+def normalise_text(text: str) -> str:
+    """Lower case, letters and single spaces only (for matching sentences).
+
+    >>> normalise_text("Tornadoes often destroy, acres!")
+    'tornadoes often destroy acres'
+    """
+    return " ".join(re.sub(r"[^a-z' ]+", " ", text.lower()).split())
+
+
+@dataclass(frozen=True, eq=False)
+class SynthRequest:
+    """One synthesis asked for: which utterance (loaded by ``load``), with which model and settings.
+
+    ``new_utterance`` is True when the utterance is not the one shown (the clock rewinds and the
+    zoom resets when it arrives); ``generation`` orders the requests.
+    """
+
+    load: Callable[[], Utterance]
+    split: str
+    new_utterance: bool
+    model: Model
+    config: SynthConfig
+    generation: int
+
+    def run(self, progress: Progress | None = None) -> UtteranceView:
+        """Load and synthesize (slow: run in a worker). Without phone labels the synthesis is
+        acoustic-only (:func:`engine.pipeline.mode_for`)."""
+        utt = self.load()
+        if progress is not None:
+            progress(0.3, f"synthesizing {utt.name}")
+        return build_view(self.model, utt, self.split, mode_for(self.config, utt.phones))
+
+
+@dataclass
+class ViewerModel:
+    """The viewer's state: corpus, model, settings, the current view and the latest request."""
+
+    synth_config: SynthConfig = field(default_factory=SynthConfig)
+    corpus: Corpus | None = None
+    model: Model | None = None
+    texts: dict[str, str] = field(default_factory=dict)
+    external: dict[str, Utterance] = field(default_factory=dict)
+    view: UtteranceView | None = None
+    pending_utterance: str | None = None     # asked for before the model was ready
+    pending_time: float | None = None        # where the first utterance starts
+    request: SynthRequest | None = None      # the latest utterance asked for
+    generation: int = 0
+
+    # ------------------------------------------------------------------ corpus and model
+    def set_model(self, corpus: Corpus, model: Model, texts: dict[str, str]) -> str | None:
+        """Use a newly loaded corpus and model: forget the view, the request and the utterances
+        opened from files. Returns the utterance to show first (the one asked for, or the default)."""
+        self.corpus, self.model, self.texts = corpus, model, texts
+        self.external.clear()
+        self.view = None
+        self.request = None
+        first = self.pending_utterance or self.default_utterance()
+        self.pending_utterance = None
+        return first
+
+    def default_utterance(self) -> str | None:
+        """The test sentence "Tornadoes often destroy acres of farm land" (paper Figure 4), else
+        the first test utterance."""
+        if self.corpus is None:
+            return None
+        info = self.corpus.info
+        want = normalise_text(DEFAULT_SENTENCE)
+        for utt_id in [*info.test, *info.train]:
+            if normalise_text(self.texts.get(utt_id, "")) == want:
+                return utt_id
+        return (info.test or info.train or [None])[0]
+
+    def add_external(self, utt: Utterance) -> str:
+        """Keep an utterance opened from files under a name no corpus utterance has; return it."""
+        name = utt.name
+        while name in (self.corpus.info.ids if self.corpus else []):
+            name += "'"
+        self.external[name] = replace(utt, name=name)
+        return name
+
+    # ------------------------------------------------------------------ requests
+    def request_utterance(self, utt_id: str) -> SynthRequest | None:
+        """A request for utterance ``utt_id`` (None while no model: it is shown once one is).
+
+        Raises :class:`FacetrajError` for an id that is neither in the corpus nor opened."""
+        if self.model is None:
+            self.pending_utterance = utt_id
+            return None
+        if utt_id in self.external:
+            utt = self.external[utt_id]
+            return self._new_request(lambda: utt, "external", True)
+        if self.corpus is None:
+            return None
+        corpus, info = self.corpus, self.corpus.info
+        if utt_id not in info.ids:
+            raise FacetrajError(f"{utt_id}: no such utterance in {corpus.root}")
+        split = "test" if utt_id in info.test else "train"
+        return self._new_request(lambda: corpus.utterance(utt_id), split, True)
+
+    def set_config(self, config: SynthConfig) -> tuple[bool, SynthRequest | None]:
+        """Use new settings: (whether they changed, the re-synthesis of the latest request)."""
+        if config == self.synth_config:
+            return False, None
+        self.synth_config = config
+        req = self.request
+        if req is None:
+            return True, None
+        # the utterance asked for last (it may still be on its way)
+        return True, self._new_request(req.load, req.split, req.new_utterance)
+
+    def _new_request(self, load: Callable[[], Utterance], split: str, new_utterance: bool) -> SynthRequest:
+        assert self.model is not None
+        self.generation += 1
+        self.request = SynthRequest(load, split, new_utterance, self.model, self.synth_config,
+                                    self.generation)
+        return self.request
+
+    def is_current(self, request: SynthRequest) -> bool:
+        """Whether ``request`` is still the latest (no newer request, the same model)."""
+        return request.generation == self.generation and request.model is self.model
+
+    def accept(self, request: SynthRequest, view: UtteranceView) -> bool:
+        """Make ``view`` (the result of ``request``) current; False (and nothing changes) when the
+        result is stale. The shown utterance becomes the latest request (no longer new)."""
+        if not self.is_current(request):
+            return False
+        self.view = view
+        utt = view.utterance
+        self.request = SynthRequest(lambda: utt, view.split, False, request.model, request.config,
+                                    request.generation)
+        return True
+
+    def take_pending_time(self, default: float) -> float:
+        """The start time asked for on the command line (once), else ``default``."""
+        if self.pending_time is None:
+            return default
+        t, self.pending_time = float(self.pending_time), None
+        return t
+
+    # ------------------------------------------------------------------ time and frames
+    def phone_at(self, t: float) -> str:
+        """The phone label at ``t`` seconds ("" outside the labels or without a view)."""
+        if self.view is None:
+            return ""
+        for seg in self.view.utterance.phones:
+            if seg.start <= t < seg.end:
+                return seg.label
+        return ""
+
+    def step_frames_target(self, t: float, n: int) -> float:
+        """The time of the frame ``n`` frames after the one at ``t`` (clipped to the view)."""
+        v = self.view
+        return t if v is None else v.frame_at(t, n) / v.rate
+
+    def step_phone_target(self, t: float, direction: int) -> float:
+        """The start of the next (``direction > 0``) or previous phone from ``t``."""
+        v = self.view
+        if v is None:
+            return t
+        starts = [s.start for s in v.utterance.phones] or [0.0]
+        if direction > 0:
+            later = [s for s in starts if s > t + 1e-6]
+            return later[0] if later else v.duration
+        earlier = [s for s in starts if s < t - 1e-3]
+        return earlier[-1] if earlier else 0.0
+
+    def correlation_ids(self) -> list[tuple[str, str]]:
+        """(split, id) of every corpus utterance, test first (the browser's score columns)."""
+        if self.corpus is None:
+            return []
+        info = self.corpus.info
+        return [(s, u) for s in ("test", "train") for u in getattr(info, s)]
+
+
+SMOOTHING_NAMES = {"triangular": "triangular", "spline": "spline", "none": "unsmoothed"}
+
+
+def view_title(view: UtteranceView) -> str:
+    """The title over the panels: utterance, split, text and how the 3-D synthesis was made."""
+    utt, cfg = view.utterance, view.synthesis.config
+    text = f" — “{utt.text}”" if utt.text else ""
+    return (f"{utt.name} ({view.split}){text}    ·    3-D: {SMOOTHING_NAMES[cfg.smoothing]} synthesis, "
+            f"{cfg.mode}, N={cfg.n_context_phones}")
+
+
+def view_summary(view: UtteranceView) -> str:
+    """The status line of a new view: frames, rate and speech frames."""
+    return (f"{view.utterance.name}: {view.n_frames} frames at {view.rate:g} Hz, "
+            f"{int(view.speech.sum())} speech frames")
+
+
+def read_texts(corpus: Corpus) -> dict[str, str]:
+    """The orthographic text of each utterance that has a ``<id>.txt`` file."""
+    texts = {}
+    for utt_id in corpus.info.ids:
+        p = corpus.data_root / f"{utt_id}.txt"
+        if p.exists():
+            texts[utt_id] = p.read_text(encoding="utf-8", errors="replace").strip()
+    return texts
+
+
+def load_model(corpus: Corpus, model_path: Path | None, progress: Progress,
+               load_or_train: Callable[..., Model]) -> tuple[Model, dict[str, str]]:
+    """The model for ``corpus`` (from ``model_path``, else ``load_or_train``: the cache or
+    training) and the utterance texts (slow: run in a worker)."""
+    texts = read_texts(corpus)
+    if model_path is not None:
+        progress(0.5, f"loading {model_path}")
+        model = Model.load(model_path)
+    else:
+        model = load_or_train(corpus, progress=progress)
+    if model.marker_names != corpus.info.marker_names:
+        raise FacetrajError(f"{model_path or corpus.root}: the model's marker set differs from the "
+                            "corpus")
+    return model, texts
+
+
+def correlation_sweep(model: Model, corpus: Corpus, ids: list[tuple[str, str]], config: SynthConfig,
+                      before: Callable[[int, str], None] = lambda k, utt_id: None,
+                      ) -> Iterator[tuple[int, str, float, float]]:
+    """Lip correlations of each ``(split, id)`` under ``config`` with its own smoothing:
+    ``(index, id, lower lip r, upper lip r)``, NaN for an utterance that cannot be read (logged).
+    ``before(index, id)`` is called before each utterance (the window reports progress there and
+    waits while sound plays)."""
+    for k, (split, utt_id) in enumerate(ids):
+        before(k, utt_id)
+        try:
+            utt = corpus.utterance(utt_id)
+            score = evaluate_utterance(model, utt, split, config, (config.smoothing,))[0]
+            yield k, utt_id, score.lower_lip, score.upper_lip
+        except FacetrajError as exc:
+            log.warning("%s", exc)
+            yield k, utt_id, math.nan, math.nan

@@ -1,0 +1,225 @@
+"""The errors view's numbers: per-frame lip error, per-phone correlation and RMS error,
+per-utterance errors and the worst segments of a synthesis against the original markers."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..config import SynthConfig
+from ..corpus import Corpus
+from ..data import PhoneSegment, Utterance
+from ..evaluation import EvalConfig, pearson, speech_mask, trajectory_correlations
+from ..model import Model
+from ..phones import SILENCE, segment_index
+from ..pipeline import Synthesis, synthesize
+from ..progress import Progress
+from .common import write_csv
+
+
+def lip_error(model: Model, original: np.ndarray, synthesized: np.ndarray) -> np.ndarray:
+    """Per-frame ``|original - synthesized|`` (Euclidean, mm) of the upper and the lower lip
+    centre markers, ``(T, 2)`` (columns upper, lower); NaN where the original is missing.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> o = np.zeros((2, 2, 3)); s = o.copy(); s[1, 1] = [3, 4, 0]
+    >>> lip_error(SimpleNamespace(upper_lip=0, lower_lip=1), o, s).tolist()
+    [[0.0, 0.0], [0.0, 5.0]]
+    """
+    n = min(len(original), len(synthesized))
+    lips = [model.upper_lip, model.lower_lip]
+    d = original[:n, lips] - synthesized[:n, lips]
+    return np.linalg.norm(d, axis=-1)
+
+
+@dataclass
+class SegmentError:
+    """Mean lip error (mm) over one phone segment of one utterance."""
+
+    utterance: str
+    label: str
+    start: float
+    end: float
+    error: float
+
+
+def segment_errors(phones: Sequence[PhoneSegment], times: np.ndarray, error: np.ndarray,
+                   utterance: str = "") -> list[SegmentError]:
+    """Mean of a per-frame error ``(T,)`` or ``(T, k)`` (averaged over columns) per phone segment;
+    segments with no finite frame are left out."""
+    e = np.asarray(error, dtype=np.float64)
+    if e.ndim == 2:
+        e = np.nanmean(e, axis=1) if np.isfinite(e).any() else e[:, 0]
+    seg = segment_index(phones, times[: len(e)])
+    out = []
+    for i, s in enumerate(phones):
+        vals = e[seg == i]
+        vals = vals[np.isfinite(vals)]
+        if vals.size:
+            out.append(SegmentError(utterance, s.label, s.start, s.end, float(vals.mean())))
+    return out
+
+
+def worst_segments(errors: Sequence[SegmentError], count: int = 5,
+                   exclude: Sequence[str] = (SILENCE,)) -> list[SegmentError]:
+    """The ``count`` segments with the largest mean error (silence left out by default).
+
+    Examples
+    --------
+    >>> segs = [SegmentError("u", "m", 0, 1, 2.0), SegmentError("u", "sil", 1, 2, 9.0),
+    ...         SegmentError("u", "aa", 2, 3, 3.0)]
+    >>> [s.label for s in worst_segments(segs, 2)]
+    ['aa', 'm']
+    """
+    keep = [s for s in errors if s.label not in exclude]
+    return sorted(keep, key=lambda s: -s.error)[:count]
+
+
+@dataclass
+class PhoneError:
+    """Correlation and RMS error of one phone, pooled over every frame labelled with it.
+
+    ``correlation`` is the mean of the upper-lip-y and lower-lip-y Pearson correlations over the
+    pooled frames; ``rms`` the root mean square lip error (mm, both lip markers).
+    """
+
+    phone: str
+    correlation: float
+    rms: float
+    frames: int
+    segments: int
+
+
+@dataclass
+class UtteranceError:
+    """Errors of one utterance: the Table 2 correlations on speech frames, the RMS lip error on
+    speech frames (mm), and its worst segment (time = segment centre)."""
+
+    utterance: str
+    split: str
+    whole_face: float
+    lower_lip: float
+    upper_lip: float
+    rms: float
+    worst_label: str
+    worst_time: float
+    worst_error: float
+
+
+@dataclass
+class UtteranceAnalysis:
+    """Everything the error views need about one utterance."""
+
+    summary: UtteranceError
+    times: np.ndarray
+    lip_error: np.ndarray           # (T, 2)
+    segments: list[SegmentError]
+    frame_phone: list[str]          # label of each frame
+    lips_y: np.ndarray              # (T, 2, 2): [frame, (original, synthesized), (upper, lower)]
+
+
+def analyse_utterance(model: Model, utt: Utterance, split: str = "test",
+                      config: SynthConfig | None = None, eval_config: EvalConfig | None = None,
+                      synthesis: Synthesis | None = None) -> UtteranceAnalysis:
+    """Synthesize ``utt`` (or use ``synthesis``) and measure its errors against the original."""
+    if utt.markers is None:
+        raise ValueError(f"{utt.name}: no original markers to compare with")
+    config = config or SynthConfig()
+    res = synthesis or synthesize(model, utt.audio, utt.sample_rate, utt.phones, config,
+                                  n_frames=utt.n_frames, source=utt.name)
+    orig = model.normalise_markers(utt.markers)
+    n = min(len(orig), len(res.markers))
+    orig, syn, times = orig[:n], res.markers[:n], res.times[:n]
+    mask = speech_mask(utt.audio, utt.sample_rate, times, eval_config)
+    corr = trajectory_correlations(orig, syn, mask, model, eval_config)
+    err = lip_error(model, orig, syn)
+    sp = err[mask]
+    sp = sp[np.isfinite(sp).all(axis=1)]
+    rms = float(np.sqrt(np.mean(sp**2))) if sp.size else float("nan")
+    segs = segment_errors(utt.phones, times, err, utt.name)
+    worst = worst_segments(segs, 1)
+    w = worst[0] if worst else SegmentError(utt.name, "", 0.0, 0.0, float("nan"))
+    idx = segment_index(utt.phones, times)
+    labels = [utt.phones[i].label for i in idx]
+    y = 1
+    lips_y = np.stack([orig[:, [model.upper_lip, model.lower_lip], y],
+                       syn[:, [model.upper_lip, model.lower_lip], y]], axis=1)
+    summary = UtteranceError(utt.name, split, corr["whole_face"], corr["lower_lip"],
+                             corr["upper_lip"], rms, w.label, 0.5 * (w.start + w.end), w.error)
+    return UtteranceAnalysis(summary, times, err, segs, labels, lips_y)
+
+
+@dataclass
+class ErrorReport:
+    """Per-phone and per-utterance errors over a set of utterances, and the worst segments."""
+
+    phones: list[PhoneError] = field(default_factory=list)
+    utterances: list[UtteranceError] = field(default_factory=list)
+    worst: list[SegmentError] = field(default_factory=list)
+
+
+def phone_errors(analyses: Sequence[UtteranceAnalysis]) -> list[PhoneError]:
+    """Pool the frames of every phone over ``analyses`` and score each phone, worst
+    (lowest correlation) first; phones with under 3 frames get NaN correlation."""
+    pooled: dict[str, list[np.ndarray]] = {}
+    errs: dict[str, list[np.ndarray]] = {}
+    nseg: dict[str, int] = {}
+    for a in analyses:
+        lab = np.array(a.frame_phone)
+        for p in np.unique(lab):
+            sel = lab == p
+            pooled.setdefault(p, []).append(a.lips_y[sel])
+            errs.setdefault(p, []).append(a.lip_error[sel])
+        for s in a.segments:
+            nseg[s.label] = nseg.get(s.label, 0) + 1
+    out = []
+    for p in pooled:
+        y = np.concatenate(pooled[p])
+        ok = np.isfinite(y).all(axis=(1, 2))
+        y = y[ok]
+        r = [pearson(y[:, 0, j], y[:, 1, j]) for j in range(2)]
+        r = [x for x in r if np.isfinite(x)]
+        e = np.concatenate(errs[p])
+        e = e[np.isfinite(e).all(axis=1)]
+        out.append(PhoneError(p, float(np.mean(r)) if r else float("nan"),
+                              float(np.sqrt(np.mean(e**2))) if e.size else float("nan"),
+                              int(ok.sum()), nseg.get(p, 0)))
+    out.sort(key=lambda x: (np.nan_to_num(x.correlation, nan=np.inf), x.phone))
+    return out
+
+
+def error_report(model: Model, corpus: Corpus, splits: Sequence[str] = ("test",),
+                 config: SynthConfig | None = None, eval_config: EvalConfig | None = None,
+                 worst_count: int = 20, progress: Progress | None = None) -> ErrorReport:
+    """Synthesize every utterance of ``splits`` and collect per-phone and per-utterance errors."""
+    ids = [(sp, u) for sp in splits for u in getattr(corpus.info, sp)]
+    analyses = []
+    for k, (sp, u) in enumerate(ids):
+        if progress:
+            progress(k / max(len(ids), 1), f"{sp}: {u}")
+        analyses.append(analyse_utterance(model, corpus.utterance(u), sp, config, eval_config))
+    if progress:
+        progress(1.0, "done")
+    segs = [s for a in analyses for s in a.segments]
+    return ErrorReport(phone_errors(analyses), [a.summary for a in analyses],
+                       worst_segments(segs, worst_count))
+
+
+def write_error_csv(path: str | os.PathLike[str], report: ErrorReport, overwrite: bool = True) -> Path:
+    """Write the per-utterance errors as CSV."""
+    return write_csv(path, ["utterance", "split", "whole_face", "lower_lip", "upper_lip", "rms_mm",
+                            "worst_phone", "worst_time", "worst_error_mm"],
+                     ([u.utterance, u.split, u.whole_face, u.lower_lip, u.upper_lip, u.rms,
+                       u.worst_label, u.worst_time, u.worst_error] for u in report.utterances),
+                     overwrite)
+
+
+__all__ = ["ErrorReport", "PhoneError", "SegmentError", "UtteranceAnalysis", "UtteranceError",
+           "analyse_utterance", "error_report", "lip_error", "phone_errors", "segment_errors",
+           "worst_segments", "write_error_csv"]
