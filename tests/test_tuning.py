@@ -39,7 +39,9 @@ def test_cross_validate_uses_training_split_only(toy_corpus):
 
 
 def _score(method, value, utt="u"):
-    return UtteranceScore(utt, "test", method, "triangular", 3, value, value, value, 100)
+    return UtteranceScore(utterance=utt, split="test", mode=method, smoothing="triangular",
+                          n_context_phones=3, whole_face=value, lower_lip=value, upper_lip=value,
+                          speech_frames=100)
 
 
 def test_label_eval_summary_and_recommendation():
