@@ -13,6 +13,7 @@ log = logging.getLogger("facetraj")
 
 
 def cmd_synth(args: argparse.Namespace) -> int:
+    from engine.errors import InputError
     from engine.export import write_trajectories
     from engine.formats import read_audio
     from engine.labelling import labels_for_audio
@@ -24,6 +25,9 @@ def cmd_synth(args: argparse.Namespace) -> int:
     model = Model.load(args.model)
     audio, rate = read_audio(args.audio)
     cfg = synth_config(args)
+    if len(audio) < 2.0 / model.marker_rate * rate:       # before the labels are checked against it
+        raise InputError(args.audio, f"the audio is too short ({len(audio) / rate * 1000:.1f} ms) "
+                                     "to synthesize")
     labels = None
     if cfg.mode in ("phonetic", "robust"):
         labels = labels_for_audio(args.audio, audio, rate, labels=args.labels, text=args.text,
