@@ -340,7 +340,7 @@ class MainWindow(QMainWindow):
         self.stop()
         first = self.state.set_model(corpus, model, texts)
         self.face.set_model(model)
-        self.settings.set_limits(model.config.context, model.config.nu)
+        self.settings.set_limits(model.config.context, model.config.nu, model.tuned)
         info = corpus.info
         self.browser.populate({"test": list(info.test), "train": list(info.train)}, texts)
         self.status_label.setText(f"{corpus.root}: {len(info.train)} training and {len(info.test)} test "

@@ -1,5 +1,6 @@
-"""The synthesis settings side panel (paper section 2.3): N, C, xi, nu, phonetic or acoustic-only
-search, smoothing. A change is announced once the user pauses (debounced)."""
+"""The synthesis settings side panel (paper section 2.3): N, C, xi, nu, the search mode (robust,
+phonetic or acoustic-only, each explained in one line), smoothing, and the robust mode's settings
+cross-validated at training. A change is announced once the user pauses (debounced)."""
 
 from __future__ import annotations
 
@@ -19,6 +20,18 @@ from PyQt6.QtWidgets import (
 
 from engine.config import SynthConfig
 
+#: One line per search mode, shown under the selector.
+MODE_NOTES = {
+    "robust": "robust: eq 4's and the acoustically nearest codewords together; each label counts "
+              "as much as the aligner/recognizer trusts it (default for automatic labels).",
+    "phonetic": "phonetic (the paper): the labels alone pick the N context-phones searched "
+                "(eq 4); best with hand-checked labels.",
+    "acoustic": "acoustic only: no labels; the codewords nearest to each frame by eq 5, found "
+                "in the model's LSF index (fast).",
+    "acoustic-full": "acoustic only, whole codebook: eqs 5-8 over every codeword, as the paper "
+                     "(slow).",
+}
+
 
 class SynthSettingsPanel(QWidget):
     """Edits a :class:`SynthConfig`; emits ``configChanged`` after a short pause in editing."""
@@ -33,6 +46,7 @@ class SynthSettingsPanel(QWidget):
         self._timer.setInterval(debounce_ms)
         self._timer.timeout.connect(lambda: self.configChanged.emit(self.config()))
         self._base = config or SynthConfig()
+        self._tuned: dict = {}
 
         self.n = QSpinBox()
         self.n.setRange(1, 50)
@@ -51,6 +65,7 @@ class SynthSettingsPanel(QWidget):
         self.nu.setDecimals(2)
         self.nu.setToolTip("ν: eq 3 constant of the visual phoneme similarity")
         self.mode = QComboBox()
+        self.mode.addItem("robust (labels weighted by confidence)", "robust")
         self.mode.addItem("phonetic (labels restrict the search)", "phonetic")
         self.mode.addItem("acoustic only, indexed (fast)", "acoustic")
         self.mode.addItem("acoustic only, whole codebook (paper, slow)", "acoustic-full")
@@ -58,7 +73,13 @@ class SynthSettingsPanel(QWidget):
             "phonetic: eq 4 picks N context-phones from the labels, eqs 5-8 weight their codewords.\n"
             "acoustic only, indexed: no labels; eqs 6-8 weight the codewords nearest to each frame by\n"
             "eq 5, found in the model's LSF index (docs/algorithm.md gives the accuracy cost).\n"
-            "acoustic only, whole codebook: eqs 5-8 over every codeword, as the paper does.")
+            "acoustic only, whole codebook: eqs 5-8 over every codeword, as the paper does.\n"
+            "robust: eq 4's codewords and the acoustically nearest together, eq 5 with acoustic\n"
+            "context plus a penalty for codewords eq 4 did not choose, times the label's confidence.")
+        self.mode_note = QLabel("")
+        self.mode_note.setWordWrap(True)
+        self.tuned_label = QLabel("")
+        self.tuned_label.setWordWrap(True)
         self.smoothing = QComboBox()
         for label, value in (("triangular, 100 ms", "triangular"), ("spline", "spline"),
                              ("none", "none")):
@@ -77,11 +98,13 @@ class SynthSettingsPanel(QWidget):
         nu_row.addWidget(self.nu_default)
         form.addRow("ν (eq 3)", nu_row)
         form.addRow("search", self.mode)
+        form.addRow(self.mode_note)
         form.addRow("smoothing", self.smoothing)
         lay = QVBoxLayout(self)
         self._layout = lay
         lay.addLayout(form)
         lay.addWidget(self.reset)
+        lay.addWidget(self.tuned_label)
         lay.addWidget(self.status)
         lay.addStretch(1)
 
@@ -92,6 +115,8 @@ class SynthSettingsPanel(QWidget):
         self.nu.valueChanged.connect(self._changed)
         self.nu_default.toggled.connect(self._on_nu_default)
         self.mode.currentIndexChanged.connect(self._changed)
+        self.mode.currentIndexChanged.connect(self._show_mode_note)
+        self._show_mode_note()
         self.smoothing.currentIndexChanged.connect(self._changed)
         self.reset.clicked.connect(lambda: (self.set_config(SynthConfig()), self._changed()))
 
@@ -99,14 +124,38 @@ class SynthSettingsPanel(QWidget):
         """Add a widget under the settings (e.g. the label source of an opened recording)."""
         self._layout.insertWidget(self._layout.count() - 2, widget)
 
-    def set_limits(self, max_context: int, default_nu: float) -> None:
-        """Fit the controls to a model: C up to its trained context, ν's default."""
+    def _show_mode_note(self, *_args) -> None:
+        self.mode_note.setText(MODE_NOTES.get(self.mode.currentData(), ""))
+        n = self._tuned.get("settings", {}).get("n_context_phones")
+        if self.mode.currentData() == "robust" and n is not None:
+            self.n.setValue(int(n))                  # the cross-validated N, still editable
+
+    def set_limits(self, max_context: int, default_nu: float, tuned: dict | None = None) -> None:
+        """Fit the controls to a model: C up to its trained context, ν's default, and the robust
+        mode's cross-validated settings (``Model.tuned``) shown."""
+        self.set_tuned(tuned or {})
         self.c.setMaximum(max_context)
         self._model_nu = default_nu
         if self.nu_default.isChecked():
             self.nu.blockSignals(True)
             self.nu.setValue(default_nu)
             self.nu.blockSignals(False)
+
+    def set_tuned(self, tuned: dict) -> None:
+        """Show the model's cross-validated robust-mode settings (or that it has none)."""
+        settings = tuned.get("settings") if tuned else None
+        self._tuned = tuned or {}
+        if not settings:
+            self.tuned_label.setText("robust mode: default settings (model trained without "
+                                     "cross-validation: facetraj train --tune)")
+            return
+        names = {"n_context_phones": "N", "xi": "ξ", "label_weight": "κ (label weight)",
+                 "context_weight": "ρ (context weight)", "gamma_max": "γ max",
+                 "robust_candidates": "acoustic candidates",
+                 "triangle_s": "smoothing (s)"}
+        text = ", ".join(f"{names.get(k, k)} = {v:g}" for k, v in settings.items())
+        self.tuned_label.setText(f"robust mode, cross-validated on the training split "
+                                 f"({tuned.get('folds', '?')} folds): {text}")
 
     def set_config(self, cfg: SynthConfig) -> None:
         """Show ``cfg`` without emitting a change."""
@@ -134,6 +183,10 @@ class SynthSettingsPanel(QWidget):
             search = {"acoustic_prefilter": None}
         elif self._base.acoustic_prefilter is None:      # back from the whole codebook: the default K
             search = {"acoustic_prefilter": SynthConfig().acoustic_prefilter}
+        if key == "robust":       # the cross-validated settings the panel has no control for
+            search.update({k: v for k, v in self._tuned.get("settings", {}).items()
+                           if k in ("label_weight", "context_weight", "robust_candidates", "gamma_max",
+                                    "triangle_s")})
         return self._base.with_(
             n_context_phones=self.n.value(), context=self.c.value(), xi=self.xi.value(),
             nu=None if self.nu_default.isChecked() else self.nu.value(),

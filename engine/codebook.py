@@ -57,6 +57,9 @@ class Codebook:
     token_utt : ``(L,)`` index of the training utterance each token comes from.
     token_start, token_end : ``(L,)`` phone boundaries in seconds.
     n_per_phone : codewords per context-phone (5); codeword ``i`` belongs to context ``i // n``.
+    lsf_context : ``(L * n, 2, P)`` each codeword's LSF vectors ``TrainConfig.lsf_context_frames``
+        marker frames before and after it (the robust mode's acoustic context), or ``None``
+        (older models, or no context trained).
     """
 
     contexts: np.ndarray
@@ -66,6 +69,7 @@ class Codebook:
     token_start: np.ndarray
     token_end: np.ndarray
     n_per_phone: int = 5
+    lsf_context: np.ndarray | None = None
 
     @property
     def n_contexts(self) -> int:
@@ -99,4 +103,6 @@ def concatenate(parts: list[Codebook]) -> Codebook:
         token_start=np.concatenate([p.token_start for p in parts]),
         token_end=np.concatenate([p.token_end for p in parts]),
         n_per_phone=parts[0].n_per_phone,
+        lsf_context=(np.concatenate([p.lsf_context for p in parts])
+                     if all(p.lsf_context is not None for p in parts) else None),
     )

@@ -10,7 +10,7 @@ from typing import Literal
 
 Placement = Literal["centres", "edges"]
 DistanceScale = Literal["max", "median", "none"]
-Mode = Literal["phonetic", "acoustic"]
+Mode = Literal["phonetic", "acoustic", "robust"]
 Smoothing = Literal["triangular", "spline", "none"]
 
 
@@ -36,6 +36,8 @@ class TrainConfig:
         distance, ``median`` by the median off-diagonal distance, ``none`` leaves it in PC units.
     index_cells : cells of the coarse k-means index over the codebook LSFs used by acoustic-only
         synthesis (``engine.lsf_index``); ``None`` takes ``round(sqrt(5L))``.
+    lsf_context_frames : the robust mode's acoustic context (``engine.selection``): each codeword
+        also stores its LSF vectors this many marker frames before and after it (0: none).
     """
 
     audio_rate: int = 16000
@@ -51,6 +53,7 @@ class TrainConfig:
     nu: float = 10.0
     distance_scale: DistanceScale = "max"
     index_cells: int | None = None
+    lsf_context_frames: int = 3
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -71,7 +74,10 @@ class SynthConfig:
     context : context C used in eq 4 at synthesis (at most the trained context).
     xi : the constant of eq 4 (> 10 so that the centre phone dominates).
     nu : override of eq 3's constant; ``None`` uses the model's.
-    mode : ``phonetic`` (labels restrict the search) or ``acoustic`` (whole codebook).
+    mode : ``phonetic`` (labels restrict the search, eq 4), ``acoustic`` (no labels) or
+        ``robust`` (eq 4's and the acoustically nearest codewords together, the labels counting
+        as much as their confidence, with acoustic context: ``engine.selection``; the default for
+        labels that are not hand-checked, :func:`engine.pipeline.mode_for`).
     gamma_min, gamma_max, gamma_steps : the grid searched for gamma (eqs 6-7).
     smoothing : ``triangular`` (100 ms zero-phase window), ``spline`` or ``none``.
     triangle_s : the triangular window's total duration.
@@ -84,6 +90,11 @@ class SynthConfig:
     speaker_warp : speaker normalisation of the input LSFs (``engine.speaker``): a warp factor
         alpha (1.0: none; below 1 lowers the frequencies, for a voice with a shorter vocal tract
         than the training voice), or ``None`` to choose it per utterance (``choose_warp``).
+    robust_candidates : robust mode: acoustically nearest codewords added to eq 4's (index search).
+    label_weight : robust mode: kappa, the cost (eq 5 units) of a codeword eq 4 did not choose,
+        times the label's confidence.
+    context_weight : robust mode: rho, the weight of the context frames in the distance.
+    mean_normalise : robust mode: move the input LSFs' mean to the training speaker's.
     """
 
     n_context_phones: int = 3
@@ -100,6 +111,10 @@ class SynthConfig:
     acoustic_prefilter: int | None = 128
     acoustic_probe: int | None = 8
     speaker_warp: float | None = 1.0
+    robust_candidates: int = 32
+    label_weight: float = 16.0
+    context_weight: float = 1.0
+    mean_normalise: bool = False
 
     def with_(self, **changes) -> SynthConfig:
         """A copy with some fields changed."""

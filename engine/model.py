@@ -51,6 +51,10 @@ class Model:
     train_utterances : ids of the training utterances (codebook ``token_utt`` indexes it).
     index : the coarse index over the codebook LSFs for acoustic-only synthesis; built by
         :func:`train`, or on first use by :meth:`lsf_index` (older model files have none).
+    lsf_mean : ``(P,)`` the training speaker's mean codeword LSF (the robust mode's speaker mean
+        normalisation); older model files have none and it is computed from the codebook.
+    tuned : the synthesis settings chosen by cross-validation on the training split
+        (:func:`engine.tuning.cross_validate`: ``{"settings": {...}, "scores": [...]}``), or empty.
     """
 
     config: TrainConfig
@@ -71,6 +75,7 @@ class Model:
     train_utterances: list[str] = field(default_factory=list)
     corpus_fingerprint: str = ""
     index: LsfIndex | None = None
+    tuned: dict = field(default_factory=dict)
 
     # ------------------------------------------------------------------ derived quantities
     @property
@@ -112,6 +117,11 @@ class Model:
             self.index = build_index(self.codebook.lsf, self.config.index_cells)
         return self.index
 
+    @property
+    def lsf_mean(self) -> np.ndarray:
+        """The training speaker's mean LSF vector (mean over the codewords), ``(P,)``."""
+        return self.codebook.lsf.mean(axis=0)
+
     def normalise_markers(self, markers: np.ndarray) -> np.ndarray:
         """Fill short gaps and remove head motion: ``(T, M, 3)`` in the model's head frame."""
         markers = np.asarray(markers, dtype=np.float64)
@@ -148,6 +158,7 @@ class Model:
             "n_per_phone": self.codebook.n_per_phone,
             "train_utterances": self.train_utterances,
             "corpus_fingerprint": self.corpus_fingerprint,
+            "tuned": self.tuned,
         }
         arrays = {
             "meta": np.array(json.dumps(meta)),
@@ -159,6 +170,8 @@ class Model:
             "cb_token_start": self.codebook.token_start, "cb_token_end": self.codebook.token_end,
             "means": self.means, "distances": self.distances, "coord_std": self.coord_std,
         }
+        if self.codebook.lsf_context is not None:
+            arrays["cb_lsf_context"] = self.codebook.lsf_context
         if self.index is not None:
             arrays.update(ix_centroids=self.index.centroids, ix_order=self.index.order,
                           ix_offsets=self.index.offsets)
@@ -176,7 +189,8 @@ class Model:
             pca = PCA(a["pca_mean"], a["pca_components"], a["pca_variances"],
                       float(meta["pca_total_variance"]))
             cb = Codebook(a["cb_contexts"], a["cb_lsf"], a["cb_pcs"], a["cb_token_utt"],
-                          a["cb_token_start"], a["cb_token_end"], int(meta["n_per_phone"]))
+                          a["cb_token_start"], a["cb_token_end"], int(meta["n_per_phone"]),
+                          a.get("cb_lsf_context"))
             index = (LsfIndex(a["ix_centroids"], a["ix_order"], a["ix_offsets"])
                      if "ix_centroids" in a else None)
             if index is not None and not _index_fits(index, cb.lsf):
@@ -190,6 +204,7 @@ class Model:
                 lip_corners=list(meta.get("lip_corners", [])),
                 train_utterances=list(meta.get("train_utterances", [])),
                 corpus_fingerprint=meta.get("corpus_fingerprint", ""), index=index,
+                tuned=dict(meta.get("tuned") or {}),
             )
         except KeyError as exc:
             raise ModelFileError(path, f"model file is incomplete: missing {exc}") from exc

@@ -153,12 +153,16 @@ def check_meta(path: Path, meta: dict, newest: int, fmt: str) -> None:
         raise bad("train_utterances", "a list of names")
     if not isinstance(meta.get("corpus_fingerprint", ""), str):
         raise bad("corpus_fingerprint", "text")
+    tuned = meta.get("tuned", {})
+    if not isinstance(tuned, dict) or not isinstance(tuned.get("settings", {}), dict) or \
+            not all(_is_num(v) for v in tuned.get("settings", {}).values()):
+        raise bad("tuned", "an object of cross-validated settings (numbers)")
 
 
 def check_config(path: Path, config: dict) -> None:
     """The training configuration's types and ranges (as the command line would accept them)."""
     ints = {"audio_rate": (8000, 192000), "lpc_order": (2, 64), "context": (0, 10),
-            "codewords_per_phone": (1, 100)}
+            "codewords_per_phone": (1, 100), "lsf_context_frames": (0, 100)}
     reals = {"window_s": (1e-3, 1.0), "preemphasis": (0.0, 1.0), "max_gap_s": (0.0, 10.0),
              "variance_target": (1e-9, 1.0), "nu": (0.0, 1e6)}
     for key, (lo, hi) in ints.items():
@@ -220,6 +224,7 @@ def check_arrays(path: Path, meta: dict, a: dict[str, np.ndarray]) -> None:
         "coord_std": ("f", (3 * m,)),
         "ix_centroids": ("f", (n_cells, p_order)), "ix_order": ("i", (n_ctx * n_per,)),
         "ix_offsets": ("i", (n_cells + 1,)),
+        "cb_lsf_context": ("f", (n_ctx * n_per, 2, p_order)),
     }
     for name, (kind, shape) in expect.items():
         if name not in a:

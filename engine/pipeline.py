@@ -1,8 +1,9 @@
 """The synthesis pipeline (paper section 2.3): input LSFs, the candidate codewords of each frame
-(eq 4 in phonetic mode, the LSF index in acoustic-only mode), eqs 5-8 (``engine.synthesis``),
-smoothing, and the PCs back to face points.
+(eq 4 in phonetic mode, the LSF index in acoustic-only mode, both in the robust mode), eqs 5-8
+(``engine.synthesis``; ``engine.selection`` for the robust mode), smoothing, and the PCs back to
+face points.
 
-The rule for input without phone labels lives here, once: :func:`mode_for`.
+The rule for which mode the labels allow lives here, once: :func:`mode_for`.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from .errors import InputError
 from .formats import validate_phones
 from .model import Model
 from .phones import SILENCE, context_ids, map_labels, segment_index
+from .selection import mean_normalise, robust_frames
 from .similarity import top_context_phones
 from .smoothing import smooth
 from .speaker import choose_warp, warp_lsf
@@ -27,17 +29,35 @@ from .synthesis import FrameWeights, gamma_grid, nearest_codewords, weight_frame
 log = logging.getLogger(__name__)
 
 
-def mode_for(config: SynthConfig, phones: Sequence[PhoneSegment] | None) -> SynthConfig:
-    """``config``, switched to acoustic-only mode when phonetic mode has no phone labels.
+#: Label sources that are hand-checked (``engine.alignment.Labels.source``): a label file is taken
+#: as hand-checked; aligned and recognized labels are not.
+HAND_CHECKED = ("file",)
+
+
+def mode_for(config: SynthConfig, phones: Sequence[PhoneSegment] | None,
+             source: str | None = "file", explicit: bool = False) -> SynthConfig:
+    """THE rule for the synthesis mode the labels allow: ``config``, switched
+
+    * to acoustic-only when a mode that needs labels (phonetic, robust) has none;
+    * from phonetic to ``robust`` when the labels are not hand-checked (``source`` not in
+      :data:`HAND_CHECKED`: aligned or recognized), unless the user chose phonetic
+      (``explicit``) -- the paper's eq 4 trusts its labels fully.
 
     >>> mode_for(SynthConfig(), None).mode
     'acoustic'
     >>> mode_for(SynthConfig(), [PhoneSegment(0.0, 0.1, "sil")]).mode
     'phonetic'
+    >>> mode_for(SynthConfig(), [PhoneSegment(0.0, 0.1, "sil")], "recognized").mode
+    'robust'
+    >>> mode_for(SynthConfig(), [PhoneSegment(0.0, 0.1, "sil")], "aligned", explicit=True).mode
+    'phonetic'
     """
-    if config.mode == "phonetic" and not phones:
+    if config.mode in ("phonetic", "robust") and not phones:
         log.info("no phone labels: acoustic-only synthesis")
         return config.with_(mode="acoustic")
+    if config.mode == "phonetic" and source not in HAND_CHECKED and not explicit:
+        log.info("%s labels are not hand-checked: robust synthesis", source)
+        return config.with_(mode="robust")
     return config
 
 
@@ -83,14 +103,19 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                phones: Sequence[PhoneSegment] | None = None, config: SynthConfig | None = None,
                n_frames: int | None = None, label_map: Mapping[str, str] | None = None,
                source: str | None = None, lsf: np.ndarray | None = None,
-               audio_source: str | None = None) -> Synthesis:
+               audio_source: str | None = None,
+               confidence: Sequence[float] | np.ndarray | None = None) -> Synthesis:
     """Synthesize face point trajectories from speech (paper section 2.3).
 
     With ``phones`` and ``mode="phonetic"``: per input phone, the top-N context-phones by eq 4,
     and per frame eqs 5-8 over their 5N codewords. Otherwise (acoustic-only) eqs 5-8 over the
     ``config.acoustic_prefilter`` codewords nearest to each frame, found through the model's LSF
     index (``acoustic_probe`` cells), or over the whole codebook as the paper does
-    (``acoustic_prefilter=None``). Then smoothing, and the PCs back to ``(T, M, 3)`` markers.
+    (``acoustic_prefilter=None``). With ``mode="robust"`` (``engine.selection``): eq 4's codewords
+    and the ``robust_candidates`` acoustically nearest together, the target cost eq 5 with acoustic
+    context plus ``label_weight`` times the label's ``confidence`` (one value in [0, 1] per phone,
+    e.g. :attr:`engine.alignment.Labels.confidence`; ``None``: 1, hand-checked) for codewords eq 4
+    did not choose. Then smoothing, and the PCs back to ``(T, M, 3)`` markers.
 
     ``n_frames`` defaults to every marker frame inside the audio. ``source`` names the input (the
     labels) in error messages, ``audio_source`` the audio (default ``source``).
@@ -117,9 +142,11 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     cb = model.codebook
     segments: list[SegmentChoice] = []
     frame_seg = None
-    if config.mode == "phonetic":
+    if config.mode == "robust" and config.mean_normalise:
+        w = mean_normalise(w, model.lsf_mean)
+    if config.mode in ("phonetic", "robust"):
         if not phones:
-            raise InputError(source, "phonetic mode needs phone labels (or use acoustic mode)")
+            raise InputError(source, f"{config.mode} mode needs phone labels (or use acoustic mode)")
         segs = validate_phones(list(phones), duration, source)
         segs = map_labels(segs, model.phones, label_map, source)
         pid = {p: i for i, p in enumerate(model.phones)}
@@ -130,13 +157,32 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         segments = [SegmentChoice(seg, ctx[i], top[i], scores[i]) for i, seg in enumerate(segs)]
         frame_seg = segment_index(segs, times)
         candidates = cb.codewords_of(top)[frame_seg]
+        if config.mode == "robust":
+            conf = frame_confidence(list(phones), confidence, times)
+            near = model.lsf_index().nearest(w, cb.lsf, config.robust_candidates,
+                                              config.acoustic_probe or 8)
+            fw = robust_frames(w, candidates, near, conf, cb.lsf, cb.pcs, _gammas(config),
+                               config.label_weight, cb.lsf_context,
+                               np.array([-mc.lsf_context_frames, mc.lsf_context_frames]),
+                               config.context_weight)
+            return _finish(model, times, w, fw, config, segments, frame_seg, warp)
     elif config.mode == "acoustic":
         candidates = acoustic_candidates(model, w, config)
     else:
-        raise ValueError(f"unknown mode {config.mode!r} (phonetic or acoustic)")
-    gammas = gamma_grid(config.gamma_min, config.gamma_max, config.gamma_steps)
-    fw = weight_frames(w, candidates, cb.lsf, cb.pcs, gammas)
-    pcs = smooth(fw.pcs, rate, config.smoothing, config.triangle_s, config.spline_knot_s)
+        raise ValueError(f"unknown mode {config.mode!r} (phonetic, acoustic or robust)")
+    fw = weight_frames(w, candidates, cb.lsf, cb.pcs, _gammas(config))
+    return _finish(model, times, w, fw, config, segments, frame_seg, warp)
+
+
+def _gammas(config: SynthConfig) -> np.ndarray:
+    return gamma_grid(config.gamma_min, config.gamma_max, config.gamma_steps)
+
+
+def _finish(model: Model, times: np.ndarray, w: np.ndarray, fw: FrameWeights, config: SynthConfig,
+            segments: list[SegmentChoice], frame_seg: np.ndarray | None, warp: float) -> Synthesis:
+    """Smoothing and the PCs back to markers."""
+    pcs = smooth(fw.pcs, model.marker_rate, config.smoothing, config.triangle_s,
+                 config.spline_knot_s)
     return Synthesis(times=times, lsf=w, raw_pcs=fw.pcs, pcs=pcs, markers=model.to_markers(pcs),
                      frames=fw, config=config, segments=segments, frame_segment=frame_seg,
                      warp=warp)
@@ -163,6 +209,25 @@ def acoustic_candidates(model: Model, w: np.ndarray, config: SynthConfig,
         return model.lsf_index().nearest(w, cb.lsf, config.acoustic_prefilter,
                                          config.acoustic_probe, grouped=grouped)
     return nearest_codewords(w, cb.lsf, config.acoustic_prefilter)   # every one, or exact K
+
+
+def frame_confidence(phones: Sequence[PhoneSegment], confidence: Sequence[float] | np.ndarray | None,
+                     times: np.ndarray) -> np.ndarray:
+    """Each frame's label confidence in [0, 1]: that of the phone holding it (1 everywhere when
+    ``confidence`` is ``None``: hand-checked labels; a NaN confidence, a phone without a score,
+    counts 1/2).
+
+    >>> segs = [PhoneSegment(0.0, 0.1, "sil"), PhoneSegment(0.1, 0.2, "p")]
+    >>> frame_confidence(segs, [0.9, float("nan")], np.array([0.05, 0.15])).tolist()
+    [0.9, 0.5]
+    """
+    if confidence is None:
+        return np.ones(len(times))
+    c = np.asarray(confidence, dtype=np.float64)
+    if c.shape != (len(phones),):
+        raise ValueError(f"{c.size} label confidences for {len(phones)} phones")
+    c = np.clip(np.where(np.isfinite(c), c, 0.5), 0.0, 1.0)
+    return c[segment_index(phones, times)]
 
 
 def resmooth(model: Model, result: Synthesis, method: str) -> np.ndarray:

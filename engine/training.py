@@ -140,6 +140,12 @@ def codebook_part(utt: Utterance, normed: np.ndarray, k: int, pca: PCA, pid: Map
     cw_pcs = interpolate_frames(pcs_frames, rate, times.ravel())
     cw_lsf = lsf_at(utt.audio, utt.sample_rate, times.ravel(), config.lpc_order,
                     config.window_s, config.audio_rate, config.preemphasis)
+    ctx_lsf = None
+    if config.lsf_context_frames > 0:
+        off = config.lsf_context_frames / rate
+        ctx_lsf = np.stack([lsf_at(utt.audio, utt.sample_rate, np.clip(times.ravel() + o, 0, None),
+                                   config.lpc_order, config.window_s, config.audio_rate,
+                                   config.preemphasis) for o in (-off, off)], axis=1)
     n = config.codewords_per_phone
     ok = np.isfinite(cw_pcs).all(axis=1).reshape(-1, n).all(axis=1)
     ok &= times[:, -1] <= (normed.shape[0] - 1) / rate + 0.5 / rate
@@ -148,7 +154,7 @@ def codebook_part(utt: Utterance, normed: np.ndarray, k: int, pca: PCA, pid: Map
                  (~ok).sum())
     keep = np.repeat(ok, n)
     return Codebook(ctx[ok], cw_lsf[keep], cw_pcs[keep], np.full(ok.sum(), k), starts[ok],
-                    ends[ok], n)
+                    ends[ok], n, None if ctx_lsf is None else ctx_lsf[keep])
 
 
 def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = None,

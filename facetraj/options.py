@@ -146,7 +146,10 @@ def add_synth_options(p: argparse.ArgumentParser, nu: bool = True) -> None:
     if nu:
         g.add_argument("--nu", type=POSITIVE, help="override eq 3's constant")
     g.add_argument("--synth-context", type=CONTEXT, help="context C used in eq 4 (default 3)")
-    g.add_argument("--mode", choices=["phonetic", "acoustic"], help="default phonetic")
+    g.add_argument("--mode", choices=["phonetic", "acoustic", "robust"],
+                   help="phonetic: the paper's eq 4, labels trusted (default for label files); "
+                        "robust: eq 4 and acoustic candidates weighted by label confidence "
+                        "(default for aligned or recognized labels); acoustic: no labels")
     g.add_argument("--smoothing", choices=["triangular", "spline", "none"])
     g.add_argument("--acoustic-prefilter", type=count_or_all, metavar="K|all",
                    help="acoustic mode: weight the K codewords nearest to each frame (default "

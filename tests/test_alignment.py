@@ -236,7 +236,9 @@ def test_align_command_dict(tmp_path, capsys):
     assert "noizee" in [w.label for w in read_textgrid_tiers(out)["words"]]
 
 
-def test_synth_with_text_aligns_then_synthesizes_phonetically(tmp_path, default_model, caplog):
+def test_synth_with_text_aligns_then_synthesizes_robustly(tmp_path, default_model, caplog):
+    """Aligned labels are not hand-checked: synth picks the robust mode (issue 16), or the
+    paper's phonetic mode when asked for explicitly."""
     import logging
 
     model = default_model.save(tmp_path / "m.npz")
@@ -250,12 +252,17 @@ def test_synth_with_text_aligns_then_synthesizes_phonetically(tmp_path, default_
     with caplog.at_level(logging.INFO, logger="facetraj"):
         assert main(["synth", str(model), str(wav), "--text", text,
                      "-o", str(tmp_path / "p.c3d")]) == 0
+    assert "robust mode (labels: aligned)" in caplog.text
+    caplog.clear()
+    with caplog.at_level(logging.INFO, logger="facetraj"):
+        assert main(["synth", str(model), str(wav), "--text", text, "--mode", "phonetic",
+                     "-o", str(tmp_path / "x.c3d")]) == 0
     assert "phonetic mode (labels: aligned)" in caplog.text
     (tmp_path / "u.txt").write_text(text)                  # the .txt beside is used
     caplog.clear()
     with caplog.at_level(logging.INFO, logger="facetraj"):
         assert main(["synth", str(model), str(wav), "-o", str(tmp_path / "t.c3d")]) == 0
-    assert "phonetic mode (labels: aligned)" in caplog.text
+    assert "robust mode (labels: aligned)" in caplog.text
     from engine.formats import read_c3d
 
     a, p, t = (read_c3d(tmp_path / f"{n}.c3d").markers for n in "apt")

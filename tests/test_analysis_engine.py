@@ -189,3 +189,28 @@ def test_inspect_frame_acoustic_only(toy_model, toy_corpus):
     assert ins.phone == "" and ins.chosen == [] and len(ins.codewords) == 10
     assert sum(res.frames.weights[30]) == pytest.approx(1.0)
     assert ins.lsf_hz == pytest.approx(ins.lsf * toy_model.config.audio_rate / (2 * np.pi))
+
+
+def test_inspect_frame_robust(toy_model, toy_corpus):
+    """Robust mode: each candidate's target cost, label cost and origin, and the frame's label
+    confidence, as the synthesis computed them (repeats of eq 4's codewords left out)."""
+    from engine.config import SynthConfig
+
+    utt = toy_corpus.utterance(toy_corpus.info.test[0])
+    conf = np.full(len(utt.phones), 0.5)
+    res = synthesize(toy_model, utt.audio, utt.sample_rate, utt.phones,
+                     SynthConfig(mode="robust", robust_candidates=16, label_weight=2.0),
+                     n_frames=utt.n_frames, confidence=conf)
+    f = 40
+    ins = inspect_frame(toy_model, res, f)
+    assert ins.mode == "robust" and ins.confidence == 0.5
+    fw = res.frames
+    valid = np.isfinite(fw.acoustic_cost[f])
+    assert len(ins.codewords) == int(valid.sum())
+    assert ins.weight_sum == pytest.approx(1.0)
+    for c in ins.codewords:
+        assert c.label_cost == (0.0 if c.from_labels else pytest.approx(2.0 * 0.5))
+        i = int(np.flatnonzero((fw.candidates[f] == c.index) & valid)[0])
+        assert c.target_cost == pytest.approx(fw.acoustic_cost[f, i])
+    assert any(not c.from_labels for c in ins.codewords)
+    assert sum(c.from_labels for c in ins.codewords) == 15

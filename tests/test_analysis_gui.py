@@ -188,6 +188,61 @@ def test_inspector_weights_sum_to_one(qtbot, model, view):
     assert w.codeword_table.rowCount() == 5 * len(seg.chosen)
 
 
+
+def test_inspector_robust_mode_explains_choice(qtbot, model, corpus, tmp_path):
+    """Robust mode: the table gains target cost, label cost and origin columns, the label
+    confidence is shown, and the numbers are the synthesis's."""
+    from app.analysis.inspector import CodebookInspector
+    from engine.pipeline import synthesize
+
+    utt = corpus.utterance(corpus.info.test[0])
+    conf = np.full(len(utt.phones), 0.25)
+    res = synthesize(model, utt.audio, utt.sample_rate, utt.phones,
+                     SynthConfig(mode="robust", label_weight=8.0), n_frames=utt.n_frames,
+                     confidence=conf)
+    w = CodebookInspector(model)
+    qtbot.addWidget(w)
+    w.resize(900, 900)
+    w.show()
+    f = len(res.times) // 2
+    with qtbot.waitSignal(w.inspected):
+        w.set_synthesis(res, f / model.marker_rate)
+    headers = [w.codeword_table.horizontalHeaderItem(c).text()
+               for c in range(w.codeword_table.columnCount())]
+    assert headers[-3:] == ["target cost", "label cost", "chosen by"]
+    assert w.confidence_label.text().startswith("0.250")
+    labels = {w.codeword_table.item(r, 9).text(): float(w.codeword_table.item(r, 8).text())
+              for r in range(w.codeword_table.rowCount())}
+    assert labels.get("acoustic") == pytest.approx(8.0 * 0.25)       # kappa * confidence
+    assert labels.get("eq 4") == 0.0
+    assert sum(cell_values(w.codeword_table, 0)) == pytest.approx(1.0, abs=1e-3)
+    shot = w.grab().toImage()
+    assert shot.save(str(tmp_path / "inspector_robust.png"))
+    assert shot.width() >= 800
+
+
+def test_settings_panel_explains_modes_and_shows_tuned(qtbot):
+    from app.settings_panel import MODE_NOTES, SynthSettingsPanel
+
+    p = SynthSettingsPanel(SynthConfig())
+    qtbot.addWidget(p)
+    p.show()
+    assert p.mode_note.text() == MODE_NOTES["phonetic"]
+    p.mode.setCurrentIndex(p.mode.findData("robust"))
+    assert p.mode_note.text() == MODE_NOTES["robust"]
+    assert "without cross-validation" in (p.set_tuned({}) or p.tuned_label.text())
+    p.set_limits(3, 10.0, {"settings": {"label_weight": 4.0, "triangle_s": 0.133,
+                                        "n_context_phones": 6}, "folds": 2})
+    assert "κ (label weight) = 4" in p.tuned_label.text() and "2 folds" in p.tuned_label.text()
+    p.mode.setCurrentIndex(p.mode.findData("phonetic"))
+    p.mode.setCurrentIndex(p.mode.findData("robust"))          # picks up the tuned N
+    cfg = p.config()
+    assert cfg.mode == "robust" and cfg.label_weight == 4.0 and cfg.triangle_s == 0.133
+    assert cfg.n_context_phones == 6
+    p.mode.setCurrentIndex(p.mode.findData("phonetic"))
+    assert p.config().label_weight == SynthConfig().label_weight
+
+
 # ---------------------------------------------------------------------- errors
 def test_error_view_matches_engine_and_jumps(qtbot, model, corpus, view):
     from app.analysis.errors_view import ErrorView, LipErrorPanel

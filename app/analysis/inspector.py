@@ -2,7 +2,10 @@
 
 The current phone and its context-phone, the top-N context-phones chosen with their n_j scores
 (eq 4), the 5N candidate codewords with their distances d_i (eq 5) and weights v_i (eq 6), the
-chosen gamma, and the input LSF vector w against its approximation w-hat (eq 7). Every number is
+chosen gamma, and the input LSF vector w against its approximation w-hat (eq 7). In the robust
+mode (``engine.selection``) each candidate also shows why it was chosen: its target cost (eq 5
+with acoustic context), its label cost (kappa times the label's confidence, when eq 4 did not
+choose it) and whether eq 4 chose it; the frame's label confidence is shown above. Every number is
 from :func:`engine.analysis.inspector.inspect_frame`.
 """
 
@@ -57,6 +60,7 @@ class CodebookInspector(QWidget):
         self.gamma_label = QLabel("-")
         self.error_label = QLabel("-")
         self.sum_label = QLabel("-")
+        self.confidence_label = QLabel("-")
         for lab in (self.context_label, self.phone_label):
             lab.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
         form = QFormLayout()
@@ -65,6 +69,7 @@ class CodebookInspector(QWidget):
         form.addRow("context-phone:", self.context_label)
         form.addRow("gamma (eqs 6-7):", self.gamma_label)
         form.addRow("sum v_i:", self.sum_label)
+        form.addRow("label confidence:", self.confidence_label)
         form.addRow("LSF error |w - w-hat|_h:", self.error_label)
 
         self.chosen_table = QTableWidget()
@@ -153,13 +158,21 @@ class CodebookInspector(QWidget):
         rows = [[NumberItem(i + 1, "{:.0f}"), text_item(txt), NumberItem(score, "{:.4f}"),
                  NumberItem(idx, "{:.0f}")] for i, (txt, score, idx) in enumerate(ins.chosen)]
         fill_table(self.chosen_table, ["rank", "context-phone", "n_j", "codebook entry"], rows)
+        robust = ins.mode == "robust"
+        self.confidence_label.setText(
+            f"{ins.confidence:.3f} (1 = the labels count fully)" if robust
+            else "- (robust mode only)")
         vmax = max((c.weight for c in ins.codewords), default=1.0)
         rows = [[heat_item(c.weight, 0.0, vmax, "{:.4f}"),
                  NumberItem(c.distance, "{:.3f}"), text_item(c.context),
                  NumberItem(c.position + 1, "{:.0f}"), text_item(c.utterance),
-                 NumberItem(c.time, "{:.3f}"), NumberItem(c.index, "{:.0f}")] for c in ins.codewords]
+                 NumberItem(c.time, "{:.3f}"), NumberItem(c.index, "{:.0f}")]
+                + ([NumberItem(c.target_cost, "{:.3f}"), NumberItem(c.label_cost, "{:.3f}"),
+                    text_item("eq 4" if c.from_labels else "acoustic")] if robust else [])
+                for c in ins.codewords]
         fill_table(self.codeword_table, ["v_i", "d_i", "context-phone", "codeword (1-5)",
-                                         "from utterance", "at (s)", "index i"], rows)
+                                         "from utterance", "at (s)", "index i"]
+                   + (["target cost", "label cost", "chosen by"] if robust else []), rows)
         self._draw(ins)
         self.inspected.emit(ins)
 

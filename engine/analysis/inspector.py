@@ -10,6 +10,7 @@ import numpy as np
 
 from ..model import Model
 from ..pipeline import Synthesis
+from ..selection import RobustFrames
 from ..synthesis import lsf_distances, perceptual_weights
 
 
@@ -25,6 +26,9 @@ class CodewordRow:
     time: float             # its time in that utterance (s)
     distance: float         # d_i (eq 5)
     weight: float           # v_i (eq 6)
+    target_cost: float = float("nan")   # robust mode: eq 5 with acoustic context (engine.selection)
+    label_cost: float = float("nan")    # robust mode: kappa * confidence if eq 4 did not choose it
+    from_labels: bool = True            # chosen by eq 4 (always, in phonetic mode)
 
 
 @dataclass
@@ -42,6 +46,8 @@ class FrameInspection:
     lsf_hat: np.ndarray      # w-hat (P,)
     error: float             # sum_k h_k |w_k - w-hat_k|
     audio_rate: float = 16000.0
+    mode: str = "phonetic"
+    confidence: float = float("nan")   # robust mode: the frame's label confidence
 
     @property
     def lsf_hz(self) -> np.ndarray:
@@ -81,6 +87,7 @@ def inspect_frame(model: Model, synthesis: Synthesis, frame: int, top: int | Non
         chosen = [(context_text(model, cb.contexts[j]), float(s), int(j))
                   for j, s in zip(sc.chosen, sc.scores, strict=True)]
     cand = np.asarray(fw.candidates[frame])
+    robust = isinstance(fw, RobustFrames)
     w = synthesis.lsf[frame]
     d = lsf_distances(w, cb.lsf[cand], perceptual_weights(w))
     v = fw.weights[frame]
@@ -89,6 +96,8 @@ def inspect_frame(model: Model, synthesis: Synthesis, frame: int, top: int | Non
         order = order[:top]
     n = cb.n_per_phone
     rows = []
+    if robust:
+        order = np.array([i for i in order if np.isfinite(fw.acoustic_cost[frame, i])], dtype=int)
     for i in order:
         ci = int(cand[i])
         ctx = ci // n
@@ -96,11 +105,16 @@ def inspect_frame(model: Model, synthesis: Synthesis, frame: int, top: int | Non
         utt = model.train_utterances[utt_k] if utt_k < len(model.train_utterances) else str(utt_k)
         pos = ci % n
         start, end = float(cb.token_start[ctx]), float(cb.token_end[ctx])
+        extra = (float(fw.acoustic_cost[frame, i]), float(fw.label_cost[frame, i]),
+                 bool(fw.from_labels[frame, i])) if robust else ()
         rows.append(CodewordRow(ci, ctx, context_text(model, cb.contexts[ctx]), pos, utt,
-                                start + (pos + 0.5) * (end - start) / n, float(d[i]), float(v[i])))
+                                start + (pos + 0.5) * (end - start) / n, float(d[i]), float(v[i]),
+                                *extra))
     return FrameInspection(frame, float(synthesis.times[frame]), phone, ctx_txt, chosen, rows,
                            float(fw.gamma[frame]), np.asarray(w), np.asarray(fw.lsf_hat[frame]),
-                           float(fw.error[frame]), float(model.config.audio_rate))
+                           float(fw.error[frame]), float(model.config.audio_rate),
+                           synthesis.config.mode,
+                           float(fw.confidence[frame]) if robust else float("nan"))
 
 
 __all__ = ["CodewordRow", "FrameInspection", "context_text", "inspect_frame"]

@@ -27,6 +27,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from ..formats import atomic_write
+from ..label_eval import LABEL_EVAL_FILE, read_label_eval
 from ..model import Model
 from ..progress import Progress
 from .compute import compute_report, figure4_data, find_utterance
@@ -53,10 +54,13 @@ def write_report(corpus_dir: str | os.PathLike[str], out_dir: str | os.PathLike[
                  ns: Iterable[int] = range(1, 11), figures: FigureMaker | None = None) -> Path:
     """Compute the report on ``corpus_dir`` and write ``out_dir/results.md``, ``results.json`` and
     (through ``figures``, drawn into ``out_dir/figures/``) its figures. Returns the ``.md`` path.
+    The evaluation with automatic labels is read from ``out_dir/label_eval.json`` (written by
+    ``facetraj report --automatic-labels``, about half an hour) when present.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     data = compute_report(corpus_dir, model, progress, ns)
+    data.label_eval = read_label_eval(out / LABEL_EVAL_FILE)
     if figures is not None:
         fig_dir = out / "figures"
         fig_dir.mkdir(exist_ok=True)

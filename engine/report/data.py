@@ -13,6 +13,7 @@ import numpy as np
 from .. import __version__
 from ..data import PhoneSegment
 from ..evaluation import METRICS
+from ..label_eval import LabelEval
 from ..paper import LEVELS_OFF_AT_N, PAPER_TABLE2
 from ..similarity import SimilarRow
 from .rows import (
@@ -94,6 +95,7 @@ class ReportData:
     timings: dict[str, float] = field(default_factory=dict)
     figures: dict[str, str] = field(default_factory=dict)
     created: str = ""
+    label_eval: LabelEval | None = None    # every mode with automatic labels (engine.label_eval)
 
     def row(self, mode: str, split: str = "test", smoothing: str = "triangular") -> ComparisonRow | None:
         """The comparison row of one mode (``phonetic``, ``acoustic``, ``acoustic-indexed``,
@@ -122,6 +124,7 @@ class ReportData:
             "table1_agreement": asdict(table1_agreement(self.table1, self.paper_table1)),
             "at_a_glance": [asdict(g) for g in at_a_glance(self)],
             "timings_s": self.timings, "figures": self.figures, "labels": self.labels,
+            "automatic_labels": self.label_eval.to_json()["summary"] if self.label_eval else None,
         })
 
 

@@ -7,6 +7,7 @@ from pathlib import Path
 
 from .. import __version__
 from ..evaluation import METRICS
+from ..label_eval import format_markdown
 from ..paper import FIGURE4_TEXT, LEVELS_OFF_AT_N, TABLE2_N, table2_value
 from .data import ReportData, at_a_glance
 from .discussion import discussion
@@ -157,6 +158,15 @@ def discussion_section(data: ReportData) -> list[str]:
     return lines
 
 
+def automatic_labels_section(data: ReportData) -> list[str]:
+    """Every mode and baseline under exact, aligned and recognized labels (``engine.label_eval``),
+    when an evaluation was saved beside the report; else nothing."""
+    if data.label_eval is None:
+        return []
+    return ["## Beyond the paper: automatic labels on held-out sentences", "",
+            format_markdown(data.label_eval)]
+
+
 def reproducing_section(data: ReportData) -> list[str]:
     """The command that wrote the report, and how long each stage took."""
     return ["## Reproducing", "",
@@ -167,20 +177,21 @@ def reproducing_section(data: ReportData) -> list[str]:
 
 #: the sections of ``results.md``, in order
 SECTIONS = (header_section, glance_section, table2_section, figure5_section, figure4_section,
-            comparisons_section, labels_section, table1_section, discussion_section,
-            reproducing_section)
+            comparisons_section, labels_section, table1_section, automatic_labels_section,
+            discussion_section, reproducing_section)
 
 
 def render_markdown(data: ReportData) -> str:
-    """``results.md`` from the report data."""
+    """``results.md`` from the report data (sections with nothing to say are left out)."""
     lines: list[str] = []
     for section in SECTIONS:
-        body = section(data)
-        if body:
-            lines += [*body, ""]
+        part = section(data)
+        if part:
+            lines += [*part, ""]
     return "\n".join(lines)
 
 
-__all__ = ["COMPARISON_ORDER", "SECTIONS", "comparisons_section", "discussion_section",
-           "figure4_section", "figure5_section", "glance_section", "header_section", "labels_section",
-           "render_markdown", "reproducing_section", "table1_section", "table2_section"]
+__all__ = ["COMPARISON_ORDER", "SECTIONS", "automatic_labels_section", "comparisons_section",
+           "discussion_section", "figure4_section", "figure5_section", "glance_section",
+           "header_section", "labels_section", "render_markdown", "reproducing_section",
+           "table1_section", "table2_section"]

@@ -9,6 +9,7 @@ from pathlib import Path
 from engine.errors import FacetrajError
 
 from ..options import FPS, add_synth_options, integer, synth_config, video_size
+from ..paths import default_corpus
 from ..progress import TerminalProgress
 
 
@@ -59,6 +60,14 @@ def cmd_report(args: argparse.Namespace) -> int:
     except ImportError as exc:
         raise FacetrajError(f"the report's figures need matplotlib: {exc}") from exc
     model = Model.load(args.model) if args.model else None
+    if args.automatic_labels:
+        from engine.corpus import load_corpus
+        from engine.label_eval import LABEL_EVAL_FILE, evaluate_labels, write_label_eval
+
+        args.output.mkdir(parents=True, exist_ok=True)
+        result = evaluate_labels(load_corpus(args.corpus or default_corpus()),
+                                 progress=TerminalProgress("automatic labels"))
+        write_label_eval(args.output / LABEL_EVAL_FILE, result)
     out = make_report(args.corpus, args.output, model=model, progress=TerminalProgress("report"),
                       ns=range(1, args.max_n + 1))
     print(out)
@@ -72,6 +81,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="folder of results.md, results.json and figures/ (default docs)")
     p.add_argument("--model", type=Path, help="a trained model (default: train on the corpus)")
     p.add_argument("--max-n", type=integer(1, 100), default=10, help="the N sweep runs 1..MAX_N")
+    p.add_argument("--automatic-labels", action="store_true",
+                   help="also evaluate every mode with aligned and recognized labels (trains and "
+                        "cross-validates three models: about half an hour), saved as "
+                        "label_eval.json beside results.md and reported from it")
     p.set_defaults(func=cmd_report)
 
     p = sub.add_parser("video", help="an MP4 of the face points and lip panels with the sound")

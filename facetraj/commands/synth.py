@@ -13,27 +13,36 @@ log = logging.getLogger("facetraj")
 
 
 def cmd_synth(args: argparse.Namespace) -> int:
+    from engine.errors import InputError
     from engine.export import write_trajectories
     from engine.formats import read_audio
     from engine.labelling import labels_for_audio
     from engine.labelmap import read_label_map
     from engine.model import Model
     from engine.pipeline import mode_for, synthesize
+    from engine.tuning import TUNED_FIELDS, tuned_config
 
     model = Model.load(args.model)
     audio, rate = read_audio(args.audio)
     cfg = synth_config(args)
+    if len(audio) < 2.0 / model.marker_rate * rate:       # before the labels are checked against it
+        raise InputError(args.audio, f"the audio is too short ({len(audio) / rate * 1000:.1f} ms) "
+                                     "to synthesize")
     labels = None
-    if cfg.mode == "phonetic":
+    if cfg.mode in ("phonetic", "robust"):
         labels = labels_for_audio(args.audio, audio, rate, labels=args.labels, text=args.text,
                                   transcript=args.transcript, recognize=args.recognize,
                                   extra_dict=extra_dictionary(args))
     phones = labels.phones if labels else None
-    cfg = mode_for(cfg, phones)
+    cfg = tuned_config(mode_for(cfg, phones, labels.source if labels else None,
+                                explicit=args.mode == "phonetic"), model.tuned,
+                       keep=[f for f in TUNED_FIELDS if getattr(args, f, None) is not None])
+    confidence = labels.confidence if labels and labels.source != "file" else None
     label_map = read_label_map(args.label_map) if args.label_map and labels and \
         labels.source == "file" else None
     res = synthesize(model, audio, rate, phones, cfg, label_map=label_map,
-                     source=str(args.labels or args.audio), audio_source=str(args.audio))
+                     source=str(args.labels or args.audio), audio_source=str(args.audio),
+                     confidence=confidence)
     out = write_trajectories(args.output, res.markers, model, res, args.overwrite)
     log.info("%d frames (%.2f s) synthesized, %s mode (labels: %s), %s smoothing", len(res.times),
              res.times[-1], cfg.mode, labels.source if labels else "none", cfg.smoothing)

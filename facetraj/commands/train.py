@@ -20,6 +20,14 @@ def cmd_train(args: argparse.Namespace) -> int:
     check_output_path(args.output, args.overwrite)  # before training, not after
     corpus = load_corpus(args.corpus)
     model = train(corpus, config=train_config(args), progress=TerminalProgress("train"))
+    if args.tune:
+        from engine.tuning import cross_validate
+
+        tuning = cross_validate(corpus, train_config(args), folds=args.tune,
+                                progress=TerminalProgress("cross-validation"))
+        model.tuned = tuning.to_json()
+        log.info("robust-mode settings by %d-fold cross-validation on the training split: %s",
+                 args.tune, tuning.settings)
     out = model.save(args.output, overwrite=args.overwrite)
     cb = model.codebook
     log.info("trained on %d utterances: %d context-phones, %d codewords, %d PCs (%.2f %% of "
@@ -34,5 +42,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("corpus", type=Path)
     p.add_argument("-o", "--output", type=Path, required=True, help="model file (.npz)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing file")
+    p.add_argument("--tune", type=int, nargs="?", const=2, default=0, metavar="FOLDS",
+                   help="choose the robust mode's N, xi, gamma range, label and context weights "
+                        "and smoothing width by FOLDS-fold cross-validation (default 2) on the "
+                        "training split, stored in the model (a few minutes)")
     add_train_options(p)
     p.set_defaults(func=cmd_train)

@@ -1,0 +1,79 @@
+"""Cross-validation of the robust mode's settings on the training split only (engine.tuning), and
+the evaluation with automatic labels (engine.label_eval) on its own numbers."""
+
+from __future__ import annotations
+
+import functools
+import operator
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from engine.config import SynthConfig
+from engine.evaluation import UtteranceScore
+from engine.label_eval import LabelEval, evaluate_kind, format_markdown
+from engine.tuning import cross_validate, fold_ids, tuned_config
+
+
+def test_fold_ids_cover_training_once():
+    ids = [f"u{i}" for i in range(7)]
+    folds = fold_ids(ids, 3)
+    assert sorted(functools.reduce(operator.iadd, folds, [])) == sorted(ids)
+    assert [len(f) for f in folds] == [3, 2, 2]
+
+
+def test_cross_validate_uses_training_split_only(toy_corpus):
+    """The test split is never read: the corpus is given test ids that do not exist."""
+    corpus = replace(toy_corpus, info=replace(toy_corpus.info, test=["no-such-utterance"]))
+    grid = ({"label_weight": 1.0, "context_weight": 0.0}, {"label_weight": 4.0, "context_weight": 1.0})
+    tuning = cross_validate(corpus, grid=grid, widths=(0.05, 0.1), folds=2, max_per_fold=2)
+    assert tuning.utterances == 4
+    assert len(tuning.scores) == 4
+    best = max(tuning.scores, key=lambda s: s["score"])
+    assert tuning.settings == {k: v for k, v in best.items() if k != "score"}
+    assert all(np.isfinite(s["score"]) and -1 <= s["score"] <= 1 for s in tuning.scores)
+    cfg = tuned_config(SynthConfig(mode="robust"), tuning.to_json())
+    assert cfg.triangle_s == tuning.settings["triangle_s"]
+    assert cfg.label_weight == tuning.settings["label_weight"]
+
+
+def _score(method, value, utt="u"):
+    return UtteranceScore(utterance=utt, split="test", mode=method, smoothing="triangular",
+                          n_context_phones=3, whole_face=value, lower_lip=value, upper_lip=value,
+                          speech_frames=100)
+
+
+def test_label_eval_summary_and_recommendation():
+    res = LabelEval(scores={"aligned": [_score("robust", 0.8, "a"), _score("robust", 0.6, "b"),
+                                        _score("phonetic", 0.65), _score("acoustic", 0.5),
+                                        _score("ridge", 0.55), _score("viseme", 0.4)]})
+    mean, sd = res.summary("aligned", "robust")["whole_face"]
+    assert (mean, sd) == (pytest.approx(0.7), pytest.approx(0.1))
+    assert res.best("aligned") == "robust" and res.beats_all("aligned")
+    text = format_markdown(res)
+    assert "| robust (" in text and "0.7000 ± 0.10" in text
+    assert "With aligned labels, **robust** (above every other method" in text
+    res.scores["aligned"].append(_score("phonetic", 0.95))
+    assert not res.beats_all("aligned")
+
+
+def test_evaluate_kind_on_toy_corpus(toy_corpus, toy_model):
+    scores, tuning = evaluate_kind(toy_corpus, "exact", model=toy_model, tune=False, max_test=2)
+    assert tuning is None
+    methods = {s.mode for s in scores}
+    assert methods == {"robust", "phonetic", "phonetic-tuned", "acoustic", "ridge", "viseme"}
+    assert all(len([s for s in scores if s.mode == m]) == 2 for m in methods)
+    assert all(-1 <= s.whole_face <= 1 for s in scores)
+
+
+def test_label_eval_file_round_trip(tmp_path):
+    from engine.label_eval import read_label_eval, write_label_eval
+
+    assert read_label_eval(tmp_path / "absent.json") is None
+    res = LabelEval(scores={"recognized": [_score("robust", 0.7), _score("phonetic", 0.5)]},
+                    tunings={"recognized": {"settings": {"label_weight": 4.0}}})
+    back = read_label_eval(write_label_eval(tmp_path / "label_eval.json", res))
+    assert back.summary("recognized", "robust") == res.summary("recognized", "robust")
+    assert back.tunings == res.tunings
+    assert "label_weight = 4" in format_markdown(back)
