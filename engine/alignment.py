@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from .data import PhoneSegment
-from .errors import InputError
+from .errors import FacetrajError, InputError
 from .phones import ARPABET, SILENCE
 
 log = logging.getLogger(__name__)
@@ -209,9 +209,7 @@ def _pcm16k(audio: np.ndarray, rate: int, source: str | os.PathLike[str] | None)
 
 
 def _decoder(**settings):
-    from pocketsphinx import Decoder
-
-    return Decoder(samprate=ALIGN_RATE, loglevel="FATAL", **settings)
+    return _pocketsphinx().Decoder(samprate=ALIGN_RATE, loglevel="FATAL", **settings)
 
 
 def _decode(decoder, pcm: bytes) -> None:
@@ -220,11 +218,25 @@ def _decode(decoder, pcm: bytes) -> None:
     decoder.end_utt()
 
 
+def _pocketsphinx():
+    """The ``pocketsphinx`` module, imported on first use; a clear error when it is missing."""
+    try:
+        import pocketsphinx
+    except ImportError as exc:
+        raise FacetrajError("phone labelling needs PocketSphinx, which is not installed "
+                            "(pip install 'pocketsphinx>=5.1,<6')") from exc
+    return pocketsphinx
+
+
 def pocketsphinx_version() -> str:
     """The installed PocketSphinx version (part of the label cache key)."""
-    from importlib.metadata import version
+    from importlib.metadata import PackageNotFoundError, version
 
-    return version("pocketsphinx")
+    _pocketsphinx()
+    try:
+        return version("pocketsphinx")
+    except PackageNotFoundError:
+        return "unknown"
 
 
 # --------------------------------------------------------------------------- alignment
@@ -356,9 +368,7 @@ def _mean_score(labels: Labels) -> float:
 # --------------------------------------------------------------------------- recognition
 def _recognize_segments(pcm: bytes) -> tuple[list[PhoneSegment], np.ndarray, int]:
     """All-phone search, then the phones found re-aligned as a phone sequence (scores)."""
-    from pocketsphinx import get_model_path
-
-    lm = os.path.join(get_model_path(), "en-us", "en-us-phone.lm.bin")
+    lm = os.path.join(_pocketsphinx().get_model_path(), "en-us", "en-us-phone.lm.bin")
     dec = _decoder(allphone=lm, **ALLPHONE_SETTINGS)
     _decode(dec, pcm)
     n_frames = dec.n_frames()

@@ -64,7 +64,7 @@ def test_open_audio_with_a_sentence_shows_aligned_phones(window, qtbot, clip, tm
     view = win.view
     utt = view.utterance
     assert view.split == "external" and utt.name == "recording" and view.original is None
-    assert utt.label_source == "aligned" and view.synthesis.config.mode == "phonetic"
+    assert utt.label_source == "aligned" and view.synthesis.config.mode == "robust"
     assert [w.label for w in utt.words] == ["the", "boy", "enjoyed", "the", "noisy", "toy"]
     assert [p.label for p in utt.phones if p.label != "sil"][:4] == ["dh", "ah", "b", "oy"]
     ax = _phone_axis(win)
