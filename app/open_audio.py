@@ -39,6 +39,8 @@ from engine.labelling import beside, file_labels, label_audio, labels_for_audio
 from engine.phones import ARPABET
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from .main_window import MainWindow
 
 log = logging.getLogger(__name__)
@@ -220,16 +222,31 @@ class AudioOpener(QObject):
         if not path:
             return
         path = Path(path)
+        read = self._read(path)  # a corrupt file is reported before the sentence is asked for
+        if read is None:
+            return
         label_file, txt = beside(path)
         if label_file is not None or txt is not None:
-            self.open(path)
+            self._open(path, read)
             return
         dialog = SentenceDialog(path.name, self.window)
         if dialog.exec() != QDialog.DialogCode.Accepted:
             return
         source, text = dialog.choice()
-        self.open(path, text=text or None, recognize=source == "recognized",
-                  acoustic_only=source == "none")
+        self._open(path, read, text=text or None, recognize=source == "recognized",
+                   acoustic_only=source == "none")
+
+    def _read(self, audio_path: Path) -> tuple[np.ndarray, int] | None:
+        """The audio of ``audio_path`` and its rate; ``None`` (after the error dialog) if it
+        cannot be read or there is no model to synthesize with."""
+        if self.window.model is None:
+            self.window.show_error("no model yet: open a corpus first")
+            return None
+        try:
+            return read_audio(audio_path)
+        except FacetrajError as exc:
+            self.window.show_error(str(exc))
+            return None
 
     # -- opening
     def open(self, audio_path: Path, labels_path: Path | None = None, text: str | None = None,
@@ -237,15 +254,16 @@ class AudioOpener(QObject):
              extra_dict: dict[str, list[str]] | None = None) -> None:
         """Open ``audio_path`` for synthesis; labels by ``engine.labelling.labels_for_audio``
         (alignment in a worker), none with ``acoustic_only``."""
+        read = self._read(audio_path)
+        if read is not None:
+            self._open(audio_path, read, labels_path, text, recognize, acoustic_only, extra_dict)
+
+    def _open(self, audio_path: Path, read: tuple[np.ndarray, int],
+              labels_path: Path | None = None, text: str | None = None, recognize: bool = False,
+              acoustic_only: bool = False,
+              extra_dict: dict[str, list[str]] | None = None) -> None:
         win = self.window
-        if win.model is None:
-            win.show_error("no model yet: open a corpus first")
-            return
-        try:
-            audio, rate = read_audio(audio_path)
-        except FacetrajError as exc:
-            win.show_error(str(exc))
-            return
+        audio, rate = read
         name = audio_path.stem
         while name in (win.corpus.info.ids if win.corpus else []):
             name += "'"

@@ -61,14 +61,17 @@ class SynthRequest:
     model: Model
     config: SynthConfig
     generation: int
+    mode_chosen: bool = False
 
     def run(self, progress: Progress | None = None) -> UtteranceView:
         """Load and synthesize (slow: run in a worker). Without phone labels the synthesis is
-        acoustic-only (:func:`engine.pipeline.mode_for`)."""
+        acoustic-only, and with labels not hand-checked robust unless the user chose the mode
+        (:func:`engine.pipeline.mode_for`)."""
         utt = self.load()
         if progress is not None:
             progress(0.3, f"synthesizing {utt.name}")
-        return build_view(self.model, utt, self.split, mode_for(self.config, utt.phones))
+        return build_view(self.model, utt, self.split, mode_for(self.config, utt.phones, utt.label_source,
+                                                                 explicit=self.mode_chosen))
 
 
 @dataclass
@@ -85,6 +88,7 @@ class ViewerModel:
     pending_time: float | None = None        # where the first utterance starts
     request: SynthRequest | None = None      # the latest utterance asked for
     generation: int = 0
+    mode_chosen: bool = False                # the user picked a search mode in the settings
 
     # ------------------------------------------------------------------ corpus and model
     def set_model(self, corpus: Corpus, model: Model, texts: dict[str, str]) -> str | None:
@@ -141,6 +145,7 @@ class ViewerModel:
         """Use new settings: (whether they changed, the re-synthesis of the latest request)."""
         if config == self.synth_config:
             return False, None
+        self.mode_chosen |= config.mode != self.synth_config.mode
         self.synth_config = config
         req = self.request
         if req is None:
@@ -152,7 +157,7 @@ class ViewerModel:
         assert self.model is not None
         self.generation += 1
         self.request = SynthRequest(load, split, new_utterance, self.model, self.synth_config,
-                                    self.generation)
+                                    self.generation, self.mode_chosen)
         return self.request
 
     def is_current(self, request: SynthRequest) -> bool:

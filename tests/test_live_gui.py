@@ -9,9 +9,8 @@ import pytest
 pytest.importorskip("pytestqt")
 pytest.importorskip("pyvistaqt")
 
-from PyQt6.QtWidgets import QMainWindow
-
 from app import live
+from app.main import build_window
 from engine.config import SynthConfig
 from engine.errors import FacetrajError
 from engine.formats import read_audio, read_c3d
@@ -78,13 +77,12 @@ def test_no_input_device_gives_the_message(qtbot, default_model, monkeypatch, ca
     assert live.NO_INPUT_DEVICE in capsys.readouterr().err
 
 
-def test_live_toggle_in_the_main_window(qtbot, default_model, monkeypatch):
+def test_live_toggle_in_the_main_window(qtbot, default_corpus, trained_cache, monkeypatch):
     monkeypatch.setattr(live, "input_devices", lambda: [])
-    window = QMainWindow()
-    window.model = default_model
-    window.show_error = lambda message: None
+    window = build_window(default_corpus.root, use_audio=False)     # as users get it
     qtbot.addWidget(window)
-    live.install(window)
+    window.show()
+    qtbot.waitUntil(lambda: window.model is not None and not window.busy, timeout=60_000)
     window.extension("live").action.setChecked(True)
     opened = [w for w in window.findChildren(live.LiveWindow)] or \
         [w for w in live.QApplication.topLevelWidgets() if isinstance(w, live.LiveWindow)]

@@ -100,6 +100,21 @@ def test_opened_audio_without_labels_is_synthesized_acoustic_only(state, toy_cor
     assert state.synth_config.mode == "phonetic"    # the settings themselves are unchanged
 
 
+def test_aligned_labels_are_synthesized_robust_unless_the_user_chose_a_mode(state, toy_corpus):
+    utt = toy_corpus.utterance(toy_corpus.info.test[0])
+    name = state.add_external(replace(utt, markers=None, label_source="aligned"))
+    assert state.request_utterance(name).run().synthesis.config.mode == "robust"
+    # the user picks phonetic in the settings (away and back): eq 4 trusts the labels, as asked
+    state.set_config(state.synth_config.with_(mode="acoustic"))
+    state.set_config(state.synth_config.with_(mode="phonetic"))
+    assert state.mode_chosen
+    assert state.request_utterance(name).run().synthesis.config.mode == "phonetic"
+    # the corpus's own (hand-checked) labels keep the paper's phonetic search
+    fresh = ViewerModel()
+    fresh.set_model(toy_corpus, state.model, {})
+    assert fresh.request_utterance(utt.name).run().synthesis.config.mode == "phonetic"
+
+
 def test_frame_and_phone_arithmetic(state, toy_corpus):
     req = state.request_utterance(toy_corpus.info.test[0])
     state.accept(req, req.run())
