@@ -198,7 +198,10 @@ class TaskRunner(QObject):
             if not task.wait(timeout_ms):
                 log.warning("task %r still running after %d ms: detached", task.label, timeout_ms)
                 for signal in (task.finished, task.progress, task.partial):
-                    signal.disconnect()     # its receivers close with the owner
+                    try:
+                        signal.disconnect()     # its receivers close with the owner
+                    except TypeError:
+                        pass                    # it had none
                 task.setParent(None)
                 _DETACHED.append(task)
 

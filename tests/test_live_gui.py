@@ -82,7 +82,7 @@ def test_live_toggle_in_the_main_window(qtbot, default_corpus, trained_cache, mo
     window = build_window(default_corpus.root, use_audio=False)     # as users get it
     qtbot.addWidget(window)
     window.show()
-    qtbot.waitUntil(lambda: window.model is not None and not window.busy, timeout=60_000)
+    qtbot.waitUntil(lambda: window.model is not None and not window.busy, timeout=240_000)
     window.extension("live").action.setChecked(True)
     opened = [w for w in window.findChildren(live.LiveWindow)] or \
         [w for w in live.QApplication.topLevelWidgets() if isinstance(w, live.LiveWindow)]
