@@ -5,7 +5,9 @@
 The main window as a phonetician meets it, at 1280x800 and 1920x1080: the default corpus, a 2-D
 MOCHA-TIMIT utterance (``../shared/data/mocha_fsew0_001``, read in place), an utterance with no
 original markers (File > Open audio of a WAV) and a long file (a few corpus utterances joined
-into one WAV); frames of ``facetraj video``; and the analysis views
+into one WAV); the dialogs of *Open audio* (the sentence, words missing from the dictionary, the
+error of a corrupt WAV) and the synthesis settings with each search mode's note, each shown
+non-modally and grabbed; frames of ``facetraj video``; and the analysis views
 (:func:`app.analysis.figures.make_figures`). Scratch files go to a temporary folder, never into
 the repository. The results figures come from ``make report``, the corpus figure from
 ``docs/figures/make_corpus_figures.py`` (``make figures`` runs that too).
@@ -15,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 import tempfile
 from pathlib import Path
@@ -109,6 +112,90 @@ def app_figures(out: Path, scratch: Path) -> list[Path]:
     return written
 
 
+def _grab(widget, path: Path) -> Path:
+    from .analysis.figures import settle
+
+    settle()
+    widget.grab().save(str(path))
+    log.info("wrote %s", path)
+    return path
+
+
+def dialog_figures(out: Path, scratch: Path) -> list[Path]:
+    """The dialogs of File > Open audio and the synthesis settings panel, each shown without
+    ``exec()`` (no modal loop waits for an answer) and grabbed."""
+    from PyQt6.QtGui import QColor, QPainter, QPixmap
+    from PyQt6.QtWidgets import QMessageBox
+
+    from .open_audio import MissingWordsDialog, SentenceDialog
+    from .settings_panel import MODE_NOTES, SynthSettingsPanel
+
+    written = []
+    win = _window(DEFAULT_CORPUS, SIZES["1280x800"])
+    dialog = SentenceDialog("my_recording.wav", win)
+    dialog.show()
+    written.append(_grab(dialog, out / "dialog_sentence.png"))
+    dialog.close()
+    dialog = MissingWordsDialog(["tornadoes", "facetraj"], win)
+    dialog.edits["tornadoes"].setText("T AO R N EY D OW Z")
+    dialog.edits["facetraj"].setText("F EY S T R AE J")     # J is not ARPAbet: the message says so
+    dialog.show()
+    written.append(_grab(dialog, out / "dialog_missing_words.png"))
+    dialog.close()
+    # a corrupt WAV through the window's own error path; the message box it would exec() is shown
+    boxes: list[QMessageBox] = []
+
+    def box(message: str) -> None:
+        b = QMessageBox(QMessageBox.Icon.Critical, "facetraj", message,
+                        QMessageBox.StandardButton.Ok, win)
+        b.show()
+        boxes.append(b)
+
+    corrupt = scratch / "damaged_recording.wav"
+    corrupt.write_bytes(b"RIFF\x24\x00\x00\x00WAVEfmt " + bytes(range(40)))
+    cwd = Path.cwd()
+    win.set_error_handler(box)
+    try:
+        os.chdir(scratch)               # the message names the file as the user gave it, not /tmp/...
+        win.audio_opener.open(Path(corrupt.name))
+    finally:
+        os.chdir(cwd)
+        win.set_error_handler(None)
+    if not boxes:
+        raise RuntimeError("opening a corrupt WAV showed no error")
+    written.append(_grab(boxes[0], out / "dialog_corrupt_wav.png"))
+    boxes[0].close()
+    # the settings panel once per search mode, side by side in one picture
+    panel = SynthSettingsPanel(win.synth_config)
+    model = win.model
+    panel.set_limits(model.config.context, model.config.nu, model.tuned)
+    width = max(360, win.settings.width())
+    shots = []
+    for mode in MODE_NOTES:
+        panel.mode.setCurrentIndex(panel.mode.findData(mode))
+        panel.resize(width, panel.sizeHint().height())
+        panel.show()
+        shot = _grab(panel, scratch / f"settings_{mode}.png")
+        shots.append(QPixmap(str(shot)))
+    panel.close()
+    gap, cols = 16, 2                   # a 2 x 2 sheet: robust, phonetic / acoustic, acoustic-full
+    w, h = max(s.width() for s in shots), max(s.height() for s in shots)
+    rows = -(-len(shots) // cols)
+    sheet = QPixmap(cols * w + (cols - 1) * gap, rows * h + (rows - 1) * gap)
+    sheet.fill(QColor("#9e9e9e"))
+    painter = QPainter(sheet)
+    for i, s in enumerate(shots):
+        x, y = (i % cols) * (w + gap), (i // cols) * (h + gap)
+        painter.fillRect(x, y, w, h, win.palette().window().color())
+        painter.drawPixmap(x, y, s)
+    painter.end()
+    sheet.save(str(out / "settings_modes.png"))
+    log.info("wrote %s", out / "settings_modes.png")
+    written.append(out / "settings_modes.png")
+    win.close()
+    return written
+
+
 def video_figures(out: Path) -> list[Path]:
     """Frames of ``facetraj video`` at its default size and a small one, and acoustic-only."""
     import imageio.v3 as iio
@@ -151,6 +238,7 @@ def make_gallery(out: Path, analysis: bool = True) -> list[Path]:
     with tempfile.TemporaryDirectory(prefix="facetraj-gallery-") as tmp:
         written = video_figures(out)
         written += app_figures(out, Path(tmp))
+        written += dialog_figures(out, Path(tmp))
     if analysis:
         written += make_figures(DEFAULT_CORPUS, out)
     return written
@@ -162,10 +250,18 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("out", type=Path, nargs="?", default=ROOT / "docs" / "figures")
     p.add_argument("--no-analysis", action="store_true", help="leave out the analysis views")
+    p.add_argument("--only-dialogs", action="store_true",
+                   help="just the dialogs and the settings panel (a quick look)")
     args = p.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     app = QApplication.instance() or QApplication(sys.argv[:1])
-    for path in make_gallery(args.out, analysis=not args.no_analysis):
+    if args.only_dialogs:
+        args.out.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(prefix="facetraj-gallery-") as tmp:
+            paths = dialog_figures(args.out, Path(tmp))
+    else:
+        paths = make_gallery(args.out, analysis=not args.no_analysis)
+    for path in paths:
         print(path)
     app.quit()
     return 0

@@ -103,15 +103,22 @@ class MissingWordsDialog(QDialog):
             e.textChanged.connect(self._check)
             self.edits[w] = e
             form.addRow(w, e)
-        self.message = QLabel("Give each word's phones (ARPAbet, as in the CMU dictionary).")
-        self.message.setWordWrap(True)
+        explain = QLabel("The pronouncing dictionary (CMUdict) does not know "
+                         f"{'this word' if len(words) == 1 else 'these words'}. Give each word's "
+                         "phones in ARPAbet, separated by spaces (stress digits are ignored); the "
+                         "sentence is then aligned again.")
+        explain.setWordWrap(True)
+        explain.setMinimumWidth(420)
+        self.message = QLabel("")
+        self.message.setStyleSheet("color: #c92a2a")
         self.buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Ok
                                         | QDialogButtonBox.StandardButton.Cancel)
         self.buttons.accepted.connect(self.accept)
         self.buttons.rejected.connect(self.reject)
         lay = QVBoxLayout(self)
-        lay.addWidget(self.message)
+        lay.addWidget(explain)
         lay.addLayout(form)
+        lay.addWidget(self.message)
         lay.addWidget(self.buttons)
         self._check()
 
@@ -124,7 +131,7 @@ class MissingWordsDialog(QDialog):
         empty = [w for w, phones in self.pronunciations().items() if not phones]
         self.buttons.button(QDialogButtonBox.StandardButton.Ok).setEnabled(not bad and not empty)
         self.message.setText(f"not ARPAbet: {' '.join(bad)}" if bad else
-                             "Give each word's phones (ARPAbet, as in the CMU dictionary).")
+                             "every word needs its phones" if empty else "")
 
 
 # --------------------------------------------------------------------------- the opened recording

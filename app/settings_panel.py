@@ -146,8 +146,9 @@ class SynthSettingsPanel(QWidget):
         settings = tuned.get("settings") if tuned else None
         self._tuned = tuned or {}
         if not settings:
-            self.tuned_label.setText("robust mode: default settings (model trained without "
-                                     "cross-validation: facetraj train --tune)")
+            self.tuned_label.setText("robust mode: default settings (the model was trained "
+                                     "without cross-validation; `facetraj train --tune` "
+                                     "tunes them)")
             return
         names = {"n_context_phones": "N", "xi": "ξ", "label_weight": "κ (label weight)",
                  "context_weight": "ρ (context weight)", "gamma_max": "γ max",

@@ -129,8 +129,15 @@ class PhoneTierPanel:
         ax.set_ylim(0, 2 if utt.words else 1)
         ax.set_yticks([])
         tier = "words\nphones" if utt.words else "phones"
-        source = f"\n({utt.label_source})" if utt.phones else ""
-        ax.set_ylabel(tier + source, fontsize=8)
+        short = {"recognized": "recog."}.get(utt.label_source, utt.label_source)
+        source = f"\n({short})" if utt.phones else ""
+        label = tier + source
+        # the label runs up the axes: its longest line must fit the tier's height (small windows)
+        fig = ax.figure
+        height_px = ax.get_position().height * fig.get_figheight() * fig.dpi
+        longest = max(len(line) for line in label.splitlines())
+        size = height_px / (0.62 * longest * fig.dpi / 72.0)
+        ax.set_ylabel(label, fontsize=max(5.0, min(8.0, size)))
         if not utt.phones:
             ax.text(0.5, 0.5, "no phone labels: acoustic-only synthesis", transform=ax.transAxes,
                     ha="center", va="center", fontsize=8, color="#777777")

@@ -329,6 +329,35 @@ def compare_landmarks(original: Sequence[Gesture], synthesized: Sequence[Gesture
     return [LandmarkTiming(o, s) for o, s in zip(original, synthesized, strict=True)]
 
 
+@dataclass(frozen=True)
+class LandmarkError:
+    """One row of the landmark table: gesture number (from 1), its phone, the landmark, and its
+    times (s) in the original and the synthesized trajectory; ``error`` is synthesized minus
+    original (s), NaN where either is missing."""
+
+    gesture: int
+    label: str
+    landmark: str
+    original: float
+    synthesized: float
+
+    @property
+    def error(self) -> float:
+        return self.synthesized - self.original
+
+
+def landmark_rows(m: GestureMeasurement) -> list[LandmarkError]:
+    """The landmark table of a measurement, gesture by gesture in :data:`LANDMARKS` order (the
+    original times NaN without original markers)."""
+    pairs = m.pairs()
+    if pairs:
+        return [LandmarkError(gi + 1, p.original.label, k, p.original.times()[k],
+                              p.synthesized.times()[k])
+                for gi, p in enumerate(pairs) for k in LANDMARKS]
+    return [LandmarkError(gi + 1, g.label, k, float("nan"), t)
+            for gi, g in enumerate(m.synthesized) for k, t in g.times().items()]
+
+
 def mean_abs_timing_error(pairs: Sequence[LandmarkTiming]) -> dict[str, float]:
     """Mean absolute timing error (seconds) of each landmark over gesture pairs (NaN skipped).
 

@@ -316,6 +316,33 @@ def synthetic_view(rate: float = 60.0):
     return view, fake_model, truth
 
 
+def assert_chart_matches_table(w) -> None:
+    """The kinematics chart has one bar per table row with a timing error, each as long as that
+    row's error and labelled with its gesture, phone and landmark; every label inside the canvas."""
+    table = {(w.table.item(r, 0).value, w.table.item(r, 1).text(), w.table.item(r, 2).text()):
+             w.table.item(r, 5).value for r in range(w.table.rowCount())}
+    finite = {k: v for k, v in table.items() if v == v}
+    ax = w.chart.figure.axes[0]
+    bars = ax.patches
+    assert len(bars) == len(finite) > 0
+    labels = [t.get_text() for t in ax.get_yticklabels()]
+    ticks = list(ax.get_yticks())
+    by_label = {}
+    for b in bars:
+        y = b.get_y() + b.get_height() / 2
+        by_label[labels[min(range(len(ticks)), key=lambda i: abs(ticks[i] - y))]] = b.get_width()
+    assert by_label == pytest.approx({f"{g:.0f} {ph} {lm}": v for (g, ph, lm), v in finite.items()})
+    assert all((b.get_facecolor()[0] > 0.5) == (b.get_width() > 0) for b in bars)   # late orange
+    w.chart.draw()
+    renderer = w.chart.figure.canvas.get_renderer()
+    fw, fh = w.chart.figure.bbox.width, w.chart.figure.bbox.height
+    for t in [*ax.get_yticklabels(), ax.xaxis.label, ax.title]:
+        e = t.get_window_extent(renderer)
+        assert e.x0 >= 0 and e.y0 >= 0 and e.x1 <= fw and e.y1 <= fh, t.get_text()
+    e = ax.get_tightbbox(renderer)                  # everything drawn, the x tick labels too
+    assert e.x0 >= 0 and e.y0 >= 0 and e.x1 <= fw and e.y1 <= fh
+
+
 def test_kinematics_landmarks_within_one_frame(qtbot, tmp_path):
     from praatio import textgrid
 
@@ -334,6 +361,8 @@ def test_kinematics_landmarks_within_one_frame(qtbot, tmp_path):
         assert abs(w.table.item(r, 3).value - truth[k]) < 1 / 60, k              # original
         assert abs(w.table.item(r, 4).value - (truth[k] + 2 / 60)) < 1 / 60, k   # synthesized
         assert w.table.item(r, 5).value == pytest.approx(2000 / 60, abs=1.0)     # error, ms
+    # beside the table: one bar per landmark row, its length the row's error, labels in the canvas
+    assert_chart_matches_table(w)
     # the threshold moves onset and offset (sin^2 = 0.5 at a quarter of each bell)
     with qtbot.waitSignal(w.measured):
         w.threshold.setValue(50)
@@ -353,6 +382,31 @@ def test_kinematics_landmarks_within_one_frame(qtbot, tmp_path):
     ax2 = fig.add_subplot(2, 1, 2)
     LipMeasurePanel(fake_model, "aperture").draw(ax2, view)
     assert np.asarray(ax2.lines[1].get_ydata()) == pytest.approx(np.abs(view.original[:, 1, 1]))
+
+
+def test_kinematics_chart_without_original_and_in_a_narrow_dock(qtbot):
+    from PyQt6.QtCore import Qt
+
+    from app.analysis.kinematics_panels import SIDE_BY_SIDE_WIDTH, KinematicsControls
+
+    view, fake_model, _truth = synthetic_view()
+    w = KinematicsControls(fake_model)
+    qtbot.addWidget(w)
+    w.resize(SIDE_BY_SIDE_WIDTH + 200, 600)
+    w.show()
+    qtbot.waitUntil(lambda: w.split.orientation() == Qt.Orientation.Horizontal)
+    assert w.chart.x() > w.table.x() + w.table.width() - 1            # beside the table
+    w.resize(SIDE_BY_SIDE_WIDTH - 300, 700)
+    qtbot.waitUntil(lambda: w.split.orientation() == Qt.Orientation.Vertical)
+    qtbot.waitUntil(lambda: w.chart.y() >= w.table.y() + w.table.height() - 1)   # under it
+    # no original: synthesized landmarks in the table, no bars and a note saying why
+    view.original = None
+    with qtbot.waitSignal(w.measured):
+        w.set_view(view)
+    assert w.table.rowCount() == 5
+    ax = w.chart.figure.axes[0]
+    assert len(ax.patches) == 0
+    assert any("no original markers" in t.get_text() for t in ax.texts)
 
 
 # ---------------------------------------------------------------------- in the main window

@@ -82,7 +82,7 @@ def test_open_audio_with_a_sentence_shows_aligned_phones(window, qtbot, clip, tm
         box.combo.setCurrentIndex(box.combo.findData("recognized"))
         box.combo.activated.emit(box.combo.currentIndex())
     assert win.view.utterance.label_source == "recognized" and win.view.utterance.words == []
-    assert _phone_axis(win).get_ylabel() == "phones\n(recognized)"
+    assert _phone_axis(win).get_ylabel() == "phones\n(recog.)"     # short: fits a small tier
     assert not np.allclose(win.view.shown, aligned_lips)
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
         box.combo.setCurrentIndex(box.combo.findData("none"))

@@ -124,6 +124,7 @@ class _ColumnStretcher(QObject):
         self.table = table
         self.widths: list[int] = []
         table.installEventFilter(self)
+        table.viewport().installEventFilter(self)   # a vertical scroll bar appearing narrows it
 
     def apply(self) -> None:
         t = self.table

@@ -78,7 +78,7 @@ def make_figures(corpus_dir: Path, out: Path, per_split: int = 6,
     written = []
     info = load_corpus(corpus_dir).info
     standalone = {"similarity": (1000, 900), "metrics": (1100, 850), "pc_modes": (1300, 750),
-                  "inspector": (900, 950), "errors": (1000, 750), "kinematics": (600, 700)}
+                  "inspector": (900, 950), "errors": (1000, 750), "kinematics": (1100, 700)}
     for key, size in standalone.items():
         if only is not None and key not in only:
             continue

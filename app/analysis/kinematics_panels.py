@@ -5,8 +5,9 @@ displacement of the lips from the neutral face) and the tangential velocity of a
 the original (dotted blue) and the synthesized (orange) trajectories. On the velocity panel the
 gesture landmarks (onset, peak velocity, maximum constriction, release peak velocity, offset) are
 found by the engine with an adjustable threshold (20 % of the peak by default), for original and
-synthesized alike; :class:`KinematicsControls` lists them with the timing error of each landmark
-and exports TSV and a TextGrid point tier.
+synthesized alike; :class:`KinematicsControls` lists them with the timing error of each landmark,
+draws those errors beside the table as bars (one per row) and exports TSV and a TextGrid point
+tier.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import logging
 from pathlib import Path
 
 import numpy as np
-from PyQt6.QtCore import pyqtSignal
+from PyQt6.QtCore import Qt, pyqtSignal
 from PyQt6.QtWidgets import (
     QComboBox,
     QDoubleSpinBox,
@@ -24,6 +25,7 @@ from PyQt6.QtWidgets import (
     QLabel,
     QLineEdit,
     QPushButton,
+    QSplitter,
     QTableWidget,
     QVBoxLayout,
     QWidget,
@@ -34,6 +36,8 @@ from engine.kinematics import (
     LABIAL_PHONES,
     LANDMARKS,
     GestureMeasurement,
+    LandmarkError,
+    landmark_rows,
     mean_abs_timing_error,
     measure_gestures,
     model_lip_measures,
@@ -42,11 +46,15 @@ from engine.kinematics import (
 )
 from engine.model import Model
 
-from .common import NumberItem, export_with_dialog, fill_table, text_item
+from .common import Canvas, NumberItem, export_with_dialog, fill_table, text_item
 
 log = logging.getLogger(__name__)
 
 LANDMARK_MARKERS = {"onset": "^", "pvel": "o", "maxc": "v", "pvel2": "o", "offset": "s"}
+#: Bar colours of the timing-error chart: the synthesized landmark late / early.
+LATE_COLOR, EARLY_COLOR = "#e8590c", "#1c7ed6"
+#: Below this width the chart goes under the table instead of beside it (px).
+SIDE_BY_SIDE_WIDTH = 900
 MEASURES = {
     "aperture": ("lip aperture", "aperture\n(mm)"),
     "width": ("lip width", "width\n(mm)"),
@@ -130,11 +138,20 @@ class KinematicsControls(QWidget):
         buttons.addWidget(tsv)
         buttons.addWidget(tg)
         buttons.addStretch(1)
+        self.chart = Canvas(4, 5)
+        self.chart.setMinimumSize(240, 220)
+        self.split = QSplitter(Qt.Orientation.Horizontal)
+        self.split.addWidget(self.table)
+        self.split.addWidget(self.chart)
+        self.split.setStretchFactor(0, 3)
+        self.split.setStretchFactor(1, 2)
+        self.split.setChildrenCollapsible(False)
         lay = QVBoxLayout(self)
         lay.addLayout(form)
         lay.addWidget(self.summary)
-        lay.addWidget(self.table, 1)
+        lay.addWidget(self.split, 1)
         lay.addLayout(buttons)
+        self.rows: list[LandmarkError] = []
 
         self.panel = VelocityPanel(self)
         if window is not None:
@@ -189,26 +206,58 @@ class KinematicsControls(QWidget):
         return m
 
     def _fill(self, m: GestureMeasurement) -> None:
-        pairs = m.pairs()
-        rows = []
-        if pairs:
-            for gi, p in enumerate(pairs):
-                o, s, e = p.original.times(), p.synthesized.times(), p.errors()
-                for k in LANDMARKS:
-                    rows.append([NumberItem(gi + 1, "{:.0f}"), text_item(p.original.label), text_item(k),
-                                 NumberItem(o[k], "{:.3f}"), NumberItem(s[k], "{:.3f}"),
-                                 NumberItem(1000 * e[k], "{:+.0f}")])
-            mae = mean_abs_timing_error(pairs)
+        self.rows = landmark_rows(m)
+        table = [[NumberItem(r.gesture, "{:.0f}"), text_item(r.label), text_item(r.landmark),
+                  NumberItem(r.original, "{:.3f}"), NumberItem(r.synthesized, "{:.3f}"),
+                  NumberItem(1000 * r.error, "{:+.0f}")] for r in self.rows]
+        if m.v_original is not None:
+            mae = mean_abs_timing_error(m.pairs())
             self.summary.setText("mean |timing error| (ms): " + ", ".join(
                 f"{k} {1000 * v:.0f}" for k, v in mae.items()))
         else:
-            for gi, g in enumerate(m.synthesized):
-                for k, t in g.times().items():
-                    rows.append([NumberItem(gi + 1, "{:.0f}"), text_item(g.label), text_item(k),
-                                 NumberItem(float("nan")), NumberItem(t, "{:.3f}"), NumberItem(float("nan"))])
             self.summary.setText("no original markers: synthesized landmarks only")
         fill_table(self.table, ["gesture", "phone", "landmark", "original (s)", "synthesized (s)",
-                                "error (ms)"], rows)
+                                "error (ms)"], table)
+        self._draw_chart(m)
+
+    def _draw_chart(self, m: GestureMeasurement) -> None:
+        """The timing error of every landmark row as a horizontal bar (synthesized minus original,
+        ms; late to the right), in the table's order from the top."""
+        fig = self.chart.figure
+        fig.clear()
+        ax = fig.add_subplot(111)
+        rows = [r for r in self.rows if np.isfinite(r.error)]
+        if not rows:
+            why = ("no original markers:\nno timing errors to show" if m.v_original is None else
+                   "no gestures found around\nthe gesture phones")
+            ax.text(0.5, 0.5, why, ha="center", va="center", transform=ax.transAxes,
+                    color="#555555", fontsize=10)
+            ax.set_axis_off()
+        else:
+            ms = np.array([1000 * r.error for r in rows])
+            y = np.arange(len(rows))[::-1]
+            ax.barh(y, ms, color=[LATE_COLOR if e > 0 else EARLY_COLOR for e in ms],
+                    edgecolor="#555555", lw=0.4, height=0.75)
+            ax.set_yticks(y, [f"{r.gesture} {r.label} {r.landmark}" for r in rows],
+                          fontsize=max(5, min(8, 520 // len(rows))))
+            ax.set_ylim(-0.6, len(rows) - 0.4)
+            lim = max(10.0, float(np.abs(ms).max()) * 1.1)
+            ax.set_xlim(-lim, lim)
+            ax.axvline(0.0, color="k", lw=0.6)
+            ax.set_xlabel("synthesized − original (ms)\n← early    late →", fontsize=8)
+            ax.tick_params(axis="x", labelsize=8)
+            ax.set_title("Landmark timing error", fontsize=10)
+            ax.grid(axis="x", alpha=0.3)
+        fig.set_layout_engine("tight")      # laid out again at every draw: resizes keep the labels in
+        self.chart.draw_idle()
+
+    def resizeEvent(self, event) -> None:
+        """The chart beside the table when there is room, under it when the dock is narrow."""
+        super().resizeEvent(event)
+        wide = self.width() >= SIDE_BY_SIDE_WIDTH
+        want = Qt.Orientation.Horizontal if wide else Qt.Orientation.Vertical
+        if self.split.orientation() != want:
+            self.split.setOrientation(want)
 
     # ------------------------------------------------------------------ export
     def _sources(self) -> dict:
