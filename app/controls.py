@@ -11,7 +11,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from PyQt6.QtCore import Qt, pyqtSignal
-from PyQt6.QtGui import QKeySequence, QShortcut
+from PyQt6.QtGui import QColor, QIcon, QKeySequence, QPainter, QPixmap, QShortcut
 from PyQt6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -33,8 +33,22 @@ from .view3d import CAMERA_PRESETS, FaceView
 SPEEDS = (1.0, 0.5, 0.25)
 
 
+def colour_dot(colour: str, size: int = 14) -> QIcon:
+    """A filled circle of ``colour``: the legend of a marker set, on its check box."""
+    pix = QPixmap(size, size)
+    pix.fill(QColor(0, 0, 0, 0))
+    painter = QPainter(pix)
+    painter.setRenderHint(QPainter.RenderHint.Antialiasing)
+    painter.setPen(QColor(colour).darker(130))
+    painter.setBrush(QColor(colour))
+    painter.drawEllipse(1, 1, size - 2, size - 2)
+    painter.end()
+    return QIcon(pix)
+
+
 class ViewBar(QWidget):
-    """Camera presets, the marker colour legend, and which point sets / the surface to show."""
+    """Camera presets, which point sets (each check box with its colour: the legend) and the
+    surface to show."""
 
     def __init__(self, face: FaceView, parent: QWidget | None = None):
         super().__init__(parent)
@@ -52,19 +66,17 @@ class ViewBar(QWidget):
             lay.addWidget(b)
             self.camera_buttons[name] = b
         self.camera_buttons[face.preset].setChecked(True)
-        lay.addSpacing(16)
-        legend = QLabel(f'<span style="color:{ORIGINAL_COLOR}; font-size:16px">●</span> original &nbsp; '
-                        f'<span style="color:{SYNTH_COLOR}; font-size:16px">●</span> synthesized')
-        legend.setToolTip("marker colours in the 3-D view (lines: lip contours; surface: the "
-                          "synthesized face)")
-        lay.addWidget(legend)
-        lay.addSpacing(16)
+        lay.addSpacing(12)
         self.side_by_side = QCheckBox("side by side")
         self.side_by_side.toggled.connect(face.set_side_by_side)
-        self.show_original = QCheckBox("show original")
-        self.show_original.setChecked(True)
-        self.show_synth = QCheckBox("show synthesized")
-        self.show_synth.setChecked(True)
+        # the check boxes of the two point sets carry their colours: they are the legend too
+        self.show_original = QCheckBox("original")
+        self.show_synth = QCheckBox("synthesized")
+        for cb, colour, what in ((self.show_original, ORIGINAL_COLOR, "the recorded markers"),
+                                 (self.show_synth, SYNTH_COLOR, "the synthesized markers")):
+            cb.setIcon(colour_dot(colour))
+            cb.setChecked(True)
+            cb.setToolTip(f"show {what} (this colour in the 3-D view; lines: lip contours)")
         for cb in (self.show_original, self.show_synth):
             cb.toggled.connect(lambda _c: face.set_sets_visible(self.show_original.isChecked(),
                                                                 self.show_synth.isChecked()))
