@@ -335,7 +335,9 @@ def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = Non
     :class:`FacetrajError` with :data:`NO_INPUT_DEVICE`. With ``screenshot``, the window is saved
     to that PNG when the file has been played (or after ``quit_after`` seconds) and closes."""
     from engine.formats import read_audio
+    from engine.threads import one_blas_thread
 
+    one_blas_thread()       # the stream is synthesized beside the rendering (engine.threads)
     app = QApplication.instance() or QApplication(sys.argv[:1])
     audio = read_audio(from_file) if from_file is not None else None
     if audio is None and not input_devices():

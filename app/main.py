@@ -67,6 +67,9 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
     from PyQt6.QtCore import QTimer
     from PyQt6.QtWidgets import QApplication
 
+    from engine.threads import one_blas_thread
+
+    one_blas_thread()       # synthesis runs beside the rendering (engine.threads)
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("facetraj")
     window = build_window(corpus, model=model, utterance=utterance, time=time)

@@ -18,6 +18,7 @@ from .corpus import Corpus
 from .data import Utterance
 from .model import Model
 from .pipeline import Synthesis, resmooth, synthesize
+from .threads import one_blas_thread
 
 log = logging.getLogger(__name__)
 
@@ -260,6 +261,7 @@ _WORKER_STATE: tuple | None = None
 def _worker_init(state: tuple) -> None:
     global _WORKER_STATE
     _WORKER_STATE = state
+    one_blas_thread()       # for the life of the worker process
 
 
 def _worker_score(split: str, utt_id: str) -> list[UtteranceScore]:
@@ -285,15 +287,23 @@ def evaluate(model: Model, corpus: Corpus, splits: Iterable[str] = ("train", "te
 
     With ``workers > 1`` the utterances are scored in that many processes (forked, so the model
     is shared, not copied through pickle); each utterance is independent, and the scores come
-    back in corpus order, equal to the serial run's.
+    back in corpus order, equal to the serial run's. BLAS runs on one thread either way
+    (:mod:`engine.threads`): the processes share the cores, and the serial run computes the same
+    sums in the same order.
     """
-    configs = list(configs or [SynthConfig()])
-    splits = list(splits)
+    with one_blas_thread():
+        return _evaluate(model, corpus, list(splits), list(configs or [SynthConfig()]),
+                         list(smoothings), eval_config, progress, workers)
+
+
+def _evaluate(model: Model, corpus: Corpus, splits: list[str], configs: list[SynthConfig],
+              smoothings: list[str], eval_config: EvalConfig | None,
+              progress: Callable[[float, str], None] | None, workers: int) -> EvalResult:
     ids = [(sp, u) for sp in splits for u in getattr(corpus.info, sp)]
     result = EvalResult()
     workers = min(workers, len(ids))
     if workers > 1 and "fork" in mp.get_all_start_methods():
-        state = (model, corpus, configs, list(smoothings), eval_config)
+        state = (model, corpus, configs, smoothings, eval_config)
         with ProcessPoolExecutor(workers, mp.get_context("fork"), initializer=_worker_init,
                                  initargs=(state,)) as pool:
             futures = [pool.submit(_worker_score, sp, u) for sp, u in ids]
