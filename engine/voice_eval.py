@@ -263,7 +263,7 @@ def verdict_paragraph(result: VoiceEval) -> str:
     for g, name in gains:
         share = f", {100 * g / drop:.0f} % of the loss" if drop > 0 and g > 0 else ""
         said.append(f"the {name} {'adds' if g > 0 else 'changes it by'} {g:+.4f}{share}")
-    text += "With normalisation " + " and ".join(said) + ". "
+    text += "With normalisation " + "; ".join(said) + ". "
     best = max(gains)[0]
     if best <= 0:
         text += "Normalisation does not help this voice. "
