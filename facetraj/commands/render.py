@@ -96,7 +96,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--second-voice", action="store_true",
                    help="also evaluate acoustic-only synthesis from a second voice made from the "
                         "test sentences (shorter vocal tract, higher pitch), with and without "
-                        "speaker normalisation (about 15 minutes), saved as voice_eval.json beside "
+                        "speaker normalisation (about 8 minutes), saved as voice_eval.json beside "
                         "results.md and reported from it")
     p.set_defaults(func=cmd_report)
 
