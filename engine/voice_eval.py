@@ -103,7 +103,7 @@ class VoiceEval:
                 "utterances": {k: [asdict(s) for s in v] for k, v in self.scores.items()}}
 
 
-def test_utterances(corpus: Corpus, max_test: int | None = None) -> list[str]:
+def held_out_ids(corpus: Corpus, max_test: int | None = None) -> list[str]:
     """The test split, or ``max_test`` utterances evenly spread over it."""
     test = list(corpus.info.test)
     if max_test is not None and len(test) > max_test:
@@ -121,7 +121,7 @@ def evaluate_voices(corpus: Corpus, model: Model | None = None, spec: VoiceSpec 
         if progress:
             progress(0.0, "training")
         model = train(corpus, config=train_config)
-    test = test_utterances(corpus, max_test)
+    test = held_out_ids(corpus, max_test)
     base = SynthConfig(mode="acoustic")
     prepared, ratios = [], []
     for j, utt_id in enumerate(test):
