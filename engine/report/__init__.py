@@ -30,6 +30,7 @@ from ..formats import atomic_write
 from ..label_eval import LABEL_EVAL_FILE, read_label_eval
 from ..model import Model
 from ..progress import Progress
+from ..voice_eval import VOICE_EVAL_FILE, read_voice_eval
 from .compute import compute_report, figure4_data, find_utterance
 from .data import Figure4Data, FigureMaker, ReportData, at_a_glance
 from .discussion import discussion
@@ -55,12 +56,14 @@ def write_report(corpus_dir: str | os.PathLike[str], out_dir: str | os.PathLike[
     """Compute the report on ``corpus_dir`` and write ``out_dir/results.md``, ``results.json`` and
     (through ``figures``, drawn into ``out_dir/figures/``) its figures. Returns the ``.md`` path.
     The evaluation with automatic labels is read from ``out_dir/label_eval.json`` (written by
-    ``facetraj report --automatic-labels``, about half an hour) when present.
+    ``facetraj report --automatic-labels``, about half an hour) when present, and the evaluation
+    with a second voice from ``out_dir/voice_eval.json`` (``facetraj report --second-voice``).
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     data = compute_report(corpus_dir, model, progress, ns)
     data.label_eval = read_label_eval(out / LABEL_EVAL_FILE)
+    data.voice_eval = read_voice_eval(out / VOICE_EVAL_FILE)
     if figures is not None:
         fig_dir = out / "figures"
         fig_dir.mkdir(exist_ok=True)

@@ -16,6 +16,7 @@ from ..evaluation import METRICS
 from ..label_eval import LabelEval
 from ..paper import LEVELS_OFF_AT_N, PAPER_TABLE2
 from ..similarity import SimilarRow
+from ..voice_eval import VoiceEval
 from .rows import (
     ComparisonRow,
     CorpusSummary,
@@ -96,6 +97,7 @@ class ReportData:
     figures: dict[str, str] = field(default_factory=dict)
     created: str = ""
     label_eval: LabelEval | None = None    # every mode with automatic labels (engine.label_eval)
+    voice_eval: VoiceEval | None = None    # acoustic-only from a second voice (engine.voice_eval)
 
     def row(self, mode: str, split: str = "test", smoothing: str = "triangular") -> ComparisonRow | None:
         """The comparison row of one mode (``phonetic``, ``acoustic``, ``acoustic-indexed``,
@@ -125,6 +127,7 @@ class ReportData:
             "at_a_glance": [asdict(g) for g in at_a_glance(self)],
             "timings_s": self.timings, "figures": self.figures, "labels": self.labels,
             "automatic_labels": self.label_eval.to_json()["summary"] if self.label_eval else None,
+            "second_voice": self.voice_eval.to_json()["summary"] if self.voice_eval else None,
         })
 
 

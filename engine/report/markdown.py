@@ -9,6 +9,7 @@ from .. import __version__
 from ..evaluation import METRICS
 from ..label_eval import format_markdown
 from ..paper import FIGURE4_TEXT, LEVELS_OFF_AT_N, TABLE2_N, table2_value
+from ..voice_eval import format_markdown as voice_markdown
 from .data import ReportData, at_a_glance
 from .discussion import discussion
 from .rows import table1_agreement
@@ -167,6 +168,16 @@ def automatic_labels_section(data: ReportData) -> list[str]:
             format_markdown(data.label_eval)]
 
 
+def second_voice_section(data: ReportData) -> list[str]:
+    """Acoustic-only synthesis from a voice other than the training voice, with and without
+    speaker normalisation (``engine.voice_eval``), when an evaluation was saved beside the report;
+    else nothing."""
+    if data.voice_eval is None:
+        return []
+    return ["## Beyond the paper: a voice other than the training voice", "",
+            voice_markdown(data.voice_eval)]
+
+
 def reproducing_section(data: ReportData) -> list[str]:
     """The command that wrote the report, and how long each stage took."""
     return ["## Reproducing", "",
@@ -178,7 +189,7 @@ def reproducing_section(data: ReportData) -> list[str]:
 #: the sections of ``results.md``, in order
 SECTIONS = (header_section, glance_section, table2_section, figure5_section, figure4_section,
             comparisons_section, labels_section, table1_section, automatic_labels_section,
-            discussion_section, reproducing_section)
+            second_voice_section, discussion_section, reproducing_section)
 
 
 def render_markdown(data: ReportData) -> str:
@@ -194,4 +205,4 @@ def render_markdown(data: ReportData) -> str:
 __all__ = ["COMPARISON_ORDER", "SECTIONS", "automatic_labels_section", "comparisons_section",
            "discussion_section", "figure4_section", "figure5_section", "glance_section",
            "header_section", "labels_section", "render_markdown", "reproducing_section",
-           "table1_section", "table2_section"]
+           "second_voice_section", "table1_section", "table2_section"]

@@ -68,6 +68,14 @@ def cmd_report(args: argparse.Namespace) -> int:
         result = evaluate_labels(load_corpus(args.corpus or default_corpus()),
                                  progress=TerminalProgress("automatic labels"))
         write_label_eval(args.output / LABEL_EVAL_FILE, result)
+    if args.second_voice:
+        from engine.corpus import load_corpus
+        from engine.voice_eval import VOICE_EVAL_FILE, evaluate_voices, write_voice_eval
+
+        args.output.mkdir(parents=True, exist_ok=True)
+        voices = evaluate_voices(load_corpus(args.corpus or default_corpus()), model=model,
+                                 progress=TerminalProgress("second voice"))
+        write_voice_eval(args.output / VOICE_EVAL_FILE, voices)
     out = make_report(args.corpus, args.output, model=model, progress=TerminalProgress("report"),
                       ns=range(1, args.max_n + 1))
     print(out)
@@ -85,6 +93,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="also evaluate every mode with aligned and recognized labels (trains and "
                         "cross-validates three models: about half an hour), saved as "
                         "label_eval.json beside results.md and reported from it")
+    p.add_argument("--second-voice", action="store_true",
+                   help="also evaluate acoustic-only synthesis from a second voice made from the "
+                        "test sentences (shorter vocal tract, higher pitch), with and without "
+                        "speaker normalisation (about 8 minutes), saved as voice_eval.json beside "
+                        "results.md and reported from it")
     p.set_defaults(func=cmd_report)
 
     p = sub.add_parser("video", help="an MP4 of the face points and lip panels with the sound")
