@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.backends.backend_qtagg import FigureCanvasQTAgg
 from matplotlib.figure import Figure
+from matplotlib.transforms import Bbox
 from PyQt6.QtCore import QTimer, pyqtSignal
 from PyQt6.QtWidgets import (
     QApplication,
@@ -176,11 +177,14 @@ class LiveWindow(QMainWindow):
         for ax, which in zip(self.axes, ("upper", "lower"), strict=True):
             ax.set_ylabel(f"{which} lip y (mm)", fontsize=8)
             ax.set_xlim(-SHOWN_S, 0.0)
-            (line,) = ax.plot([], [], color="#d62728", lw=1.5)
-            (dots,) = ax.plot([], [], ls="none", marker=".", ms=3, color="#2ca02c")
+            # animated: left out of full draws, blitted over the cached background (_plot)
+            (line,) = ax.plot([], [], color="#d62728", lw=1.5, animated=True)
+            (dots,) = ax.plot([], [], ls="none", marker=".", ms=3, color="#2ca02c", animated=True)
             self.lines.append(line)
             self.dots.append(dots)
         self.axes[1].set_xlabel("time (s, 0 = now)", fontsize=8)
+        self._background = None
+        self.canvas.mpl_connect("draw_event", self._on_full_draw)
         right.addWidget(self.canvas, 1)
         lay.addLayout(right, 2)
         self.setCentralWidget(central)
@@ -311,10 +315,14 @@ class LiveWindow(QMainWindow):
         self.speech.extend(bool(v > threshold and peak - floor > 6.0) for v in e[-len(times):])
 
     def _plot(self) -> None:
+        """Scroll the lip panels: the lines and dots blitted over the cached axes (a few ms); the
+        whole figure is drawn again only when a panel's y range must change (matplotlib's full
+        draw with its layout takes 100-250 ms, which would hold up the face)."""
         markers = np.concatenate(self.markers)
         n = min(len(markers), int(SHOWN_S * self.model.marker_rate))
         t = (np.arange(len(markers) - n, len(markers)) - (len(markers) - 1)) / self.model.marker_rate
         speech = np.asarray(self.speech[-n:])
+        rescale = False
         for ax, line, dots, k in zip(self.axes, self.lines, self.dots,
                                      (self.model.upper_lip, self.model.lower_lip), strict=True):
             y = markers[-n:, k, 1]
@@ -323,8 +331,28 @@ class LiveWindow(QMainWindow):
             dots.set_data(t[speech], np.full(int(speech.sum()), mid))
             lo, hi = float(y.min()), float(y.max())
             pad = 0.15 * max(hi - lo, 0.5)
-            ax.set_ylim(lo - pad, hi + pad)
-        self.canvas.draw_idle()
+            y0, y1 = ax.get_ylim()
+            # outside the axes, or using less than half of them: new limits (and a full draw)
+            if lo < y0 or hi > y1 or (hi - lo + 2 * pad) < 0.5 * (y1 - y0):
+                ax.set_ylim(lo - pad, hi + pad)
+                rescale = True
+        if rescale or self._background is None:
+            self.canvas.draw_idle()             # _on_full_draw blits the lines
+        else:
+            self._blit()
+
+    def _on_full_draw(self, _event) -> None:
+        self._background = self.canvas.copy_from_bbox(self.figure.bbox)
+        self._blit(restore=False)
+
+    def _blit(self, restore: bool = True) -> None:
+        if restore:
+            self.canvas.restore_region(self._background)
+        for ax, line, dots in zip(self.axes, self.lines, self.dots, strict=True):
+            ax.draw_artist(line)
+            ax.draw_artist(dots)
+        # the rectangle of the two axes only (a Qt repaint of that region)
+        self.canvas.blit(Bbox.union([ax.bbox for ax in self.axes]))
 
 
 def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = None,
