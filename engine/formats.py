@@ -191,6 +191,22 @@ def write_audio(path: str | os.PathLike[str], samples: np.ndarray, rate: int,
         sf.write(str(tmp), np.clip(samples, -1.0, 1.0), int(rate), subtype="PCM_16", format=fmt)
 
 
+def write_json(path: str | os.PathLike[str], data: object, overwrite: bool = True) -> Path:
+    """Write ``data`` as indented JSON (UTF-8, a final newline) through :func:`atomic_write`.
+
+    >>> import tempfile, pathlib
+    >>> out = write_json(pathlib.Path(tempfile.mkdtemp()) / "r.json", {"r": 0.87})
+    >>> out.read_text().splitlines()
+    ['{', ' "r": 0.87', '}']
+    """
+    import json
+
+    path = Path(path)
+    with atomic_write(path, overwrite) as tmp:
+        tmp.write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
+    return path
+
+
 # --------------------------------------------------------------------------- labels
 def _read_text(path: Path) -> str:
     if not path.exists():

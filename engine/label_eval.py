@@ -24,7 +24,7 @@ from .baselines import evaluate_baselines, fit_baselines, frame_data
 from .config import SynthConfig, TrainConfig
 from .corpus import Corpus
 from .evaluation import METRICS, UtteranceScore, evaluate_utterance, speech_mask
-from .formats import atomic_write
+from .formats import write_json
 from .labelling import RelabelledCorpus, relabelled
 from .model import Model
 from .pipeline import synthesize
@@ -187,11 +187,7 @@ def evaluate_labels(corpus: Corpus, kinds: Sequence[str] = LABEL_KINDS,
 
 def write_label_eval(path: str | os.PathLike[str], result: LabelEval) -> Path:
     """Save ``result`` as JSON (read by the report generator, ``engine.report``)."""
-    path = Path(path)
-    with atomic_write(path) as tmp:
-        tmp.write_text(json.dumps(result.to_json(), indent=1) + "\n", encoding="utf-8")
-    path.chmod(0o644)
-    return path
+    return write_json(path, result.to_json())
 
 
 def read_label_eval(path: str | os.PathLike[str]) -> LabelEval | None:
@@ -202,7 +198,12 @@ def read_label_eval(path: str | os.PathLike[str]) -> LabelEval | None:
     return LabelEval.from_json(json.loads(path.read_text(encoding="utf-8")))
 
 
-def _cell(v: tuple[float, float]) -> str:
+def mean_sd(v: tuple[float, float]) -> str:
+    """A table cell: mean ± standard deviation.
+
+    >>> mean_sd((0.87254, 0.0491))
+    '0.8725 ± 0.05'
+    """
     return f"{v[0]:.4f} ± {v[1]:.2f}"
 
 
@@ -225,8 +226,8 @@ def format_markdown(result: LabelEval) -> str:
             if not rows:
                 continue
             s = result.summary(kind, m)
-            lines.append(f"| {m} ({METHOD_NOTES[m]}) | {_cell(s['whole_face'])} | "
-                         f"{_cell(s['lower_lip'])} | {_cell(s['upper_lip'])} | {len(rows)} |")
+            lines.append(f"| {m} ({METHOD_NOTES[m]}) | {mean_sd(s['whole_face'])} | "
+                         f"{mean_sd(s['lower_lip'])} | {mean_sd(s['upper_lip'])} | {len(rows)} |")
         tuned = result.tunings.get(kind, {}).get("settings")
         if tuned:
             lines += ["", "Robust settings chosen by cross-validation on the training split: "

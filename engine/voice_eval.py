@@ -25,7 +25,8 @@ import numpy as np
 from .config import SynthConfig, TrainConfig
 from .corpus import Corpus
 from .evaluation import METRICS, UtteranceScore, evaluate_utterance, speech_mask
-from .formats import atomic_write
+from .formats import write_json
+from .label_eval import mean_sd
 from .model import Model
 from .pipeline import synthesize
 from .speaker import choose_warp
@@ -163,11 +164,7 @@ def evaluate_voices(corpus: Corpus, model: Model | None = None, spec: VoiceSpec 
 
 def write_voice_eval(path: str | os.PathLike[str], result: VoiceEval) -> Path:
     """Save ``result`` as JSON (read by the report generator, ``engine.report``)."""
-    path = Path(path)
-    with atomic_write(path) as tmp:
-        tmp.write_text(json.dumps(result.to_json(), indent=1) + "\n", encoding="utf-8")
-    path.chmod(0o644)
-    return path
+    return write_json(path, result.to_json())
 
 
 def read_voice_eval(path: str | os.PathLike[str]) -> VoiceEval | None:
@@ -179,10 +176,6 @@ def read_voice_eval(path: str | os.PathLike[str]) -> VoiceEval | None:
 
 
 # --------------------------------------------------------------------------- the report's text
-def _cell(v: tuple[float, float]) -> str:
-    return f"{v[0]:.4f} ± {v[1]:.2f}"
-
-
 def _factors(spec: dict) -> str:
     return ", ".join(f"x {k:g} at {f:g} Hz" for f, k in spec["formant_factors"])
 
@@ -222,8 +215,8 @@ def table_lines(result: VoiceEval) -> list[str]:
             if not rows:
                 continue
             s = result.summary(condition(v, n))
-            lines.append(f"| {v} | {NORMALISATION_NOTES[n]} | {_cell(s['whole_face'])} | "
-                         f"{_cell(s['lower_lip'])} | {_cell(s['upper_lip'])} | {len(rows)} |")
+            lines.append(f"| {v} | {NORMALISATION_NOTES[n]} | {mean_sd(s['whole_face'])} | "
+                         f"{mean_sd(s['lower_lip'])} | {mean_sd(s['upper_lip'])} | {len(rows)} |")
     return lines
 
 
