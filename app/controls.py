@@ -88,6 +88,14 @@ class ViewBar(QWidget):
             lay.addWidget(w)
         lay.addStretch(1)
 
+    def set_planar(self, planar: bool) -> None:
+        """Midsagittal (2-D) markers: the profile camera, and no face surface to offer."""
+        self.surface.setEnabled(not planar)
+        self.surface.setToolTip("2-D (midsagittal) markers: no face surface to draw" if planar
+                                else "the synthesized face as a surface through its markers")
+        if planar:
+            self.set_camera("profile")
+
     def set_camera(self, name: str) -> None:
         """Use camera preset ``name`` and check its button."""
         self.face.set_camera(name)

@@ -38,7 +38,7 @@ from engine.errors import FacetrajError
 from engine.export import write_trajectories
 from engine.formats import write_audio
 from engine.model import Model
-from engine.streaming import StreamConfig, StreamingSynthesizer
+from engine.streaming import LIVE_BATCH_FRAMES, StreamConfig, StreamingSynthesizer
 
 from .view3d import FaceView
 
@@ -50,7 +50,7 @@ NO_INPUT_DEVICE = ("no audio input device found (is a microphone connected and a
 MIC_RATE = 16000
 SHOWN_S = 4.0
 TICK_MS = 15
-PLOT_EVERY_S = 0.1
+PLOT_EVERY_S = 0.2
 
 
 def input_devices() -> list:
@@ -131,6 +131,9 @@ class LiveWindow(QMainWindow):
         self.speech: list[bool] = []
         self.rate = MIC_RATE
         self.updates = 0
+        self._shown = -1
+        self._level = -60
+        self._samples = self._frames = 0
         self._t_start = 0.0
         self._last_plot = 0.0
         self._timer = QTimer(self)
@@ -208,10 +211,14 @@ class LiveWindow(QMainWindow):
             self.message.setText(NO_INPUT_DEVICE)
             return
         self.rate = self.feeder.rate
-        self.stream = StreamingSynthesizer(self.model, StreamConfig(self.rate, self.config))
+        self.stream = StreamingSynthesizer(self.model, StreamConfig(self.rate, self.config,
+                                                                     LIVE_BATCH_FRAMES))
         self.audio, self.markers, self.speech = [], [], []
+        self._samples = self._frames = 0        # running lengths of the take (no sums per tick)
         self._energy: list[float] = []
         self.updates = 0
+        self._shown = -1                # the frame on screen
+        self._level = -60               # the loudest block (dB) since the meter was last set
         self._t_start = time.perf_counter()
         self.start_action.setEnabled(False)
         self.stop_action.setEnabled(True)
@@ -227,6 +234,7 @@ class LiveWindow(QMainWindow):
         self.feeder.stop()
         self._consume(self.stream.flush())
         self.stream = None
+        self._show_due()
         self.start_action.setEnabled(True)
         self.stop_action.setEnabled(False)
         self.save_action.setEnabled(self.n_frames > 0)
@@ -236,11 +244,11 @@ class LiveWindow(QMainWindow):
 
     @property
     def n_frames(self) -> int:
-        return sum(len(m) for m in self.markers)
+        return self._frames
 
     @property
     def take_seconds(self) -> float:
-        return sum(len(a) for a in self.audio) / float(self.rate)
+        return self._samples / float(self.rate)
 
     @property
     def fps(self) -> float:
@@ -282,22 +290,53 @@ class LiveWindow(QMainWindow):
             return
         if len(block):
             self.audio.append(block)
+            self._samples += len(block)
             rms = float(np.sqrt(np.mean(block**2)) + 1e-12)
-            self.level.setValue(int(np.clip(20 * np.log10(rms), -60, 0)))
+            self._level = max(self._level, int(np.clip(20 * np.log10(rms), -60, 0)))
             self._consume(self.stream.feed(block))
+        self._show_due()
 
     def _consume(self, frames) -> None:
+        """Keep the frames of the take; they are shown when due (:meth:`_show_due`)."""
         if len(frames) == 0:
             return
         self.markers.append(frames.markers)
+        self._frames += len(frames.markers)
         self._mark_speech(frames.times)
-        self.face.synth.set_points(frames.markers[-1])
+
+    def _show_due(self) -> None:
+        """Show the frame due now: the stream's delay behind the audio received, so that the
+        frames of a batch are shown one after the other at their own times, not all at once."""
+        if not self.markers:
+            return
+        if self.stream is None:                                  # the take ended: the last one
+            due = self.n_frames - 1
+        else:
+            t = self.take_seconds - self.stream.lookahead_s
+            due = min(int(np.floor(t * self.model.marker_rate)), self.n_frames - 1)
+        if due <= self._shown:
+            return
+        self._shown = due
+        self.face.synth.set_points(self._frame(due))
         self.face.plotter.update()
         self.updates += 1
         now = time.perf_counter()
         if now - self._last_plot >= PLOT_EVERY_S or self.stream is None:
+            # the panels and the meter together: any repaint beside the OpenGL view recomposes
+            # the window (measured 4-35 ms under Xvfb/Mesa), so they are not repainted per frame
             self._last_plot = now
+            self.level.setValue(self._level)
+            self._level = -60
             self._plot()
+
+    def _frame(self, k: int) -> np.ndarray:
+        """Marker frame ``k`` of the take (the last chunks are searched from the end)."""
+        end = self.n_frames
+        for chunk in reversed(self.markers):
+            end -= len(chunk)
+            if k >= end:
+                return chunk[k - end]
+        raise IndexError(k)
 
     def _mark_speech(self, times: np.ndarray) -> None:
         """Speech/silence of each new frame: the energy (dB) of the 20 ms of audio before it
@@ -318,14 +357,20 @@ class LiveWindow(QMainWindow):
         """Scroll the lip panels: the lines and dots blitted over the cached axes (a few ms); the
         whole figure is drawn again only when a panel's y range must change (matplotlib's full
         draw with its layout takes 100-250 ms, which would hold up the face)."""
-        markers = np.concatenate(self.markers)
-        n = min(len(markers), int(SHOWN_S * self.model.marker_rate))
-        t = (np.arange(len(markers) - n, len(markers)) - (len(markers) - 1)) / self.model.marker_rate
+        n = min(self.n_frames, int(SHOWN_S * self.model.marker_rate))
+        tail, have = [], 0
+        for chunk in reversed(self.markers):            # only the chunks the panels show
+            if have >= n:
+                break
+            tail.append(chunk)
+            have += len(chunk)
+        markers = np.concatenate(tail[::-1])[-n:]
+        t = (np.arange(n) - (n - 1)) / self.model.marker_rate
         speech = np.asarray(self.speech[-n:])
         rescale = False
         for ax, line, dots, k in zip(self.axes, self.lines, self.dots,
                                      (self.model.upper_lip, self.model.lower_lip), strict=True):
-            y = markers[-n:, k, 1]
+            y = markers[:, k, 1]
             line.set_data(t, y)
             mid = float(np.median(y))
             dots.set_data(t[speech], np.full(int(speech.sum()), mid))

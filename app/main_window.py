@@ -355,8 +355,7 @@ class MainWindow(QMainWindow):
     def _show_planar(self, planar: bool) -> None:
         """Midsagittal (2-D) data is shown as such: the profile camera and a status-bar note."""
         self.dimensions_label.setVisible(planar)
-        if planar:
-            self.view_bar.set_camera("profile")
+        self.view_bar.set_planar(planar)
 
     # ================================================================== synthesis
     def set_synth_config(self, cfg: SynthConfig) -> None:

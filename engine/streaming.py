@@ -6,7 +6,8 @@ between blocks: the resampler's filter memory (``engine.lsf.ResampleStream``), t
 for the pre-emphasis, the analysis samples not yet used by a frame, and the smoother's last raw
 frames (``engine.smoothing.TriangularStream``). Frame t (at ``t / marker_rate``) is emitted once
 the audio up to ``t / marker_rate + lookahead_s`` has arrived: half the analysis window (12.5 ms),
-the resampler's few samples and the smoothing window's second half (3 frames, 50 ms, at 60 Hz).
+the resampler's few samples and the smoothing window's second half (3 frames, 50 ms, at 60 Hz),
+plus up to ``batch_frames - 1`` frames when frames are analysed in batches (live mode: 3).
 The frames emitted by the blocks and :meth:`StreamingSynthesizer.flush` together equal the
 offline synthesis of the whole audio, frame for frame (to rounding).
 
@@ -41,10 +42,25 @@ class StreamConfig:
     synth : the synthesis settings (acoustic mode is used whatever ``synth.mode`` says; smoothing
         ``triangular`` or ``none``; ``speaker_warp`` must be a number: a stream has no whole
         utterance to choose it from).
+    batch_frames : analyse the determined frames once this many are waiting (1: each as soon as
+        it is determined). Larger batches make fewer, larger numpy calls (the per-call overhead
+        dominates one frame's LPC, index search and eqs 5-8) for up to ``batch_frames - 1``
+        frames more delay; the frames themselves are the same.
     """
 
     sample_rate: int = 16000
     synth: SynthConfig = field(default_factory=lambda: SynthConfig(mode="acoustic"))
+    batch_frames: int = 1
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.batch_frames, int) and 1 <= self.batch_frames <= 60):
+            raise ValueError(f"batch_frames must be an integer from 1 to 60, not {self.batch_frames!r}")
+
+
+#: the frame batch of live mode (``facetraj live`` and the Live window): 3 frames at 60 Hz add
+#: at most 33 ms to the lookahead and make the 10 ms-block stream about 2-3 times faster
+#: (docs/benchmarks.md)
+LIVE_BATCH_FRAMES = 3
 
 
 @dataclass
@@ -102,10 +118,12 @@ class StreamingSynthesizer:
 
     @property
     def lookahead_s(self) -> float:
-        """Audio needed after a frame's time before the frame is emitted (the algorithm's delay)."""
+        """Audio needed after a frame's time before the frame is emitted (the algorithm's delay;
+        with ``batch_frames > 1`` the most: the first frame of a batch waits for its last)."""
         resampler = self._resampler.lookahead / self.config.sample_rate
         window = (self._n - self._half) / self._audio_rate
-        return window + resampler + self._smoother.lookahead / self.rate
+        batch = (self.config.batch_frames - 1) / self.rate
+        return window + resampler + batch + self._smoother.lookahead / self.rate
 
     @property
     def received_s(self) -> float:
@@ -132,6 +150,8 @@ class StreamingSynthesizer:
         last = self._next
         while self._window_start(last) + self._n <= self._analysed:
             last += 1
+        if last - self._next < self.config.batch_frames:
+            last = self._next                           # not a whole batch yet: wait
         return self._emit(self._analyse(last, self._analysed), self._smoother.feed)
 
     def flush(self) -> StreamFrames:

@@ -90,6 +90,7 @@ def test_midsagittal_corpus_shown_and_exported(mocha_window, tmp_path, qtbot):
     assert win.view.utterance.name == "fsew0_001" and win.model.n_markers == 9
     assert win.face.preset == "profile" and win.camera_buttons["profile"].isChecked()
     assert win.dimensions_label.isVisible() and "midsagittal" in win.dimensions_label.text()
+    assert not win.view_bar.surface.isEnabled()        # no face surface through 2-D points
     # lips and jaw in the time-aligned panels: the real trajectories against the speech
     jaw = win.marker_panels[0]
     assert jaw.marker == "LI" and win.timeline.axes_of(jaw) is not None

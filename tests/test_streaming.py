@@ -163,3 +163,19 @@ def test_synthesize_chooses_the_warp_per_utterance(default_model, utterance):
     audio, rate = utterance
     res = synthesize(default_model, audio, rate, None, ACOUSTIC.with_(speaker_warp=None))
     assert 0.9 <= res.warp <= 1.1                       # the training voice needs about none
+
+
+def test_batched_frames_are_the_same_frames_at_most_a_batch_later(default_model):
+    x = np.random.default_rng(5).standard_normal(16000) * 0.1
+    one = StreamingSynthesizer(default_model, StreamConfig(16000, ACOUSTIC))
+    three = StreamingSynthesizer(default_model, StreamConfig(16000, ACOUSTIC, batch_frames=3))
+    assert three.lookahead_s == pytest.approx(one.lookahead_s + 2 / 60)
+    early = one.feed(x[:8000]).index.tolist()           # frames 0..26 (see above)
+    late = three.feed(x[:8000]).index.tolist()
+    assert late == early[:len(late)] and len(early) - 2 <= len(late) <= len(early)
+    rest_one = np.concatenate([one.feed(x[8000:]).pcs, one.flush().pcs])
+    rest_three = np.concatenate([three.feed(x[8000:]).pcs, three.flush().pcs])
+    np.testing.assert_array_equal(three.raw_pcs, one.raw_pcs)
+    assert len(rest_three) == len(rest_one) + len(early) - len(late)
+    with pytest.raises(ValueError, match="batch_frames"):
+        StreamConfig(16000, ACOUSTIC, batch_frames=0)

@@ -49,9 +49,9 @@ def stream_file(model, audio: np.ndarray, rate: int, cfg, block_s: float,
                 real_time: bool) -> tuple[np.ndarray, float]:
     """Markers ``(T, M, 3)`` of ``audio`` streamed in blocks of ``block_s`` seconds, paced to the
     audio clock when ``real_time``; and the wall time it took."""
-    from engine.streaming import StreamConfig, StreamingSynthesizer
+    from engine.streaming import LIVE_BATCH_FRAMES, StreamConfig, StreamingSynthesizer
 
-    stream = StreamingSynthesizer(model, StreamConfig(rate, cfg))
+    stream = StreamingSynthesizer(model, StreamConfig(rate, cfg, LIVE_BATCH_FRAMES))
     block = max(1, int(round(block_s * rate)))
     parts = []
     t0 = time.perf_counter()
