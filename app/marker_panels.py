@@ -11,7 +11,7 @@ from PyQt6.QtWidgets import QComboBox, QDialog, QDialogButtonBox, QFormLayout, Q
 from engine.errors import FacetrajError
 from engine.model import Model
 
-from .style import ORIGINAL_COLOR, SPLINE_COLOR, TRIANGULAR_COLOR
+from .style import ORIGINAL_COLOR, SPLINE_COLOR, TRIANGULAR_COLOR, fit_ylabel
 from .timeline import Timeline
 
 JAW_NAMES = ("LI", "JAW", "JAW_C", "CN_C", "CHIN", "CN")
@@ -39,7 +39,7 @@ class MarkerPanel:
         ax.plot(t, view.spline[:, k, a], color=SPLINE_COLOR, lw=1.3)
         if view.original is not None:
             ax.plot(t, view.original[:, k, a], color=ORIGINAL_COLOR, lw=1.5, ls=(0, (2, 1.5)))
-        ax.set_ylabel(f"{self.marker}\n{self.axis} (mm)", fontsize=8)
+        fit_ylabel(ax, f"{self.marker}\n{self.axis} (mm)")
 
 def jaw_marker(names: list[str]) -> str | None:
     """The jaw marker among ``names`` (MOCHA's lower incisor LI, or a chin/jaw marker), if any."""

@@ -28,6 +28,7 @@ from .style import (
     SPEECH_DOT_COLOR,
     SPLINE_COLOR,
     TRIANGULAR_COLOR,
+    fit_ylabel,
 )
 
 log = logging.getLogger(__name__)
@@ -131,13 +132,7 @@ class PhoneTierPanel:
         tier = "words\nphones" if utt.words else "phones"
         short = {"recognized": "recog."}.get(utt.label_source, utt.label_source)
         source = f"\n({short})" if utt.phones else ""
-        label = tier + source
-        # the label runs up the axes: its longest line must fit the tier's height (small windows)
-        fig = ax.figure
-        height_px = ax.get_position().height * fig.get_figheight() * fig.dpi
-        longest = max(len(line) for line in label.splitlines())
-        size = height_px / (0.62 * longest * fig.dpi / 72.0)
-        ax.set_ylabel(label, fontsize=max(5.0, min(8.0, size)))
+        fit_ylabel(ax, tier + source)
         if not utt.phones:
             ax.text(0.5, 0.5, "no phone labels: acoustic-only synthesis", transform=ax.transAxes,
                     ha="center", va="center", fontsize=8, color="#777777")
@@ -193,7 +188,7 @@ class LipPanel:
         sp = view.speech
         ax.plot(t[sp], np.full(int(sp.sum()), mid), ls="none", marker=".", ms=2.2,
                 color=SPEECH_DOT_COLOR, label="speech frames")
-        ax.set_ylabel(f"{self.which} lip\ny (mm)", fontsize=8)
+        fit_ylabel(ax, f"{self.which} lip\ny (mm)")
         if self.which == "upper":
             ax.legend(loc="upper right", fontsize=7, ncol=4, frameon=True, framealpha=0.85,
                       handlelength=2.2, borderpad=0.3)
@@ -268,8 +263,10 @@ class Timeline(QWidget):
             return
         # the bottom margin in pixels: room for the tick labels and "time (s)" at any height
         bottom = min(0.3, 40.0 / max(fig.get_figheight() * fig.dpi, 1.0))
+        # the left margin too: two-line y labels beside tick labels such as "-22.5"
+        left = min(0.3, 84.0 / max(fig.get_figwidth() * fig.dpi, 1.0))
         grid = fig.add_gridspec(len(self.panels), 1, height_ratios=[p.height for p in self.panels],
-                                left=0.075, right=0.99, top=0.985, bottom=bottom, hspace=0.09)
+                                left=left, right=0.99, top=0.985, bottom=bottom, hspace=0.09)
         first = None
         for i, panel in enumerate(self.panels):
             ax = fig.add_subplot(grid[i, 0], sharex=first)
