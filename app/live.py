@@ -410,12 +410,19 @@ def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = Non
     from engine.formats import read_audio
     from engine.threads import one_blas_thread
 
+    from .main import ensure_display, require_display
+
+    # what the options name is read first: a bad file or model is an error before any window
+    audio = read_audio(from_file) if from_file is not None else None
+    model = model_loader()
+    if screenshot:
+        ensure_display()
+    require_display("the Live window (facetraj live without -o)")
     one_blas_thread()       # the stream is synthesized beside the rendering (engine.threads)
     app = QApplication.instance() or QApplication(sys.argv[:1])
-    audio = read_audio(from_file) if from_file is not None else None
     if audio is None and not input_devices():
         raise FacetrajError(NO_INPUT_DEVICE)
-    window = LiveWindow(model_loader(), config, audio, block_s, fast, device)
+    window = LiveWindow(model, config, audio, block_s, fast, device)
     window.resize(1400, 800)
     window.show()
 

@@ -15,7 +15,7 @@ log = logging.getLogger(__name__)
 WINDOW_SIZE = (1600, 1000)
 
 
-def _ensure_display() -> subprocess.Popen | None:
+def ensure_display() -> subprocess.Popen | None:
     """For a screenshot on a machine without a display: start a private Xvfb (None if not needed)."""
     if os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
         return None
@@ -34,6 +34,18 @@ def _ensure_display() -> subprocess.Popen | None:
     os.environ["DISPLAY"] = f":{number}"
     log.info("started Xvfb on display :%s for the screenshot", number)
     return proc
+
+
+def require_display(what: str) -> None:
+    """A window needs a display: a :class:`FacetrajError` (exit 2) naming what was asked for,
+    instead of Qt aborting the process when it finds no platform to open windows on."""
+    if os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY") or \
+            os.environ.get("QT_QPA_PLATFORM", "").split(":")[0] in ("offscreen", "minimal", "vnc"):
+        return
+    from engine.errors import FacetrajError
+
+    raise FacetrajError(f"{what} needs a display, and neither DISPLAY nor WAYLAND_DISPLAY is set: "
+                        "run it in a desktop session or under xvfb-run")
 
 
 def build_window(corpus: Path | str | None, model: Path | None = None, utterance: str | None = None,
@@ -62,7 +74,8 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
     Returns the process exit status (2 when the corpus, model or utterance cannot be used in
     screenshot mode).
     """
-    xvfb = _ensure_display() if screenshot else None
+    xvfb = ensure_display() if screenshot else None
+    require_display("the facetraj window")
     os.environ.setdefault("QT_LOGGING_RULES", "qt.multimedia.*=false;qt.multimedia.ffmpeg=false")
     from PyQt6.QtCore import QTimer
     from PyQt6.QtWidgets import QApplication

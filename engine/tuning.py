@@ -19,6 +19,7 @@ import numpy as np
 
 from .config import SynthConfig, TrainConfig
 from .corpus import Corpus
+from .errors import InputError
 from .evaluation import speech_mask, trajectory_correlations
 from .pipeline import synthesize
 from .smoothing import smooth
@@ -90,6 +91,9 @@ def cross_validate(corpus: Corpus, train_config: TrainConfig | None = None,
     label confidence (automatic labels); ``max_per_fold`` held-out utterances are scored per fold
     (evenly spread) to bound the time."""
     ids = list(corpus.info.train)
+    if not 2 <= folds <= len(ids):
+        raise InputError(corpus.root, f"{folds}-fold cross-validation needs 2 to {len(ids)} folds "
+                                      f"(one per training utterance at most)")
     parts = fold_ids(ids, folds)
     totals = np.zeros((len(grid), len(widths)))
     counts = np.zeros((len(grid), len(widths)))

@@ -44,6 +44,18 @@ def test_live_bad_input_exit_2(args, message, model_file, tmp_path, capsys, monk
     assert message in capsys.readouterr().err
 
 
+def test_live_window_without_a_display_is_an_error_not_an_abort(model_file, default_corpus,
+                                                                capsys, monkeypatch):
+    for var in ("DISPLAY", "WAYLAND_DISPLAY", "QT_QPA_PLATFORM"):
+        monkeypatch.delenv(var, raising=False)
+    wav = default_corpus.root / f"{default_corpus.info.test[0]}.flac"
+    assert main(["-q", "live", "--model", str(model_file), "--from-file", str(wav)]) == 2
+    assert "needs a display" in capsys.readouterr().err
+    # the options are read first: a bad model is named before the display is looked for
+    assert main(["-q", "live", "--model", "missing.npz", "--from-file", str(wav)]) == 2
+    assert "missing.npz: no such model file" in capsys.readouterr().err
+
+
 def test_live_benchmark_rows_and_section(toy_corpus_dir, tmp_path, monkeypatch):
     from benchmarks import live as bench
     from benchmarks.common import load_context

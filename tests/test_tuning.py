@@ -11,9 +11,11 @@ import numpy as np
 import pytest
 
 from engine.config import SynthConfig
+from engine.errors import InputError
 from engine.evaluation import UtteranceScore
 from engine.label_eval import LabelEval, evaluate_kind, format_markdown
 from engine.tuning import cross_validate, fold_ids, tuned_config
+from facetraj.cli import main
 
 
 def test_fold_ids_cover_training_once():
@@ -42,6 +44,16 @@ def _score(method, value, utt="u"):
     return UtteranceScore(utterance=utt, split="test", mode=method, smoothing="triangular",
                           n_context_phones=3, whole_face=value, lower_lip=value, upper_lip=value,
                           speech_frames=100)
+
+
+@pytest.mark.parametrize("folds", [1, 10**20])
+def test_cross_validate_refuses_impossible_folds(toy_corpus, folds):
+    # (found by the fuzz run: --tune=99999999999999999999 tried to allocate that many folds)
+    with pytest.raises(InputError, match="fold cross-validation needs 2 to"):
+        cross_validate(toy_corpus, folds=folds)
+    with pytest.raises(SystemExit) as exit_:            # the option parser's range
+        main(["-q", "train", str(toy_corpus.root), "-o", "x.npz", f"--tune={folds}"])
+    assert exit_.value.code == 2
 
 
 def test_label_eval_summary_and_recommendation():

@@ -6,7 +6,7 @@ import argparse
 import logging
 from pathlib import Path
 
-from ..options import add_train_options, train_config
+from ..options import add_train_options, integer, train_config
 from ..progress import TerminalProgress
 
 log = logging.getLogger("facetraj")
@@ -42,7 +42,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("corpus", type=Path)
     p.add_argument("-o", "--output", type=Path, required=True, help="model file (.npz)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing file")
-    p.add_argument("--tune", type=int, nargs="?", const=2, default=0, metavar="FOLDS",
+    p.add_argument("--tune", type=integer(2, 100), nargs="?", const=2, default=0, metavar="FOLDS",
                    help="choose the robust mode's N, xi, gamma range, label and context weights "
                         "and smoothing width by FOLDS-fold cross-validation (default 2) on the "
                         "training split, stored in the model (a few minutes)")
