@@ -17,6 +17,7 @@ from alignment_cases import alignment_cases
 from conftest import edited_model_file
 from fuzzing import _c3d_rate
 
+from app.main import require_display
 from engine.config import SynthConfig
 from engine.corpus import CorpusInfo, load_corpus, save_corpus_info
 from engine.data import PhoneSegment, Utterance
@@ -194,6 +195,10 @@ def produce(case: str, tmp: Path, toy_dir: Path, model: Model, caplog) -> str:
             os, "access", lambda *a: False, lambda: atomic_write(tmp / "o.tsv").__enter__()),
         "an output on a read-only file system": lambda: _patched(
             tempfile, "mkstemp", _erofs, lambda: atomic_write(tmp / "o.tsv").__enter__()),
+        "a window (`facetraj gui`, `facetraj live` without `-o`) on a machine without a display":
+            lambda: _patched(os, "environ", {k: v for k, v in os.environ.items() if k not in (
+                "DISPLAY", "WAYLAND_DISPLAY", "QT_QPA_PLATFORM")},
+                lambda: require_display("the Live window")),
     }
     cases.update(alignment_cases(tmp))
     caplog.clear()
