@@ -126,15 +126,8 @@ class LiveWindow(QMainWindow):
         self.from_file, self.block_s, self.fast = from_file, block_s, fast
         self.stream: StreamingSynthesizer | None = None
         self.feeder: FileFeeder | MicFeeder | None = None
-        self.audio: list[np.ndarray] = []
-        self.markers: list[np.ndarray] = []
-        self.speech: list[bool] = []
         self.rate = MIC_RATE
-        self.updates = 0
-        self._shown = -1
-        self._level = -60
-        self._samples = self._frames = 0
-        self._t_start = 0.0
+        self._new_take()
         self._last_plot = 0.0
         self._timer = QTimer(self)
         self._timer.setInterval(TICK_MS)
@@ -213,18 +206,24 @@ class LiveWindow(QMainWindow):
         self.rate = self.feeder.rate
         self.stream = StreamingSynthesizer(self.model, StreamConfig(self.rate, self.config,
                                                                      LIVE_BATCH_FRAMES))
-        self.audio, self.markers, self.speech = [], [], []
-        self._samples = self._frames = 0        # running lengths of the take (no sums per tick)
-        self._energy: list[float] = []
-        self.updates = 0
-        self._shown = -1                # the frame on screen
-        self._level = -60               # the loudest block (dB) since the meter was last set
-        self._t_start = time.perf_counter()
+        self._new_take()
         self.start_action.setEnabled(False)
         self.stop_action.setEnabled(True)
         self.save_action.setEnabled(False)
         self.message.setText("live")
         self._timer.start()
+
+    def _new_take(self) -> None:
+        """An empty take, its clock starting now."""
+        self.audio: list[np.ndarray] = []
+        self.markers: list[np.ndarray] = []
+        self.speech: list[bool] = []
+        self._energy: list[float] = []
+        self._samples = self._frames = 0        # running lengths of the take (no sums per tick)
+        self.updates = 0
+        self._shown = -1                # the frame on screen
+        self._level = -60               # the loudest block (dB) since the meter was last set
+        self._t_start = time.perf_counter()
 
     def stop(self) -> None:
         """End the take: the last frames come out (the smoothing's lookahead) and it is kept."""

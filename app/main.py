@@ -15,9 +15,16 @@ log = logging.getLogger(__name__)
 WINDOW_SIZE = (1600, 1000)
 
 
+def has_display() -> bool:
+    """Whether Qt can open a window here: an X or Wayland display, or a Qt platform that needs
+    no display server (``QT_QPA_PLATFORM`` offscreen, minimal or vnc)."""
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) or \
+        os.environ.get("QT_QPA_PLATFORM", "").split(":")[0] in ("offscreen", "minimal", "vnc")
+
+
 def ensure_display() -> subprocess.Popen | None:
     """For a screenshot on a machine without a display: start a private Xvfb (None if not needed)."""
-    if os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
+    if has_display():
         return None
     xvfb = shutil.which("Xvfb")
     if xvfb is None:
@@ -39,8 +46,7 @@ def ensure_display() -> subprocess.Popen | None:
 def require_display(what: str) -> None:
     """A window needs a display: a :class:`FacetrajError` (exit 2) naming what was asked for,
     instead of Qt aborting the process when it finds no platform to open windows on."""
-    if os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY") or \
-            os.environ.get("QT_QPA_PLATFORM", "").split(":")[0] in ("offscreen", "minimal", "vnc"):
+    if has_display():
         return
     from engine.errors import FacetrajError
 

@@ -16,7 +16,6 @@ import datetime as dt
 import importlib
 import importlib.util
 import logging
-import os
 import sys
 import time
 from collections.abc import Sequence
@@ -45,9 +44,9 @@ NOTES = REPO / "benchmarks" / "profile_notes.md"
 
 def display_available() -> tuple[bool, str]:
     """Whether a Qt window can open here, and why not."""
-    if os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
-        return True, ""
-    if os.environ.get("QT_QPA_PLATFORM") == "offscreen":
+    from app.main import has_display
+
+    if has_display():
         return True, ""
     return False, "no DISPLAY (run under xvfb-run, as make bench does)"
 

@@ -94,7 +94,9 @@ def run(ctx: BenchContext) -> list[BenchRow]:
 
 def _live_fps(ctx: BenchContext, seconds: float) -> list[BenchRow]:
     """Face updates per second of the Live window playing test speech in real time."""
-    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+    from app.main import has_display
+
+    if not has_display():
         return [BenchRow("live", "Live window face updates", float("nan"), "fps",
                          note="skipped: no DISPLAY (run under xvfb-run, as make bench does)")]
     from PyQt6.QtWidgets import QApplication

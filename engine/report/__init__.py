@@ -20,13 +20,12 @@ The paper's own numbers (Tables 1 and 2, Figure 4's sentence) are in :mod:`engin
 
 from __future__ import annotations
 
-import json
 import logging
 import os
 from collections.abc import Iterable
 from pathlib import Path
 
-from ..formats import atomic_write
+from ..formats import atomic_write, write_json
 from ..label_eval import LABEL_EVAL_FILE, read_label_eval
 from ..model import Model
 from ..progress import Progress
@@ -72,9 +71,7 @@ def write_report(corpus_dir: str | os.PathLike[str], out_dir: str | os.PathLike[
     md = out / "results.md"
     with atomic_write(md) as tmp:
         tmp.write_text(render_markdown(data), encoding="utf-8")
-    with atomic_write(out / "results.json") as tmp:
-        tmp.write_text(json.dumps(data.to_json(), indent=1) + "\n", encoding="utf-8")
-    for p in (md, out / "results.json"):
+    for p in (md, write_json(out / "results.json", data.to_json())):
         p.chmod(0o644)  # atomic_write's temporary files are private
     log.info("report written to %s", md)
     return md
