@@ -13,7 +13,7 @@ cells, about ``sqrt(5L)`` each, instead of 5L (an inverted-file search; Jegou et
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -79,6 +79,9 @@ class LsfIndex:
     centroids: np.ndarray
     order: np.ndarray
     offsets: np.ndarray
+    #: the float32 grouped codebook of the last ``cb_lsf`` searched (kept with that array)
+    _search_lsf: tuple[np.ndarray, np.ndarray] | None = field(default=None, init=False,
+                                                             repr=False, compare=False)
 
     @property
     def n_cells(self) -> int:
@@ -102,6 +105,13 @@ class LsfIndex:
         search a few frames at a time and pass it to :meth:`nearest` on every call."""
         return np.asarray(cb_lsf, dtype=np.float64)[self.order]
 
+    def _cell_lsf(self, cb_lsf: np.ndarray, grouped: np.ndarray | None) -> np.ndarray:
+        """:meth:`grouped` in float32 for the search, made once per codebook array."""
+        if self._search_lsf is None or self._search_lsf[0] is not cb_lsf:
+            src = self.grouped(cb_lsf) if grouped is None else grouped
+            self._search_lsf = (cb_lsf, np.asarray(src, dtype=np.float32))
+        return self._search_lsf[1]
+
     def nearest(self, w: np.ndarray, cb_lsf: np.ndarray, count: int, probe: int,
                 chunk: int | None = None, grouped: np.ndarray | None = None) -> np.ndarray:
         """The ``count`` codewords nearest to each frame by eq 5, among the members of the
@@ -110,7 +120,9 @@ class LsfIndex:
         ``w`` is ``(T, P)`` input LSFs, ``cb_lsf`` the codebook the index was built on. ``probe``
         is raised when the opened cells could hold fewer than ``count`` codewords; probing every
         cell finds the exact nearest. The distances are computed cell by cell, for all the frames
-        of a chunk that open the cell at once, so the cell's codewords are a slice, not a gather.
+        of a chunk that open the cell at once, so the cell's codewords are a slice, not a gather,
+        and in float32 (half the memory traffic of the search's largest arrays; the distances
+        only rank the codewords: eqs 5-8 are computed again in float64 on the ``count`` found).
         ``grouped`` may pass :meth:`grouped` of ``cb_lsf``, computed once.
 
         Examples
@@ -128,15 +140,16 @@ class LsfIndex:
         count = min(count, self.n_codewords)
         probe = min(max(probe, self.min_probe(count)), self.n_cells)
         sizes = self.sizes
-        cell_lsf = self.grouped(cb_lsf) if grouped is None else grouped   # codewords by cell
+        cell_lsf = self._cell_lsf(cb_lsf, grouped)                        # codewords by cell
         width_max = int(np.sort(sizes)[-probe:].sum())
         chunk = chunk or max(1, min(1024, int(4e6 // max(self.n_cells * order, width_max))))
         out = np.empty((n_frames, count), dtype=np.int64)
         for a in range(0, n_frames, chunk):
             b = min(a + chunk, n_frames)
-            wc = np.asarray(w[a:b], dtype=np.float64)
-            h = perceptual_weights(wc)                                           # eq 5
-            dc = np.matmul(np.abs(wc[:, None, :] - self.centroids), h[:, :, None])[..., 0]
+            h = perceptual_weights(np.asarray(w[a:b], dtype=np.float64)).astype(np.float32)
+            wc = np.asarray(w[a:b], dtype=np.float32)                            # eq 5
+            dc = np.matmul(np.abs(wc[:, None, :] - self.centroids.astype(np.float32)),
+                           h[:, :, None])[..., 0]
             cells = (np.argpartition(dc, probe - 1, axis=1)[:, :probe] if probe < self.n_cells
                      else np.broadcast_to(np.arange(self.n_cells), dc.shape))
             sz = sizes[cells]                                                    # (t, probe)
@@ -144,7 +157,7 @@ class LsfIndex:
             starts = ends - sz                          # and starts here
             col0 = starts.ravel()
             width = int(ends[:, -1].max())
-            d = np.full((b - a) * width, np.inf)      # row t: its cells' members side by side
+            d = np.full((b - a) * width, np.inf, dtype=np.float32)   # row t: its cells side by side
             flat = cells.ravel()
             by_cell = np.argsort(flat, kind="stable")
             bounds = np.searchsorted(flat[by_cell], np.arange(self.n_cells + 1))
