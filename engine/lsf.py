@@ -4,6 +4,8 @@ from the roots of the sum and difference polynomials.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 #: white-noise correction added to r[0] (a -40 dB noise floor) so that LPC of near-silent or
@@ -39,13 +41,14 @@ def levinson(r: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
     return a, err
 
 
+@lru_cache(maxsize=8)
 def _autocorrelation_basis(n_fft: int, lags: int) -> np.ndarray:
     """``(n_fft/2 + 1, lags)`` matrix taking a power spectrum ``|X_f|^2`` (rfft bins) to the
     autocorrelation lags ``0 .. lags-1``: the inverse real DFT of those columns only."""
     f = np.arange(n_fft // 2 + 1)
     twice = np.full(len(f), 2.0)
     twice[0] = twice[-1] = 1.0                       # DC and Nyquist appear once in a real DFT
-    return np.cos(2.0 * np.pi * np.outer(f, np.arange(lags)) / n_fft) * (twice / n_fft)[:, None]
+    return _frozen(np.cos(2.0 * np.pi * np.outer(f, np.arange(lags)) / n_fft) * (twice / n_fft)[:, None])
 
 
 def autocorrelation(frames: np.ndarray, lags: int) -> np.ndarray:
@@ -112,7 +115,7 @@ def _poly2lsf_companion(a: np.ndarray) -> np.ndarray:
     return out.reshape(*lead, order)
 
 
-def _cheb_colleague_eigs(c: np.ndarray) -> np.ndarray:
+def colleague_eigenvalues(c: np.ndarray) -> np.ndarray:
     """Roots (complex) of Chebyshev series rows ``c`` (``(B, m+1)``, highest last) by batched
     colleague-matrix eigenvalues (numpy's ``chebcompanion``, vectorised over rows)."""
     m = c.shape[1] - 1
@@ -148,26 +151,40 @@ def _clenshaw(c: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return c[:, 0] + x * b1 - b2, b1 + x * d1 - d2
 
 
-def chebyshev_real_roots(c: np.ndarray, grid: int = ROOT_GRID, tol: float = 1e-13,
+@lru_cache(maxsize=8)
+def _root_grid(m: int, grid: int) -> tuple[np.ndarray, np.ndarray]:
+    """The grid ``x = cos(w)`` of :func:`chebyshev_real_roots` and ``T_k(x) = cos(k w)``,
+    ``(m+1, grid+1)``."""
+    w = np.linspace(0.0, np.pi, grid + 1)
+    return _frozen(np.cos(w)), _frozen(np.cos(np.outer(np.arange(m + 1), w)))
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    """``a`` made read-only: a cached table is shared by every caller."""
+    a.setflags(write=False)
+    return a
+
+
+def chebyshev_real_roots(c: np.ndarray, grid: int = ROOT_GRID, tol: float = 1e-9,
                          max_iter: int = 12) -> np.ndarray:
     """The ``m`` roots in (-1, 1), descending, of Chebyshev series rows ``c`` (``(B, m+1)``,
     highest last) whose roots are all real and inside: the fast kernel of :func:`poly2lsf`.
 
     Each row is evaluated on ``x = cos(w)`` for ``grid + 1`` angles ``w`` in [0, pi] (one matrix
     product); each sign change brackets one root, which Newton's method (Clenshaw values and
-    derivatives, bisection when a step leaves the bracket) polishes to ``tol``. A row with fewer
+    derivatives, bisection when a step leaves the bracket) polishes until a Newton step is below
+    ``tol`` (the step after it would be of order ``tol^2``, at rounding level). A row with fewer
     than ``m`` sign changes (two roots closer than a grid cell) or a root not polished in
     ``max_iter`` steps is solved by the reference instead: the eigenvalues of its colleague matrix
-    (:func:`_cheb_colleague_eigs`). Tested equal to the reference to 1e-12.
+    (:func:`colleague_eigenvalues`). Tested equal to the reference to 1e-12.
 
     >>> chebyshev_real_roots(np.array([[0.0, 0.0, 1.0]])).round(12).tolist()   # T2: +-1/sqrt 2
     [[0.707106781187, -0.707106781187]]
     """
     c = np.asarray(c, dtype=np.float64)
     n_rows, m = c.shape[0], c.shape[1] - 1
-    w = np.linspace(0.0, np.pi, grid + 1)
-    xg = np.cos(w)
-    values = c @ np.cos(np.outer(np.arange(m + 1), w))            # (B, grid+1)
+    xg, basis = _root_grid(m, grid)
+    values = c @ basis                                             # (B, grid+1)
     neg = values < 0
     change = neg[:, 1:] != neg[:, :-1]
     whole = np.count_nonzero(change, axis=1) == m
@@ -177,23 +194,25 @@ def chebyshev_real_roots(c: np.ndarray, grid: int = ROOT_GRID, tol: float = 1e-1
     f_lo, f_hi = values[rows, cells + 1], values[rows, cells]
     x = lo + (hi - lo) * (f_lo / (f_lo - f_hi))                    # regula falsi start
     cr, neg_lo = c[rows], f_lo < 0
-    step = np.zeros_like(x)
+    done = np.zeros(x.shape, dtype=bool)
     for _ in range(max_iter):
         f, fp = _clenshaw(cr, x)
         above = (f < 0) == neg_lo                                  # the root is above x
         lo, hi = np.where(above, x, lo), np.where(above, hi, x)
         with np.errstate(divide="ignore", invalid="ignore"):
-            new = x - f / fp
-        new = np.where((new >= lo) & (new <= hi), new, 0.5 * (lo + hi))
-        step, x = np.abs(new - x), new
-        if step.max(initial=0.0) <= tol:
+            step = f / fp
+        # a Newton step of size s leaves an error of order s^2: done after a small one
+        done = np.abs(step) <= tol
+        new = x - step
+        x = np.where(done | ((new >= lo) & (new <= hi)), new, 0.5 * (lo + hi))
+        if done.all():
             break
     out = np.empty((n_rows, m))
     out[whole] = x.reshape(-1, m)
     redo = ~whole
-    redo[rows[~(step <= tol)]] = True
+    redo[rows[~done]] = True
     if redo.any():
-        out[redo] = -np.sort(-_cheb_colleague_eigs(c[redo]).real, axis=1)
+        out[redo] = -np.sort(-colleague_eigenvalues(c[redo]).real, axis=1)
     return out
 
 
@@ -380,8 +399,7 @@ def analysis_frames(audio: np.ndarray, rate: int, times: np.ndarray, window_s: f
     half = n // 2
     pad = np.concatenate([np.zeros(half), x, np.zeros(n)])
     starts = np.clip(frame_starts(times, rate), 0, len(x))
-    idx = starts[:, None] + np.arange(n)[None, :]
-    return pad[idx] * np.hamming(n)[None, :]
+    return np.lib.stride_tricks.sliding_window_view(pad, n)[starts] * np.hamming(n)
 
 
 def frame_lsf(frames: np.ndarray, order: int) -> np.ndarray:

@@ -163,3 +163,18 @@ def test_nearest_codeword_prefilter():
     idx = nearest_codewords(w, cb, 2)
     assert sorted(idx[0].tolist()) == [0, 2]
     assert nearest_codewords(w, cb, None).shape == (1, 4)
+
+
+def test_grid_weights_equal_eq6_for_every_gamma():
+    """The fast kernel of eq 6 on an evenly spaced gamma grid (two exponentials per codeword)
+    against the reference softmax, for each gamma; an uneven grid takes the reference path."""
+    from engine.synthesis import codebook_weights, gamma_grid, grid_weights
+
+    rng = np.random.default_rng(13)
+    d = rng.gamma(2.0, 20.0, size=(50, 128))           # eq 5 distances of 128 candidates
+    g = gamma_grid(0.2, 2.0, 10)
+    fast = grid_weights(d, g)
+    for j, gamma in enumerate(g):
+        np.testing.assert_allclose(fast[:, j], codebook_weights(d, gamma), rtol=1e-12, atol=1e-300)
+    uneven = np.array([0.2, 0.5, 2.0])
+    np.testing.assert_array_equal(grid_weights(d, uneven), codebook_weights(d[:, None, :], uneven))

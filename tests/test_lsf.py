@@ -96,3 +96,65 @@ def test_resampling_to_16k():
     x = rng.standard_normal(44100)
     w44 = lsf_at(x, 44100, np.array([0.3, 0.6]))
     assert w44.shape == (2, 18) and np.all(np.isfinite(w44))
+
+
+def _cheb_rows(a):
+    """The Chebyshev rows poly2lsf solves (P and Q with the trivial roots divided out)."""
+    from engine.lsf import _sum_difference
+
+    _, order, p_rows, q_rows = _sum_difference(a)
+    half = order // 2
+    rows = []
+    for poly, sign in ((p_rows, -1.0), (q_rows, 1.0)):
+        g = np.empty((poly.shape[0], order + 1))
+        g[:, 0] = poly[:, 0]
+        for k in range(1, order + 1):
+            g[:, k] = poly[:, k] + sign * g[:, k - 1]
+        rows.append(np.concatenate([g[:, half:half + 1], 2.0 * g[:, half - 1::-1]], axis=1))
+    return np.concatenate(rows)
+
+
+def test_fast_root_kernel_equals_colleague_eigenvalues():
+    """The grid + Newton kernel against its reference, the colleague-matrix eigenvalues, on
+    random minimum-phase polynomials and on LPC of real-like frames (AR(2) noise)."""
+    from engine.lsf import chebyshev_real_roots, colleague_eigenvalues
+
+    rng = np.random.default_rng(11)
+    polys = [_stable_poly(rng, 18) for _ in range(300)]
+    x = lfilter([1], [1, -1.2, 0.7], rng.standard_normal(40 * 400)).reshape(40, 400)
+    polys += list(lpc(x * np.hamming(400), 18))
+    c = _cheb_rows(np.array(polys))
+    fast = chebyshev_real_roots(c)
+    ref = -np.sort(-colleague_eigenvalues(c).real, axis=1)
+    np.testing.assert_allclose(fast, ref, atol=1e-12)
+
+
+def test_close_lsf_pairs_fall_back_to_the_reference(monkeypatch):
+    """A P root pair closer than a grid cell (pi/128) is not bracketed: the row is solved by the
+    eigenvalues, so the LSFs still come back right; a row of well-separated LSFs does not."""
+    from engine import lsf as lsf_mod
+
+    w = np.linspace(0.1, 3.0, 18)
+    close = w.copy()
+    close[2] = close[0] + 0.004            # LSFs 0 and 2 (both P roots) inside one grid cell
+    close[1] = close[0] + 0.002
+    calls = []
+    real = lsf_mod.colleague_eigenvalues
+
+    def spy(c):
+        calls.append(len(c))
+        return real(c)
+
+    monkeypatch.setattr(lsf_mod, "colleague_eigenvalues", spy)
+    np.testing.assert_allclose(poly2lsf(lsf2poly(w)), w, atol=1e-9)
+    assert calls == []
+    np.testing.assert_allclose(poly2lsf(lsf2poly(close)), close, atol=1e-7)
+    assert calls == [1]
+
+
+def test_autocorrelation_equals_the_direct_sums():
+    from engine.lsf import autocorrelation
+
+    x = np.random.default_rng(12).standard_normal((5, 400))
+    direct = np.array([[row[: 400 - k] @ row[k:] for k in range(19)] for row in x])
+    np.testing.assert_allclose(autocorrelation(x, 19), direct, rtol=1e-12, atol=1e-9)
