@@ -41,7 +41,8 @@ class BenchRow:
 
     Attributes
     ----------
-    group : ``train``, ``synth``, ``scaling``, ``eval``, ``labels``, ``playback``, ``startup`` or ``live``.
+    group : ``train``, ``synth``, ``stages``, ``scaling``, ``eval``, ``labels``, ``playback``, ``startup``
+        or ``live``.
     name : what was measured.
     value : the number (NaN when it could not be measured).
     unit : ``s``, ``MiB``, ``x RT`` (times faster than real time), ``corr``, ``ms``...

@@ -10,19 +10,37 @@ call includes the LSF analysis of the input, eqs 4-8, smoothing and the PC-to-ma
 
 from __future__ import annotations
 
+import contextlib
 import logging
-from collections.abc import Sequence
+import time
+from collections.abc import Iterator, Sequence
+from unittest import mock
 
+from engine import lsf, pipeline
 from engine.config import SynthConfig
+from engine.lsf_index import LsfIndex
+from engine.model import Model
 from engine.pipeline import synthesize
 
-from .common import BenchContext, BenchRow, best_time, concatenate_input
+from .common import BenchContext, BenchRow, Timing, best_time, concatenate_input, timed
 
 log = logging.getLogger(__name__)
 
 DURATIONS = (1.0, 10.0, 60.0)
 SMOKE_DURATIONS = (1.0, 2.0)
-AIMS = {"phonetic": 200.0, "acoustic": 50.0}
+AIMS = {"phonetic": 1000.0, "acoustic": 300.0}     # issue 15
+#: the stages of a synthesis call, timed by wrapping the engine function that does each
+STAGES = (
+    ("LSF analysis: framing (analysis_frames)", lsf, "analysis_frames"),
+    ("LSF analysis: LPC (autocorrelation + Levinson)", lsf, "lpc"),
+    ("LSF analysis: LSF roots (poly2lsf)", lsf, "poly2lsf"),
+    ("eq 4 search (top_context_phones)", pipeline, "top_context_phones"),
+    ("LSF index search (acoustic candidates)", LsfIndex, "nearest"),
+    ("eqs 5-8 (weight_frames)", pipeline, "weight_frames"),
+    ("smoothing", pipeline, "smooth"),
+    ("PCA back-projection (to_markers)", Model, "to_markers"),
+)
+STAGE_SECONDS = 10.0
 
 
 def run(ctx: BenchContext, durations: Sequence[float] | None = None) -> list[BenchRow]:
@@ -53,4 +71,57 @@ def run(ctx: BenchContext, durations: Sequence[float] | None = None) -> list[Ben
             rows.append(BenchRow("synth", f"{mode}, {seconds:g} s input", rtf, "x RT",
                                  aim=f">= {aim:.0f}x", ok=None if ctx.smoke else rtf >= aim,
                                  note=f"{t * 1000:.1f} ms; {what}", cpu=seconds / tm.cpu))
+    return rows
+
+
+@contextlib.contextmanager
+def _stage_clock(spent: dict[str, Timing]) -> Iterator[None]:
+    """Add each stage's wall and CPU seconds to ``spent`` while inside (the engine functions
+    wrapped)."""
+    with contextlib.ExitStack() as stack:
+        for label, owner, name in STAGES:
+            real = getattr(owner, name)
+
+            def clocked(*args, _real=real, _label=label, **kwargs):
+                t = Timing(time.perf_counter(), time.process_time())
+                try:
+                    return _real(*args, **kwargs)
+                finally:
+                    before = spent.get(_label, Timing(0.0, 0.0))
+                    spent[_label] = Timing(before.wall + time.perf_counter() - t.wall,
+                                           before.cpu + time.process_time() - t.cpu)
+
+            stack.enter_context(mock.patch.object(owner, name, clocked))
+        yield
+
+
+def stages(ctx: BenchContext, seconds: float = STAGE_SECONDS, repeat: int = 7) -> list[BenchRow]:
+    """Milliseconds per stage of phonetic and acoustic-only synthesis of ``seconds`` of input,
+    from the fastest (by wall time) of ``repeat`` calls, and the rest of that call."""
+    source = ctx.test_utts or ctx.train_utts
+    audio, rate, phones = concatenate_input(source, seconds)
+    rows = []
+    for mode in ("phonetic", "acoustic"):
+        cfg = SynthConfig(mode=mode)
+        labels = phones if mode == "phonetic" else None
+        best: dict[str, Timing] = {}
+        for _ in range(repeat):
+            spent: dict[str, Timing] = {}
+            with _stage_clock(spent):
+                whole, _ = timed(lambda cfg=cfg, labels=labels: synthesize(ctx.model, audio, rate,
+                                                                           labels, cfg))
+            if not best or whole.wall < best["whole call"].wall:
+                best = {**spent, "whole call": whole}
+        call = best.pop("whole call")
+        rest = Timing(call.wall - sum(t.wall for t in best.values()),
+                      call.cpu - sum(t.cpu for t in best.values()))
+        for label, _, _ in STAGES:
+            if label in best:
+                t = best[label]
+                rows.append(BenchRow("stages", f"{mode} {seconds:g} s: {label}", t.wall * 1000, "ms",
+                                     note=f"{t.wall / call.wall:.0%} of the call", cpu=t.cpu * 1000))
+        rows.append(BenchRow("stages", f"{mode} {seconds:g} s: the rest (labels, gathers, checks)",
+                             rest.wall * 1000, "ms", cpu=rest.cpu * 1000))
+        rows.append(BenchRow("stages", f"{mode} {seconds:g} s: whole call", call.wall * 1000, "ms",
+                             note=f"{seconds / call.wall:.0f}x real time", cpu=call.cpu * 1000))
     return rows

@@ -50,8 +50,15 @@ def test_smoke_rows_positive_finite(toy: Path) -> None:
     ctx = load_context(toy, smoke=True)
     rows = run_all(ctx, ("train", "synth", "scaling"))
     groups = {r.group for r in rows}
-    assert groups == {"train", "synth", "scaling"}
+    assert groups == {"train", "synth", "scaling", "stages"}
     assert sum(r.group == "synth" for r in rows) == 4          # 2 modes x 2 durations
+    for mode in ("phonetic", "acoustic"):                     # the stages add up to the call
+        parts = [r.value for r in rows if r.group == "stages" and r.name.startswith(mode)
+                 and not r.name.endswith("whole call")]
+        whole = [r.value for r in rows if r.group == "stages" and r.name.startswith(mode)
+                 and r.name.endswith("whole call")]
+        assert len(parts) >= 5 and len(whole) == 1
+        assert sum(parts) == pytest.approx(whole[0], rel=1e-9)
     for r in rows:
         assert math.isfinite(r.value), r
         if r.unit != "e":                                       # growth exponents may be ~0
