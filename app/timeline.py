@@ -306,6 +306,12 @@ class Timeline(QWidget):
             self._spans.append(ax.axvspan(span[0], span[1], color=LOOP_COLOR, alpha=0.18, lw=0))
 
     # ------------------------------------------------------------------ cursor (blitting)
+    @property
+    def cursor_ready(self) -> bool:
+        """Whether the cursor moves by blitting now (the background of the last full draw is
+        current); if not, the next move asks for a full draw."""
+        return self._bg is not None
+
     def _request_draw(self) -> None:
         """A full draw at the next idle moment (layout, zoom, loop range): the saved background
         is stale until then, so the cursor waits for it."""
