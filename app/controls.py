@@ -31,6 +31,8 @@ from .transport import PlaybackClock
 from .view3d import CAMERA_PRESETS, FaceView
 
 SPEEDS = (1.0, 0.5, 0.25)
+#: the longest read-out the time label is sized for (``MainWindow._show_time`` writes it)
+TIME_TEMPLATE = "000.000 / 000.000 s  frame 00000  /xxxxx/"
 
 
 def colour_dot(colour: str, size: int = 14) -> QIcon:
@@ -124,8 +126,12 @@ class TransportBar(QWidget):
         self.slider.setFocusPolicy(Qt.FocusPolicy.NoFocus)
         lay.addWidget(self.slider, 1)
         self.time_label = QLabel("0.000 s")
-        self.time_label.setMinimumWidth(300)
         self.time_label.setStyleSheet("font-family: monospace;")
+        # a fixed size: a new text every frame then repaints the label without laying out the
+        # bars and the splitter around it again (a label whose size hint may change does)
+        self.time_label.ensurePolished()
+        width = self.time_label.fontMetrics().horizontalAdvance(TIME_TEMPLATE)
+        self.time_label.setFixedSize(max(300, width), self.time_label.sizeHint().height())
         lay.addWidget(self.time_label)
         self.speed = QComboBox()
         for s in SPEEDS:
@@ -157,11 +163,14 @@ class TransportBar(QWidget):
         self.slider.blockSignals(False)
 
     def show_frame(self, frame: int, text: str) -> None:
-        """Move the slider (without signalling a seek) and set the read-out."""
-        self.slider.blockSignals(True)
-        self.slider.setValue(frame)
-        self.slider.blockSignals(False)
-        self.time_label.setText(text)
+        """Move the slider (without signalling a seek) and set the read-out; a widget whose
+        value is unchanged is not touched (no repaint)."""
+        if self.slider.value() != frame:
+            self.slider.blockSignals(True)
+            self.slider.setValue(frame)
+            self.slider.blockSignals(False)
+        if self.time_label.text() != text:
+            self.time_label.setText(text)
 
 
 def add_shortcuts(widget: QWidget,

@@ -317,7 +317,7 @@ class LiveWindow(QMainWindow):
             return
         self._shown = due
         self.face.synth.set_points(self._frame(due))
-        self.face.plotter.update()
+        self.face.request_render()
         self.updates += 1
         now = time.perf_counter()
         if now - self._last_plot >= PLOT_EVERY_S or self.stream is None:

@@ -13,7 +13,7 @@ Window contract
 ===============
 Attributes
     ``model``, ``corpus``, ``view`` (``UtteranceView``, ``app/state.py``), ``synth_config`` (read
-    from ``state``), ``plotter`` (the pyvistaqt ``QtInteractor``), ``face`` (``FaceView``),
+    from ``state``), ``plotter`` (a plotter widget, ``app/plotter_widget.py``), ``face`` (``FaceView``),
     ``timeline`` (``app/timeline.py``), ``analysis_menu``, ``marker_panels`` (``MarkerPanels``),
     ``action_screenshot`` (File-menu entries of extensions go before it).
 

@@ -1,15 +1,18 @@
 """The playback scheduler: which frame to show while the sound plays, and when.
 
-:class:`PlaybackScheduler` runs a precise 5 ms timer while the clock (``app/transport.py``) plays.
-Each tick it aims at the clock time when the update will reach the screen (the clock time plus a
-running estimate of one frame's latency, measured from the window's flushes), skips frames rather
-than drifting, and asks for at most one frame per flush (``frameDue``). Its :attr:`idle` gate is
-open while no sound plays: background work that must not disturb playback waits on it
-(:meth:`app.workers.Progress.wait_open`) instead of polling the clock.
+:class:`PlaybackScheduler` shows one update per marker frame, each timed to reach the screen when
+the audio clock (``app/transport.py``) is at that frame's time: a precise single-shot timer fires
+when the clock plus the running estimate of one update's latency (tick to the window's flush)
+reaches the next frame, so the frame lands in the middle of its own interval. An update that took
+too long makes the next one skip frames rather than drift, and at most one frame is asked for per
+flush (``frameDue``). Its :attr:`idle` gate is open while no sound plays: background work that must
+not disturb playback waits on it (:meth:`app.workers.Progress.wait_open`) instead of polling the
+clock.
 """
 
 from __future__ import annotations
 
+import math
 import time
 
 from PyQt6.QtCore import QObject, Qt, QTimer, pyqtSignal
@@ -18,9 +21,9 @@ from .state import frame_index
 from .transport import PlaybackClock
 from .workers import Gate
 
-TICK_MS = 5
 FLUSH_TIMEOUT = 0.25     # s without a flush (window hidden?) before the next frame is sent anyway
 MAX_LATENCY = 0.08       # s: the lookahead never exceeds this
+MAX_WAIT = 0.1           # s: the clock is polled at least this often (loop and end of the sound)
 
 
 class PlaybackScheduler(QObject):
@@ -45,8 +48,8 @@ class PlaybackScheduler(QObject):
         self.stats: list[tuple[float, int, float, float]] | None = None
         self._pending: tuple[float, int] | None = None   # (tick time, frame) until flushed
         self._timer = QTimer(self)
+        self._timer.setSingleShot(True)
         self._timer.setTimerType(Qt.TimerType.PreciseTimer)
-        self._timer.setInterval(TICK_MS)
         self._timer.timeout.connect(self._tick)
         clock.playingChanged.connect(self._on_playing_changed)
 
@@ -69,12 +72,33 @@ class PlaybackScheduler(QObject):
         self._timer.stop()
         self.idle.set_open(True)
 
+    def plan(self, t: float) -> tuple[float | None, float]:
+        """At clock time ``t`` while playing: the clock time of the frame to show now (None:
+        the frame on screen is still the right one), and the wall-clock seconds until the next
+        update should start (when ``t`` plus the latency reaches the next frame's time)."""
+        clock = self.clock
+        end = clock.loop[1] if (clock.looping and clock.loop) else clock.duration
+        lead = self.latency * clock.speed
+        target = min(t + lead, end)
+        k = self.frame_at(target)
+        shown = self.displayed_frame
+        if k != shown:
+            return target, 0.0                # the next frame, frames skipped, or a jump back
+        start = (k + 1) / self.rate - lead    # when the next frame's update should start
+        if k >= self.n_frames - 1 or start + lead > end:
+            start = end                       # no next frame before the end (or the loop's)
+        return None, min(max((start - t) / clock.speed, 0.0), MAX_WAIT)
+
     def _on_playing_changed(self, playing: bool) -> None:
         self.idle.set_open(not playing)
         if playing:
-            self._timer.start()
+            self._timer.start(0)
         else:
             self._timer.stop()
+
+    def _start_timer(self, wait: float) -> None:
+        """The next tick in ``wait`` seconds (whole milliseconds, never early)."""
+        self._timer.start(max(0, math.ceil(wait * 1000.0)))
 
     def _tick(self) -> None:
         """One timer tick: the frame at the audio clock (skip frames, never drift)."""
@@ -85,21 +109,23 @@ class PlaybackScheduler(QObject):
         if not clock.playing:
             self.frameDue.emit(t)
             return
-        # aim at the clock time when this update reaches the screen
-        end = clock.loop[1] if (clock.looping and clock.loop) else clock.duration
-        target = min(t + self.latency * clock.speed, end)
-        k = self.frame_at(target)
         if self._pending is not None:
-            if time.perf_counter() - self._pending[0] < FLUSH_TIMEOUT:
+            waited = time.perf_counter() - self._pending[0]
+            if waited < FLUSH_TIMEOUT:
+                self._start_timer(FLUSH_TIMEOUT - waited)    # flushed() starts the next one
                 return
             self._pending = None    # no flush came: do not stall
-        if k == self.displayed_frame:
+        target, wait = self.plan(t)
+        if target is None:
+            self._start_timer(wait)
             return
-        self._pending = (time.perf_counter(), k)
+        self._pending = (time.perf_counter(), self.frame_at(target))
+        self._start_timer(FLUSH_TIMEOUT)
         self.frameDue.emit(target)
 
     def flushed(self) -> None:
-        """The window's flush (UpdateRequest) put the pending frame on screen: time it."""
+        """The window's flush (UpdateRequest) put the pending frame on screen: time it, and
+        time the next update."""
         if self._pending is None:
             return
         start, k = self._pending
@@ -108,3 +134,5 @@ class PlaybackScheduler(QObject):
         self.latency = min(0.8 * self.latency + 0.2 * spent, MAX_LATENCY) if self.latency else spent
         if self.stats is not None:
             self.stats.append((start, k, spent, self.clock.time()))
+        if self.clock.playing:
+            self._start_timer(self.plan(self.clock.time())[1])

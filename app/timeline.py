@@ -2,7 +2,8 @@
 
 A panel is any object with ``title: str``, ``height: float`` (relative) and
 ``draw(ax, view) -> None``. The timeline lays the panels out, redraws them when the view changes,
-and draws the moving cursor by blitting (a full redraw happens only on layout, zoom or pan).
+and draws the moving cursor by blitting (a full redraw happens only on layout, zoom or pan): the
+cursor of every panel is one line artist in pixels, restored and drawn over a strip in one pass.
 
 Mouse: click to seek, drag to select a loop range, wheel to zoom the time axis around the pointer,
 right or middle drag to pan, double-click to show the whole utterance.
@@ -16,7 +17,8 @@ from typing import Protocol
 import numpy as np
 from matplotlib.backends.backend_qtagg import FigureCanvasQTAgg
 from matplotlib.figure import Figure
-from matplotlib.transforms import Bbox
+from matplotlib.lines import Line2D
+from matplotlib.transforms import Bbox, IdentityTransform
 from PyQt6.QtCore import pyqtSignal
 from PyQt6.QtWidgets import QSizePolicy, QVBoxLayout, QWidget
 
@@ -216,9 +218,11 @@ class Timeline(QWidget):
         self.view: UtteranceView | None = None
         self.cursor_time = 0.0
         self.loop: tuple[float, float] | None = None
-        self._cursors: list = []
+        self._cursor: Line2D | None = None     # the cursors of all panels (display pixels)
+        self._cursor_rows: list[tuple[float, float]] = []   # each axes' bottom and top (pixels)
+        self._cursor_columns: tuple[float, float] = (0.0, 0.0)  # the axes' left and right
         self._spans: list = []
-        self._bg = None
+        self._bg = None                         # the figure without the cursor; None: redraw due
         self._cursor_x: float | None = None
         self._bg_bounds: tuple[float, ...] = ()
         self._press: tuple[float, float, int] | None = None   # (xdata, xpixel, button)
@@ -256,10 +260,9 @@ class Timeline(QWidget):
         """Rebuild the figure: one axes per panel, shared time axis, then a full draw."""
         fig = self.figure
         fig.clear()
-        self.axes, self._cursors, self._spans = [], [], []
-        self._bg = None
+        self.axes, self._spans, self._cursor = [], [], None
         if not self.panels or self.view is None:
-            self.canvas.draw_idle()
+            self._request_draw()
             return
         # the bottom margin in pixels: room for the tick labels and "time (s)" at any height
         bottom = min(0.3, 40.0 / max(fig.get_figheight() * fig.dpi, 1.0))
@@ -283,9 +286,10 @@ class Timeline(QWidget):
             ax.grid(axis="x", color="#dddddd", lw=0.5)
             self.axes.append(ax)
         self.axes[-1].set_xlabel("time (s)", fontsize=8)
-        for ax in self.axes:
-            cur = ax.axvline(self.cursor_time, color=CURSOR_COLOR, lw=1.2, animated=True)
-            self._cursors.append(cur)
+        # animated: left out of full draws, drawn over the saved background (_on_draw, set_cursor)
+        self._cursor = Line2D([], [], color=CURSOR_COLOR, lw=1.2, animated=True,
+                              transform=IdentityTransform())
+        fig.add_artist(self._cursor)
         self._draw_loop_spans()
         first.set_xlim(*(xlim or (0.0, self.view.duration)))
         fig.align_ylabels(self.axes)
@@ -302,12 +306,38 @@ class Timeline(QWidget):
             self._spans.append(ax.axvspan(span[0], span[1], color=LOOP_COLOR, alpha=0.18, lw=0))
 
     # ------------------------------------------------------------------ cursor (blitting)
+    @property
+    def cursor_ready(self) -> bool:
+        """Whether the cursor moves by blitting now (the background of the last full draw is
+        current); if not, the next move asks for a full draw."""
+        return self._bg is not None
+
+    def _request_draw(self) -> None:
+        """A full draw at the next idle moment (layout, zoom, loop range): the saved background
+        is stale until then, so the cursor waits for it."""
+        self._bg = None
+        self.canvas.draw_idle()
+
     def _on_draw(self, event) -> None:
         self._bg = self.canvas.copy_from_bbox(self.figure.bbox)
         self._bg_bounds = tuple(self.figure.bbox.bounds)
-        self._cursor_x = self._cursor_px(self.cursor_time) if self.axes else None
-        for ax, cur in zip(self.axes, self._cursors, strict=True):
-            ax.draw_artist(cur)
+        self._cursor_rows = [(ax.bbox.y0, ax.bbox.y1) for ax in self.axes]
+        self._cursor_columns = (self.axes[0].bbox.x0, self.axes[0].bbox.x1) if self.axes else (0, 0)
+        self._cursor_x = None
+        if self._cursor is not None:
+            self._cursor_x = self._cursor_px(self.cursor_time)
+            self._draw_cursor(self._cursor_x)
+
+    def _draw_cursor(self, x: float) -> None:
+        """The cursor at pixel ``x``: one vertical segment per panel, drawn as one path (none
+        when ``x`` is outside the panels, as a clipped line would be)."""
+        lo, hi = self._cursor_columns
+        rows = self._cursor_rows if lo <= x <= hi else []
+        xs = np.tile([x, x, np.nan], len(rows))
+        # 1 px inside the frame at both ends, where the per-axes lines were clipped
+        ys = np.array([[y0 + 1.0, y1 - 1.0, np.nan] for y0, y1 in rows]).ravel()
+        self._cursor.set_data(xs, ys)
+        self.figure.draw_artist(self._cursor)
 
     def _on_resize(self, event) -> None:
         self._bg = None
@@ -326,13 +356,10 @@ class Timeline(QWidget):
                 self.axes[0].set_xlim(lo, lo + width)
                 self.canvas.draw()
                 return
-        x_new = self._cursor_px(t)
-        for cur in self._cursors:
-            cur.set_xdata([t, t])
-        if self._bg is None or getattr(self.canvas, "_draw_pending", False) \
-                or tuple(self.figure.bbox.bounds) != self._bg_bounds:
-            self.canvas.draw_idle()     # a full draw is due anyway (layout, resize, zoom)
+        if self._bg is None or tuple(self.figure.bbox.bounds) != self._bg_bounds:
+            self._request_draw()     # a full draw is due anyway (layout, resize, zoom)
             return
+        x_new = self._cursor_px(t)
         # restore and repaint only the strip between the old and the new cursor position
         fig_box = self.figure.bbox
         x_old = self._cursor_x if self._cursor_x is not None else x_new
@@ -341,8 +368,7 @@ class Timeline(QWidget):
         self._cursor_x = x_new
         strip = Bbox([[np.floor(lo), fig_box.y0], [np.ceil(hi), fig_box.y1]])
         self.canvas.restore_region(self._bg, bbox=strip, xy=(strip.x0, strip.y0))
-        for ax, cur in zip(self.axes, self._cursors, strict=True):
-            ax.draw_artist(cur)
+        self._draw_cursor(x_new)
         self.canvas.blit(strip)
 
     def _cursor_px(self, t: float) -> float:
@@ -351,7 +377,7 @@ class Timeline(QWidget):
     def set_loop(self, loop: tuple[float, float] | None) -> None:
         self.loop = loop
         self._draw_loop_spans()
-        self.canvas.draw_idle()
+        self._request_draw()
 
     def xlim(self) -> tuple[float, float]:
         return tuple(self.axes[0].get_xlim()) if self.axes else (0.0, 0.0)
@@ -362,7 +388,7 @@ class Timeline(QWidget):
             width = min(max(hi - lo, 0.02), dur)
             lo = min(max(0.0, lo), dur - width)
             self.axes[0].set_xlim(lo, lo + width)
-            self.canvas.draw_idle()
+            self._request_draw()
 
     def reset_zoom(self) -> None:
         if self.view is not None:
@@ -385,7 +411,7 @@ class Timeline(QWidget):
             if abs(event.x - px0) >= 4:
                 self._drag_span = (min(x0, event.xdata), max(x0, event.xdata))
                 self._draw_loop_spans()
-                self.canvas.draw_idle()
+                self._request_draw()
         elif button in (2, 3) and self.axes:
             ax = self.axes[0]
             inv = ax.transData.inverted()
@@ -405,7 +431,7 @@ class Timeline(QWidget):
         if span is not None and span[1] - span[0] > 1e-3:
             self.loop = span
             self._draw_loop_spans()
-            self.canvas.draw_idle()
+            self._request_draw()
             self.loopSelected.emit(span[0], span[1])
         else:
             self.seekRequested.emit(x0)

@@ -14,11 +14,11 @@ import pyvista as pv
 from PyQt6.QtCore import QPoint
 from PyQt6.QtGui import QCursor, QImage, QPainter, QPixmap
 from PyQt6.QtWidgets import QToolTip, QVBoxLayout, QWidget
-from pyvistaqt import QtInteractor
 from scipy.spatial import Delaunay
 
 from engine.model import Model
 
+from .plotter_widget import is_native, make_plotter
 from .state import UtteranceView
 from .style import BACKGROUND, ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
 
@@ -133,7 +133,7 @@ def _fill_nan(markers: np.ndarray, fallback: np.ndarray) -> np.ndarray:
 class MarkerSet:
     """One marker set in the scene: points, lip lines, optionally a surface, all sharing points."""
 
-    def __init__(self, plotter: QtInteractor, name: str, color: str, neutral: np.ndarray,
+    def __init__(self, plotter: pv.BasePlotter, name: str, color: str, neutral: np.ndarray,
                  contours: list[list[int]], triangles: np.ndarray | None):
         self.name = name
         self.points = pv.PolyData(neutral.copy())
@@ -170,14 +170,18 @@ class MarkerSet:
                                                   specular=0.1, ambient=0.3, diffuse=0.75)
             self.surface_actor.GetProperty().SetInterpolationToGouraud()
         self.current = neutral.copy()
+        # numpy views of the VTK point arrays: a frame update writes into them in place
+        self.xyz = self.points.points
+        self.surface_xyz = self.surface.points if self._inset is not None else None
 
     def set_points(self, pts: np.ndarray) -> None:
+        """Move the markers (and their lip lines and surface) to ``pts``, in place: the same
+        actors and point arrays, no new VTK objects."""
         self.current = pts
-        arr = self.points.points
-        arr[:] = pts
+        np.copyto(self.xyz, pts)
         self.points.GetPoints().Modified()
-        if self._inset is not None:
-            self.surface.points[:] = pts - self._inset
+        if self.surface_xyz is not None:
+            np.subtract(pts, self._inset, out=self.surface_xyz)
             self.surface.GetPoints().Modified()
 
     def set_visible(self, visible: bool, surface: bool) -> None:
@@ -188,11 +192,13 @@ class MarkerSet:
 
 
 class FaceView(QWidget):
-    """The 3-D marker view (pyvistaqt). ``show_frame(k)`` displays frame ``k`` of the view."""
+    """The 3-D marker view (a PyVista plotter widget, ``app/plotter_widget.py``).
+    ``show_frame(k)`` displays frame ``k`` of the view."""
 
-    def __init__(self, parent: QWidget | None = None, multi_samples: int = 0):
+    def __init__(self, parent: QWidget | None = None, multi_samples: int = 0,
+                 native: bool | None = None):
         super().__init__(parent)
-        self.plotter = QtInteractor(self, auto_update=False, multi_samples=multi_samples)
+        self.plotter = make_plotter(self, multi_samples, native)
         self.plotter.set_background(BACKGROUND)
         lay = QVBoxLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
@@ -252,9 +258,8 @@ class FaceView(QWidget):
         self._offset = self._half_gap if (self.side_by_side and has_orig) else np.zeros(3)
 
     def show_frame(self, k: int, render: bool = True) -> None:
-        """Put frame ``k`` of the current view in the scene and ask for a repaint (the render
-        happens in the widget's paint, together with the rest of the window's; ``render()`` on
-        the plotter would render twice)."""
+        """Put frame ``k`` of the current view in the scene (the points move in place) and put
+        it on screen (:meth:`request_render`)."""
         if self._syn is None:
             return
         k = int(np.clip(k, 0, len(self._syn) - 1))
@@ -263,7 +268,16 @@ class FaceView(QWidget):
             self.original.set_points(self._orig[min(k, len(self._orig) - 1)] - self._offset)
         self.frame = k
         if render:
+            self.request_render()
+
+    def request_render(self) -> None:
+        """One render of the changed scene: at once in a native window (it swaps only its own
+        pixels), else at the widget's next paint, which Qt composes with the rest of the window's
+        (a ``render()`` there would render twice). A hidden view renders when it is shown."""
+        if not is_native(self.plotter):
             self.plotter.update()
+        elif self.plotter.isVisible():
+            self.plotter.render()
 
     def rerender(self) -> None:
         """Render now (synchronously), e.g. before a screenshot."""

@@ -6,6 +6,10 @@ time the update took (3-D render + blitted cursor + transport widgets), and the 
 audio clock at the moment the update is on screen minus the time of the frame shown, in marker
 frames. Prints a table and returns :class:`benchmarks.common.BenchRow` rows.
 
+Aims (issue 15): one update per marker frame (60 per second on 60 Hz data; met at 98 % of the
+marker rate, which leaves room for the first update and the loop's wrap) and a drift of at most
+half a frame at the 95th percentile.
+
     xvfb-run -a -s "-screen 0 1600x1200x24" python -m benchmarks.playback [--seconds 10] [--smoke]
 """
 
@@ -23,6 +27,14 @@ from pathlib import Path
 import numpy as np
 
 log = logging.getLogger("benchmarks.playback")
+
+DRIFT_AIM = 0.5            # frames, 95th percentile
+RATE_AIM_SHARE = 0.98      # of the marker rate: one update per marker frame
+
+
+def rate_aim(marker_rate: float) -> float:
+    """The updates per second that count as one update per marker frame."""
+    return RATE_AIM_SHARE * marker_rate
 
 
 def measure(corpus: Path, seconds: float, utterance: str | None = None, during_correlations: bool = False,
@@ -110,14 +122,15 @@ def _rows(r: dict) -> list:
     from benchmarks.common import BenchRow
 
     note = f"{r['utterance']}, {r['window']} window, {r['clock']} clock, {r['seconds']} s played"
+    rate = r["marker_rate"]
     return [
-        BenchRow("playback", "frame updates per second", r["updates_per_s"], "/s", ">= 30",
-                 r["updates_per_s"] >= 30, note),
+        BenchRow("playback", "frame updates per second", r["updates_per_s"], "/s",
+                 f">= {rate:g} (one per marker frame)", r["updates_per_s"] >= rate_aim(rate), note),
         BenchRow("playback", "time per frame update, median", r["update_ms_median"], "ms"),
         BenchRow("playback", "time per frame update, 95th percentile", r["update_ms_p95"], "ms"),
         BenchRow("playback", "drift clock vs frame shown, median", r["drift_frames_median"], "frames"),
         BenchRow("playback", "drift clock vs frame shown, 95th percentile", r["drift_frames_p95"], "frames",
-                 "<= 1", r["drift_frames_p95"] <= 1.0),
+                 f"<= {DRIFT_AIM:g}", r["drift_frames_p95"] <= DRIFT_AIM),
         BenchRow("playback", "drift clock vs frame shown, max", r["drift_frames_max"], "frames"),
     ]
 
@@ -126,12 +139,13 @@ def format_result(r: dict) -> str:
     lines = [f"playback of {r['utterance']} ({r['frames']} frames at {r['marker_rate']:g} Hz), "
              f"{r['window']} window, {r['clock']} clock, {r['seconds']} s at {r['speed']:g}x"
              + (", lip correlations running" if r["during_correlations"] else ""),
-             f"  frame updates per second     {r['updates_per_s']:8.1f}   (aim >= 30)",
+             f"  frame updates per second     {r['updates_per_s']:8.1f}   (aim >= {r['marker_rate']:g}, "
+             "one per marker frame)",
              f"  time per update  median      {r['update_ms_median']:8.1f} ms",
              f"  time per update  95th pct    {r['update_ms_p95']:8.1f} ms",
              f"  marker frames skipped/update {r['frames_skipped_per_update']:8.2f}",
              f"  drift |clock - frame| median {r['drift_frames_median']:8.2f} frames",
-             f"  drift |clock - frame| 95th   {r['drift_frames_p95']:8.2f} frames   (aim <= 1)",
+             f"  drift |clock - frame| 95th   {r['drift_frames_p95']:8.2f} frames   (aim <= {DRIFT_AIM:g})",
              f"  drift |clock - frame| max    {r['drift_frames_max']:8.2f} frames",
              f"  startup (model from cache + first synthesis) {r['startup_s']:.1f} s; browser "
              f"correlations of every utterance {r['correlations_s']:.1f} s more"]

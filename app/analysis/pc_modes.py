@@ -25,8 +25,8 @@ from PyQt6.QtWidgets import (
     QVBoxLayout,
     QWidget,
 )
-from pyvistaqt import QtInteractor
 
+from app.plotter_widget import make_plotter
 from app.style import BACKGROUND, SURFACE_COLOR, SYNTH_COLOR
 from app.view3d import face_triangles, lip_contours
 from engine.analysis.pc_modes import describe_mode, mode_displacement, mode_sd, variance_shares
@@ -110,7 +110,7 @@ class PCModeExplorer(QWidget):
         controls.addWidget(reset)
         controls.addWidget(self.animate_btn)
 
-        self.plotter = QtInteractor(self, auto_update=False)
+        self.plotter = make_plotter(self)    # native on X11: the main window stays raster
         self.plotter.set_background(BACKGROUND)
         self.canvas = Canvas(5, 6)
         split = QSplitter(Qt.Orientation.Horizontal)

@@ -1,0 +1,232 @@
+"""Playback (issue #15): the scheduler's timing of each frame against the audio clock, and what a
+frame update does in the window: the 3-D points move in place with one render, the panels are not
+redrawn (the cursor is blitted), and the time read-out does not lay the bars out again."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pytestqt")
+
+from PyQt6.QtCore import QEvent, QObject, pyqtSignal
+
+from app.playback import MAX_WAIT, PlaybackScheduler
+
+RATE = 60.0
+
+
+class FakeClock(QObject):
+    """A playback clock whose time the test sets."""
+
+    playingChanged = pyqtSignal(bool)
+
+    def __init__(self, duration: float = 10.0, speed: float = 1.0):
+        super().__init__()
+        self.t, self.duration, self.speed = 0.0, duration, speed
+        self.playing, self.looping, self.loop = True, False, None
+
+    def time(self) -> float:
+        return self.t
+
+    def poll(self) -> float:
+        return self.t
+
+
+def scheduler(qapp, t: float, shown: int, latency: float = 0.01, speed: float = 1.0,
+              duration: float = 10.0) -> PlaybackScheduler:
+    clock = FakeClock(duration, speed)
+    clock.t = t
+    s = PlaybackScheduler(clock)
+    s.set_frames(int(duration * RATE), RATE)
+    s.shown(shown)
+    s.latency = latency
+    return s
+
+
+def test_waits_until_the_next_frame_lands_on_its_time(qapp):
+    # 0.5 s + 10 ms of latency = frame 30.6 -> frame 31 is right; frame 32 starts 10 ms before 32/60 s
+    s = scheduler(qapp, 0.5, shown=31)
+    target, wait = s.plan(0.5)
+    assert target is None
+    assert wait == pytest.approx(32 / RATE - 0.5 - 0.01)
+
+
+def test_the_next_frame_is_sent_with_the_latency_as_lookahead(qapp):
+    s = scheduler(qapp, 32 / RATE - 0.01, shown=31)
+    target, wait = s.plan(32 / RATE - 0.01)
+    assert wait == 0.0 and s.frame_at(target) == 32
+    assert target == pytest.approx(32 / RATE)
+
+
+def test_late_updates_skip_frames_rather_than_drift(qapp):
+    s = scheduler(qapp, 40.2 / RATE, shown=31, latency=0.03)
+    target, wait = s.plan(40.2 / RATE)
+    assert wait == 0.0
+    assert s.frame_at(target) == round(40.2 + 0.03 * RATE)      # frame 42: 32-41 never shown
+
+
+def test_a_jump_back_of_the_clock_is_shown_at_once(qapp):
+    s = scheduler(qapp, 0.1, shown=150)                            # the loop wrapped
+    target, wait = s.plan(0.1)
+    assert wait == 0.0 and s.frame_at(target) == round((0.1 + 0.01) * RATE)
+
+
+def test_the_wait_is_in_wall_seconds_at_half_speed(qapp):
+    # the 10 ms latency is 5 ms of clock at half speed: frame 30.3 -> 30 is right
+    s = scheduler(qapp, 0.5, shown=30, speed=0.5)
+    target, wait = s.plan(0.5)
+    assert target is None
+    assert wait == pytest.approx((31 / RATE - 0.5 - 0.005) / 0.5)
+
+
+def test_after_the_last_frame_the_clock_is_polled_until_the_end(qapp):
+    s = scheduler(qapp, 9.99, shown=599, duration=10.0)
+    target, wait = s.plan(9.99)
+    assert target is None
+    assert wait == pytest.approx(0.01)
+    s.clock.t = 9.0
+    s.shown(round(9.01 * RATE))
+    assert s.plan(9.0)[1] <= MAX_WAIT
+
+
+# ---------------------------------------------------------------------- in the window
+gui = pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (xvfb-run)")
+
+
+@pytest.fixture
+def window(qtbot, trained_cache):
+    from app.main import build_window
+    from facetraj.paths import default_corpus
+
+    win = build_window(default_corpus(), use_audio=False)
+    qtbot.addWidget(win)
+    win.resize(1600, 1000)
+    with qtbot.waitSignal(win.synthesisChanged, timeout=240_000):
+        win.show()
+    qtbot.waitExposed(win)
+    qtbot.waitUntil(lambda: not win.busy, timeout=240_000)
+    win.timeline.canvas.draw()           # any pending full draw (layout, resize) done now
+    qtbot.waitUntil(lambda: win.timeline.cursor_ready, timeout=10_000)
+    yield win
+    win.close()
+
+
+class _Counter(QObject):
+    """Counts the events of some types an object receives."""
+
+    def __init__(self, *types: QEvent.Type):
+        super().__init__()
+        self.types, self.count = set(types), 0
+
+    def eventFilter(self, obj, event) -> bool:
+        if event.type() in self.types:
+            self.count += 1
+        return False
+
+
+@gui
+@pytest.mark.gui
+def test_playback_blits_the_cursor_without_redrawing_the_panels(window, qtbot, monkeypatch):
+    win = window
+    timeline = win.timeline
+    full_draws, blits = [], []
+    draw, blit = timeline.figure.draw, timeline.canvas.blit
+    monkeypatch.setattr(timeline.figure, "draw", lambda *a, **k: (full_draws.append(1), draw(*a, **k))[1])
+    monkeypatch.setattr(timeline.canvas, "blit", lambda *a, **k: (blits.append(1), blit(*a, **k))[1])
+    win.seek(0.0)
+    win.play()
+    qtbot.waitUntil(lambda: win.displayed_frame >= 15, timeout=20_000)
+    win.pause()
+    qtbot.waitUntil(lambda: not win.playback.pending, timeout=5_000)
+    assert blits, "the cursor moved by blitting"
+    assert full_draws == [], "no panel data changed: no full draw of the figure"
+    assert timeline.cursor_time == pytest.approx(win.current_time())
+
+
+@gui
+@pytest.mark.gui
+def test_the_cursor_is_drawn_in_every_panel_at_its_time(window):
+    from matplotlib.colors import to_rgb
+
+    from app.style import CURSOR_COLOR
+
+    timeline = window.timeline
+    t = 0.37 * window.view.duration
+    window.seek(t)
+    rgba = np.asarray(timeline.canvas.buffer_rgba())
+    height = rgba.shape[0]
+    want = np.array(to_rgb(CURSOR_COLOR)) * 255
+    for ax in timeline.axes:
+        x, _ = ax.transData.transform((t, 0))
+        y_mid = (ax.bbox.y0 + ax.bbox.y1) / 2
+        column = rgba[int(height - y_mid), int(x) - 1:int(x) + 2, :3].astype(float)
+        assert np.min(np.abs(column - want).sum(axis=1)) < 60, ax
+
+
+@gui
+@pytest.mark.gui
+def test_a_frame_update_moves_the_points_in_place_with_one_render(window, qtbot):
+    from PyQt6.QtWidgets import QApplication
+
+    from app.plotter_widget import is_native
+
+    win = window
+    face = win.face
+    assert is_native(face.plotter)               # X11 (Xvfb): the native-window plotter
+    actor, points, xyz = face.synth.actor, face.synth.points.GetPoints(), face.synth.xyz
+    renders = []
+    face.plotter.ren_win.AddObserver("EndEvent", lambda *_: renders.append(1))
+    QApplication.processEvents()
+    renders.clear()
+    frames = [10, 11, 30, 31]
+    for k in frames:
+        win.seek(k / win.view.rate)
+        QApplication.processEvents()
+    assert len(renders) == len(frames)           # one render per update, none from a repaint
+    assert face.synth.actor is actor and face.synth.points.GetPoints() is points
+    assert np.shares_memory(face.synth.xyz, xyz)
+    np.testing.assert_allclose(np.asarray(face.synth.points.points),
+                               face._syn[frames[-1]] + face._offset)
+
+
+@gui
+@pytest.mark.gui
+def test_the_time_read_out_does_not_lay_the_window_out_again(window):
+    from PyQt6.QtWidgets import QApplication
+
+    bar = window.transport
+    counter = _Counter(QEvent.Type.LayoutRequest)
+    for w in (bar, bar.parentWidget()):
+        w.installEventFilter(counter)
+    size = bar.time_label.size()
+    for k, text in enumerate([" 0.017 / 3.400 s  frame    1  /sil/", " 1.017 / 3.400 s  frame   61",
+                              "12.500 / 13.400 s  frame  750  /aa/"]):
+        bar.show_frame(k, text)
+        QApplication.processEvents()
+    assert counter.count == 0
+    assert bar.time_label.size() == size and bar.time_label.text().startswith("12.500")
+
+
+@gui
+@pytest.mark.gui
+def test_both_plotter_widgets_draw_the_same_face(qtbot, default_model):
+    """The native-window plotter (X11) and pyvistaqt's QOpenGLWidget one render the same image."""
+    from app.view3d import FaceView
+
+    images = []
+    for native in (True, False):
+        face = FaceView(native=native)
+        qtbot.addWidget(face)
+        face.set_model(default_model)
+        face.resize(500, 400)
+        face.show()
+        qtbot.waitExposed(face)
+        face.rerender()
+        images.append(np.asarray(face.plotter.screenshot(), dtype=float))
+        face.close_view()
+    native_img, qt_img = images
+    assert native_img.shape == qt_img.shape and native_img.std() > 10
+    assert np.mean(np.abs(native_img - qt_img) > 40) < 0.01
