@@ -57,10 +57,10 @@ class StreamConfig:
             raise ValueError(f"batch_frames must be an integer from 1 to 60, not {self.batch_frames!r}")
 
 
-#: the frame batch of live mode (``facetraj live`` and the Live window): 3 frames at 60 Hz add
-#: at most 33 ms to the lookahead and make the 10 ms-block stream about 2-3 times faster
-#: (docs/benchmarks.md)
-LIVE_BATCH_FRAMES = 3
+#: the frame batch of live mode (``facetraj live`` and the Live window): 4 frames at 60 Hz add
+#: at most 50 ms to the lookahead (112.5 ms in all, under the 150 ms aim of issue 13) and make the
+#: 10 ms-block stream about 3 times faster (docs/benchmarks.md)
+LIVE_BATCH_FRAMES = 4
 
 
 @dataclass
