@@ -178,3 +178,27 @@ def test_grid_weights_equal_eq6_for_every_gamma():
         np.testing.assert_allclose(fast[:, j], codebook_weights(d, gamma), rtol=1e-12, atol=1e-300)
     uneven = np.array([0.2, 0.5, 2.0])
     np.testing.assert_array_equal(grid_weights(d, uneven), codebook_weights(d[:, None, :], uneven))
+
+
+@pytest.mark.parametrize("count", [1, 3, 12])
+def test_pruned_eq4_search_equals_scoring_every_context(count):
+    """top_context_phones (pruned by the centre bound, all queries in one sort) returns exactly
+    the full eq 4 ranking: the same contexts, scores and lower-index-first ties; phone 4 has
+    fewer than 12 contexts at its best centre similarity (the unpruned path)."""
+    from engine.similarity import context_similarity, top_context_phones, top_contexts
+
+    rng = np.random.default_rng(count)
+    n_phones, context = 6, 3
+    s = np.round(rng.uniform(0.0, 0.9, (n_phones, n_phones)), 1)   # rounded: ties happen
+    s = (s + s.T) / 2
+    np.fill_diagonal(s, 1.0)
+    codebook = rng.integers(0, n_phones, (300, 2 * context + 1))
+    codebook[codebook[:, context] == 4, context] = 5
+    codebook[:5, context] = 4                                           # 5 contexts of phone 4
+    query = rng.integers(0, n_phones, (40, 2 * context + 1))
+    for c in (context, 1):
+        top, scores = top_context_phones(query, codebook, s, 20.0, c, count)
+        n = context_similarity(query, codebook, s, 20.0, c)
+        ref = top_contexts(n, count)
+        np.testing.assert_array_equal(top, ref)
+        np.testing.assert_array_equal(scores, np.take_along_axis(n, ref, axis=1))
