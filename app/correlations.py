@@ -1,5 +1,6 @@
 """The browser's lip-correlation columns: the current utterance scored at once, every corpus
-utterance in a low-priority background sweep that waits while sound plays (playback first)."""
+utterance in a low-priority background sweep that waits while sound plays (playback first) and
+while foreground work runs (the first frame, a synthesis the user asked for)."""
 
 from __future__ import annotations
 
@@ -47,10 +48,11 @@ class BrowserScores:
             return
         self.browser.clear_scores()
         corpus, model, cfg, ids = state.corpus, state.model, state.synth_config, state.correlation_ids()
-        idle = self.idle
+        idle, foreground_idle = self.idle, self.tasks.foreground_idle
 
         def work(progress: Progress) -> None:
             def before(k: int, utt_id: str) -> None:
+                progress.wait_open(foreground_idle)
                 progress.wait_open(idle)
                 progress(k / max(len(ids), 1), f"lip correlations: {utt_id}")
 
