@@ -10,6 +10,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from .phases import mark
+
 log = logging.getLogger(__name__)
 
 WINDOW_SIZE = (1600, 1000)
@@ -63,13 +65,16 @@ def build_window(corpus: Path | str | None, model: Path | None = None, utterance
     from . import analysis, live, own_data
     from .main_window import MainWindow
 
+    mark("window modules imported")
     window = MainWindow(None if corpus is None else Path(corpus), model_path=model, utterance=utterance,
                         start_time=time, use_audio=use_audio)
+    mark("main window built")
     for extension in (own_data, analysis, live):
         try:
             extension.install(window)
         except Exception:
             log.exception("%s could not be installed", extension.__name__)
+    mark("extensions installed")
     return window
 
 
@@ -80,6 +85,7 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
     Returns the process exit status (2 when the corpus, model or utterance cannot be used in
     screenshot mode).
     """
+    mark("run_app")
     xvfb = ensure_display() if screenshot else None
     require_display("the facetraj window")
     os.environ.setdefault("QT_LOGGING_RULES", "qt.multimedia.*=false;qt.multimedia.ffmpeg=false")
@@ -89,8 +95,10 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
     from engine.threads import one_blas_thread
 
     one_blas_thread()       # synthesis runs beside the rendering (engine.threads)
+    mark("Qt imported")
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("facetraj")
+    mark("QApplication")
     window = build_window(corpus, model=model, utterance=utterance, time=time)
     window.resize(*WINDOW_SIZE)
     status = {"code": 0}
@@ -110,7 +118,9 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
             try:
                 window.seek(time or 0.0)
                 app.processEvents()
+                mark("screenshot due")
                 window.save_screenshot(out)
+                mark("screenshot written")
                 log.info("screenshot written to %s", out)
                 print(out)
             except Exception as exc:
@@ -118,11 +128,15 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
                 return
             app.quit()
 
-        window.synthesisChanged.connect(lambda: QTimer.singleShot(300, shoot))
+        # at once: the view is laid out and drawn when synthesisChanged arrives, and shoot() lets
+        # the pending events (paints, resizes) through before rendering and grabbing
+        window.synthesisChanged.connect(lambda: QTimer.singleShot(0, shoot))
     window.show()
     try:
         rc = app.exec()
+        mark("event loop left")
     finally:
         window.close()
+        mark("window closed")
     del xvfb   # it ends when this process disconnects
     return status["code"] or rc

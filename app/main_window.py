@@ -87,6 +87,7 @@ from .controls import (
 from .correlations import BrowserScores
 from .marker_panels import MarkerPanels
 from .open_audio import AudioOpener
+from .phases import mark
 from .playback import PlaybackScheduler
 from .settings_panel import SynthSettingsPanel
 from .state import UtteranceView
@@ -332,11 +333,13 @@ class MainWindow(QMainWindow):
         except FacetrajError as exc:
             self.report_error(exc)
             return
+        mark("corpus index read")
         self.status_label.setText(f"opening {corpus.root} …")
         self.run_task(lambda p: load_model(corpus, model_path, p, load_or_train),
                       lambda r: self._on_model_ready(corpus, *r), "preparing the model (first run trains it)")
 
     def _on_model_ready(self, corpus: Corpus, model: Model, texts: dict[str, str]) -> None:
+        mark("model ready")
         self.stop()
         first = self.state.set_model(corpus, model, texts)
         self.face.set_model(model)
@@ -348,6 +351,7 @@ class MainWindow(QMainWindow):
         self._show_planar(model.is_planar)
         self.marker_panels.set_model(model)
         self.modelReady.emit()
+        mark("model shown")
         if first:
             self.set_utterance(first)
         self.scores.start(self.state, lambda _r: self.correlationsDone.emit())
@@ -376,6 +380,7 @@ class MainWindow(QMainWindow):
         self.run_task(request.run, done, "synthesizing")
 
     def _apply_view(self, view: UtteranceView, new_utterance: bool) -> None:
+        mark("synthesis done")
         t = 0.0 if new_utterance else self.clock.time()
         was_playing = self.clock.playing and not new_utterance
         if new_utterance:
@@ -387,6 +392,7 @@ class MainWindow(QMainWindow):
         self.playback.set_frames(view.n_frames, view.rate)
         self.face.set_view(view)
         self.timeline.set_view(view, keep_zoom=not new_utterance)
+        mark("timeline drawn")
         self.transport.set_frames(view.n_frames)
         self._show_titles(view)
         self.clock.seek(t)
@@ -395,6 +401,7 @@ class MainWindow(QMainWindow):
             self.clock.play()
         if new_utterance:
             self.utteranceChanged.emit(view.utterance.name)
+        mark("view applied")
         self.synthesisChanged.emit()
 
     def _show_titles(self, view: UtteranceView) -> None:
@@ -482,8 +489,11 @@ class MainWindow(QMainWindow):
     def save_screenshot(self, path: Path) -> Path:
         """Render the whole window (with the 3-D view) to a PNG."""
         self.face.rerender()
+        mark("screenshot: 3-D rendered")
         self.timeline.canvas.draw()
+        mark("screenshot: timeline drawn")
         pix = self.grab()
+        mark("screenshot: window grabbed")
         self.face.paint_into(pix, self)
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
