@@ -133,7 +133,7 @@ class MainWindow(QMainWindow):
         self._build_menus()
         self._build_shortcuts()
         if corpus_path is not None:
-            QTimer.singleShot(0, lambda: self.open_corpus(Path(corpus_path), model_path))
+            self._open_first_corpus(Path(corpus_path), model_path)
 
     # ================================================================== state (read-only views)
     model = property(lambda self: self.state.model, doc="The model (None until one is loaded).")
@@ -333,6 +333,20 @@ class MainWindow(QMainWindow):
         except FacetrajError as exc:
             self.report_error(exc)
             return
+        self._load_model(corpus, model_path)
+
+    def _open_first_corpus(self, path: Path, model_path: Path | None) -> None:
+        """The corpus given to the constructor: its model starts loading at once, beside the
+        window's first paint; an error is reported once the event loop runs (after the caller
+        has set its error handler)."""
+        try:
+            corpus = load_corpus(path)
+        except FacetrajError as exc:
+            QTimer.singleShot(0, lambda e=exc: self.report_error(e))
+            return
+        self._load_model(corpus, model_path)
+
+    def _load_model(self, corpus: Corpus, model_path: Path | None) -> None:
         mark("corpus index read")
         self.status_label.setText(f"opening {corpus.root} …")
         self.run_task(lambda p: load_model(corpus, model_path, p, load_or_train),
