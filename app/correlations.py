@@ -25,6 +25,7 @@ class BrowserScores:
         self.tasks = tasks
         self.idle = idle
         self.task: Task | None = None
+        self.enabled = True         # False: no sweep (the utterance shown is still scored)
 
     @property
     def running(self) -> bool:
@@ -41,10 +42,11 @@ class BrowserScores:
             log.debug("scoring the current utterance failed", exc_info=True)
 
     def start(self, state: ViewerModel, on_done=None) -> None:
-        """(Re)start the sweep of every corpus utterance under the current settings."""
+        """(Re)start the sweep of every corpus utterance under the current settings (only cancel
+        the running one while disabled)."""
         if self.task is not None:
             self.task.cancel()
-        if state.corpus is None or state.model is None:
+        if not self.enabled or state.corpus is None or state.model is None:
             return
         self.browser.clear_scores()
         corpus, model, cfg, ids = state.corpus, state.model, state.synth_config, state.correlation_ids()

@@ -131,6 +131,7 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
             app.quit()
 
         window.set_error_handler(fail)     # no dialogs in screenshot mode
+        window.set_correlation_sweep(False)  # one frame: nothing to compute in the background
 
         def shoot() -> None:
             if window.view is None:

@@ -30,7 +30,8 @@ Methods
     background=False) -> Task``: ``fn(progress)`` in a worker thread, the status bar shows its
     progress, the callbacks run on the GUI thread, an error goes to ``on_error`` or
     ``report_error``; ``report_error(exc)`` and ``show_error(message)`` (a dialog, or the handler
-    set with ``set_error_handler(fn)``); ``show_status(text, timeout_ms=0)``;
+    set with ``set_error_handler(fn)``); ``set_correlation_sweep(on)`` (the browser's background
+    lip correlations); ``show_status(text, timeout_ms=0)``;
     ``add_extension(name, obj)`` / ``extension(name)``; ``set_utterance(utt_id)``, ``seek(t)``,
     ``current_time()``, ``open_corpus(path)``, ``open_audio(path, labels)``.
 
@@ -368,6 +369,16 @@ class MainWindow(QMainWindow):
         mark("model shown")
         if first:
             self.set_utterance(first)
+        self._start_sweep()
+
+    def set_correlation_sweep(self, on: bool) -> None:
+        """Whether every corpus utterance's lip correlations are computed in the background (the
+        browser's columns; on by default, off for a one-frame screenshot). The utterance shown
+        is scored either way."""
+        self.scores.enabled = bool(on)
+        self._start_sweep()
+
+    def _start_sweep(self) -> None:
         self.scores.start(self.state, lambda _r: self.correlationsDone.emit())
 
     def _show_planar(self, planar: bool) -> None:
@@ -384,7 +395,7 @@ class MainWindow(QMainWindow):
         self.settings.set_config(cfg)
         if request is not None:
             self._synthesize(request)
-        self.scores.start(self.state, lambda _r: self.correlationsDone.emit())
+        self._start_sweep()
 
     def _synthesize(self, request: SynthRequest) -> None:
         def done(view: UtteranceView) -> None:
