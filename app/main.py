@@ -93,7 +93,6 @@ def build_window(corpus: Path | str | None, model: Path | None = None, utterance
             extension.install(window)
         except Exception:
             log.exception("%s could not be installed", extension.__name__)
-    mark("extensions installed")
     return window
 
 
@@ -114,7 +113,6 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
     from engine.threads import one_blas_thread
 
     one_blas_thread()       # synthesis runs beside the rendering (engine.threads)
-    mark("Qt imported")
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("facetraj")
     mark("QApplication")
@@ -155,9 +153,7 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
     window.show()
     try:
         rc = app.exec()
-        mark("event loop left")
     finally:
         window.close()
-        mark("window closed")
     del xvfb   # it ends when this process disconnects
     return status["code"] or rc

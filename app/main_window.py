@@ -366,7 +366,6 @@ class MainWindow(QMainWindow):
         self._show_planar(model.is_planar)
         self.marker_panels.set_model(model)
         self.modelReady.emit()
-        mark("model shown")
         if first:
             self.set_utterance(first)
         self._start_sweep()
@@ -426,7 +425,6 @@ class MainWindow(QMainWindow):
             self.clock.play()
         if new_utterance:
             self.utteranceChanged.emit(view.utterance.name)
-        mark("view applied")
         self.synthesisChanged.emit()
 
     def _show_titles(self, view: UtteranceView) -> None:
@@ -514,11 +512,9 @@ class MainWindow(QMainWindow):
     def save_screenshot(self, path: Path) -> Path:
         """Render the whole window (with the 3-D view) to a PNG."""
         self.face.rerender()
-        mark("screenshot: 3-D rendered")
-        self.timeline.canvas.draw()
+        self.timeline.canvas.draw()     # a full draw: the canvas holds the cursor's blits
         mark("screenshot: timeline drawn")
         pix = self.grab()
-        mark("screenshot: window grabbed")
         self.face.paint_into(pix, self)
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)

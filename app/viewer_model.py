@@ -251,7 +251,6 @@ def load_model(corpus: Corpus, model_path: Path | None, progress: Progress,
     """The model for ``corpus`` (from ``model_path``, else ``load_or_train``: the cache or
     training) and the utterance texts (slow: run in a worker)."""
     texts = read_texts(corpus)
-    mark("utterance texts read")
     if model_path is not None:
         progress(0.5, f"loading {model_path}")
         model = Model.load(model_path)
