@@ -62,7 +62,7 @@ def require_display(what: str) -> None:
 @contextmanager
 def long_lived_objects() -> Iterator[None]:
     """A block that makes objects living as long as the process (the window's imports: some
-    200,000 objects): the cyclic garbage collector pauses during it and leaves its objects out of
+    250,000 objects): the cyclic garbage collector pauses during it and leaves its objects out of
     later passes (``gc.freeze``); its full passes over them took 0.2-0.3 s of the first frame
     (issue #15)."""
     was_enabled = gc.isenabled()

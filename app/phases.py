@@ -35,4 +35,4 @@ def process_seconds() -> float:
 def mark(phase: str) -> None:
     """Log that start-up reached ``phase`` (debug level, with the time since the process started)."""
     if log.isEnabledFor(logging.DEBUG):
-        log.debug("start-up: %-32s %6.2f s", phase, process_seconds())
+        log.debug("phase %-34s %6.2f s after the process started", phase, process_seconds())
