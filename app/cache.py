@@ -14,7 +14,6 @@ from engine.corpus import Corpus
 from engine.errors import ModelFileError
 from engine.model import Model
 from engine.progress import Progress
-from engine.training import train
 
 log = logging.getLogger(__name__)
 
@@ -49,6 +48,8 @@ def load_or_train(corpus: Corpus, config: TrainConfig | None = None,
             return model
         except ModelFileError as exc:
             log.warning("ignoring unreadable cached model: %s", exc)
+    from engine.training import train  # only here: a cached model is the usual case
+
     log.info("training the model on %s (first run; cached in %s)", corpus.root, path.parent)
     model = train(corpus, config=config, progress=lambda f, m: progress(0.02 + 0.96 * f, f"training: {m}"))
     try:

@@ -1,5 +1,6 @@
 """The browser's lip-correlation columns: the current utterance scored at once, every corpus
-utterance in a low-priority background sweep that waits while sound plays (playback first)."""
+utterance in a low-priority background sweep that waits while sound plays (playback first) and
+while foreground work runs (the first frame, a synthesis the user asked for)."""
 
 from __future__ import annotations
 
@@ -24,6 +25,7 @@ class BrowserScores:
         self.tasks = tasks
         self.idle = idle
         self.task: Task | None = None
+        self.enabled = True         # False: no sweep (the utterance shown is still scored)
 
     @property
     def running(self) -> bool:
@@ -40,17 +42,19 @@ class BrowserScores:
             log.debug("scoring the current utterance failed", exc_info=True)
 
     def start(self, state: ViewerModel, on_done=None) -> None:
-        """(Re)start the sweep of every corpus utterance under the current settings."""
+        """(Re)start the sweep of every corpus utterance under the current settings (only cancel
+        the running one while disabled)."""
         if self.task is not None:
             self.task.cancel()
-        if state.corpus is None or state.model is None:
+        if not self.enabled or state.corpus is None or state.model is None:
             return
         self.browser.clear_scores()
         corpus, model, cfg, ids = state.corpus, state.model, state.synth_config, state.correlation_ids()
-        idle = self.idle
+        idle, foreground_idle = self.idle, self.tasks.foreground_idle
 
         def work(progress: Progress) -> None:
             def before(k: int, utt_id: str) -> None:
+                progress.wait_open(foreground_idle)
                 progress.wait_open(idle)
                 progress(k / max(len(ids), 1), f"lip correlations: {utt_id}")
 

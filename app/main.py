@@ -3,12 +3,17 @@
 
 from __future__ import annotations
 
+import gc
 import logging
 import os
 import shutil
 import subprocess
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+
+from .phases import mark
 
 log = logging.getLogger(__name__)
 
@@ -54,6 +59,22 @@ def require_display(what: str) -> None:
                         "run it in a desktop session or under xvfb-run")
 
 
+@contextmanager
+def long_lived_objects() -> Iterator[None]:
+    """A block that makes objects living as long as the process (the window's imports: some
+    250,000 objects): the cyclic garbage collector pauses during it and leaves its objects out of
+    later passes (``gc.freeze``); its full passes over them took 0.2-0.3 s of the first frame
+    (issue #15)."""
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        gc.freeze()
+        if was_enabled:
+            gc.enable()
+
+
 def build_window(corpus: Path | str | None, model: Path | None = None, utterance: str | None = None,
                  time: float | None = None, use_audio: bool | None = None):
     """The main window as users get it: with the analysis views and the import/export entries.
@@ -63,8 +84,10 @@ def build_window(corpus: Path | str | None, model: Path | None = None, utterance
     from . import analysis, live, own_data
     from .main_window import MainWindow
 
+    mark("window modules imported")
     window = MainWindow(None if corpus is None else Path(corpus), model_path=model, utterance=utterance,
                         start_time=time, use_audio=use_audio)
+    mark("main window built")
     for extension in (own_data, analysis, live):
         try:
             extension.install(window)
@@ -80,6 +103,7 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
     Returns the process exit status (2 when the corpus, model or utterance cannot be used in
     screenshot mode).
     """
+    mark("run_app")
     xvfb = ensure_display() if screenshot else None
     require_display("the facetraj window")
     os.environ.setdefault("QT_LOGGING_RULES", "qt.multimedia.*=false;qt.multimedia.ffmpeg=false")
@@ -91,7 +115,9 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
     one_blas_thread()       # synthesis runs beside the rendering (engine.threads)
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("facetraj")
-    window = build_window(corpus, model=model, utterance=utterance, time=time)
+    mark("QApplication")
+    with long_lived_objects():
+        window = build_window(corpus, model=model, utterance=utterance, time=time)
     window.resize(*WINDOW_SIZE)
     status = {"code": 0}
     if screenshot:
@@ -103,6 +129,7 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
             app.quit()
 
         window.set_error_handler(fail)     # no dialogs in screenshot mode
+        window.set_correlation_sweep(False)  # one frame: nothing to compute in the background
 
         def shoot() -> None:
             if window.view is None:
@@ -110,7 +137,9 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
             try:
                 window.seek(time or 0.0)
                 app.processEvents()
+                mark("screenshot due")
                 window.save_screenshot(out)
+                mark("screenshot written")
                 log.info("screenshot written to %s", out)
                 print(out)
             except Exception as exc:
@@ -118,7 +147,9 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
                 return
             app.quit()
 
-        window.synthesisChanged.connect(lambda: QTimer.singleShot(300, shoot))
+        # at once: the view is laid out and drawn when synthesisChanged arrives, and shoot() lets
+        # the pending events (paints, resizes) through before rendering and grabbing
+        window.synthesisChanged.connect(lambda: QTimer.singleShot(0, shoot))
     window.show()
     try:
         rc = app.exec()

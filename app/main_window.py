@@ -30,7 +30,8 @@ Methods
     background=False) -> Task``: ``fn(progress)`` in a worker thread, the status bar shows its
     progress, the callbacks run on the GUI thread, an error goes to ``on_error`` or
     ``report_error``; ``report_error(exc)`` and ``show_error(message)`` (a dialog, or the handler
-    set with ``set_error_handler(fn)``); ``show_status(text, timeout_ms=0)``;
+    set with ``set_error_handler(fn)``); ``set_correlation_sweep(on)`` (the browser's background
+    lip correlations); ``show_status(text, timeout_ms=0)``;
     ``add_extension(name, obj)`` / ``extension(name)``; ``set_utterance(utt_id)``, ``seek(t)``,
     ``current_time()``, ``open_corpus(path)``, ``open_audio(path, labels)``.
 
@@ -87,6 +88,7 @@ from .controls import (
 from .correlations import BrowserScores
 from .marker_panels import MarkerPanels
 from .open_audio import AudioOpener
+from .phases import mark
 from .playback import PlaybackScheduler
 from .settings_panel import SynthSettingsPanel
 from .state import UtteranceView
@@ -132,7 +134,7 @@ class MainWindow(QMainWindow):
         self._build_menus()
         self._build_shortcuts()
         if corpus_path is not None:
-            QTimer.singleShot(0, lambda: self.open_corpus(Path(corpus_path), model_path))
+            self._open_first_corpus(Path(corpus_path), model_path)
 
     # ================================================================== state (read-only views)
     model = property(lambda self: self.state.model, doc="The model (None until one is loaded).")
@@ -332,11 +334,27 @@ class MainWindow(QMainWindow):
         except FacetrajError as exc:
             self.report_error(exc)
             return
+        self._load_model(corpus, model_path)
+
+    def _open_first_corpus(self, path: Path, model_path: Path | None) -> None:
+        """The corpus given to the constructor: its model starts loading at once, beside the
+        window's first paint; an error is reported once the event loop runs (after the caller
+        has set its error handler)."""
+        try:
+            corpus = load_corpus(path)
+        except FacetrajError as exc:
+            QTimer.singleShot(0, lambda e=exc: self.report_error(e))
+            return
+        self._load_model(corpus, model_path)
+
+    def _load_model(self, corpus: Corpus, model_path: Path | None) -> None:
+        mark("corpus index read")
         self.status_label.setText(f"opening {corpus.root} …")
         self.run_task(lambda p: load_model(corpus, model_path, p, load_or_train),
                       lambda r: self._on_model_ready(corpus, *r), "preparing the model (first run trains it)")
 
     def _on_model_ready(self, corpus: Corpus, model: Model, texts: dict[str, str]) -> None:
+        mark("model ready")
         self.stop()
         first = self.state.set_model(corpus, model, texts)
         self.face.set_model(model)
@@ -350,6 +368,16 @@ class MainWindow(QMainWindow):
         self.modelReady.emit()
         if first:
             self.set_utterance(first)
+        self._start_sweep()
+
+    def set_correlation_sweep(self, on: bool) -> None:
+        """Whether every corpus utterance's lip correlations are computed in the background (the
+        browser's columns; on by default, off for a one-frame screenshot). The utterance shown
+        is scored either way."""
+        self.scores.enabled = bool(on)
+        self._start_sweep()
+
+    def _start_sweep(self) -> None:
         self.scores.start(self.state, lambda _r: self.correlationsDone.emit())
 
     def _show_planar(self, planar: bool) -> None:
@@ -366,7 +394,7 @@ class MainWindow(QMainWindow):
         self.settings.set_config(cfg)
         if request is not None:
             self._synthesize(request)
-        self.scores.start(self.state, lambda _r: self.correlationsDone.emit())
+        self._start_sweep()
 
     def _synthesize(self, request: SynthRequest) -> None:
         def done(view: UtteranceView) -> None:
@@ -376,6 +404,7 @@ class MainWindow(QMainWindow):
         self.run_task(request.run, done, "synthesizing")
 
     def _apply_view(self, view: UtteranceView, new_utterance: bool) -> None:
+        mark("synthesis done")
         t = 0.0 if new_utterance else self.clock.time()
         was_playing = self.clock.playing and not new_utterance
         if new_utterance:
@@ -387,6 +416,7 @@ class MainWindow(QMainWindow):
         self.playback.set_frames(view.n_frames, view.rate)
         self.face.set_view(view)
         self.timeline.set_view(view, keep_zoom=not new_utterance)
+        mark("timeline drawn")
         self.transport.set_frames(view.n_frames)
         self._show_titles(view)
         self.clock.seek(t)
@@ -482,7 +512,8 @@ class MainWindow(QMainWindow):
     def save_screenshot(self, path: Path) -> Path:
         """Render the whole window (with the 3-D view) to a PNG."""
         self.face.rerender()
-        self.timeline.canvas.draw()
+        self.timeline.canvas.draw()     # a full draw: the canvas holds the cursor's blits
+        mark("screenshot: timeline drawn")
         pix = self.grab()
         self.face.paint_into(pix, self)
         path = Path(path)

@@ -31,15 +31,15 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from engine.alignment import Labels, MissingWordsError
 from engine.data import Utterance
 from engine.errors import FacetrajError, InputError
 from engine.formats import read_audio
-from engine.labelling import beside, file_labels, label_audio, labels_for_audio
 from engine.phones import ARPABET
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:   # the labelling engine is imported when audio is opened (issue #15: cold start)
     import numpy as np
+
+    from engine.alignment import Labels
 
     from .main_window import MainWindow
 
@@ -150,6 +150,8 @@ class OpenedAudio:
 
     def labels_for(self, source: str) -> Labels | None:
         """Labels of ``source`` (computed on the first call: run in a worker)."""
+        from engine.labelling import file_labels, label_audio
+
         if source not in self.labels:
             if source == "none":
                 self.labels[source] = None
@@ -228,6 +230,8 @@ class AudioOpener(QObject):
                                               "Audio (*.wav *.flac);;All files (*)")
         if not path:
             return
+        from engine.labelling import beside
+
         path = Path(path)
         read = self._read(path)  # a corrupt file is reported before the sentence is asked for
         if read is None:
@@ -269,6 +273,9 @@ class AudioOpener(QObject):
               labels_path: Path | None = None, text: str | None = None, recognize: bool = False,
               acoustic_only: bool = False,
               extra_dict: dict[str, list[str]] | None = None) -> None:
+        from engine.alignment import MissingWordsError
+        from engine.labelling import beside, labels_for_audio
+
         win = self.window
         audio, rate = read
         name = audio_path.stem

@@ -30,6 +30,7 @@ from engine.paper import FIGURE4_TEXT
 from engine.pipeline import mode_for
 from engine.progress import Progress
 
+from .phases import mark
 from .state import UtteranceView, build_view
 
 log = logging.getLogger(__name__)
@@ -68,6 +69,7 @@ class SynthRequest:
         acoustic-only, and with labels not hand-checked robust unless the user chose the mode
         (:func:`engine.pipeline.mode_for`)."""
         utt = self.load()
+        mark(f"utterance {utt.name} read")
         if progress is not None:
             progress(0.3, f"synthesizing {utt.name}")
         return build_view(self.model, utt, self.split, mode_for(self.config, utt.phones, utt.label_source,

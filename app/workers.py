@@ -135,7 +135,9 @@ class TaskRunner(QObject):
     """Starts tasks, keeps them until they finish, routes their results and errors, stops them.
 
     ``error_handler(exc)`` receives the errors of tasks started without ``on_error`` and the
-    exceptions raised by completion handlers (a handler never crashes the app).
+    exceptions raised by completion handlers (a handler never crashes the app). The gate
+    ``foreground_idle`` is open while no foreground task runs: background work waits on it, so
+    that it never competes with what the user waits for (e.g. the first frame, a synthesis).
     """
 
     started = pyqtSignal(object)                 # the task
@@ -149,6 +151,7 @@ class TaskRunner(QObject):
         self.error_handler = error_handler
         self.tasks: list[Task] = []
         self.closed = False
+        self.foreground_idle = Gate(is_open=True)
 
     def run(self, fn: Callable[[Progress], Any], on_done: Callable[[Any], None] | None, label: str, *,
             on_error: Callable[[BaseException], None] | None = None,
@@ -170,6 +173,8 @@ class TaskRunner(QObject):
             task.partial.connect(lambda obj: self._safe(on_partial, obj))
         task.finished.connect(lambda: self._finished(task))
         self.tasks.append(task)
+        if not background:
+            self.foreground_idle.set_open(False)
         task.start()
         if background and task.isRunning():
             task.setPriority(Task.Priority.LowPriority)
@@ -225,5 +230,6 @@ class TaskRunner(QObject):
         if task in self.tasks:
             self.tasks.remove(task)
         task.deleteLater()
+        self.foreground_idle.set_open(not self.busy)
         self.finished.emit(task)
         self.busyChanged.emit(bool(self.tasks))

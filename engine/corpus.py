@@ -29,6 +29,7 @@ from .formats import (
     read_textgrid_tiers,
     validate_phones,
 )
+from .hash_memo import folder_key, memoized_hash
 
 log = logging.getLogger(__name__)
 
@@ -269,15 +270,22 @@ class Corpus:
 
     def fingerprint(self) -> str:
         """A hash of the description and every data file (names and contents), for caching
-        models; computed once per corpus object."""
+        models; computed once per corpus object, and known from the files' stamps alone when
+        they are unchanged since an earlier computation (:mod:`engine.hash_memo`)."""
         if "fingerprint" not in self._memo:
-            h = hashlib.sha256()
-            h.update(json.dumps(self.info.to_json(), sort_keys=True).encode())
-            for p in sorted(self.data_root.iterdir()):
-                if p.is_file() and p.name != "corpus.json":
+            description = json.dumps(self.info.to_json(), sort_keys=True)
+            files = [p for p in sorted(self.data_root.iterdir())
+                     if p.is_file() and p.name != "corpus.json"]
+
+            def contents() -> str:
+                h = hashlib.sha256(description.encode())
+                for p in files:
                     h.update(p.name.encode())
                     h.update(p.read_bytes())
-            self._memo["fingerprint"] = h.hexdigest()[:16]
+                return h.hexdigest()[:16]
+
+            self._memo["fingerprint"] = memoized_hash(folder_key(self.data_root), files, contents,
+                                                      extra=description)
         return self._memo["fingerprint"]
 
 

@@ -5,10 +5,8 @@ between original and synthesized trajectories (Table 2, Figure 5).
 from __future__ import annotations
 
 import logging
-import multiprocessing as mp
 import os
 from collections.abc import Callable, Iterable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -302,7 +300,11 @@ def _evaluate(model: Model, corpus: Corpus, splits: list[str], configs: list[Syn
     ids = [(sp, u) for sp in splits for u in getattr(corpus.info, sp)]
     result = EvalResult()
     workers = min(workers, len(ids))
+    import multiprocessing as mp  # here: the app's first frame scores one utterance only
+
     if workers > 1 and "fork" in mp.get_all_start_methods():
+        from concurrent.futures import ProcessPoolExecutor
+
         state = (model, corpus, configs, smoothings, eval_config)
         with ProcessPoolExecutor(workers, mp.get_context("fork"), initializer=_worker_init,
                                  initargs=(state,)) as pool:

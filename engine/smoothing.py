@@ -1,12 +1,14 @@
 """Smoothing of synthesized PC trajectories (paper section 2.3): a 100 ms triangular window, or a
 cubic spline.
+
+Both are computed in numpy (:func:`convolve_nearest`, :func:`not_a_knot_spline`; tested equal to
+``scipy.ndimage.convolve1d`` and ``scipy.interpolate.CubicSpline``): importing those scipy
+modules takes longer than the app's whole synthesis of its first utterance (issue #15).
 """
 
 from __future__ import annotations
 
 import numpy as np
-from scipy.interpolate import CubicSpline
-from scipy.ndimage import convolve1d
 
 
 def triangular_window(rate: float, width_s: float = 0.1) -> np.ndarray:
@@ -26,10 +28,83 @@ def triangular_window(rate: float, width_s: float = 0.1) -> np.ndarray:
     return w / w.sum()
 
 
+def convolve_nearest(x: np.ndarray, window: np.ndarray) -> np.ndarray:
+    """``x`` convolved along axis 0 with a symmetric odd-length ``window``, the edges extended
+    with the end values (``scipy.ndimage.convolve1d(x, window, axis=0, mode="nearest")``).
+
+    >>> convolve_nearest(np.array([0.0, 0.0, 3.0]), np.ones(3) / 3).tolist()
+    [0.0, 1.0, 2.0]
+    """
+    x = np.asarray(x, dtype=np.float64)
+    half = len(window) // 2
+    padded = np.concatenate([np.repeat(x[:1], half, axis=0), x, np.repeat(x[-1:], half, axis=0)])
+    out = np.zeros_like(x)
+    for k, w in enumerate(window):
+        out += w * padded[k:k + len(x)]
+    return out
+
+
 def triangular_smooth(x: np.ndarray, rate: float, width_s: float = 0.1) -> np.ndarray:
     """Zero-phase triangular moving average along axis 0 (edges extended with the end values)."""
-    return convolve1d(np.asarray(x, dtype=np.float64), triangular_window(rate, width_s), axis=0,
-                      mode="nearest")
+    return convolve_nearest(x, triangular_window(rate, width_s))
+
+
+def not_a_knot_spline(knots: np.ndarray, values: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """The not-a-knot cubic spline through ``(knots, values)`` (along axis 0 of ``values``)
+    evaluated at ``at`` (within the knots): ``scipy.interpolate.CubicSpline(knots, values,
+    axis=0, bc_type="not-a-knot")(at)``. Two knots give a line, three a parabola.
+
+    >>> not_a_knot_spline(np.arange(5.0), np.arange(5.0) ** 3, np.array([1.5, 2.5])).round(9).tolist()
+    [3.375, 15.625]
+    """
+    x = np.asarray(knots, dtype=np.float64)
+    y = np.asarray(values, dtype=np.float64)
+    dx = np.diff(x).reshape(-1, *([1] * (y.ndim - 1)))
+    slope = np.diff(y, axis=0) / dx
+    n = len(x)
+    if n == 2:
+        s = np.stack([slope[0], slope[0]])
+    elif n == 3:
+        a = np.array([[1.0, 1.0, 0.0],
+                      [dx[1].item(), 2.0 * (dx[0] + dx[1]).item(), dx[0].item()],
+                      [0.0, 1.0, 1.0]])
+        b = np.stack([2 * slope[0], 3 * (dx[0] * slope[1] + dx[1] * slope[0]), 2 * slope[1]])
+        s = np.linalg.solve(a, b.reshape(3, -1)).reshape(b.shape)
+    else:
+        s = _not_a_knot_slopes(dx, slope)
+    i = np.clip(np.searchsorted(x, at, side="right") - 1, 0, n - 2)
+    t = (np.asarray(at, dtype=np.float64) - x[i]).reshape(-1, *([1] * (y.ndim - 1)))
+    h = dx[i]
+    c2 = (3 * slope[i] - 2 * s[i] - s[i + 1]) / h
+    c3 = (s[i] + s[i + 1] - 2 * slope[i]) / h ** 2
+    return ((c3 * t + c2) * t + s[i]) * t + y[i]
+
+
+def _not_a_knot_slopes(dx: np.ndarray, slope: np.ndarray) -> np.ndarray:
+    """The spline's slopes at four or more knots: the tridiagonal system of
+    ``scipy.interpolate.CubicSpline`` (continuous second derivative inside, not-a-knot at both
+    ends), solved by elimination without pivoting (its pivots stay positive)."""
+    n = len(dx) + 1
+    lower = np.empty((n, *dx.shape[1:]))      # lower[i]: the coefficient of s[i - 1] in row i
+    diag = np.empty_like(lower)
+    upper = np.empty_like(lower)              # upper[i]: the coefficient of s[i + 1] in row i
+    rhs = np.empty((n, *slope.shape[1:]))
+    d0, d1 = dx[0] + dx[1], dx[-2] + dx[-1]
+    diag[0], upper[0] = dx[1], d0
+    rhs[0] = ((dx[0] + 2 * d0) * dx[1] * slope[0] + dx[0] ** 2 * slope[1]) / d0
+    lower[1:-1], diag[1:-1], upper[1:-1] = dx[1:], 2 * (dx[:-1] + dx[1:]), dx[:-1]
+    rhs[1:-1] = 3 * (dx[1:] * slope[:-1] + dx[:-1] * slope[1:])
+    lower[-1], diag[-1] = d1, dx[-2]
+    rhs[-1] = (dx[-1] ** 2 * slope[-2] + (2 * d1 + dx[-1]) * dx[-2] * slope[-1]) / d1
+    for i in range(1, n):                     # forward elimination
+        f = lower[i] / diag[i - 1]
+        diag[i] = diag[i] - f * upper[i - 1]
+        rhs[i] = rhs[i] - f * rhs[i - 1]
+    s = np.empty_like(rhs)
+    s[-1] = rhs[-1] / diag[-1]
+    for i in range(n - 2, -1, -1):            # back substitution
+        s[i] = (rhs[i] - upper[i] * s[i + 1]) / diag[i]
+    return s
 
 
 def spline_smooth(x: np.ndarray, rate: float, knot_s: float = 0.1) -> np.ndarray:
@@ -49,9 +124,8 @@ def spline_smooth(x: np.ndarray, rate: float, knot_s: float = 0.1) -> np.ndarray
     if knots[-1] != n - 1:
         knots = np.append(knots, n - 1)
     box = np.ones(step | 1) / (step | 1)
-    local = convolve1d(x, box, axis=0, mode="nearest")
-    spline = CubicSpline(knots, local[knots], axis=0, bc_type="not-a-knot")
-    return spline(np.arange(n))
+    local = convolve_nearest(x, box)
+    return not_a_knot_spline(knots, local[knots], np.arange(n))
 
 
 def smooth(x: np.ndarray, rate: float, method: str = "triangular", width_s: float = 0.1,

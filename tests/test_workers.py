@@ -48,3 +48,30 @@ def test_a_task_that_ignores_cancel_is_detached_not_destroyed(qtbot):
     release.set()
     qtbot.waitUntil(task.isFinished, timeout=10_000)
     assert failures == []
+
+
+def test_background_work_waits_while_foreground_work_runs(qtbot):
+    """``foreground_idle``: closed while a foreground task runs (not for background ones); a
+    background task waiting on it goes on once the foreground work is done."""
+    owner = QObject()
+    runner = TaskRunner(owner)
+    release = threading.Event()
+    order: list[str] = []
+
+    def sweep(progress) -> None:
+        progress.wait_open(runner.foreground_idle)
+        order.append("background")
+
+    runner.run(sweep, None, "sweep", background=True)
+    qtbot.waitUntil(lambda: not runner.tasks, timeout=10_000)    # nothing in the foreground yet
+    assert runner.foreground_idle.is_open and order == ["background"]
+    runner.run(lambda progress: (release.wait(30), order.append("foreground")), None, "synthesis")
+    assert not runner.foreground_idle.is_open
+    waiting = runner.run(sweep, None, "sweep", background=True)
+    qtbot.wait(100)
+    assert order == ["background"] and runner.running(waiting)
+    release.set()
+    qtbot.waitUntil(lambda: not runner.tasks, timeout=10_000)
+    assert order == ["background", "foreground", "background"]
+    assert runner.foreground_idle.is_open
+    runner.close()
