@@ -367,7 +367,8 @@ class Timeline(QWidget):
         hi = min(fig_box.x1, max(x_old, x_new) + 3)
         self._cursor_x = x_new
         strip = Bbox([[np.floor(lo), fig_box.y0], [np.ceil(hi), fig_box.y1]])
-        self.canvas.restore_region(self._bg, bbox=strip, xy=(strip.x0, strip.y0))
+        # xy is where the saved region's lower-left corner goes (the figure's), not the strip's
+        self.canvas.restore_region(self._bg, bbox=strip, xy=(fig_box.x0, fig_box.y0))
         self._draw_cursor(x_new)
         self.canvas.blit(strip)
 

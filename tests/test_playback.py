@@ -162,8 +162,26 @@ def test_the_cursor_is_drawn_in_every_panel_at_its_time(window):
     for ax in timeline.axes:
         x, _ = ax.transData.transform((t, 0))
         y_mid = (ax.bbox.y0 + ax.bbox.y1) / 2
-        column = rgba[int(height - y_mid), int(x) - 1:int(x) + 2, :3].astype(float)
-        assert np.min(np.abs(column - want).sum(axis=1)) < 60, ax
+        row = int(height - y_mid)
+        column = rgba[row, int(x) - 1:int(x) + 2, :3].astype(float)
+        beside = rgba[row, int(x) + 12, :3].astype(float)       # the panel without the cursor
+        on = np.min(np.abs(column - want).sum(axis=1))          # a 1.2 px line: partly blended
+        assert on < 100 and on < 0.5 * np.abs(beside - want).sum(), ax
+
+
+@gui
+@pytest.mark.gui
+def test_a_moved_cursor_leaves_no_trace(window):
+    """After the cursor moves on by blitting, the figure is pixel for pixel what a full draw
+    with the cursor at its new time gives: the old cursor and its strip are restored in place."""
+    timeline = window.timeline
+    window.seek(0.30 * window.view.duration)
+    window.seek(0.34 * window.view.duration)
+    blitted = np.asarray(timeline.canvas.buffer_rgba()).copy()
+    timeline.canvas.draw()                     # the reference: a full draw, cursor drawn anew
+    timeline.set_cursor(0.34 * window.view.duration)
+    drawn = np.asarray(timeline.canvas.buffer_rgba())
+    assert (blitted != drawn).any(axis=2).sum() <= 2 * len(timeline.axes)   # cursor-end pixels
 
 
 @gui
