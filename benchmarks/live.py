@@ -26,6 +26,7 @@ import numpy as np
 
 from engine.config import SynthConfig
 from engine.streaming import LIVE_BATCH_FRAMES, StreamConfig, StreamingSynthesizer
+from engine.threads import one_blas_thread
 
 from .common import BenchContext, BenchRow, concatenate_input, load_context, markdown_table
 
@@ -61,6 +62,13 @@ def _stream(model, audio: np.ndarray, rate: int, block_s: float, batch: int = LI
 
 
 def run(ctx: BenchContext) -> list[BenchRow]:
+    """The live rows, on one BLAS thread as live mode runs (``app.live.run_live``,
+    ``facetraj live -o``)."""
+    with one_blas_thread():
+        return _run(ctx)
+
+
+def _run(ctx: BenchContext) -> list[BenchRow]:
     model = ctx.model
     seconds = 5.0 if ctx.smoke else 30.0
     audio, rate, _ = concatenate_input(ctx.test_utts or ctx.train_utts, seconds)

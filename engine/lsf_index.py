@@ -161,8 +161,9 @@ class LsfIndex:
             flat = cells.ravel()
             by_cell = np.argsort(flat, kind="stable")
             bounds = np.searchsorted(flat[by_cell], np.arange(self.n_cells + 1))
-            for c in np.flatnonzero((np.diff(bounds) > 0) & (sizes > 0)):   # opened, not empty
-                lo, hi = self.offsets[c], self.offsets[c + 1]
+            offsets, bounds = self.offsets.tolist(), bounds.tolist()      # Python ints: cheap
+            for c in np.flatnonzero((np.diff(bounds) > 0) & (sizes > 0)).tolist():   # opened
+                lo, hi = offsets[c], offsets[c + 1]
                 step = max(1, int(4e6 // ((hi - lo) * order)))   # bound the (f, size, P) temporary
                 for r0 in range(bounds[c], bounds[c + 1], step):
                     pairs = by_cell[r0:min(r0 + step, bounds[c + 1])]

@@ -57,10 +57,10 @@ class StreamConfig:
             raise ValueError(f"batch_frames must be an integer from 1 to 60, not {self.batch_frames!r}")
 
 
-#: the frame batch of live mode (``facetraj live`` and the Live window): 4 frames at 60 Hz add
-#: at most 50 ms to the lookahead (112.5 ms in all, under the 150 ms aim of issue 13) and make the
+#: the frame batch of live mode (``facetraj live`` and the Live window): 5 frames at 60 Hz add
+#: at most 67 ms to the lookahead (129.2 ms in all, under the 150 ms aim of issue 13) and make the
 #: 10 ms-block stream about 3 times faster (docs/benchmarks.md)
-LIVE_BATCH_FRAMES = 4
+LIVE_BATCH_FRAMES = 5
 
 
 @dataclass
@@ -182,7 +182,7 @@ class StreamingSynthesizer:
 
     def _window_start(self, t: int) -> int:
         """The first analysis sample of frame t's window (may be negative: zeros before)."""
-        return int(frame_starts(np.array([t / self.rate]), self._audio_rate)[0]) - self._half
+        return int(round(t / self.rate * self._audio_rate)) - self._half   # frame_starts, on a scalar
 
     def _analyse(self, stop: int, length: int) -> np.ndarray:
         """Raw PCs (eqs 5-8) of frames ``self._next .. stop-1``; analysis samples at or beyond

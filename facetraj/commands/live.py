@@ -50,18 +50,20 @@ def stream_file(model, audio: np.ndarray, rate: int, cfg, block_s: float,
     """Markers ``(T, M, 3)`` of ``audio`` streamed in blocks of ``block_s`` seconds, paced to the
     audio clock when ``real_time``; and the wall time it took."""
     from engine.streaming import LIVE_BATCH_FRAMES, StreamConfig, StreamingSynthesizer
+    from engine.threads import one_blas_thread
 
     stream = StreamingSynthesizer(model, StreamConfig(rate, cfg, LIVE_BATCH_FRAMES))
     block = max(1, int(round(block_s * rate)))
     parts = []
     t0 = time.perf_counter()
-    for a in range(0, len(audio), block):
-        if real_time:                                   # the block's last sample "arrives" now
-            delay = t0 + min(a + block, len(audio)) / rate - time.perf_counter()
-            if delay > 0:
-                time.sleep(delay)
-        parts.append(stream.feed(audio[a:a + block]).markers)
-    parts.append(stream.flush().markers)
+    with one_blas_thread():                             # small products: threads only cost
+        for a in range(0, len(audio), block):
+            if real_time:                               # the block's last sample "arrives" now
+                delay = t0 + min(a + block, len(audio)) / rate - time.perf_counter()
+                if delay > 0:
+                    time.sleep(delay)
+            parts.append(stream.feed(audio[a:a + block]).markers)
+        parts.append(stream.flush().markers)
     return np.concatenate(parts), time.perf_counter() - t0
 
 
