@@ -23,7 +23,8 @@ from engine.model import Model
 from engine.pipeline import Synthesis
 
 from .style import BACKGROUND, CURSOR_COLOR, ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
-from .view3d import CAMERA_PRESETS, MarkerSet, face_triangles, lip_contours
+from .surface import face_triangles, lip_contours
+from .view3d import CAMERA_PRESETS, MarkerSet
 
 log = logging.getLogger(__name__)
 

@@ -14,13 +14,13 @@ import pyvista as pv
 from PyQt6.QtCore import QPoint
 from PyQt6.QtGui import QCursor, QImage, QPainter, QPixmap
 from PyQt6.QtWidgets import QToolTip, QVBoxLayout, QWidget
-from scipy.spatial import Delaunay
 
 from engine.model import Model
 
 from .plotter_widget import is_native, make_plotter
 from .state import UtteranceView
 from .style import BACKGROUND, ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
+from .surface import lip_contours, stored_face_triangles
 
 log = logging.getLogger(__name__)
 
@@ -32,83 +32,6 @@ CAMERA_PRESETS: dict[str, tuple[tuple[float, float, float], tuple[float, float, 
     "profile": ((-1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
     "three-quarter": ((-0.6, 0.12, 1.0), (0.0, 1.0, 0.0)),
 }
-
-
-def lip_contours(neutral: np.ndarray, upper: int, lower: int, corners: list[int]) -> list[list[int]]:
-    """Upper and lower lip contour polylines (marker indices, corner to corner), found from the
-    neutral face: the markers between the corners that lie close to each lip centre's height."""
-    if len(corners) != 2:
-        return [[upper, lower]]
-    xs = neutral[corners, 0]
-    x_lo, x_hi = float(xs.min()), float(xs.max())
-    y_c = float(neutral[corners, 1].mean())
-    lines = []
-    for centre, sign in ((upper, 1.0), (lower, -1.0)):
-        height = abs(float(neutral[centre, 1]) - y_c) + 1e-6
-        picked = []
-        for i, (x, y, _z) in enumerate(neutral):
-            if i in corners or not x_lo + 1.0 < x < x_hi - 1.0:
-                continue
-            if 0.15 * height <= (y - y_c) * sign <= 1.5 * height:
-                picked.append(i)
-        if centre not in picked:
-            picked.append(centre)
-        left, right = sorted(corners, key=lambda i: neutral[i, 0])
-        lines.append([left, *sorted(picked, key=lambda i: neutral[i, 0]), right])
-    return lines
-
-
-def unroll(points: np.ndarray) -> np.ndarray:
-    """The face unrolled onto a plane, ``(M, 2)``: arc length around a vertical axis behind the
-    face (x centred, z = front - 0.6 x width; z points forward) and height y. Markers that turn
-    away from the viewer (jaw line, temples) stay beside the cheeks instead of folding onto them."""
-    xc = float(np.median(points[:, 0]))
-    zc = float(points[:, 2].max()) - 0.6 * float(np.ptp(points[:, 0]))
-    dx, dz = points[:, 0] - xc, points[:, 2] - zc
-    radius = float(np.median(np.hypot(dx, dz)))
-    return np.column_stack([radius * np.arctan2(dx, dz), points[:, 1]])
-
-
-def face_triangles(neutral: np.ndarray, contours: list[list[int]], alpha: float = 2.5) -> np.ndarray:
-    """Triangles ``(n, 3)`` of a face surface over the markers.
-
-    2-D Delaunay triangulation of the neutral face unrolled around a vertical axis
-    (:func:`unroll`), without the mouth opening (triangles joining upper- and lower-lip contour
-    markers only), and peeled from the outline: a triangle whose side on the outline is longer
-    than ``alpha`` times the marker spacing at both its ends (each end's nearest-neighbour
-    distance) bridges a notch of the outline and is removed, repeatedly (as an alpha shape
-    does). Midsagittal (2-D) data, or markers not spanning the x-y plane, have no surface: no
-    triangles.
-    """
-    if len(neutral) < 4 or np.ptp(neutral[:, 0]) == 0 or np.ptp(neutral[:, 1]) == 0:
-        return np.zeros((0, 3), dtype=int)
-    uv = unroll(neutral)
-    delaunay = Delaunay(uv)
-    tri, neighbours = delaunay.simplices, delaunay.neighbors
-    a, b, c = uv[tri[:, 0]], uv[tri[:, 1]], uv[tri[:, 2]]
-    sides = np.stack([np.linalg.norm(b - c, axis=1), np.linalg.norm(c - a, axis=1),
-                      np.linalg.norm(a - b, axis=1)], axis=1)
-    area = 0.5 * np.abs((b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0])
-    keep = area > 1e-9 * float(np.ptp(uv[:, 0]) * np.ptp(uv[:, 1]))         # no degenerate slivers
-    if len(contours) == 2:
-        up, lo = set(contours[0]), set(contours[1])
-        lips = up | lo
-        keep &= ~np.array([set(t) <= lips and bool(set(t) & (up - lo)) and bool(set(t) & (lo - up))
-                           for t in tri.tolist()])
-    # the local marker spacing: each marker's distance to its nearest Delaunay neighbour
-    spacing = np.full(len(uv), np.inf)
-    for k in range(3):                                      # side k is opposite vertex k
-        for v in ((k + 1) % 3, (k + 2) % 3):
-            np.minimum.at(spacing, tri[:, v], sides[:, k])
-    ends = np.stack([np.maximum(spacing[tri[:, (k + 1) % 3]], spacing[tri[:, (k + 2) % 3]])
-                     for k in range(3)], axis=1)
-    too_long = sides > alpha * ends
-    while True:
-        outside = np.append(~keep, True)[neighbours]           # neighbour -1: the hull
-        peel = keep & (outside & too_long).any(axis=1)
-        if not peel.any():
-            return tri[keep]
-        keep &= ~peel
 
 
 def _fill_nan(markers: np.ndarray, fallback: np.ndarray) -> np.ndarray:
@@ -232,7 +155,7 @@ class FaceView(QWidget):
         neutral = model.neutral_face()
         self.neutral = neutral
         self.contours = lip_contours(neutral, model.upper_lip, model.lower_lip, list(model.lip_corners))
-        tri = face_triangles(neutral, self.contours)
+        tri = stored_face_triangles(neutral, self.contours)
         self.synth = MarkerSet(self.plotter, "synthesized", SYNTH_COLOR, neutral, self.contours, tri)
         self.original = MarkerSet(self.plotter, "original", ORIGINAL_COLOR, neutral, self.contours, None)
         width = float(np.ptp(neutral[:, 0]))

@@ -8,7 +8,7 @@ import pytest
 
 pytest.importorskip("pyvistaqt")
 
-from app.view3d import face_triangles, lip_contours, unroll
+from app.surface import face_triangles, lip_contours, unroll
 
 
 def _pieces(tri: np.ndarray) -> int:
@@ -96,3 +96,36 @@ def test_notch_in_the_outline_is_peeled():
 def test_no_surface_for_midsagittal_data():
     flat = np.column_stack([np.zeros(6), np.arange(6.0), np.arange(6.0) ** 2])   # x constant
     assert face_triangles(flat, [[0, 1], [2, 3]]).shape == (0, 3)
+
+
+def test_the_triangulation_is_stored_and_read_back(tmp_path, monkeypatch, default_model):
+    """stored_face_triangles: made once and kept in the cache folder; read back without
+    triangulating; a damaged or foreign file is made again, a folder that cannot be written
+    only costs the triangulation."""
+    from app import surface
+
+    monkeypatch.setenv("FACETRAJ_CACHE_DIR", str(tmp_path / "cache"))
+    neutral = default_model.neutral_face()
+    contours = lip_contours(neutral, default_model.upper_lip, default_model.lower_lip,
+                            list(default_model.lip_corners))
+    made = surface.stored_face_triangles(neutral, contours)
+    np.testing.assert_array_equal(made, face_triangles(neutral, contours))
+    [stored] = (tmp_path / "cache" / "surfaces").glob("*.npy")
+
+    def no_triangulation(*_a, **_k):
+        raise AssertionError("triangulated again")
+
+    monkeypatch.setattr(surface, "face_triangles", no_triangulation)
+    np.testing.assert_array_equal(surface.stored_face_triangles(neutral, contours), made)
+    monkeypatch.undo()
+    monkeypatch.setenv("FACETRAJ_CACHE_DIR", str(tmp_path / "cache"))
+    for damage in (b"not a numpy file", None):
+        if damage is None:
+            np.save(stored, np.full((4, 3), len(neutral) + 5))       # indices beyond the face
+        else:
+            stored.write_bytes(damage)
+        np.testing.assert_array_equal(surface.stored_face_triangles(neutral, contours), made)
+        np.testing.assert_array_equal(np.load(stored), made)           # and stored right again
+    (tmp_path / "blocked").write_text("a file where the cache folder should be")
+    monkeypatch.setenv("FACETRAJ_CACHE_DIR", str(tmp_path / "blocked"))
+    np.testing.assert_array_equal(surface.stored_face_triangles(neutral, contours), made)

@@ -28,7 +28,7 @@ from PyQt6.QtWidgets import (
 
 from app.plotter_widget import make_plotter
 from app.style import BACKGROUND, SURFACE_COLOR, SYNTH_COLOR
-from app.view3d import face_triangles, lip_contours
+from app.surface import face_triangles, lip_contours
 from engine.analysis.pc_modes import describe_mode, mode_displacement, mode_sd, variance_shares
 from engine.model import Model
 
