@@ -216,6 +216,24 @@ def chebyshev_real_roots(c: np.ndarray, grid: int = ROOT_GRID, tol: float = 1e-9
     return out
 
 
+def lsf_chebyshev_series(p_rows: np.ndarray, q_rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The Chebyshev series in ``x = cos w`` (``(B, P/2 + 1)``, lowest first) whose roots are the
+    LSFs of P(z) and of Q(z) (rows of :func:`_sum_difference`, even order P): the trivial root
+    (z = -1 of P, z = +1 of Q) divided out, the symmetric rest folded into a cosine series."""
+    order = p_rows.shape[1] - 2
+    half = order // 2
+    chebs = []
+    for poly, sign in ((p_rows, -1.0), (q_rows, 1.0)):
+        # divide by (1 - sign z^-1): g_k = p_k + sign g_(k-1); degree P, symmetric
+        g = np.empty((poly.shape[0], order + 1))
+        g[:, 0] = poly[:, 0]
+        for k in range(1, order + 1):
+            g[:, k] = poly[:, k] + sign * g[:, k - 1]
+        # cosine series: g_half + 2 sum_k g_(half-k) cos(k w) -> Chebyshev coefficients
+        chebs.append(np.concatenate([g[:, half:half + 1], 2.0 * g[:, half - 1::-1]], axis=1))
+    return chebs[0], chebs[1]
+
+
 def poly2lsf(a: np.ndarray) -> np.ndarray:
     """LSF in radians, ascending in (0, pi), of LPC polynomials ``a`` (``(..., P+1)``, ``a0 = 1``).
 
@@ -235,16 +253,7 @@ def poly2lsf(a: np.ndarray) -> np.ndarray:
     lead, order, p_rows, q_rows = _sum_difference(a)
     if order % 2 or order < 2:
         return _poly2lsf_companion(a)
-    half = order // 2
-    chebs = []
-    for poly, sign in ((p_rows, -1.0), (q_rows, 1.0)):
-        # divide by (1 - sign z^-1): g_k = p_k + sign g_(k-1); degree P, symmetric
-        g = np.empty((poly.shape[0], order + 1))
-        g[:, 0] = poly[:, 0]
-        for k in range(1, order + 1):
-            g[:, k] = poly[:, k] + sign * g[:, k - 1]
-        # cosine series: g_half + 2 sum_k g_(half-k) cos(k w) -> Chebyshev coefficients
-        chebs.append(np.concatenate([g[:, half:half + 1], 2.0 * g[:, half - 1::-1]], axis=1))
+    chebs = lsf_chebyshev_series(p_rows, q_rows)
     n = p_rows.shape[0]
     out = np.empty((n, order))
     for a0 in range(0, n, _ROOT_CHUNK):                            # a chunk's arrays stay in cache

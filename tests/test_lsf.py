@@ -100,18 +100,10 @@ def test_resampling_to_16k():
 
 def _cheb_rows(a):
     """The Chebyshev rows poly2lsf solves (P and Q with the trivial roots divided out)."""
-    from engine.lsf import _sum_difference
+    from engine.lsf import _sum_difference, lsf_chebyshev_series
 
-    _, order, p_rows, q_rows = _sum_difference(a)
-    half = order // 2
-    rows = []
-    for poly, sign in ((p_rows, -1.0), (q_rows, 1.0)):
-        g = np.empty((poly.shape[0], order + 1))
-        g[:, 0] = poly[:, 0]
-        for k in range(1, order + 1):
-            g[:, k] = poly[:, k] + sign * g[:, k - 1]
-        rows.append(np.concatenate([g[:, half:half + 1], 2.0 * g[:, half - 1::-1]], axis=1))
-    return np.concatenate(rows)
+    _, _, p_rows, q_rows = _sum_difference(a)
+    return np.concatenate(lsf_chebyshev_series(p_rows, q_rows))
 
 
 def test_fast_root_kernel_equals_colleague_eigenvalues():
