@@ -207,6 +207,23 @@ def write_json(path: str | os.PathLike[str], data: object, overwrite: bool = Tru
     return path
 
 
+def read_json(path: str | os.PathLike[str]) -> object | None:
+    """The JSON value in the file at ``path`` (what :func:`write_json` wrote), or ``None`` when
+    there is no such file.
+
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> read_json(write_json(folder / "r.json", {"r": 0.87})), read_json(folder / "none.json")
+    ({'r': 0.87}, None)
+    """
+    import json
+
+    path = Path(path)
+    if not path.is_file():
+        return None
+    return json.loads(path.read_text(encoding="utf-8"))
+
+
 # --------------------------------------------------------------------------- labels
 def _read_text(path: Path) -> str:
     if not path.exists():

@@ -11,7 +11,6 @@ all scored as Table 2 (triangular smoothing, speech frames).
 
 from __future__ import annotations
 
-import json
 import logging
 import os
 from collections.abc import Callable, Sequence
@@ -24,7 +23,7 @@ from .baselines import evaluate_baselines, fit_baselines, frame_data
 from .config import SynthConfig, TrainConfig
 from .corpus import Corpus
 from .evaluation import METRICS, UtteranceScore, evaluate_utterance, speech_mask
-from .formats import write_json
+from .formats import read_json, write_json
 from .labelling import RelabelledCorpus, relabelled
 from .model import Model
 from .pipeline import synthesize
@@ -192,10 +191,8 @@ def write_label_eval(path: str | os.PathLike[str], result: LabelEval) -> Path:
 
 def read_label_eval(path: str | os.PathLike[str]) -> LabelEval | None:
     """The saved evaluation at ``path``, or ``None`` when there is none."""
-    path = Path(path)
-    if not path.is_file():
-        return None
-    return LabelEval.from_json(json.loads(path.read_text(encoding="utf-8")))
+    data = read_json(path)
+    return None if data is None else LabelEval.from_json(data)
 
 
 def mean_sd(v: tuple[float, float]) -> str:

@@ -13,7 +13,6 @@ Everything is scored as Table 2 (triangular smoothing, speech frames of the orig
 
 from __future__ import annotations
 
-import json
 import logging
 import os
 from collections.abc import Callable
@@ -25,7 +24,7 @@ import numpy as np
 from .config import SynthConfig, TrainConfig
 from .corpus import Corpus
 from .evaluation import METRICS, UtteranceScore, evaluate_utterance, speech_mask
-from .formats import write_json
+from .formats import read_json, write_json
 from .label_eval import mean_sd
 from .model import Model
 from .pipeline import synthesize
@@ -169,10 +168,8 @@ def write_voice_eval(path: str | os.PathLike[str], result: VoiceEval) -> Path:
 
 def read_voice_eval(path: str | os.PathLike[str]) -> VoiceEval | None:
     """The saved evaluation at ``path``, or ``None`` when there is none."""
-    path = Path(path)
-    if not path.is_file():
-        return None
-    return VoiceEval.from_json(json.loads(path.read_text(encoding="utf-8")))
+    data = read_json(path)
+    return None if data is None else VoiceEval.from_json(data)
 
 
 # --------------------------------------------------------------------------- the report's text
