@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .config import SynthConfig
-from .lsf import ResampleStream, frame_lsf, frame_starts, preemphasize
+from .lsf import ResampleStream, frame_lsf, frame_start, frame_starts, preemphasize
 from .model import Model
 from .pipeline import acoustic_candidates
 from .smoothing import TriangularStream
@@ -182,7 +182,7 @@ class StreamingSynthesizer:
 
     def _window_start(self, t: int) -> int:
         """The first analysis sample of frame t's window (may be negative: zeros before)."""
-        return int(round(t / self.rate * self._audio_rate)) - self._half   # frame_starts, on a scalar
+        return frame_start(t / self.rate, self._audio_rate) - self._half
 
     def _analyse(self, stop: int, length: int) -> np.ndarray:
         """Raw PCs (eqs 5-8) of frames ``self._next .. stop-1``; analysis samples at or beyond
