@@ -5,6 +5,7 @@ from the roots of the sum and difference polynomials.
 from __future__ import annotations
 
 from functools import lru_cache
+from itertools import pairwise
 
 import numpy as np
 
@@ -134,21 +135,22 @@ def colleague_eigenvalues(c: np.ndarray) -> np.ndarray:
 
 #: grid of the root bracketing in :func:`chebyshev_real_roots`: cells of pi/128 rad in w
 ROOT_GRID = 128
-#: frames per :func:`chebyshev_real_roots` call in :func:`poly2lsf`
-_ROOT_CHUNK = 512
+#: most frames per :func:`chebyshev_real_roots` call in :func:`poly2lsf` (equal chunks)
+_ROOT_CHUNK = 1024
 
 
 def _clenshaw(c: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Value and derivative of the Chebyshev series rows ``c`` (``(R, m+1)``) at ``x`` (``(R,)``),
-    by Clenshaw's recurrence ``b_k = c_k + 2x b_(k+1) - b_(k+2)`` and its derivative."""
-    m = c.shape[1] - 1
+    """Value and derivative of Chebyshev series at ``x`` (``(R,)``), coefficient ``k`` of every
+    series in row ``c[k]`` (``(m+1, R)``: the rows are contiguous), by Clenshaw's recurrence
+    ``b_k = c_k + 2x b_(k+1) - b_(k+2)`` and its derivative."""
+    m = c.shape[0] - 1
     x2 = 2.0 * x
-    b1, b2 = c[:, m].copy(), np.zeros_like(x)
+    b1, b2 = c[m].copy(), np.zeros_like(x)
     d1, d2 = np.zeros_like(x), np.zeros_like(x)
     for k in range(m - 1, 0, -1):
         d1, d2 = 2.0 * b1 + x2 * d1 - d2, d1
-        b1, b2 = c[:, k] + x2 * b1 - b2, b1
-    return c[:, 0] + x * b1 - b2, b1 + x * d1 - d2
+        b1, b2 = c[k] + x2 * b1 - b2, b1
+    return c[0] + x * b1 - b2, b1 + x * d1 - d2
 
 
 @lru_cache(maxsize=8)
@@ -173,8 +175,9 @@ def chebyshev_real_roots(c: np.ndarray, grid: int = ROOT_GRID, tol: float = 1e-9
     Each row is evaluated on ``x = cos(w)`` for ``grid + 1`` angles ``w`` in [0, pi] (one matrix
     product); each sign change brackets one root, which Newton's method (Clenshaw values and
     derivatives, bisection when a step leaves the bracket) polishes until a Newton step is below
-    ``tol`` (the step after it would be of order ``tol^2``, at rounding level). A row with fewer
-    than ``m`` sign changes (two roots closer than a grid cell) or a root not polished in
+    ``tol`` (the step after it would be of order ``tol^2``, at rounding level); a polished root
+    leaves the iteration, so its value does not depend on the other rows of the call. A row with
+    fewer than ``m`` sign changes (two roots closer than a grid cell) or a root not polished in
     ``max_iter`` steps is solved by the reference instead: the eigenvalues of its colleague matrix
     (:func:`colleague_eigenvalues`). Tested equal to the reference to 1e-12.
 
@@ -193,8 +196,9 @@ def chebyshev_real_roots(c: np.ndarray, grid: int = ROOT_GRID, tol: float = 1e-9
     lo, hi = xg[cells + 1], xg[cells]                              # x descends as w ascends
     f_lo, f_hi = values[rows, cells + 1], values[rows, cells]
     x = lo + (hi - lo) * (f_lo / (f_lo - f_hi))                    # regula falsi start
-    cr, neg_lo = c[rows], f_lo < 0
-    done = np.zeros(x.shape, dtype=bool)
+    cr, neg_lo = np.ascontiguousarray(c.T)[:, rows], f_lo < 0
+    roots = np.empty(x.shape)
+    live = np.arange(x.size)                                       # the roots not yet polished
     for _ in range(max_iter):
         f, fp = _clenshaw(cr, x)
         above = (f < 0) == neg_lo                                  # the root is above x
@@ -205,12 +209,18 @@ def chebyshev_real_roots(c: np.ndarray, grid: int = ROOT_GRID, tol: float = 1e-9
         done = np.abs(step) <= tol
         new = x - step
         x = np.where(done | ((new >= lo) & (new <= hi)), new, 0.5 * (lo + hi))
+        roots[live[done]] = x[done]
         if done.all():
+            live = live[:0]
             break
+        if done.any():                                             # iterate on the rest only
+            more = ~done
+            live, x, lo, hi = live[more], x[more], lo[more], hi[more]
+            neg_lo, cr = neg_lo[more], cr[:, more]
     out = np.empty((n_rows, m))
-    out[whole] = x.reshape(-1, m)
+    out[whole] = roots.reshape(-1, m)
     redo = ~whole
-    redo[rows[~done]] = True
+    redo[rows[live]] = True
     if redo.any():
         out[redo] = -np.sort(-colleague_eigenvalues(c[redo]).real, axis=1)
     return out
@@ -256,8 +266,8 @@ def poly2lsf(a: np.ndarray) -> np.ndarray:
     chebs = lsf_chebyshev_series(p_rows, q_rows)
     n = p_rows.shape[0]
     out = np.empty((n, order))
-    for a0 in range(0, n, _ROOT_CHUNK):                            # a chunk's arrays stay in cache
-        b0 = min(a0 + _ROOT_CHUNK, n)
+    bounds = np.linspace(0, n, -(-n // _ROOT_CHUNK) + 1).astype(int).tolist()
+    for a0, b0 in pairwise(bounds):                                # a chunk's arrays stay in cache
         x = chebyshev_real_roots(np.concatenate([chebs[0][a0:b0], chebs[1][a0:b0]]))
         both = np.arccos(np.clip(x, -1.0, 1.0))
         out[a0:b0] = np.sort(np.concatenate([both[:b0 - a0], both[b0 - a0:]], axis=1), axis=1)

@@ -106,10 +106,11 @@ class LsfIndex:
         return np.asarray(cb_lsf, dtype=np.float64)[self.order]
 
     def _cell_lsf(self, cb_lsf: np.ndarray, grouped: np.ndarray | None) -> np.ndarray:
-        """:meth:`grouped` in float32 for the search, made once per codebook array."""
+        """:meth:`grouped` transposed, ``(P, 5L)``, in float32 for the search, made once per
+        codebook array: a cell's codewords are the columns ``offsets[c]:offsets[c + 1]``."""
         if self._search_lsf is None or self._search_lsf[0] is not cb_lsf:
             src = self.grouped(cb_lsf) if grouped is None else grouped
-            self._search_lsf = (cb_lsf, np.asarray(src, dtype=np.float32))
+            self._search_lsf = (cb_lsf, np.ascontiguousarray(np.asarray(src, dtype=np.float32).T))
         return self._search_lsf[1]
 
     def nearest(self, w: np.ndarray, cb_lsf: np.ndarray, count: int, probe: int,
@@ -121,9 +122,10 @@ class LsfIndex:
         is raised when the opened cells could hold fewer than ``count`` codewords; probing every
         cell finds the exact nearest. The distances are computed cell by cell, for all the frames
         of a chunk that open the cell at once, so the cell's codewords are a slice, not a gather,
-        and in float32 (half the memory traffic of the search's largest arrays; the distances
-        only rank the codewords: eqs 5-8 are computed again in float64 on the ``count`` found).
-        ``grouped`` may pass :meth:`grouped` of ``cb_lsf``, computed once.
+        laid out ``(P, size)`` so that the innermost loops run along the cell's codewords, and in
+        float32 (half the memory traffic of the search's largest arrays; the distances only rank
+        the codewords: eqs 5-8 are computed again in float64 on the ``count`` found). ``grouped``
+        may pass :meth:`grouped` of ``cb_lsf``, computed once.
 
         Examples
         --------
@@ -140,43 +142,49 @@ class LsfIndex:
         count = min(count, self.n_codewords)
         probe = min(max(probe, self.min_probe(count)), self.n_cells)
         sizes = self.sizes
-        cell_lsf = self._cell_lsf(cb_lsf, grouped)                        # codewords by cell
+        cell_lsf = self._cell_lsf(cb_lsf, grouped)                        # (P, 5L) by cell
         width_max = int(np.sort(sizes)[-probe:].sum())
         chunk = chunk or max(1, min(1024, int(4e6 // max(self.n_cells * order, width_max))))
         out = np.empty((n_frames, count), dtype=np.int64)
+        centroids = np.ascontiguousarray(self.centroids.T, dtype=np.float32)     # (P, C)
         for a in range(0, n_frames, chunk):
             b = min(a + chunk, n_frames)
             h = perceptual_weights(np.asarray(w[a:b], dtype=np.float64)).astype(np.float32)
             wc = np.asarray(w[a:b], dtype=np.float32)                            # eq 5
-            dc = np.matmul(np.abs(wc[:, None, :] - self.centroids.astype(np.float32)),
-                           h[:, :, None])[..., 0]
+            dc = wc[:, :, None] - centroids                                      # (t, P, C)
+            np.abs(dc, out=dc)
+            dc = np.matmul(h[:, None, :], dc)[:, 0]                              # eq 5, (t, C)
             cells = (np.argpartition(dc, probe - 1, axis=1)[:, :probe] if probe < self.n_cells
                      else np.broadcast_to(np.arange(self.n_cells), dc.shape))
             sz = sizes[cells]                                                    # (t, probe)
             ends = np.cumsum(sz, axis=1)               # each opened cell's block in its row ends
             starts = ends - sz                          # and starts here
-            col0 = starts.ravel()
             width = int(ends[:, -1].max())
-            d = np.full((b - a) * width, np.inf, dtype=np.float32)   # row t: its cells side by side
+            # row t: its cells side by side; a cell's block starts at t * width + starts[t, slot]
+            at = (np.arange(b - a)[:, None] * width + starts).ravel()
+            d = np.full((b - a) * width, np.inf, dtype=np.float32)
             flat = cells.ravel()
             by_cell = np.argsort(flat, kind="stable")
             bounds = np.searchsorted(flat[by_cell], np.arange(self.n_cells + 1))
             offsets, bounds = self.offsets.tolist(), bounds.tolist()      # Python ints: cheap
             for c in np.flatnonzero((np.diff(bounds) > 0) & (sizes > 0)).tolist():   # opened
                 lo, hi = offsets[c], offsets[c + 1]
-                step = max(1, int(4e6 // ((hi - lo) * order)))   # bound the (f, size, P) temporary
+                step = max(1, int(4e6 // ((hi - lo) * order)))   # bound the (f, P, size) temporary
                 for r0 in range(bounds[c], bounds[c + 1], step):
                     pairs = by_cell[r0:min(r0 + step, bounds[c + 1])]
                     rows = pairs // probe
-                    block = np.matmul(np.abs(wc[rows, None, :] - cell_lsf[lo:hi]),
-                                      h[rows, :, None])[..., 0]                 # eq 5, (f, size)
-                    d[(rows * width + col0[pairs])[:, None] + np.arange(hi - lo)] = block
+                    diff = wc[rows, :, None] - cell_lsf[:, lo:hi]                # (f, P, size)
+                    np.abs(diff, out=diff)
+                    block = np.matmul(h[rows, None, :], diff)[:, 0]              # eq 5, (f, size)
+                    d[at[pairs][:, None] + np.arange(hi - lo)] = block
             d = d.reshape(b - a, width)
             cols = (np.argpartition(d, count - 1, axis=1)[:, :count] if count < width
                     else np.broadcast_to(np.arange(width), (b - a, width)))
-            # column -> (which opened cell, place in it) -> codebook index
-            slot = (cols[:, :, None] >= ends[:, None, :]).sum(axis=2)
+            # column -> (which opened cell, place in it) -> codebook index: the block ends of all
+            # rows, each row shifted by its offset, ascend, so one search finds every column's cell
             rows = np.arange(b - a)[:, None]
+            slot = np.searchsorted((ends + rows * width).ravel(), (cols + rows * width).ravel(),
+                                   side="right").reshape(cols.shape) - rows * probe
             within = cols - starts[rows, slot]
             out[a:b] = self.order[self.offsets[cells[rows, slot]] + within]
         return out

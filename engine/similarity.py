@@ -143,34 +143,65 @@ def top_contexts(n: np.ndarray, count: int) -> np.ndarray:
 
 def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, xi: float,
                        context: int | None, count: int) -> tuple[np.ndarray, np.ndarray]:
-    """Eq 4 then :func:`top_contexts`, without scoring every codebook context for every query.
+    """Eq 4 then :func:`top_contexts`, without scoring every codebook context for every query:
+    the fast kernel of the pair (the reference).
 
     The context terms of eq 4 add at most ``B = 2 sum_i xi^-i`` (similarities are <= 1), so a
     codebook context whose centre similarity is below ``S_max - B`` (``S_max`` the query centre's
     best centre similarity in the codebook) can never outrank one whose centre reaches ``S_max``.
-    Queries are grouped by centre phone and scored only against the contexts that can win; the
-    result (including the lower-index-first tie order) is that of the full computation. Groups
-    with fewer than ``count`` contexts reaching ``S_max`` fall back to the full scoring.
+    Each query is scored only against the contexts that can win (all of them when fewer than
+    ``count`` reach ``S_max``), every query at once: the pairs side by side in one flat array, each
+    term ``xi^-i S`` looked up in a table of the weighted similarities and the terms added in
+    :func:`context_similarity`'s order, so the scores are its scores to the bit; then the
+    ``count``-th best score of each query (a partition) and a sort of the few scores reaching it.
+    The result, including the lower-index-first tie order, is that of the full computation
+    (tested).
 
     Returns ``(top, scores)``, both ``(Q, count)``.
+
+    >>> s = np.array([[1.0, 0.5], [0.5, 1.0]])
+    >>> top, n = top_context_phones(np.array([[0, 0, 1]]), np.array([[1, 0, 1], [0, 0, 0]]), s,
+    ...                             10.0, 1, 1)
+    >>> top.tolist(), n.round(6).tolist()        # both score 1.15: the lower index first
+    ([[0]], [[1.15]])
     """
     q = np.atleast_2d(np.asarray(query))
+    n_q, n_cb, n_ph = q.shape[0], codebook.shape[0], s.shape[0]
     full = (q.shape[1] - 1) // 2
     c = full if context is None else min(context, full)
     bound = 2.0 * sum(xi ** (-i) for i in range(1, c + 1))
-    centres = codebook[:, full]
-    count = min(count, codebook.shape[0])
-    top = np.empty((q.shape[0], count), dtype=np.int64)
-    scores = np.empty((q.shape[0], count))
-    for centre in np.unique(q[:, full]):
-        rows = np.flatnonzero(q[:, full] == centre)
-        sim = s[centre, centres]
-        best = sim.max()
-        cand = np.flatnonzero(sim >= best - bound - 1e-12)
-        if (sim >= best).sum() < count:
-            cand = np.arange(codebook.shape[0])
-        n = context_similarity(q[rows], codebook[cand], s, xi, c)
-        order = top_contexts(n, count)
-        top[rows] = cand[order]
-        scores[rows] = np.take_along_axis(n, order, axis=1)
-    return top, scores
+    count = min(count, n_cb)
+    # the contexts that can win, per distinct query centre u: cand_all[u_start[u]:][:u_size[u]]
+    centres, inverse = np.unique(q[:, full], return_inverse=True)
+    sim = s[centres][:, codebook[:, full]]                                  # (U, L)
+    best = sim.max(axis=1, keepdims=True)
+    keep = sim >= best - bound - 1e-12
+    keep[np.count_nonzero(sim >= best, axis=1) < count] = True
+    u_size = np.count_nonzero(keep, axis=1)
+    cand_all = np.nonzero(keep)[1]
+    # every (query, context) pair, query by query: pair p is query rows[p] and context cand[p]
+    sizes = u_size[inverse]
+    ends = np.cumsum(sizes)
+    starts = ends - sizes
+    rows = np.repeat(np.arange(n_q), sizes)
+    place = np.arange(ends[-1]) - np.repeat(starts, sizes)                  # within its query
+    cand = cand_all[np.repeat((np.cumsum(u_size) - u_size)[inverse], sizes) + place]
+    # eq 4's terms xi^-i S[query phone, context phone], added column by column
+    cols = np.arange(full - c, full + c + 1)
+    tables = (context_weights(c, xi)[:, None, None] * s).ravel()            # (2c+1) x n x n
+    at = np.take(q.T[cols] * n_ph + (np.arange(len(cols)) * n_ph * n_ph)[:, None], rows, axis=1)
+    at += np.take(codebook.T[cols], cand, axis=1)
+    terms = tables.take(at)
+    n = terms[0].copy()
+    for term in terms[1:]:
+        n += term
+    # the count best of each query: its count-th best score, then the few pairs reaching it
+    width = int(sizes.max())
+    grid = np.full((n_q, width), -np.inf)
+    grid.ravel()[rows * width + place] = n
+    kth = np.partition(grid, width - count, axis=1)[:, width - count]
+    r, k = np.nonzero(grid >= kth[:, None])                                # ties included
+    order = np.lexsort((k, -grid[r, k], r))                # by query, best first, lower index first
+    r, k = r[order], k[order]
+    k = k[np.searchsorted(r, np.arange(n_q))[:, None] + np.arange(count)]
+    return cand[starts[:, None] + k], np.take_along_axis(grid, k, axis=1)

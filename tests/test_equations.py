@@ -182,7 +182,7 @@ def test_grid_weights_equal_eq6_for_every_gamma():
 
 @pytest.mark.parametrize("count", [1, 3, 12])
 def test_pruned_eq4_search_equals_scoring_every_context(count):
-    """top_context_phones (pruned by the centre bound, all queries in one sort) returns exactly
+    """top_context_phones (pruned by the centre bound, all queries at once) returns exactly
     the full eq 4 ranking: the same contexts, scores and lower-index-first ties; phone 4 has
     fewer than 12 contexts at its best centre similarity (the unpruned path)."""
     from engine.similarity import context_similarity, top_context_phones, top_contexts
