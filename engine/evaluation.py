@@ -5,7 +5,6 @@ between original and synthesized trajectories (Table 2, Figure 5).
 from __future__ import annotations
 
 import logging
-import os
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass, field
 
@@ -16,7 +15,7 @@ from .corpus import Corpus
 from .data import Utterance
 from .model import Model
 from .pipeline import Synthesis, resmooth, synthesize
-from .threads import one_blas_thread
+from .threads import limit_frame_threads, one_blas_thread, usable_cores
 
 log = logging.getLogger(__name__)
 
@@ -264,15 +263,13 @@ def _worker_init(state: tuple) -> None:
 
 def _worker_score(split: str, utt_id: str) -> list[UtteranceScore]:
     assert _WORKER_STATE is not None
-    return _score_utterance(*_WORKER_STATE[:2], split, utt_id, *_WORKER_STATE[2:])
+    with limit_frame_threads(1):        # as evaluate() does (the worker may run in a new context)
+        return _score_utterance(*_WORKER_STATE[:2], split, utt_id, *_WORKER_STATE[2:])
 
 
 def default_workers() -> int:
     """Worker processes for :func:`evaluate` by default: the cores this process may use."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:                          # not on Linux
-        return max(1, os.cpu_count() or 1)
+    return usable_cores()
 
 
 def evaluate(model: Model, corpus: Corpus, splits: Iterable[str] = ("train", "test"),
@@ -287,9 +284,11 @@ def evaluate(model: Model, corpus: Corpus, splits: Iterable[str] = ("train", "te
     is shared, not copied through pickle); each utterance is independent, and the scores come
     back in corpus order, equal to the serial run's. BLAS runs on one thread either way
     (:mod:`engine.threads`): the processes share the cores, and the serial run computes the same
-    sums in the same order.
+    sums in the same order; and each utterance is synthesized on one frame thread
+    (:func:`engine.threads.limit_frame_threads`), in the serial run too, so that the scores do not
+    depend on ``workers`` even at rounding level.
     """
-    with one_blas_thread():
+    with one_blas_thread(), limit_frame_threads(1):
         return _evaluate(model, corpus, list(splits), list(configs or [SynthConfig()]),
                          list(smoothings), eval_config, progress, workers)
 

@@ -9,6 +9,8 @@ from itertools import pairwise
 
 import numpy as np
 
+from .threads import map_spans
+
 #: white-noise correction added to r[0] (a -40 dB noise floor) so that LPC of near-silent or
 #: perfectly periodic frames stays well conditioned.
 WHITE_NOISE_CORRECTION = 1e-4
@@ -439,10 +441,13 @@ def frame_lsf(frames: np.ndarray, order: int) -> np.ndarray:
 
 def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
            window_s: float = 0.025, audio_rate: int = 16000,
-           preemphasis: float = 0.97) -> np.ndarray:
+           preemphasis: float = 0.97, threads: int | None = 1) -> np.ndarray:
     """LSF vectors ``(len(times), order)`` from 25 ms Hamming frames centred on ``times``.
 
-    The audio is resampled to ``audio_rate`` first (the paper analyses 16 kHz speech).
+    The audio is resampled to ``audio_rate`` first (the paper analyses 16 kHz speech). The frames
+    are analysed in ``threads`` spans at once (``None``: :func:`engine.threads.frame_threads`).
+    The LSFs equal one thread's to rounding: BLAS's matrix products (autocorrelation lags, the
+    root bracketing grid) may add a row's terms in another order for another number of rows.
 
     Examples
     --------
@@ -457,4 +462,5 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     x = resample_audio(x, rate, audio_rate)
     frames = analysis_frames(x, audio_rate, np.asarray(times, dtype=np.float64), window_s,
                              preemphasis)
-    return frame_lsf(frames, order)
+    return np.concatenate(map_spans(lambda a, b: frame_lsf(frames[a:b], order), len(frames),
+                                    threads))

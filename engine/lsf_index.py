@@ -116,7 +116,8 @@ class LsfIndex:
     def nearest(self, w: np.ndarray, cb_lsf: np.ndarray, count: int, probe: int,
                 chunk: int | None = None, grouped: np.ndarray | None = None) -> np.ndarray:
         """The ``count`` codewords nearest to each frame by eq 5, among the members of the
-        ``probe`` cells whose centroids are nearest by eq 5; ``(T, count)`` codebook indices.
+        ``probe`` cells whose centroids are nearest by eq 5; ``(T, count)`` codebook indices,
+        ascending.
 
         ``w`` is ``(T, P)`` input LSFs, ``cb_lsf`` the codebook the index was built on. ``probe``
         is raised when the opened cells could hold fewer than ``count`` codewords; probing every
@@ -187,6 +188,7 @@ class LsfIndex:
                                    side="right").reshape(cols.shape) - rows * probe
             within = cols - starts[rows, slot]
             out[a:b] = self.order[self.offsets[cells[rows, slot]] + within]
+        out.sort(axis=1)            # in codebook order: the same whatever frames share a call
         return out
 
 

@@ -104,11 +104,13 @@ class Model:
         coeffs[component] = value
         return self.pca.inverse(coeffs).reshape(self.n_markers, 3)
 
-    def input_lsf(self, audio: np.ndarray, sample_rate: int, times: np.ndarray) -> np.ndarray:
-        """The input LSF vectors w (eq 5) at ``times``, analysed as in training, ``(T, P)``."""
+    def input_lsf(self, audio: np.ndarray, sample_rate: int, times: np.ndarray,
+                  threads: int | None = 1) -> np.ndarray:
+        """The input LSF vectors w (eq 5) at ``times``, analysed as in training, ``(T, P)``, in
+        ``threads`` spans of frames (``None``: :func:`engine.threads.frame_threads`)."""
         mc = self.config
         return lsf_at(audio, sample_rate, times, mc.lpc_order, mc.window_s, mc.audio_rate,
-                      mc.preemphasis)
+                      mc.preemphasis, threads)
 
     def lsf_index(self) -> LsfIndex:
         """The coarse LSF index of the codebook (``engine.lsf_index``), built here and kept if the

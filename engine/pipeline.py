@@ -25,6 +25,7 @@ from .similarity import top_context_phones
 from .smoothing import smooth
 from .speaker import choose_warp, warp_lsf
 from .synthesis import FrameWeights, gamma_grid, nearest_codewords, weight_frames
+from .threads import frame_threads, map_spans
 
 log = logging.getLogger(__name__)
 
@@ -132,8 +133,9 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                          f"the audio is too short ({duration * 1000:.1f} ms) to synthesize")
     times = np.arange(n_frames) / rate
     mc = model.config
+    threads = frame_threads()
     if lsf is None:
-        w = model.input_lsf(audio, sample_rate, times)
+        w = model.input_lsf(audio, sample_rate, times, threads)
     elif lsf.shape != (n_frames, mc.lpc_order):
         raise ValueError(f"lsf must be ({n_frames}, {mc.lpc_order}) for these frames, got {lsf.shape}")
     else:
@@ -166,11 +168,16 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                                np.array([-mc.lsf_context_frames, mc.lsf_context_frames]),
                                config.context_weight)
             return _finish(model, times, w, fw, config, segments, frame_seg, warp)
+
+        def span(a: int, b: int) -> FrameWeights:
+            return weight_frames(w[a:b], candidates[a:b], cb.lsf, cb.pcs, _gammas(config))
     elif config.mode == "acoustic":
-        candidates = acoustic_candidates(model, w, config)
+        def span(a: int, b: int) -> FrameWeights:
+            return weight_frames(w[a:b], acoustic_candidates(model, w[a:b], config), cb.lsf,
+                                 cb.pcs, _gammas(config))
     else:
         raise ValueError(f"unknown mode {config.mode!r} (phonetic, acoustic or robust)")
-    fw = weight_frames(w, candidates, cb.lsf, cb.pcs, _gammas(config))
+    fw = FrameWeights.concatenate(map_spans(span, n_frames, threads))    # frames independent
     return _finish(model, times, w, fw, config, segments, frame_seg, warp)
 
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -119,6 +119,20 @@ class FrameWeights:
     candidates: np.ndarray
     lsf_hat: np.ndarray
     error: np.ndarray
+
+    @classmethod
+    def concatenate(cls, parts: list[FrameWeights]) -> FrameWeights:
+        """The frames of ``parts`` one after another (spans of frames weighted apart).
+        Candidates that every frame shares (a broadcast row: the whole codebook) stay one row."""
+        if len(parts) == 1:
+            return parts[0]
+        joined = {f.name: np.concatenate([getattr(p, f.name) for p in parts])
+                  for f in fields(cls) if f.name != "candidates"}
+        cands = [p.candidates for p in parts]
+        if all(c.strides[0] == 0 and np.array_equal(c[0], cands[0][0]) for c in cands):
+            n = sum(len(c) for c in cands)
+            return cls(**joined, candidates=np.broadcast_to(cands[0][0], (n, cands[0].shape[1])))
+        return cls(**joined, candidates=np.concatenate(cands))
 
 
 def weight_frames(w: np.ndarray, candidates: np.ndarray, cb_lsf: np.ndarray, cb_pcs: np.ndarray,

@@ -1,4 +1,5 @@
-"""How many threads numpy's BLAS may use.
+"""How many threads numpy's BLAS may use, and how many threads synthesis splits its frames
+between.
 
 OpenBLAS keeps a thread per core and lets idle ones spin while they wait for work. Our matrix
 products are small (frames x codewords), so a second BLAS thread buys little, and when the cores
@@ -6,13 +7,40 @@ are busy (the evaluation's worker processes, the app's synthesis beside its rend
 programs) the spinning threads take the cores from the work: a whole-codebook synthesis measured
 0.65 s of CPU with one BLAS thread and 2.2-10.5 s with two, on the 2-core machine under load
 (docs/benchmarks.md). Work that runs beside other work therefore uses one BLAS thread.
+
+Synthesis parallelises above BLAS instead: its per-frame stages (the LSF analysis, the LSF index
+search, eqs 5-8) are independent from frame to frame, and numpy releases the interpreter lock
+inside its array operations, so contiguous spans of frames run in threads, one per usable core
+(:func:`frame_threads`), each frame computed as it would be alone. The rule for how many lives
+here, once.
 """
 
 from __future__ import annotations
 
+import contextlib
+import os
+from collections.abc import Callable, Iterator
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import AbstractContextManager
+from contextvars import ContextVar
+from itertools import pairwise
+from typing import TypeVar
 
 from threadpoolctl import threadpool_limits
+
+T = TypeVar("T")
+
+#: environment variable that sets the frame threads (a positive integer) in place of the cores
+THREADS_ENV = "FACETRAJ_THREADS"
+#: the fewest frames a thread is given: below 2 s of 60 Hz frames per thread, a thread's start
+#: and the interpreter lock cost more than the split saves (docs/benchmarks.md)
+MIN_FRAMES_PER_THREAD = 120
+#: at most this many frame threads, whatever the machine
+MAX_FRAME_THREADS = 8
+
+_limit: ContextVar[int | None] = ContextVar("frame_thread_limit", default=None)
+#: the frame threads' pool and its size, made when first needed
+_pool: tuple[ThreadPoolExecutor, int] | None = None
 
 
 def one_blas_thread() -> AbstractContextManager:
@@ -25,3 +53,72 @@ def one_blas_thread() -> AbstractContextManager:
     3.0
     """
     return threadpool_limits(limits=1, user_api="blas")
+
+
+def usable_cores() -> int:
+    """The cores this process may run on (its CPU affinity where the OS tells it)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:                          # not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def frame_threads() -> int:
+    """How many threads synthesis splits its frames between: the limit set by
+    :func:`limit_frame_threads` in this thread, else ``$FACETRAJ_THREADS``, else the usable cores
+    (at most :data:`MAX_FRAME_THREADS`).
+
+    >>> with limit_frame_threads(1):
+    ...     frame_threads()
+    1
+    """
+    limit = _limit.get()
+    if limit is not None:
+        return limit
+    env = os.environ.get(THREADS_ENV, "").strip()
+    if env.isdigit() and int(env) > 0:
+        return min(int(env), MAX_FRAME_THREADS)
+    return min(usable_cores(), MAX_FRAME_THREADS)
+
+
+@contextlib.contextmanager
+def limit_frame_threads(n: int) -> Iterator[None]:
+    """Synthesis in this thread (and its context) uses at most ``n`` frame threads until the end
+    of the ``with`` block: for work that already runs one process per core (the evaluation)."""
+    token = _limit.set(max(1, int(n)))
+    try:
+        yield
+    finally:
+        _limit.reset(token)
+
+
+def frame_spans(n_frames: int, threads: int | None = None) -> list[tuple[int, int]]:
+    """``n_frames`` cut into contiguous ``(start, stop)`` spans, one per thread (``threads``,
+    default :func:`frame_threads`), none shorter than :data:`MIN_FRAMES_PER_THREAD` frames.
+
+    >>> frame_spans(1000, 2), frame_spans(150, 2), frame_spans(0, 2)
+    ([(0, 500), (500, 1000)], [(0, 150)], [(0, 0)])
+    """
+    threads = frame_threads() if threads is None else threads
+    k = max(1, min(threads, n_frames // MIN_FRAMES_PER_THREAD))
+    cuts = [n_frames * i // k for i in range(k + 1)]
+    return list(pairwise(cuts))
+
+
+def map_spans(fn: Callable[[int, int], T], n_frames: int, threads: int | None = None) -> list[T]:
+    """``fn(start, stop)`` for each of :func:`frame_spans`, in threads when there are several;
+    the results in span order. An exception in a span is raised here. (The threads' matrix
+    products are small: callers run BLAS on one thread, as the app, the CLI's synthesis and the
+    evaluation do, :func:`one_blas_thread`.)
+
+    >>> map_spans(lambda a, b: b - a, 1000, 2)
+    [500, 500]
+    """
+    spans = frame_spans(n_frames, threads)
+    if len(spans) == 1:
+        return [fn(*spans[0])]
+    global _pool
+    if _pool is None or _pool[1] < len(spans):
+        _pool = (ThreadPoolExecutor(len(spans), thread_name_prefix="facetraj-frames"), len(spans))
+    futures = [_pool[0].submit(fn, a, b) for a, b in spans]
+    return [f.result() for f in futures]
