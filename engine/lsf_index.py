@@ -179,8 +179,7 @@ class LsfIndex:
                     block = np.matmul(h[rows, None, :], diff)[:, 0]              # eq 5, (f, size)
                     d[at[pairs][:, None] + np.arange(hi - lo)] = block
             d = d.reshape(b - a, width)
-            cols = (np.argpartition(d, count - 1, axis=1)[:, :count] if count < width
-                    else np.broadcast_to(np.arange(width), (b - a, width)))
+            cols = _smallest(d, count)
             # column -> (which opened cell, place in it) -> codebook index: the block ends of all
             # rows, each row shifted by its offset, ascend, so one search finds every column's cell
             rows = np.arange(b - a)[:, None]
@@ -190,6 +189,25 @@ class LsfIndex:
             out[a:b] = self.order[self.offsets[cells[rows, slot]] + within]
         out.sort(axis=1)            # in codebook order: the same whatever frames share a call
         return out
+
+
+def _smallest(d: np.ndarray, count: int) -> np.ndarray:
+    """Columns of the ``count`` smallest values of each row of ``d``, ascending (of equal values
+    at the edge, the first columns): the ``count``-th smallest value of each row by a partition
+    (values only: faster than ``argpartition``), then the columns at or below it.
+
+    >>> _smallest(np.array([[5.0, 1.0, 3.0, 1.0], [0.0, 9.0, 9.0, 9.0]]), 2).tolist()
+    [[1, 3], [0, 1]]
+    """
+    rows, width = d.shape
+    if count >= width:
+        return np.broadcast_to(np.arange(width), (rows, width))
+    kth = np.partition(d, count - 1, axis=1)[:, count - 1]
+    r, cols = np.nonzero(d <= kth[:, None])
+    if len(r) > rows * count:                                  # ties at the edge: the first ones
+        first = np.searchsorted(r, np.arange(rows))
+        cols = cols[np.arange(len(r)) - first[r] < count]
+    return cols.reshape(rows, count)
 
 
 def default_cells(n_codewords: int) -> int:

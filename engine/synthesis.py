@@ -136,7 +136,7 @@ class FrameWeights:
 
 
 def weight_frames(w: np.ndarray, candidates: np.ndarray, cb_lsf: np.ndarray, cb_pcs: np.ndarray,
-                  gammas: np.ndarray, chunk: int = 256) -> FrameWeights:
+                  gammas: np.ndarray, chunk: int = 1024) -> FrameWeights:
     """Eqs 5-8 for every frame: distances to its candidate codewords, gamma searched on
     ``gammas`` to minimise ``sum_k h_k |w_k - w-hat_k|``, and ``p-hat = sum_i v_i F_i``.
 
