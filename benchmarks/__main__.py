@@ -21,7 +21,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from engine.threads import one_blas_thread
+from engine.threads import limit_frame_threads, one_blas_thread
 
 from . import labels, live, scaling, startup, synth, train
 from .common import (
@@ -87,7 +87,8 @@ def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS, factors: Sequence[i
             rows += synth.run(ctx)
             rows += synth.stages(ctx, 2.0 if ctx.smoke else synth.STAGE_SECONDS, 2 if ctx.smoke else 7)
     if "scaling" in only:
-        rows += scaling.run(ctx, factors, prefilters)
+        with limit_frame_threads(1):              # how the search grows, on one core
+            rows += scaling.run(ctx, factors, prefilters)
     if "eval" in only:
         rows += startup.evaluation(ctx)
     if "labels" in only:

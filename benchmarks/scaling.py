@@ -12,7 +12,8 @@ PCs + 5 % of each PC's standard deviation), which keeps the codeword density rea
 index is rebuilt (timed on its own row). The accuracy cost of a search is the correlation between
 its synthesized trajectories and the full search's on the same input (1 = identical), averaged over
 the moving coordinates as in the "whole face" figure, and, for the x1 codebook, the whole-face
-correlation with the original markers on test utterances, scored as in Table 2.
+correlation with the original markers on test utterances, scored as in Table 2. It runs on one
+frame thread (``make bench`` limits it): how a search grows with the codebook, on one core.
 """
 
 from __future__ import annotations

@@ -43,15 +43,19 @@ def test_smoke_table(toy: Path, tmp_path: Path, capsys) -> None:
         assert name in text, name
 
 
-def test_smoke_rows_positive_finite(toy: Path) -> None:
+def test_smoke_rows_positive_finite(toy: Path, monkeypatch) -> None:
     from benchmarks.__main__ import run_all
     from benchmarks.common import load_context
+    from engine.threads import THREADS_ENV
 
+    monkeypatch.setenv(THREADS_ENV, "2")
     ctx = load_context(toy, smoke=True)
     rows = run_all(ctx, ("train", "synth", "scaling"))
     groups = {r.group for r in rows}
     assert groups == {"train", "synth", "scaling", "stages"}
-    assert sum(r.group == "synth" for r in rows) == 4          # 2 modes x 2 durations
+    synth = [r.name for r in rows if r.group == "synth"]     # 2 modes x 2 durations, each also
+    assert len(synth) == 8                                    # on one frame thread
+    assert sum(name.endswith(", one frame thread") for name in synth) == 4
     for mode in ("phonetic", "acoustic"):                     # the stages add up to the call
         parts = [r.value for r in rows if r.group == "stages" and r.name.startswith(mode)
                  and not r.name.endswith("whole call")]
