@@ -512,8 +512,7 @@ class MainWindow(QMainWindow):
     def save_screenshot(self, path: Path) -> Path:
         """Render the whole window (with the 3-D view) to a PNG."""
         self.face.rerender()
-        self.timeline.canvas.draw()     # a full draw: the canvas holds the cursor's blits
-        mark("screenshot: timeline drawn")
+        self.timeline.ensure_drawn()
         pix = self.grab()
         self.face.paint_into(pix, self)
         path = Path(path)

@@ -312,6 +312,14 @@ class Timeline(QWidget):
         current); if not, the next move asks for a full draw."""
         return self._bg is not None
 
+    def ensure_drawn(self) -> None:
+        """Bring the canvas up to date for a picture of it (a screenshot): a full draw only when
+        the last one is stale (never drawn, resized, zoomed, loop range changed). Otherwise the
+        canvas already holds that draw with the cursor blitted at ``cursor_time``, pixel for
+        pixel what a new full draw gives (``test_a_moved_cursor_leaves_no_trace``)."""
+        if not self.cursor_ready or tuple(self.figure.bbox.bounds) != self._bg_bounds:
+            self.canvas.draw()
+
     def _request_draw(self) -> None:
         """A full draw at the next idle moment (layout, zoom, loop range): the saved background
         is stale until then, so the cursor waits for it."""
