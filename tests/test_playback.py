@@ -224,6 +224,18 @@ def test_a_screenshot_uses_the_panels_as_drawn(window, tmp_path, monkeypatch):
 
 @gui
 @pytest.mark.gui
+def test_a_new_scene_renders_once(window):
+    """Building the scene for a model adds five meshes and renders the finished scene once (a
+    render per mesh was four renders too many on the first frame's path)."""
+    face = window.face
+    renders = []
+    face.plotter.ren_win.AddObserver("EndEvent", lambda *_: renders.append(1))
+    face.set_model(window.model)
+    assert len(renders) == 1
+
+
+@gui
+@pytest.mark.gui
 def test_a_frame_update_moves_the_points_in_place_with_one_render(window, qtbot):
     from PyQt6.QtWidgets import QApplication
 
