@@ -11,8 +11,9 @@ from pathlib import Path
 from engine.cachedir import cache_dir
 from engine.config import TrainConfig
 from engine.corpus import Corpus
-from engine.errors import ModelFileError
+from engine.errors import InputError, ModelFileError
 from engine.model import Model
+from engine.model_file import is_compressed
 from engine.progress import Progress
 
 log = logging.getLogger(__name__)
@@ -32,6 +33,18 @@ def cached_model_path(corpus: Corpus, config: TrainConfig | None = None) -> Path
     return cache_dir() / f"model-{model_key(corpus.fingerprint(), config)}.npz"
 
 
+def _store_uncompressed(model: Model, path: Path) -> None:
+    """A cached model written compressed by an older facetraj is written again as
+    :meth:`Model.save` writes it now (uncompressed: later starts skip inflating it)."""
+    if not is_compressed(path):
+        return
+    try:
+        model.save(path)
+        log.info("cached model %s stored uncompressed", path)
+    except (OSError, InputError) as exc:
+        log.info("cached model %s left compressed (%s)", path, exc)
+
+
 def load_or_train(corpus: Corpus, config: TrainConfig | None = None,
                   progress: Progress | None = None) -> Model:
     """The cached model of ``corpus``, training and caching it on the first call."""
@@ -44,6 +57,7 @@ def load_or_train(corpus: Corpus, config: TrainConfig | None = None,
             progress(0.5, f"loading cached model {path.name}")
             model = Model.load(path)
             log.info("loaded cached model %s", path)
+            _store_uncompressed(model, path)
             progress(1.0, "model loaded")
             return model
         except ModelFileError as exc:

@@ -75,14 +75,39 @@ def long_lived_objects() -> Iterator[None]:
             gc.enable()
 
 
+@contextmanager
+def matplotlib_without_property_docs() -> Iterator[None]:
+    """A block that imports matplotlib (if nothing did before) without its property tables.
+
+    While it is first imported, matplotlib writes the docstring of each artist class's ``set``
+    and of the plotting methods that pass properties on: tables of every settable property
+    (``matplotlib.artist.kwdoc``), about 0.2 s of the window's imports (issue #15), for
+    ``help()`` text the app never shows. Within this block ``kwdoc`` gives an empty text; the
+    ``set`` signatures, the properties and everything drawn are unchanged. Once matplotlib is
+    imported the block does nothing.
+    """
+    if "matplotlib.figure" in sys.modules:
+        yield
+        return
+    import matplotlib.artist
+
+    kwdoc = matplotlib.artist.kwdoc
+    matplotlib.artist.kwdoc = lambda _artist: ""
+    try:
+        yield
+    finally:
+        matplotlib.artist.kwdoc = kwdoc
+
+
 def build_window(corpus: Path | str | None, model: Path | None = None, utterance: str | None = None,
                  time: float | None = None, use_audio: bool | None = None):
     """The main window as users get it: with the analysis views and the import/export entries.
 
     A view set that fails to install is logged and left out; the window still opens.
     """
-    from . import analysis, live, own_data
-    from .main_window import MainWindow
+    with matplotlib_without_property_docs():
+        from . import analysis, live, own_data
+        from .main_window import MainWindow
 
     mark("window modules imported")
     window = MainWindow(None if corpus is None else Path(corpus), model_path=model, utterance=utterance,

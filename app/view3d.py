@@ -54,7 +54,8 @@ def _fill_nan(markers: np.ndarray, fallback: np.ndarray) -> np.ndarray:
 
 
 class MarkerSet:
-    """One marker set in the scene: points, lip lines, optionally a surface, all sharing points."""
+    """One marker set in the scene: points, lip lines, optionally a surface, all sharing points.
+    Adding them renders nothing (the owner renders the finished scene once)."""
 
     def __init__(self, plotter: pv.BasePlotter, name: str, color: str, neutral: np.ndarray,
                  contours: list[list[int]], triangles: np.ndarray | None):
@@ -64,12 +65,12 @@ class MarkerSet:
         self.actor = plotter.add_mesh(self.points, color=color, render_points_as_spheres=True,
                                       point_size=11, style="points", name=f"{name}-points",
                                       reset_camera=False, lighting=True, pickable=False,
-                                      ambient=0.3, diffuse=0.8)
+                                      ambient=0.3, diffuse=0.8, render=False)
         self.lines = pv.PolyData()
         self.lines.SetPoints(self.points.GetPoints())
         self.lines.lines = np.concatenate([[len(c), *c] for c in contours])
         self.line_actor = plotter.add_mesh(self.lines, color=color, line_width=3, name=f"{name}-lips",
-                                           reset_camera=False, pickable=False)
+                                           reset_camera=False, pickable=False, render=False)
         self.surface_actor = None
         self._inset: np.ndarray | None = None
         if triangles is not None and len(triangles):
@@ -90,7 +91,7 @@ class MarkerSet:
             self.surface_actor = plotter.add_mesh(self.surface, color=SURFACE_COLOR, opacity=1.0,
                                                   smooth_shading=False, name=f"{name}-surface",
                                                   reset_camera=False, pickable=False,
-                                                  specular=0.1, ambient=0.3, diffuse=0.75)
+                                                  specular=0.1, ambient=0.3, diffuse=0.75, render=False)
             self.surface_actor.GetProperty().SetInterpolationToGouraud()
         self.current = neutral.copy()
         # numpy views of the VTK point arrays: a frame update writes into them in place
@@ -164,6 +165,7 @@ class FaceView(QWidget):
         # software renderer; the window shows the legend and the time in Qt widgets instead
         self._update_visibility()
         self.set_camera(self.preset, render=False)
+        self.request_render()       # once: the meshes were added without a render each
 
     def set_view(self, view: UtteranceView) -> None:
         self.view = view

@@ -258,6 +258,16 @@ def _shape(shape: tuple[int, ...]) -> str:
                                                                          else ")")
 
 
+def is_compressed(path: str | os.PathLike[str]) -> bool:
+    """Whether a model archive has deflated members (as facetraj wrote them before storing
+    them uncompressed); False for an unreadable file."""
+    try:
+        with zipfile.ZipFile(path) as zf:
+            return any(info.compress_type != zipfile.ZIP_STORED for info in zf.infolist())
+    except (OSError, zipfile.BadZipFile):
+        return False
+
+
 def read_model_file(path: str | os.PathLike[str], newest: int, fmt: str
                     ) -> tuple[dict, dict[str, np.ndarray]]:
     """The checked metadata and arrays of a model file (see the module's description)."""

@@ -77,6 +77,40 @@ def test_first_frame_imports_and_reads_only_what_it_shows(trained_cache, tmp_pat
     assert len(got["audio_reads"]) == 1, got["audio_reads"]
 
 
+MATPLOTLIB_QUICKLY = """
+import inspect, json, sys
+import numpy as np
+from app.main import matplotlib_without_property_docs
+with matplotlib_without_property_docs():
+    import matplotlib.artist
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+fig = Figure(figsize=(2, 1), dpi=50)
+ax = fig.add_subplot()
+line, = ax.plot([0, 1], [0, 1])
+line.set(color="red", lw=3)
+FigureCanvasAgg(fig).draw()
+rgba = np.asarray(fig.canvas.buffer_rgba())
+with matplotlib_without_property_docs():       # matplotlib imported: nothing changes
+    kwdoc_inside = matplotlib.artist.kwdoc(Line2D)
+print(json.dumps({
+    "table_in_set_doc": "antialiased" in (Line2D.set.__doc__ or ""),
+    "set_signature": "color" in inspect.signature(Line2D.set).parameters,
+    "kwdoc": "antialiased" in matplotlib.artist.kwdoc(Line2D),
+    "kwdoc_inside": "antialiased" in kwdoc_inside,
+    "red": bool(((rgba[..., 0] > 200) & (rgba[..., 1] < 60)).any()),
+}))
+"""
+
+
+def test_matplotlib_is_imported_without_its_property_tables_only():
+    out = subprocess.run([sys.executable, "-c", MATPLOTLIB_QUICKLY], capture_output=True, text=True,
+                         check=True, cwd=ROOT, env={"PATH": "", "MPLBACKEND": "agg"})
+    assert json.loads(out.stdout) == {"table_in_set_doc": False, "set_signature": True,
+                                      "kwdoc": True, "kwdoc_inside": True, "red": True}
+
+
 # ---------------------------------------------------------------------- the corpus fingerprint
 @pytest.fixture
 def corpus_copy(toy_corpus_dir, tmp_path, monkeypatch):

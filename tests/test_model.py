@@ -53,6 +53,42 @@ def test_save_load_round_trip_bit_for_bit(toy_model, tmp_path):
         assert json.loads(str(z["meta"]))["format"] == "facetraj-model"
 
 
+def test_a_model_is_stored_uncompressed_and_a_compressed_one_still_loads(toy_model, tmp_path):
+    from engine.model_file import is_compressed
+
+    path = toy_model.save(tmp_path / "m.npz")
+    with zipfile.ZipFile(path) as z:
+        assert {i.compress_type for i in z.infolist()} == {zipfile.ZIP_STORED}
+    assert not is_compressed(path)
+    old = tmp_path / "old.npz"                    # as facetraj wrote models before
+    with zipfile.ZipFile(path) as src, zipfile.ZipFile(old, "w", zipfile.ZIP_DEFLATED) as dst:
+        for info in src.infolist():
+            dst.writestr(info.filename, src.read(info))
+    assert is_compressed(old) and not is_compressed(tmp_path / "absent.npz")
+    back = Model.load(old)
+    assert np.array_equal(back.codebook.lsf, toy_model.codebook.lsf) and back.phones == toy_model.phones
+
+
+def test_a_compressed_cached_model_is_stored_uncompressed_once(toy_model, toy_corpus, tmp_path,
+                                                                monkeypatch):
+    from app.cache import cached_model_path, load_or_train
+    from engine.model_file import is_compressed
+
+    monkeypatch.setenv("FACETRAJ_CACHE_DIR", str(tmp_path / "cache"))
+    path = cached_model_path(toy_corpus)
+    path.parent.mkdir(parents=True)
+    saved = toy_model.save(tmp_path / "m.npz")
+    with zipfile.ZipFile(saved) as src, zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as dst:
+        for info in src.infolist():
+            dst.writestr(info.filename, src.read(info))
+    first = load_or_train(toy_corpus)
+    assert not is_compressed(path)
+    assert path.read_bytes() == saved.read_bytes()           # as Model.save writes it now
+    again = load_or_train(toy_corpus)
+    for model in (first, again):
+        assert np.array_equal(model.codebook.pcs, toy_model.codebook.pcs)
+
+
 def test_bad_model_files(toy_model, tmp_path):
     (tmp_path / "text.npz").write_text("hello")
     with pytest.raises(ModelFileError, match="text.npz: not a facetraj model"):

@@ -186,6 +186,56 @@ def test_a_moved_cursor_leaves_no_trace(window):
 
 @gui
 @pytest.mark.gui
+def test_a_screenshot_uses_the_panels_as_drawn(window, tmp_path, monkeypatch):
+    """A screenshot draws the panels again only when their last full draw is stale (here after
+    a zoom); either way the saved picture holds the canvas as a full draw makes it, cursor
+    included."""
+    from PyQt6.QtCore import QPoint
+    from PyQt6.QtGui import QImage
+
+    timeline = window.timeline
+    full_draws = []
+    draw = timeline.figure.draw
+    monkeypatch.setattr(timeline.figure, "draw", lambda *a, **k: (full_draws.append(1), draw(*a, **k))[1])
+
+    def canvas_in_shot(path) -> tuple[np.ndarray, np.ndarray]:
+        img = QImage(str(path)).convertToFormat(QImage.Format.Format_RGBA8888)
+        ptr = img.constBits()
+        ptr.setsize(img.sizeInBytes())
+        shot = np.frombuffer(ptr, np.uint8).reshape(img.height(), img.bytesPerLine() // 4, 4)
+        p = timeline.canvas.mapTo(window, QPoint(0, 0))
+        buf = np.asarray(timeline.canvas.buffer_rgba())
+        return (shot[p.y():p.y() + buf.shape[0], p.x():p.x() + buf.shape[1], :3].copy(),
+                buf[:, :, :3].copy())
+
+    window.seek(0.3 * window.view.duration)
+    window.seek(0.4 * window.view.duration)
+    shot, canvas = canvas_in_shot(window.save_screenshot(tmp_path / "current.png"))
+    assert full_draws == []
+    np.testing.assert_array_equal(shot, canvas)
+    timeline.canvas.draw()                          # the reference: a full draw, cursor drawn anew
+    np.testing.assert_array_equal(shot, np.asarray(timeline.canvas.buffer_rgba())[:, :, :3])
+    full_draws.clear()
+    timeline.set_xlim(0.0, 0.5 * window.view.duration)        # zoomed: the last draw is stale
+    shot, canvas = canvas_in_shot(window.save_screenshot(tmp_path / "zoomed.png"))
+    assert full_draws
+    np.testing.assert_array_equal(shot, canvas)
+
+
+@gui
+@pytest.mark.gui
+def test_a_new_scene_renders_once(window):
+    """Building the scene for a model adds five meshes and renders the finished scene once (a
+    render per mesh was four renders too many on the first frame's path)."""
+    face = window.face
+    renders = []
+    face.plotter.ren_win.AddObserver("EndEvent", lambda *_: renders.append(1))
+    face.set_model(window.model)
+    assert len(renders) == 1
+
+
+@gui
+@pytest.mark.gui
 def test_a_frame_update_moves_the_points_in_place_with_one_render(window, qtbot):
     from PyQt6.QtWidgets import QApplication
 
