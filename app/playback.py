@@ -3,9 +3,9 @@
 :class:`PlaybackScheduler` shows one update per marker frame, each timed to reach the screen when
 the audio clock (``app/transport.py``) is at that frame's time: a precise single-shot timer fires
 when the clock plus the running estimate of one update's latency (tick to the window's flush)
-reaches the next frame, so the frame lands in the middle of its own interval. An update that took
-too long makes the next one skip frames rather than drift, and at most one frame is asked for per
-flush (``frameDue``). Its :attr:`idle` gate is open while no sound plays: background work that must
+reaches the next frame's time, so the frame lands on its time, never before it. An update that
+took too long makes the next one skip frames rather than drift, and at most one frame is asked for
+per flush (``frameDue``). Its :attr:`idle` gate is open while no sound plays: background work that must
 not disturb playback waits on it (:meth:`app.workers.Progress.wait_open`) instead of polling the
 clock.
 """
@@ -24,6 +24,7 @@ from .workers import Gate
 FLUSH_TIMEOUT = 0.25     # s without a flush (window hidden?) before the next frame is sent anyway
 MAX_LATENCY = 0.08       # s: the lookahead never exceeds this
 MAX_WAIT = 0.1           # s: the clock is polled at least this often (loop and end of the sound)
+EARLY = 0.001            # s: a frame may land this much before its time rather than wait again
 
 
 class PlaybackScheduler(QObject):
@@ -75,17 +76,22 @@ class PlaybackScheduler(QObject):
     def plan(self, t: float) -> tuple[float | None, float]:
         """At clock time ``t`` while playing: the clock time of the frame to show now (None:
         the frame on screen is still the right one), and the wall-clock seconds until the next
-        update should start (when ``t`` plus the latency reaches the next frame's time)."""
+        update should start (when ``t`` plus the latency reaches the next frame's time).
+
+        An update started now lands at ``t`` plus the latency and shows the frame nearest to that
+        time; the next frame is not started before it would land on its own time (with a latency
+        over half a frame, starting as soon as the nearest frame changes would put every frame on
+        screen up to half a frame early)."""
         clock = self.clock
         end = clock.loop[1] if (clock.looping and clock.loop) else clock.duration
         lead = self.latency * clock.speed
         target = min(t + lead, end)
         k = self.frame_at(target)
-        shown = self.displayed_frame
-        if k != shown:
-            return target, 0.0                # the next frame, frames skipped, or a jump back
-        start = (k + 1) / self.rate - lead    # when the next frame's update should start
-        if k >= self.n_frames - 1 or start + lead > end:
+        following = self.displayed_frame + 1
+        start = following / self.rate - lead  # when the following frame's update should start
+        if k != following - 1 and not (k == following and t < start - EARLY * clock.speed):
+            return target, 0.0                # the next frame on time or late, frames skipped, a jump back
+        if following > self.n_frames - 1 or start + lead > end:
             start = end                       # no next frame before the end (or the loop's)
         return None, min(max((start - t) / clock.speed, 0.0), MAX_WAIT)
 

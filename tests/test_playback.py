@@ -61,6 +61,26 @@ def test_the_next_frame_is_sent_with_the_latency_as_lookahead(qapp):
     assert target == pytest.approx(32 / RATE)
 
 
+def test_a_frame_is_not_started_to_land_before_its_time(qapp):
+    # 14 ms of latency (0.84 frame) right after frame 30 reached the screen: an update started now
+    # would land at frame 30.84, nearest to frame 31 but 0.16 frame early; it starts 14 ms
+    # before 31/60 s instead, and then lands on time
+    s = scheduler(qapp, 30 / RATE, shown=30, latency=0.014)
+    target, wait = s.plan(30 / RATE)
+    assert target is None
+    assert wait == pytest.approx(31 / RATE - 0.014 - 30 / RATE)
+    start = 30 / RATE + wait
+    target, wait = s.plan(start)
+    assert wait == 0.0 and s.frame_at(target) == 31 and target == pytest.approx(31 / RATE)
+
+
+def test_a_late_update_shows_the_frame_nearest_to_its_landing_time(qapp):
+    # lands at frame 31.3: frame 31, 0.3 frame late (waiting for 32 would skip 31)
+    s = scheduler(qapp, 31.3 / RATE - 0.014, shown=30, latency=0.014)
+    target, wait = s.plan(31.3 / RATE - 0.014)
+    assert wait == 0.0 and s.frame_at(target) == 31
+
+
 def test_late_updates_skip_frames_rather_than_drift(qapp):
     s = scheduler(qapp, 40.2 / RATE, shown=31, latency=0.03)
     target, wait = s.plan(40.2 / RATE)
