@@ -3,9 +3,11 @@
 :class:`PlaybackScheduler` shows one update per marker frame, each timed to reach the screen when
 the audio clock (``app/transport.py``) is at that frame's time: a precise single-shot timer fires
 when the clock plus the running estimate of one update's latency (tick to the window's flush)
-reaches the next frame's time, so the frame lands on its time, never before it. An update that
-took too long makes the next one skip frames rather than drift, and at most one frame is asked for
-per flush (``frameDue``). Its :attr:`idle` gate is open while no sound plays: background work that must
+reaches the next frame's time, so the frame lands on its time, never before it. The next frame is
+rendered ahead right after a flush (``prepareDue``), so that the update at its time only puts it on
+screen: its latency, and the uncertainty of that latency, are a fraction of a render's. An update
+that took too long makes the next one skip frames rather than drift, and at most one frame is asked
+for per flush (``frameDue``). Its :attr:`idle` gate is open while no sound plays: background work that must
 not disturb playback waits on it (:meth:`app.workers.Progress.wait_open`) instead of polling the
 clock.
 """
@@ -32,11 +34,15 @@ class PlaybackScheduler(QObject):
 
     ``frameDue(t)`` asks the window to show the frame at ``t`` seconds; the window reports back
     with :meth:`shown` and calls :meth:`flushed` when its next paint reaches the screen.
-    ``stats``, when set to a list, receives ``(start, frame, latency, clock time)`` per flush
-    (the playback benchmark's hook).
+    ``prepareDue(t)`` (while playing, after a flush) asks it to render the frame at ``t`` ahead,
+    off screen, at once: a later ``frameDue`` for that frame then only puts it on screen.
+    ``stats``, when set to a list, receives ``(start, frame, work, clock time)`` per flush (the
+    playback benchmark's hook): the tick's time, the frame shown, the seconds its update took
+    (rendering it ahead plus tick to flush) and the clock at the flush.
     """
 
     frameDue = pyqtSignal(float)
+    prepareDue = pyqtSignal(float)
 
     def __init__(self, clock: PlaybackClock, parent: QObject | None = None):
         super().__init__(parent)
@@ -45,9 +51,11 @@ class PlaybackScheduler(QObject):
         self.n_frames = 0
         self.rate = 60.0
         self.displayed_frame = -1
-        self.latency = 0.0            # running estimate of one frame update (s)
+        self.latency = 0.0            # running estimate of one frame update, tick to flush (s)
+        self.prepare_time = 0.0       # running estimate of rendering a frame ahead (s)
         self.stats: list[tuple[float, int, float, float]] | None = None
-        self._pending: tuple[float, int] | None = None   # (tick time, frame) until flushed
+        self._pending: tuple[float, int, float] | None = None   # (tick time, frame, ahead s) until flushed
+        self._ahead: tuple[int, float] | None = None    # (frame, seconds) rendered ahead, not shown
         self._timer = QTimer(self)
         self._timer.setSingleShot(True)
         self._timer.setTimerType(Qt.TimerType.PreciseTimer)
@@ -62,7 +70,14 @@ class PlaybackScheduler(QObject):
         return frame_index(t, self.rate, self.n_frames)
 
     def shown(self, frame: int) -> None:
+        """The window shows ``frame``; any frame rendered ahead is used or stale now."""
         self.displayed_frame = int(frame)
+        self._ahead = None
+
+    @property
+    def ahead(self) -> int | None:
+        """The frame rendered ahead and not shown yet (None: none)."""
+        return None if self._ahead is None else self._ahead[0]
 
     @property
     def pending(self) -> bool:
@@ -83,20 +98,46 @@ class PlaybackScheduler(QObject):
         over half a frame, starting as soon as the nearest frame changes would put every frame on
         screen up to half a frame early)."""
         clock = self.clock
-        end = clock.loop[1] if (clock.looping and clock.loop) else clock.duration
+        end = self._end()
         lead = self.latency * clock.speed
         target = min(t + lead, end)
         k = self.frame_at(target)
-        following = self.displayed_frame + 1
+        shown = self.displayed_frame
+        following = shown + 1 if self._ahead is None else self._ahead[0]
         start = following / self.rate - lead  # when the following frame's update should start
-        if k != following - 1 and not (k == following and t < start - EARLY * clock.speed):
-            return target, 0.0                # the next frame on time or late, frames skipped, a jump back
+        if not shown <= k <= following:
+            return target, 0.0                # late (frames skipped) or a jump back
+        if k != shown and t >= start - EARLY * clock.speed:
+            return target, 0.0                # the following frame, landing on its time
         if following > self.n_frames - 1 or start + lead > end:
             start = end                       # no next frame before the end (or the loop's)
         return None, min(max((start - t) / clock.speed, 0.0), MAX_WAIT)
 
+    def prepare_next(self, t: float) -> int | None:
+        """At clock time ``t`` while playing, after a flush: have the frame that follows the one on
+        screen rendered ahead (``prepareDue``; a later one if it could not be shown by its time).
+        Returns that frame (None: no frame follows before the end)."""
+        clock = self.clock
+        end = self._end()
+        lead = (self.latency + self.prepare_time) * clock.speed
+        k = max(self.displayed_frame + 1, self.frame_at(min(t + lead, end)))
+        if k > self.n_frames - 1 or k / self.rate > end:
+            return None
+        t0 = time.perf_counter()
+        self.prepareDue.emit(k / self.rate)
+        took = time.perf_counter() - t0
+        self.prepare_time = _running(self.prepare_time, took)
+        self._ahead = (k, took)
+        return k
+
+    def _end(self) -> float:
+        """The clock time playback wraps or stops at."""
+        clock = self.clock
+        return clock.loop[1] if (clock.looping and clock.loop) else clock.duration
+
     def _on_playing_changed(self, playing: bool) -> None:
         self.idle.set_open(not playing)
+        self._ahead = None
         if playing:
             self._timer.start(0)
         else:
@@ -125,7 +166,9 @@ class PlaybackScheduler(QObject):
         if target is None:
             self._start_timer(wait)
             return
-        self._pending = (time.perf_counter(), self.frame_at(target))
+        k = self.frame_at(target)
+        ahead = self._ahead[1] if self._ahead is not None and self._ahead[0] == k else 0.0
+        self._pending = (time.perf_counter(), k, ahead)
         self._start_timer(FLUSH_TIMEOUT)
         self.frameDue.emit(target)
 
@@ -134,11 +177,17 @@ class PlaybackScheduler(QObject):
         time the next update."""
         if self._pending is None:
             return
-        start, k = self._pending
+        start, k, ahead = self._pending
         self._pending = None
         spent = time.perf_counter() - start
-        self.latency = min(0.8 * self.latency + 0.2 * spent, MAX_LATENCY) if self.latency else spent
+        self.latency = _running(self.latency, spent)
         if self.stats is not None:
-            self.stats.append((start, k, spent, self.clock.time()))
+            self.stats.append((start, k, ahead + spent, self.clock.time()))
         if self.clock.playing:
+            self.prepare_next(self.clock.time())
             self._start_timer(self.plan(self.clock.time())[1])
+
+
+def _running(estimate: float, seconds: float) -> float:
+    """A running estimate of a duration (the first value as it is), at most MAX_LATENCY."""
+    return min(0.8 * estimate + 0.2 * seconds, MAX_LATENCY) if estimate else min(seconds, MAX_LATENCY)

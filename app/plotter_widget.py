@@ -100,6 +100,21 @@ class NativePlotter(QVTKRenderWindowInteractor, BasePlotter):
         """Render and swap now (``QWidget.render`` would shadow PyVista's)."""
         BasePlotter.render(self)
 
+    def render_ahead(self) -> None:
+        """Render the scene into VTK's own framebuffer and wait until it is drawn, without putting
+        it on screen: :meth:`present` does, in a fraction of the time."""
+        rw = self.ren_win
+        rw.SwapBuffersOff()
+        try:
+            BasePlotter.render(self)
+        finally:
+            rw.SwapBuffersOn()
+        rw.WaitForCompletion()
+
+    def present(self) -> None:
+        """Put the last render on screen: copy it to the window and swap."""
+        self.ren_win.Frame()
+
     def _check_has_ren_win(self) -> None:
         """Screenshots read this window's pixels: make its context current first (another
         view's render may have made its own current)."""

@@ -81,6 +81,36 @@ def test_a_late_update_shows_the_frame_nearest_to_its_landing_time(qapp):
     assert wait == 0.0 and s.frame_at(target) == 31
 
 
+def test_after_a_flush_the_following_frame_is_rendered_ahead_and_shown_at_its_time(qapp):
+    s = scheduler(qapp, 30 / RATE, shown=30, latency=0.005)
+    s.prepare_time = 0.008
+    asked = []
+    s.prepareDue.connect(asked.append)
+    assert s.prepare_next(30 / RATE) == 31 and s.ahead == 31
+    assert asked == [pytest.approx(31 / RATE)]
+    target, wait = s.plan(30 / RATE + 0.008)
+    assert target is None                           # rendered: it waits for its time
+    assert wait == pytest.approx(31 / RATE - 0.005 - (30 / RATE + 0.008))
+    target, wait = s.plan(31 / RATE - 0.005)
+    assert wait == 0.0 and s.frame_at(target) == 31
+    s.shown(31)
+    assert s.ahead is None
+
+
+def test_a_frame_that_cannot_be_ready_by_its_time_is_not_rendered_ahead(qapp):
+    # 13 ms to render ahead and show: frame 31 (due in 1.7 ms) would be late, 32 is rendered
+    s = scheduler(qapp, 30.9 / RATE, shown=30, latency=0.005)
+    s.prepare_time = 0.008
+    assert s.prepare_next(30.9 / RATE) == 32
+    target, wait = s.plan(30.9 / RATE + 0.008)
+    assert target is None and wait == pytest.approx(32 / RATE - 0.005 - (30.9 / RATE + 0.008))
+
+
+def test_nothing_is_rendered_ahead_after_the_last_frame(qapp):
+    s = scheduler(qapp, 9.99, shown=599, duration=10.0)
+    assert s.prepare_next(9.99) is None and s.ahead is None
+
+
 def test_late_updates_skip_frames_rather_than_drift(qapp):
     s = scheduler(qapp, 40.2 / RATE, shown=31, latency=0.03)
     target, wait = s.plan(40.2 / RATE)
@@ -228,6 +258,71 @@ def test_a_frame_update_moves_the_points_in_place_with_one_render(window, qtbot)
     assert np.shares_memory(face.synth.xyz, xyz)
     np.testing.assert_allclose(np.asarray(face.synth.points.points),
                                face._syn[frames[-1]] + face._offset)
+
+
+def _on_screen(widget) -> np.ndarray:
+    """The pixels of ``widget``'s area as the X server shows them (RGB)."""
+    from PyQt6.QtCore import QPoint
+    from PyQt6.QtGui import QGuiApplication, QImage
+    from PyQt6.QtWidgets import QApplication
+
+    QApplication.processEvents()
+    pos = widget.mapToGlobal(QPoint(0, 0))
+    image = QGuiApplication.primaryScreen().grabWindow(0, pos.x(), pos.y(), widget.width(),
+                                                       widget.height()).toImage()
+    image = image.convertToFormat(QImage.Format.Format_RGB888)
+    rows = np.frombuffer(image.constBits().asstring(image.sizeInBytes()), np.uint8)
+    rows = rows.reshape(image.height(), image.bytesPerLine())[:, :3 * image.width()]
+    return rows.reshape(image.height(), image.width(), 3).astype(int)
+
+
+@gui
+@pytest.mark.gui
+def test_a_frame_rendered_ahead_reaches_the_screen_only_when_shown(window):
+    """The native view copies only its colour to the window, and a frame rendered ahead stays
+    off screen until ``show_frame`` puts it there, without another render: the same pixels as
+    a full render of that frame."""
+    face = window.face
+    plotter = face.plotter
+    renders = []
+    plotter.ren_win.AddObserver("EndEvent", lambda *_: renders.append(1))
+    face.show_frame(40)
+    frame_40 = _on_screen(plotter)
+    assert np.abs(frame_40 - plotter.screenshot()[:, :, :3]).max() == 0    # on screen: VTK's image
+    face.show_frame(80)
+    frame_80 = _on_screen(plotter)
+    assert (frame_80 != frame_40).any(axis=2).sum() > 1000
+    renders.clear()
+    face.prepare_frame(40)
+    assert len(renders) == 1 and face.ahead == 40
+    assert np.array_equal(_on_screen(plotter), frame_80)          # still frame 80 on screen
+    face.show_frame(40)
+    assert len(renders) == 1 and face.frame == 40 and face.ahead == -1
+    assert np.array_equal(_on_screen(plotter), frame_40)
+
+
+@gui
+@pytest.mark.gui
+def test_playback_renders_each_frame_ahead_and_shows_it_without_another_render(window, qtbot,
+                                                                               monkeypatch):
+    win = window
+    plotter = win.face.plotter
+    renders, presents = [], []
+    plotter.ren_win.AddObserver("EndEvent", lambda *_: renders.append(1))
+    present = plotter.present
+    monkeypatch.setattr(plotter, "present", lambda: (presents.append(1), present())[1])
+    win.seek(0.0)
+    win.stats = []
+    win.play()
+    qtbot.waitUntil(lambda: len(win.stats) >= 30, timeout=20_000)
+    win.pause()
+    qtbot.waitUntil(lambda: not win.playback.pending, timeout=5_000)
+    shown = len(win.stats)
+    win.stats = None
+    # the first frames are rendered when due (nothing is ahead yet, and the first estimates of
+    # the times may make a frame rendered ahead stale); every later one once, ahead, then shown
+    assert presents and len(presents) >= shown - 4
+    assert len(renders) <= shown + 6     # + the seek's, the pause's and a few at the start
 
 
 @gui
