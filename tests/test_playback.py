@@ -303,26 +303,30 @@ def test_a_frame_rendered_ahead_reaches_the_screen_only_when_shown(window):
 
 @gui
 @pytest.mark.gui
-def test_playback_renders_each_frame_ahead_and_shows_it_without_another_render(window, qtbot,
-                                                                               monkeypatch):
+def test_the_window_renders_a_due_frame_ahead_and_shows_it_without_another_render(window,
+                                                                                   monkeypatch):
+    """The scheduler's two requests, as playback sends them: ``prepareDue`` renders the frame
+    off screen (the cursor and the frame on screen stay), ``frameDue`` then only presents it."""
+    from PyQt6.QtWidgets import QApplication
+
     win = window
     plotter = win.face.plotter
+    rate = win.view.rate
+    win.seek(20 / rate)
+    QApplication.processEvents()
     renders, presents = [], []
     plotter.ren_win.AddObserver("EndEvent", lambda *_: renders.append(1))
     present = plotter.present
     monkeypatch.setattr(plotter, "present", lambda: (presents.append(1), present())[1])
-    win.seek(0.0)
-    win.stats = []
-    win.play()
-    qtbot.waitUntil(lambda: len(win.stats) >= 30, timeout=20_000)
-    win.pause()
-    qtbot.waitUntil(lambda: not win.playback.pending, timeout=5_000)
-    shown = len(win.stats)
-    win.stats = None
-    # the first frames are rendered when due (nothing is ahead yet, and the first estimates of
-    # the times may make a frame rendered ahead stale); every later one once, ahead, then shown
-    assert presents and len(presents) >= shown - 4
-    assert len(renders) <= shown + 6     # + the seek's, the pause's and a few at the start
+    win.playback.prepareDue.emit(21 / rate)
+    assert (len(renders), len(presents)) == (1, 0)
+    assert win.displayed_frame == 20 and win.timeline.cursor_time == pytest.approx(20 / rate)
+    win.playback.frameDue.emit(21 / rate)
+    QApplication.processEvents()
+    assert (len(renders), len(presents)) == (1, 1)
+    assert win.displayed_frame == 21 and win.face.frame == 21
+    np.testing.assert_allclose(np.asarray(win.face.synth.points.points),
+                               win.face._syn[21] + win.face._offset)
 
 
 @gui
