@@ -27,6 +27,7 @@ FLUSH_TIMEOUT = 0.25     # s without a flush (window hidden?) before the next fr
 MAX_LATENCY = 0.08       # s: the lookahead never exceeds this
 MAX_WAIT = 0.1           # s: the clock is polled at least this often (loop and end of the sound)
 EARLY = 0.001            # s: a frame may land this much before its time rather than wait again
+MAX_WAKE = 0.004         # s: the most a tick is timed early for its usual lateness
 
 
 class PlaybackScheduler(QObject):
@@ -53,9 +54,11 @@ class PlaybackScheduler(QObject):
         self.displayed_frame = -1
         self.latency = 0.0            # running estimate of one frame update, tick to flush (s)
         self.prepare_time = 0.0       # running estimate of rendering a frame ahead (s)
+        self.wake = 0.0               # running estimate of how late a timed tick comes (s)
         self.stats: list[tuple[float, int, float, float]] | None = None
         self._pending: tuple[float, int, float] | None = None   # (tick time, frame, ahead s) until flushed
         self._ahead: tuple[int, float] | None = None    # (frame, seconds) rendered ahead, not shown
+        self._due: float | None = None    # when the pacing timer should fire (perf_counter s)
         self._timer = QTimer(self)
         self._timer.setSingleShot(True)
         self._timer.setTimerType(Qt.TimerType.PreciseTimer)
@@ -104,7 +107,8 @@ class PlaybackScheduler(QObject):
         k = self.frame_at(target)
         shown = self.displayed_frame
         following = shown + 1 if self._ahead is None else self._ahead[0]
-        start = following / self.rate - lead  # when the following frame's update should start
+        # when the following frame's update should start, and its timer fire (a tick comes late)
+        start = following / self.rate - lead - self.wake * clock.speed
         if not shown <= k <= following:
             return target, 0.0                # late (frames skipped) or a jump back
         if k != shown and t >= start - EARLY * clock.speed:
@@ -137,18 +141,23 @@ class PlaybackScheduler(QObject):
 
     def _on_playing_changed(self, playing: bool) -> None:
         self.idle.set_open(not playing)
-        self._ahead = None
+        self._ahead = self._due = None
         if playing:
             self._timer.start(0)
         else:
             self._timer.stop()
 
-    def _start_timer(self, wait: float) -> None:
-        """The next tick in ``wait`` seconds (whole milliseconds, never early)."""
+    def _start_timer(self, wait: float, paced: bool = True) -> None:
+        """The next tick in ``wait`` seconds (whole milliseconds, never early); a ``paced`` one
+        (the start of an update, not a flush timeout) is timed for :attr:`wake`."""
+        self._due = time.perf_counter() + wait if paced else None
         self._timer.start(max(0, math.ceil(wait * 1000.0)))
 
     def _tick(self) -> None:
         """One timer tick: the frame at the audio clock (skip frames, never drift)."""
+        if self._due is not None:
+            self.wake = min(_running(self.wake, max(time.perf_counter() - self._due, 0.0)), MAX_WAKE)
+            self._due = None
         if self.n_frames == 0:
             return
         clock = self.clock
@@ -159,7 +168,7 @@ class PlaybackScheduler(QObject):
         if self._pending is not None:
             waited = time.perf_counter() - self._pending[0]
             if waited < FLUSH_TIMEOUT:
-                self._start_timer(FLUSH_TIMEOUT - waited)    # flushed() starts the next one
+                self._start_timer(FLUSH_TIMEOUT - waited, paced=False)   # flushed() starts the next
                 return
             self._pending = None    # no flush came: do not stall
         target, wait = self.plan(t)
@@ -169,7 +178,7 @@ class PlaybackScheduler(QObject):
         k = self.frame_at(target)
         ahead = self._ahead[1] if self._ahead is not None and self._ahead[0] == k else 0.0
         self._pending = (time.perf_counter(), k, ahead)
-        self._start_timer(FLUSH_TIMEOUT)
+        self._start_timer(FLUSH_TIMEOUT, paced=False)
         self.frameDue.emit(target)
 
     def flushed(self) -> None:

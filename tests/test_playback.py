@@ -74,6 +74,16 @@ def test_a_frame_is_not_started_to_land_before_its_time(qapp):
     assert wait == 0.0 and s.frame_at(target) == 31 and target == pytest.approx(31 / RATE)
 
 
+def test_the_wait_allows_for_the_usual_lateness_of_a_tick(qapp):
+    s = scheduler(qapp, 0.5, shown=31)
+    s.wake = 0.002
+    target, wait = s.plan(0.5)
+    assert target is None and wait == pytest.approx(32 / RATE - 0.01 - 0.002 - 0.5)
+    # the tick, 2 ms late as usual: the update starts, and lands on frame 32's time
+    target, wait = s.plan(0.5 + wait + 0.002)
+    assert wait == 0.0 and target == pytest.approx(32 / RATE)
+
+
 def test_a_late_update_shows_the_frame_nearest_to_its_landing_time(qapp):
     # lands at frame 31.3: frame 31, 0.3 frame late (waiting for 32 would skip 31)
     s = scheduler(qapp, 31.3 / RATE - 0.014, shown=30, latency=0.014)
