@@ -129,6 +129,7 @@ class MainWindow(QMainWindow):
         self.clock = PlaybackClock(self, use_audio=use_audio)
         self.playback = PlaybackScheduler(self.clock, self)
         self.playback.frameDue.connect(lambda t: self._show_time(t, force=True))
+        self.playback.prepareDue.connect(self._prepare_time)
         self.clock.playingChanged.connect(self._on_playing_changed)
         self._error_handler: Callable[[str], None] | None = None
         self._extensions: dict[str, object] = {}
@@ -500,6 +501,11 @@ class MainWindow(QMainWindow):
                                      f"{('/' + phone + '/') if phone else ''}")
         self.timeline.set_cursor(t, follow=self.clock.playing)
         self.cursorMoved.emit(float(t))
+
+    def _prepare_time(self, t: float) -> None:
+        """Render the 3-D frame at ``t`` ahead, off screen (the scheduler shows it at its time)."""
+        if self.view is not None:
+            self.face.prepare_frame(self.view.frame_at(t))
 
     # ================================================================== files
     def open_audio(self, audio_path: Path, labels_path: Path | None = None, **kw) -> None:

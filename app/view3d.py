@@ -136,6 +136,7 @@ class FaceView(QWidget):
         self.show_original = True
         self.show_synth = True
         self.frame = -1
+        self.ahead = -1              # the frame rendered ahead, not on screen yet (prepare_frame)
         self.preset = "three-quarter"
         self._orig = self._syn = None
         self._offset = np.zeros(3)
@@ -146,6 +147,7 @@ class FaceView(QWidget):
     def set_model(self, model: Model) -> None:
         """Build the scene for ``model``'s marker set."""
         self.model = model
+        self.ahead = -1
         self.plotter.clear()
         # one light that follows the camera plus a key light from above: shading that shows
         # the face's shape at little cost (each light is per-fragment work on a software renderer)
@@ -175,6 +177,7 @@ class FaceView(QWidget):
         self.frame = -1
 
     def _update_visibility(self) -> None:
+        self.ahead = -1
         if self.synth is None:
             return
         has_orig = self._orig is not None or self.view is None
@@ -184,16 +187,36 @@ class FaceView(QWidget):
 
     def show_frame(self, k: int, render: bool = True) -> None:
         """Put frame ``k`` of the current view in the scene (the points move in place) and put
-        it on screen (:meth:`request_render`)."""
+        it on screen (:meth:`request_render`); a frame rendered ahead (:meth:`prepare_frame`) is
+        only put on screen."""
         if self._syn is None:
             return
         k = int(np.clip(k, 0, len(self._syn) - 1))
-        self.synth.set_points(self._syn[k] + self._offset)
-        if self._orig is not None:
-            self.original.set_points(self._orig[min(k, len(self._orig) - 1)] - self._offset)
+        ahead, self.ahead = self.ahead, -1
+        if render and k == ahead:
+            self.frame = k
+            self.plotter.present()
+            return
+        self._move_points(k)
         self.frame = k
         if render:
             self.request_render()
+
+    def prepare_frame(self, k: int) -> None:
+        """Render frame ``k`` ahead, off screen, so that ``show_frame(k)`` only has to put it on
+        screen (playback: the render's time does not delay the frame's arrival). Native view
+        only (:func:`app.plotter_widget.is_native`), when shown; the frame on screen stays."""
+        if self._syn is None or not is_native(self.plotter) or not self.plotter.isVisible():
+            return
+        k = int(np.clip(k, 0, len(self._syn) - 1))
+        self._move_points(k)
+        self.plotter.render_ahead()
+        self.ahead = k
+
+    def _move_points(self, k: int) -> None:
+        self.synth.set_points(self._syn[k] + self._offset)
+        if self._orig is not None:
+            self.original.set_points(self._orig[min(k, len(self._orig) - 1)] - self._offset)
 
     def request_render(self) -> None:
         """One render of the changed scene: at once in a native window (it swaps only its own
@@ -262,6 +285,8 @@ class FaceView(QWidget):
         self.plotter.camera.zoom(1.45)
         if render:
             self.plotter.render()
+        else:
+            self.ahead = -1                     # a frame rendered ahead has the old camera
 
     # ------------------------------------------------------------------ hover
     def _project(self, pts: np.ndarray) -> np.ndarray:

@@ -61,6 +61,66 @@ def test_the_next_frame_is_sent_with_the_latency_as_lookahead(qapp):
     assert target == pytest.approx(32 / RATE)
 
 
+def test_a_frame_is_not_started_to_land_before_its_time(qapp):
+    # 14 ms of latency (0.84 frame) right after frame 30 reached the screen: an update started now
+    # would land at frame 30.84, nearest to frame 31 but 0.16 frame early; it starts 14 ms
+    # before 31/60 s instead, and then lands on time
+    s = scheduler(qapp, 30 / RATE, shown=30, latency=0.014)
+    target, wait = s.plan(30 / RATE)
+    assert target is None
+    assert wait == pytest.approx(31 / RATE - 0.014 - 30 / RATE)
+    start = 30 / RATE + wait
+    target, wait = s.plan(start)
+    assert wait == 0.0 and s.frame_at(target) == 31 and target == pytest.approx(31 / RATE)
+
+
+def test_the_wait_allows_for_the_usual_lateness_of_a_tick(qapp):
+    s = scheduler(qapp, 0.5, shown=31)
+    s.wake = 0.002
+    target, wait = s.plan(0.5)
+    assert target is None and wait == pytest.approx(32 / RATE - 0.01 - 0.002 - 0.5)
+    # the tick, 2 ms late as usual: the update starts, and lands on frame 32's time
+    target, wait = s.plan(0.5 + wait + 0.002)
+    assert wait == 0.0 and target == pytest.approx(32 / RATE)
+
+
+def test_a_late_update_shows_the_frame_nearest_to_its_landing_time(qapp):
+    # lands at frame 31.3: frame 31, 0.3 frame late (waiting for 32 would skip 31)
+    s = scheduler(qapp, 31.3 / RATE - 0.014, shown=30, latency=0.014)
+    target, wait = s.plan(31.3 / RATE - 0.014)
+    assert wait == 0.0 and s.frame_at(target) == 31
+
+
+def test_after_a_flush_the_following_frame_is_rendered_ahead_and_shown_at_its_time(qapp):
+    s = scheduler(qapp, 30 / RATE, shown=30, latency=0.005)
+    s.prepare_time = 0.008
+    asked = []
+    s.prepareDue.connect(asked.append)
+    assert s.prepare_next(30 / RATE) == 31 and s.ahead == 31
+    assert asked == [pytest.approx(31 / RATE)]
+    target, wait = s.plan(30 / RATE + 0.008)
+    assert target is None                           # rendered: it waits for its time
+    assert wait == pytest.approx(31 / RATE - 0.005 - (30 / RATE + 0.008))
+    target, wait = s.plan(31 / RATE - 0.005)
+    assert wait == 0.0 and s.frame_at(target) == 31
+    s.shown(31)
+    assert s.ahead is None
+
+
+def test_a_frame_that_cannot_be_ready_by_its_time_is_not_rendered_ahead(qapp):
+    # 13 ms to render ahead and show: frame 31 (due in 1.7 ms) would be late, 32 is rendered
+    s = scheduler(qapp, 30.9 / RATE, shown=30, latency=0.005)
+    s.prepare_time = 0.008
+    assert s.prepare_next(30.9 / RATE) == 32
+    target, wait = s.plan(30.9 / RATE + 0.008)
+    assert target is None and wait == pytest.approx(32 / RATE - 0.005 - (30.9 / RATE + 0.008))
+
+
+def test_nothing_is_rendered_ahead_after_the_last_frame(qapp):
+    s = scheduler(qapp, 9.99, shown=599, duration=10.0)
+    assert s.prepare_next(9.99) is None and s.ahead is None
+
+
 def test_late_updates_skip_frames_rather_than_drift(qapp):
     s = scheduler(qapp, 40.2 / RATE, shown=31, latency=0.03)
     target, wait = s.plan(40.2 / RATE)
@@ -258,6 +318,75 @@ def test_a_frame_update_moves_the_points_in_place_with_one_render(window, qtbot)
     assert np.shares_memory(face.synth.xyz, xyz)
     np.testing.assert_allclose(np.asarray(face.synth.points.points),
                                face._syn[frames[-1]] + face._offset)
+
+
+def _on_screen(widget) -> np.ndarray:
+    """The pixels of ``widget``'s area as the X server shows them (RGB)."""
+    from PyQt6.QtCore import QPoint
+    from PyQt6.QtGui import QGuiApplication, QImage
+    from PyQt6.QtWidgets import QApplication
+
+    QApplication.processEvents()
+    pos = widget.mapToGlobal(QPoint(0, 0))
+    image = QGuiApplication.primaryScreen().grabWindow(0, pos.x(), pos.y(), widget.width(),
+                                                       widget.height()).toImage()
+    image = image.convertToFormat(QImage.Format.Format_RGB888)
+    rows = np.frombuffer(image.constBits().asstring(image.sizeInBytes()), np.uint8)
+    rows = rows.reshape(image.height(), image.bytesPerLine())[:, :3 * image.width()]
+    return rows.reshape(image.height(), image.width(), 3).astype(int)
+
+
+@gui
+@pytest.mark.gui
+def test_a_frame_rendered_ahead_reaches_the_screen_only_when_shown(window):
+    """The native view copies only its colour to the window, and a frame rendered ahead stays
+    off screen until ``show_frame`` puts it there, without another render: the same pixels as
+    a full render of that frame."""
+    face = window.face
+    plotter = face.plotter
+    renders = []
+    plotter.ren_win.AddObserver("EndEvent", lambda *_: renders.append(1))
+    face.show_frame(40)
+    frame_40 = _on_screen(plotter)
+    assert np.abs(frame_40 - plotter.screenshot()[:, :, :3]).max() == 0    # on screen: VTK's image
+    face.show_frame(80)
+    frame_80 = _on_screen(plotter)
+    assert (frame_80 != frame_40).any(axis=2).sum() > 1000
+    renders.clear()
+    face.prepare_frame(40)
+    assert len(renders) == 1 and face.ahead == 40
+    assert np.array_equal(_on_screen(plotter), frame_80)          # still frame 80 on screen
+    face.show_frame(40)
+    assert len(renders) == 1 and face.frame == 40 and face.ahead == -1
+    assert np.array_equal(_on_screen(plotter), frame_40)
+
+
+@gui
+@pytest.mark.gui
+def test_the_window_renders_a_due_frame_ahead_and_shows_it_without_another_render(window,
+                                                                                   monkeypatch):
+    """The scheduler's two requests, as playback sends them: ``prepareDue`` renders the frame
+    off screen (the cursor and the frame on screen stay), ``frameDue`` then only presents it."""
+    from PyQt6.QtWidgets import QApplication
+
+    win = window
+    plotter = win.face.plotter
+    rate = win.view.rate
+    win.seek(20 / rate)
+    QApplication.processEvents()
+    renders, presents = [], []
+    plotter.ren_win.AddObserver("EndEvent", lambda *_: renders.append(1))
+    present = plotter.present
+    monkeypatch.setattr(plotter, "present", lambda: (presents.append(1), present())[1])
+    win.playback.prepareDue.emit(21 / rate)
+    assert (len(renders), len(presents)) == (1, 0)
+    assert win.displayed_frame == 20 and win.timeline.cursor_time == pytest.approx(20 / rate)
+    win.playback.frameDue.emit(21 / rate)
+    QApplication.processEvents()
+    assert (len(renders), len(presents)) == (1, 1)
+    assert win.displayed_frame == 21 and win.face.frame == 21
+    np.testing.assert_allclose(np.asarray(win.face.synth.points.points),
+                               win.face._syn[21] + win.face._offset)
 
 
 @gui
