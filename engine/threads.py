@@ -32,9 +32,10 @@ T = TypeVar("T")
 
 #: environment variable that sets the frame threads (a positive integer) in place of the cores
 THREADS_ENV = "FACETRAJ_THREADS"
-#: the fewest frames a thread is given: below 2 s of 60 Hz frames per thread, a thread's start
-#: and the interpreter lock cost more than the split saves (docs/benchmarks.md)
-MIN_FRAMES_PER_THREAD = 120
+#: the fewest frames a thread is given. Numpy releases the interpreter lock only inside each
+#: array operation, and a thread waits for it between operations: with 10 s of 60 Hz frames in
+#: all, two threads took longer than one; with 60 s, 1.2-1.3x less time (docs/benchmarks.md)
+MIN_FRAMES_PER_THREAD = 600
 #: at most this many frame threads, whatever the machine
 MAX_FRAME_THREADS = 8
 
@@ -96,8 +97,8 @@ def frame_spans(n_frames: int, threads: int | None = None) -> list[tuple[int, in
     """``n_frames`` cut into contiguous ``(start, stop)`` spans, one per thread (``threads``,
     default :func:`frame_threads`), none shorter than :data:`MIN_FRAMES_PER_THREAD` frames.
 
-    >>> frame_spans(1000, 2), frame_spans(150, 2), frame_spans(0, 2)
-    ([(0, 500), (500, 1000)], [(0, 150)], [(0, 0)])
+    >>> frame_spans(3000, 2), frame_spans(1000, 2), frame_spans(0, 2)
+    ([(0, 1500), (1500, 3000)], [(0, 1000)], [(0, 0)])
     """
     threads = frame_threads() if threads is None else threads
     k = max(1, min(threads, n_frames // MIN_FRAMES_PER_THREAD))
@@ -111,8 +112,8 @@ def map_spans(fn: Callable[[int, int], T], n_frames: int, threads: int | None = 
     products are small: callers run BLAS on one thread, as the app, the CLI's synthesis and the
     evaluation do, :func:`one_blas_thread`.)
 
-    >>> map_spans(lambda a, b: b - a, 1000, 2)
-    [500, 500]
+    >>> map_spans(lambda a, b: b - a, 3000, 2)
+    [1500, 1500]
     """
     spans = frame_spans(n_frames, threads)
     if len(spans) == 1:

@@ -10,7 +10,6 @@ import pytest
 from engine.config import SynthConfig
 from engine.pipeline import synthesize
 from engine.threads import (
-    MIN_FRAMES_PER_THREAD,
     THREADS_ENV,
     frame_spans,
     frame_threads,
@@ -26,9 +25,20 @@ def _long_input(corpus, seconds: float):
     return concatenate_input([corpus.utterance(u) for u in corpus.info.test[:6]], seconds)
 
 
+SHORT = 120          # frames: 2 s
+
+
+@pytest.fixture
+def short_spans(monkeypatch):
+    """Spans of 2 s, so that a few seconds of speech split between threads."""
+    from engine import threads
+
+    monkeypatch.setattr(threads, "MIN_FRAMES_PER_THREAD", SHORT)
+
+
 @pytest.mark.parametrize("mode", ["phonetic", "acoustic"])
-def test_threads_give_the_same_synthesis(default_model, default_corpus, mode):
-    """Three threads (three spans of frames, each at least MIN_FRAMES_PER_THREAD) against one: the
+def test_threads_give_the_same_synthesis(default_model, default_corpus, mode, short_spans):
+    """Three threads (three spans of frames of at least 2 s) against one: the
     same candidates, gammas and weights; LSFs and face points equal to rounding."""
     audio, rate, phones = _long_input(default_corpus, 7.0)
     labels = phones if mode == "phonetic" else None
@@ -45,7 +55,7 @@ def test_threads_give_the_same_synthesis(default_model, default_corpus, mode):
     np.testing.assert_allclose(three.markers, one.markers, rtol=0, atol=1e-9)       # mm
 
 
-def test_the_whole_codebook_stays_one_shared_row(default_model, default_corpus):
+def test_the_whole_codebook_stays_one_shared_row(default_model, default_corpus, short_spans):
     """Acoustic-only over every codeword (the paper's search) in two spans: the candidates stay a
     broadcast row (not 5L indices per frame), and the result is one thread's."""
     audio, rate, _ = _long_input(default_corpus, 4.5)
@@ -59,28 +69,28 @@ def test_the_whole_codebook_stays_one_shared_row(default_model, default_corpus):
     np.testing.assert_allclose(two.raw_pcs, one.raw_pcs, rtol=0, atol=1e-9)
 
 
-def test_thread_count_rule(monkeypatch):
+def test_thread_count_rule(monkeypatch, short_spans):
     monkeypatch.setenv(THREADS_ENV, "3")
     assert frame_threads() == 3
     with limit_frame_threads(1):
         assert frame_threads() == 1
-        assert frame_spans(10 * MIN_FRAMES_PER_THREAD) == [(0, 10 * MIN_FRAMES_PER_THREAD)]
+        assert frame_spans(10 * SHORT) == [(0, 10 * SHORT)]
     assert frame_threads() == 3
     monkeypatch.setenv(THREADS_ENV, "zero")          # not a positive integer: the cores
     assert frame_threads() >= 1
-    spans = frame_spans(5 * MIN_FRAMES_PER_THREAD - 1, 8)
-    assert len(spans) == 4 and spans[0][0] == 0 and spans[-1][1] == 5 * MIN_FRAMES_PER_THREAD - 1
-    assert all(b - a >= MIN_FRAMES_PER_THREAD for a, b in spans)
+    spans = frame_spans(5 * SHORT - 1, 8)
+    assert len(spans) == 4 and spans[0][0] == 0 and spans[-1][1] == 5 * SHORT - 1
+    assert all(b - a >= SHORT for a, b in spans)
 
 
-def test_an_error_in_a_span_reaches_the_caller():
+def test_an_error_in_a_span_reaches_the_caller(short_spans):
     def fail_late(a: int, b: int) -> int:
         if a > 0:
             raise ValueError(f"frames {a}-{b}")
         return b
 
     with pytest.raises(ValueError, match="frames 120-240"):
-        map_spans(fail_late, 2 * MIN_FRAMES_PER_THREAD, 2)
+        map_spans(fail_late, 2 * SHORT, 2)
 
 
 def test_evaluation_synthesizes_on_one_frame_thread(default_model, default_corpus, monkeypatch):
