@@ -24,7 +24,7 @@ def test_result_arrives_and_close_waits_for_a_cancelled_task(qtbot):
     with qtbot.waitSignal(runner.finished, timeout=10_000):
         runner.run(lambda progress: 6 * 7, results.append, "answer")
     assert results == [42] and not runner.busy
-    gate = Gate()       # closed: the task waits on it until cancelled
+    gate = Gate(is_open=False)      # closed: the task waits on it until cancelled
     task = runner.run(lambda progress: progress.wait_open(gate), results.append, "waiting")
     runner.close(timeout_ms=10_000)
     assert task.isFinished() and results == [42]
