@@ -23,7 +23,7 @@ from engine import lsf, pipeline
 from engine.config import SynthConfig
 from engine.lsf_index import LsfIndex
 from engine.model import Model
-from engine.pipeline import synthesize
+from engine.pipeline import Synthesis, synthesize
 from engine.threads import frame_spans, frame_threads, limit_frame_threads
 
 from .common import BenchContext, BenchRow, Timing, best_time, concatenate_input, timed
@@ -61,22 +61,22 @@ def run(ctx: BenchContext, durations: Sequence[float] | None = None) -> list[Ben
             audio, rate, phones = concatenate_input(source, seconds)
             labels = phones if mode == "phonetic" else None
 
-            def call(audio=audio, rate=rate, labels=labels, cfg=cfg) -> None:
-                synthesize(model, audio, rate, labels, cfg)
+            def call(audio=audio, rate=rate, labels=labels, cfg=cfg) -> Synthesis:
+                return synthesize(model, audio, rate, labels, cfg)
 
             what = ("N = 3" if mode == "phonetic" else
                     f"K = {cfg.acoustic_prefilter} of {n_cw} codewords, {cfg.acoustic_probe} of "
                     f"{model.lsf_index().n_cells} index cells")
             for n_threads in dict.fromkeys((threads, 1)):
                 with limit_frame_threads(n_threads):
-                    call()  # warm-up
+                    n_frames = len(call().times)  # warm-up
                     tm = best_time(call, repeat=3 if seconds <= 10 else 1,
                                    min_total_s=0.5 if seconds <= 10 else 0.0)
                 t = tm.wall
                 rtf = seconds / t
                 log.info("synth %s %.0f s, %d frame threads: %.3f s (%.0fx real time)", mode,
                          seconds, n_threads, t, rtf)
-                spans = len(frame_spans(int(seconds * model.marker_rate) + 1, n_threads))
+                spans = len(frame_spans(n_frames, n_threads))
                 note = f"{t * 1000:.1f} ms; {what}; {spans} frame thread{'s' * (spans > 1)}"
                 if n_threads == threads:
                     aim = AIMS[mode]

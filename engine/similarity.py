@@ -178,6 +178,7 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     keep = sim >= best - bound - 1e-12
     keep[np.count_nonzero(sim >= best, axis=1) < count] = True
     u_size = np.count_nonzero(keep, axis=1)
+    u_start = np.cumsum(u_size) - u_size
     cand_all = np.nonzero(keep)[1]
     # every (query, context) pair, query by query: pair p is query rows[p] and context cand[p]
     sizes = u_size[inverse]
@@ -185,7 +186,7 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     starts = ends - sizes
     rows = np.repeat(np.arange(n_q), sizes)
     place = np.arange(ends[-1]) - np.repeat(starts, sizes)                  # within its query
-    cand = cand_all[np.repeat((np.cumsum(u_size) - u_size)[inverse], sizes) + place]
+    cand = cand_all[np.repeat(u_start[inverse], sizes) + place]
     # eq 4's terms xi^-i S[query phone, context phone], added column by column
     cols = np.arange(full - c, full + c + 1)
     tables = (context_weights(c, xi)[:, None, None] * s).ravel()            # (2c+1) x n x n

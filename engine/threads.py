@@ -34,7 +34,8 @@ T = TypeVar("T")
 THREADS_ENV = "FACETRAJ_THREADS"
 #: the fewest frames a thread is given. Numpy releases the interpreter lock only inside each
 #: array operation, and a thread waits for it between operations: with 10 s of 60 Hz frames in
-#: all, two threads took longer than one; with 60 s, 1.2-1.3x less time (docs/benchmarks.md)
+#: all, two threads took longer than one; with 60 s, up to 1.5x (phonetic) and 1.8x
+#: (acoustic-only) less time (docs/benchmarks.md)
 MIN_FRAMES_PER_THREAD = 600
 #: at most this many frame threads, whatever the machine
 MAX_FRAME_THREADS = 8
@@ -109,8 +110,8 @@ def frame_spans(n_frames: int, threads: int | None = None) -> list[tuple[int, in
 def map_spans(fn: Callable[[int, int], T], n_frames: int, threads: int | None = None) -> list[T]:
     """``fn(start, stop)`` for each of :func:`frame_spans`, in threads when there are several;
     the results in span order. An exception in a span is raised here. (The threads' matrix
-    products are small: callers run BLAS on one thread, as the app, the CLI's synthesis and the
-    evaluation do, :func:`one_blas_thread`.)
+    products are small: callers that run beside other work run BLAS on one thread, as the app,
+    live mode and the evaluation do, :func:`one_blas_thread`.)
 
     >>> map_spans(lambda a, b: b - a, 3000, 2)
     [1500, 1500]
