@@ -8,12 +8,12 @@ import json
 import logging
 from pathlib import Path
 
-from engine.cachedir import cache_dir
 from engine.config import TrainConfig
-from engine.corpus import Corpus
 from engine.errors import InputError, ModelFileError
-from engine.model import Model
-from engine.model_file import is_compressed
+from engine.io.cachedir import cache_dir
+from engine.io.corpus import Corpus
+from engine.io.model_file import is_compressed
+from engine.method.model import Model
 from engine.progress import Progress
 
 log = logging.getLogger(__name__)
@@ -62,7 +62,7 @@ def load_or_train(corpus: Corpus, config: TrainConfig | None = None,
             return model
         except ModelFileError as exc:
             log.warning("ignoring unreadable cached model: %s", exc)
-    from engine.training import train  # only here: a cached model is the usual case
+    from engine.method.training import train
 
     log.info("training the model on %s (first run; cached in %s)", corpus.root, path.parent)
     model = train(corpus, config=config, progress=lambda f, m: progress(0.02 + 0.96 * f, f"training: {m}"))

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import logging
 
-from engine.evaluation import trajectory_correlations
-from engine.model import Model
+from engine.evaluation.scores import trajectory_correlations
+from engine.method.model import Model
 
 from .browser import UtteranceBrowser
 from .state import UtteranceView

@@ -67,8 +67,8 @@ def _open_audio(win, wav: Path) -> None:
 
 def long_file(corpus_dir: Path, out: Path, n: int = LONG_FILE_UTTERANCES) -> Path:
     """A WAV of the first ``n`` utterances of a corpus joined end to end (a long file)."""
-    from engine.corpus import load_corpus
-    from engine.formats import write_audio
+    from engine.io.audio import write_audio
+    from engine.io.corpus import load_corpus
 
     corpus = load_corpus(corpus_dir)
     utts = [corpus.utterance(u) for u in corpus.info.ids[:n]]
@@ -78,8 +78,8 @@ def long_file(corpus_dir: Path, out: Path, n: int = LONG_FILE_UTTERANCES) -> Pat
 
 def app_figures(out: Path, scratch: Path) -> list[Path]:
     """The main window: default corpus at both sizes, MOCHA, open audio, a long file."""
-    from engine.corpus import init_corpus, load_corpus
-    from engine.formats import write_audio
+    from engine.io.audio import write_audio
+    from engine.io.corpus import init_corpus, load_corpus
 
     from .main import WINDOW_SIZE
 
@@ -201,8 +201,8 @@ def video_figures(out: Path) -> list[Path]:
     import imageio.v3 as iio
 
     from engine.config import SynthConfig
-    from engine.corpus import load_corpus
-    from engine.pipeline import mode_for, synthesize
+    from engine.io.corpus import load_corpus
+    from engine.method.pipeline import mode_for, synthesize
 
     from .cache import load_or_train
     from .video import VideoFrames, VideoSettings

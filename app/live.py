@@ -35,10 +35,10 @@ from PyQt6.QtWidgets import (
 
 from engine.config import SynthConfig
 from engine.errors import FacetrajError
-from engine.export import write_trajectories
-from engine.formats import write_audio
-from engine.model import Model
-from engine.streaming import LIVE_BATCH_FRAMES, StreamConfig, StreamingSynthesizer
+from engine.io.audio import write_audio
+from engine.io.export import write_trajectories
+from engine.method.model import Model
+from engine.streaming.synthesizer import LIVE_BATCH_FRAMES, StreamConfig, StreamingSynthesizer
 
 from .view3d import FaceView
 
@@ -268,7 +268,8 @@ class LiveWindow(QMainWindow):
         path = Path(path)
         wav = path.with_suffix(".wav")
         write_audio(wav, audio, rate, overwrite)
-        out = write_trajectories(path, markers, self.model, None, overwrite)
+        out = write_trajectories(path, markers, self.model.marker_rate, self.model.marker_names,
+                                 overwrite=overwrite)
         self.message.setText(f"take saved: {out} and {wav.name}")
         return out, wav
 
@@ -406,10 +407,10 @@ def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = Non
     """Open the Live window (``facetraj live``) and start a take. No input device and no file:
     :class:`FacetrajError` with :data:`NO_INPUT_DEVICE`. With ``screenshot``, the window is saved
     to that PNG when the file has been played (or after ``quit_after`` seconds) and closes."""
-    from engine.formats import read_audio
+    from engine.io.audio import read_audio
     from engine.threads import one_blas_thread
 
-    from .main import ensure_display, require_display
+    from .display import ensure_display, require_display
 
     # what the options name is read first: a bad file or model is an error before any window
     audio = read_audio(from_file) if from_file is not None else None

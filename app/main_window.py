@@ -55,7 +55,7 @@ from pathlib import Path
 from typing import Any
 
 from PyQt6.QtCore import QEvent, Qt, QTimer, pyqtSignal
-from PyQt6.QtGui import QAction, QKeySequence
+from PyQt6.QtGui import QKeySequence
 from PyQt6.QtWidgets import (
     QDockWidget,
     QLabel,
@@ -69,10 +69,10 @@ from PyQt6.QtWidgets import (
 )
 
 from engine.config import SynthConfig
-from engine.corpus import Corpus, load_corpus
 from engine.data import Utterance
 from engine.errors import FacetrajError
-from engine.model import Model
+from engine.io.corpus import Corpus, load_corpus
+from engine.method.model import Model
 
 from .browser import UtteranceBrowser
 from .cache import load_or_train
@@ -97,6 +97,7 @@ from .timeline import LipPanel, PhoneTierPanel, SpectrogramPanel, Timeline, Wave
 from .transport import PlaybackClock
 from .view3d import FaceView
 from .viewer_model import DEFAULT_SENTENCE, SynthRequest, ViewerModel, load_model, view_summary, view_title
+from .window_frame import WindowDocks, WindowMenus
 from .workers import Progress, Task, TaskRunner
 
 __all__ = ["DEFAULT_SENTENCE", "SPEEDS", "MainWindow"]
@@ -133,7 +134,8 @@ class MainWindow(QMainWindow):
         self.clock.playingChanged.connect(self._on_playing_changed)
         self._error_handler: Callable[[str], None] | None = None
         self._extensions: dict[str, object] = {}
-        self._menus: dict[str, QMenu] = {}
+        self.menus = WindowMenus(self, self.report_error)
+        self.docks = WindowDocks(self)
         self._build_widgets()
         self.audio_opener = AudioOpener(self)       # "Open audio…" and its label sources
         self.settings.add_widget(self.audio_opener.box)
@@ -177,13 +179,12 @@ class MainWindow(QMainWindow):
         self.setCentralWidget(self.splitter)
         self.browser = UtteranceBrowser(self)
         self.browser.utteranceSelected.connect(self.set_utterance)
-        self.browser_dock = self._dock(self.browser, "Utterances", Qt.DockWidgetArea.LeftDockWidgetArea)
+        self.browser_dock = self.docks.dock(self.browser, "Utterances", Qt.DockWidgetArea.LeftDockWidgetArea)
         self.settings = SynthSettingsPanel(self.synth_config, self)
         self.settings.configChanged.connect(self.set_synth_config)
-        self.settings_dock = self._dock(self.settings, "Synthesis settings",
+        self.settings_dock = self.docks.dock(self.settings, "Synthesis settings",
                                         Qt.DockWidgetArea.LeftDockWidgetArea)
         self.resizeDocks([self.browser_dock], [400], Qt.Orientation.Horizontal)
-        self._extra_docks: dict[Qt.DockWidgetArea, QDockWidget] = {}
         self.status = StatusArea(self.statusBar(), self.tasks)
         self.status_label, self.progress = self.status.label, self.status.progress
         self.dimensions_label = self.status.dimensions_label
@@ -200,48 +201,25 @@ class MainWindow(QMainWindow):
         self.loop = LoopRange(self.clock, self.timeline, bar.loop_box, self.seek)
         return bar
 
-    def _dock(self, widget: QWidget, title: str, area: Qt.DockWidgetArea) -> QDockWidget:
-        dock = QDockWidget(title, self)
-        dock.setObjectName(title)
-        dock.setWidget(widget)
-        dock.setFeatures(QDockWidget.DockWidgetFeature.DockWidgetMovable
-                         | QDockWidget.DockWidgetFeature.DockWidgetFloatable
-                         | QDockWidget.DockWidgetFeature.DockWidgetClosable)
-        self.addDockWidget(area, dock)
-        return dock
-
-    def _action(self, menu: str, text: str, slot: Callable[[], Any]) -> QAction:
-        """A menu entry; an engine error its slot raises is reported, never raised."""
-        def run(_checked: bool = False) -> None:
-            try:
-                slot()
-            except FacetrajError as exc:
-                self.report_error(exc)
-
-        action = QAction(text, self)
-        action.triggered.connect(run)
-        self.menu(menu).addAction(action)
-        return action
-
     def _build_menus(self) -> None:
-        self.action_open_corpus = self._action("File", "Open &corpus folder…",
+        self.action_open_corpus = self.menus.action("File", "Open &corpus folder…",
                                                lambda: _given(ask_corpus_folder(self), self.open_corpus))
-        self.action_open_audio = self._action("File", "Open &audio for synthesis…",
+        self.action_open_audio = self.menus.action("File", "Open &audio for synthesis…",
                                               lambda: self.audio_opener.ask())
-        self.action_screenshot = self._action("File", "Save &screenshot…",
+        self.action_screenshot = self.menus.action("File", "Save &screenshot…",
                                               lambda: _given(ask_screenshot_path(self), self.save_screenshot))
         self.menu("File").addSeparator()
-        self._action("File", "&Quit", self.close).setShortcut(QKeySequence.StandardKey.Quit)
+        self.menus.action("File", "&Quit", self.close).setShortcut(QKeySequence.StandardKey.Quit)
         self.view_menu = self.menu("View")
         self.view_menu.addAction(self.browser_dock.toggleViewAction())
         self.view_menu.addAction(self.settings_dock.toggleViewAction())
-        self._action("View", "Show the whole utterance", self.timeline.reset_zoom)
+        self.menus.action("View", "Show the whole utterance", self.timeline.reset_zoom)
         self.view_menu.addSeparator()
-        self.action_add_marker_panel = self._action("View", "Add a marker trajectory panel…",
+        self.action_add_marker_panel = self.menus.action("View", "Add a marker trajectory panel…",
                                                     lambda: self.marker_panels.ask(self.model, self))
-        self._action("View", "Remove the marker trajectory panels", self.marker_panels.clear)
+        self.menus.action("View", "Remove the marker trajectory panels", self.marker_panels.clear)
         self.analysis_menu = self.menu("Analysis")
-        self._action("Help", "Keys", lambda: QMessageBox.information(self, "Keys", KEYS_HELP))
+        self.menus.action("Help", "Keys", lambda: QMessageBox.information(self, "Keys", KEYS_HELP))
 
     def _build_shortcuts(self) -> None:
         K, M = Qt.Key, Qt.KeyboardModifier
@@ -260,23 +238,12 @@ class MainWindow(QMainWindow):
     # ================================================================== public contract
     def menu(self, name: str) -> QMenu:
         """The menu ``name`` ("File", "View", "Analysis", "Help"; another name: a new menu)."""
-        if name not in self._menus:
-            help_menu = self._menus.get("Help")
-            if help_menu is None:
-                self._menus[name] = self.menuBar().addMenu(f"&{name}")
-            else:
-                self._menus[name] = QMenu(f"&{name}", self)
-                self.menuBar().insertMenu(help_menu.menuAction(), self._menus[name])
-        return self._menus[name]
+        return self.menus.menu(name)
 
     def add_dock(self, widget: QWidget, title: str,
                  area: Qt.DockWidgetArea = Qt.DockWidgetArea.RightDockWidgetArea) -> QDockWidget:
         """Add ``widget`` as a dock; docks added to the same area are tabbed together."""
-        dock = self._dock(widget, title, area)
-        previous = self._extra_docks.get(area)
-        if previous is not None:
-            self.tabifyDockWidget(previous, dock)
-        self._extra_docks[area] = dock
+        dock = self.docks.add(widget, title, area)
         self.view_menu.addAction(dock.toggleViewAction())
         return dock
 

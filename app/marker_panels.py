@@ -1,7 +1,7 @@
 """Time-aligned panels of single marker coordinates (e.g. the jaw of midsagittal EMA data).
 
 :class:`MarkerPanels` keeps the panels the user added (View menu) and, for a planar model
-(:attr:`engine.model.Model.is_planar`: midsagittal 2-D data), puts the jaw beside the lips.
+(:attr:`engine.method.model.Model.is_planar`: midsagittal 2-D data), puts the jaw beside the lips.
 """
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from __future__ import annotations
 from PyQt6.QtWidgets import QComboBox, QDialog, QDialogButtonBox, QFormLayout, QWidget
 
 from engine.errors import FacetrajError
-from engine.model import Model
+from engine.method.model import Model
 
 from .style import ORIGINAL_COLOR, SPLINE_COLOR, TRIANGULAR_COLOR, fit_ylabel
 from .timeline import Timeline

@@ -1,7 +1,7 @@
 """Opening a recording for synthesis, with phone labels from wherever they can come from.
 
 "Open audio…" uses a label file or a ``.txt`` transcript beside the audio (the one rule,
-``engine.labelling.labels_for_audio``), otherwise asks for the sentence (:class:`SentenceDialog`:
+``engine.io.labelling.labels_for_audio``), otherwise asks for the sentence (:class:`SentenceDialog`:
 empty = recognize the phones; or no labels, acoustic-only). Alignment runs in a worker with the
 window's busy indicator; words missing from the dictionary are asked for
 (:class:`MissingWordsDialog`) and the alignment retried. The :class:`LabelSourceBox` in the settings
@@ -12,12 +12,12 @@ lips of each can be compared.
 from __future__ import annotations
 
 import logging
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
-from PyQt6.QtCore import QObject, pyqtSignal
+from PyQt6.QtCore import QObject, pyqtBoundSignal, pyqtSignal
 from PyQt6.QtWidgets import (
     QComboBox,
     QDialog,
@@ -33,15 +33,17 @@ from PyQt6.QtWidgets import (
 
 from engine.data import Utterance
 from engine.errors import FacetrajError, InputError
-from engine.formats import read_audio
-from engine.phones import ARPABET
+from engine.io.audio import read_audio
+from engine.labels.phoneset import ARPABET
 
 if TYPE_CHECKING:   # the labelling engine is imported when audio is opened (issue #15: cold start)
     import numpy as np
 
-    from engine.alignment import Labels
+    from engine.io.corpus import Corpus
+    from engine.labels.alignment import Labels
+    from engine.method.model import Model
 
-    from .main_window import MainWindow
+    from .viewer_model import UtteranceView
 
 log = logging.getLogger(__name__)
 
@@ -150,7 +152,7 @@ class OpenedAudio:
 
     def labels_for(self, source: str) -> Labels | None:
         """Labels of ``source`` (computed on the first call: run in a worker)."""
-        from engine.labelling import file_labels, label_audio
+        from engine.io.labelling import file_labels, label_audio
 
         if source not in self.labels:
             if source == "none":
@@ -211,12 +213,25 @@ class LabelSourceBox(QWidget):
 
 
 # --------------------------------------------------------------------------- the controller
-class AudioOpener(QObject):
-    """"Open audio…" for a :class:`MainWindow`: finds or asks for the labels, aligns in a worker,
-    shows the result, and switches label sources."""
+class AudioHost(Protocol):
+    """What :class:`AudioOpener` needs of the window it serves (the main window)."""
 
-    def __init__(self, window: MainWindow):
-        super().__init__(window)
+    utteranceChanged: pyqtBoundSignal
+    model: Model | None
+    corpus: Corpus | None
+    view: UtteranceView | None
+
+    def show_error(self, message: str) -> None: ...
+    def run_task(self, fn: Callable, on_done: Callable | None, label: str, **options) -> object: ...
+    def show_external(self, utt: Utterance) -> None: ...
+
+
+class AudioOpener(QObject):
+    """"Open audio…" for the main window (an :class:`AudioHost`): finds or asks for the labels,
+    aligns in a worker, shows the result, and switches label sources."""
+
+    def __init__(self, window: AudioHost):
+        super().__init__(window)  # the main window, a QObject
         self.window = window
         self.opened: dict[str, OpenedAudio] = {}
         self.box = LabelSourceBox()
@@ -230,7 +245,7 @@ class AudioOpener(QObject):
                                               "Audio (*.wav *.flac);;All files (*)")
         if not path:
             return
-        from engine.labelling import beside
+        from engine.io.labelling import beside
 
         path = Path(path)
         read = self._read(path)  # a corrupt file is reported before the sentence is asked for
@@ -263,7 +278,7 @@ class AudioOpener(QObject):
     def open(self, audio_path: Path, labels_path: Path | None = None, text: str | None = None,
              recognize: bool = False, acoustic_only: bool = False,
              extra_dict: dict[str, list[str]] | None = None) -> None:
-        """Open ``audio_path`` for synthesis; labels by ``engine.labelling.labels_for_audio``
+        """Open ``audio_path`` for synthesis; labels by ``engine.io.labelling.labels_for_audio``
         (alignment in a worker), none with ``acoustic_only``."""
         read = self._read(audio_path)
         if read is not None:
@@ -273,8 +288,8 @@ class AudioOpener(QObject):
               labels_path: Path | None = None, text: str | None = None, recognize: bool = False,
               acoustic_only: bool = False,
               extra_dict: dict[str, list[str]] | None = None) -> None:
-        from engine.alignment import MissingWordsError
-        from engine.labelling import beside, labels_for_audio
+        from engine.io.labelling import beside, labels_for_audio
+        from engine.labels.alignment import MissingWordsError
 
         win = self.window
         audio, rate = read

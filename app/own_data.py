@@ -3,7 +3,7 @@
 In: a dialog that describes a folder of recordings (audio + labels + markers) as a corpus: which
 markers are the fixed head references and which are the lip centres, and an editable table that
 maps the folder's labels onto ARPAbet (a MOCHA-TIMIT preset is provided). The description is
-written by the engine (:func:`engine.corpus.init_corpus`) and opened like any corpus.
+written by the engine (:func:`engine.io.corpus.init_corpus`) and opened like any corpus.
 
 Out: the current synthesized or original trajectories (C3D, TSV, NPZ), the time-aligned panels as
 a figure (PNG, SVG, PDF), the model file, and a video (MP4) with a progress bar. Every file is
@@ -42,12 +42,13 @@ from PyQt6.QtWidgets import (
 )
 
 from app.analysis.common import ask_save_path
-from engine.corpus import FolderScan, init_corpus, scan_folder
 from engine.errors import FacetrajError
-from engine.export import write_trajectories
-from engine.formats import atomic_write
-from engine.labelmap import MOCHA_TO_ARPABET, read_label_map, write_label_map
-from engine.phones import ARPABET, SILENCE, SILENCE_LABELS, normalise_label
+from engine.io.corpus import FolderScan, init_corpus, scan_folder
+from engine.io.export import write_trajectories
+from engine.io.files import atomic_write
+from engine.io.labelfiles import write_label_map
+from engine.labels.labelmap import MOCHA_TO_ARPABET, read_label_map
+from engine.labels.phoneset import ARPABET, SILENCE, SILENCE_LABELS, normalise_label
 
 log = logging.getLogger(__name__)
 
@@ -303,7 +304,9 @@ def export_trajectories(window, path: Path, which: str = "synthesized") -> Path:
     markers = view.shown if which == "synthesized" else view.original
     if markers is None:
         raise FacetrajError(f"{view.utterance.name} has no original markers")
-    return write_trajectories(path, markers, model, view.synthesis, which=which)
+    return write_trajectories(path, markers, model.marker_rate, model.marker_names,
+                              view.synthesis.arrays() if view.synthesis is not None else None,
+                              which=which)
 
 
 def export_figure(window, path: Path) -> Path:

@@ -21,9 +21,9 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from engine.evaluation import METRICS
-from engine.model import Model
-from engine.paper import PAPER_TABLE2, TABLE2_N
+from engine.evaluation.paper import PAPER_TABLE2, TABLE2_N
+from engine.evaluation.scores import METRICS
+from engine.method.model import Model
 from engine.report import ComparisonRow, ReportData, write_report
 
 log = logging.getLogger(__name__)

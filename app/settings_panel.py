@@ -47,7 +47,12 @@ class SynthSettingsPanel(QWidget):
         self._timer.timeout.connect(lambda: self.configChanged.emit(self.config()))
         self._base = config or SynthConfig()
         self._tuned: dict = {}
+        self._build_inputs()
+        self._build_layout()
+        self.set_config(self._base)
+        self._connect()
 
+    def _build_inputs(self) -> None:
         self.n = QSpinBox()
         self.n.setRange(1, 50)
         self.n.setToolTip("N: the number of visually most similar context-phones searched (eq 4-5)")
@@ -89,6 +94,7 @@ class SynthSettingsPanel(QWidget):
         self.status = QLabel("")
         self.status.setWordWrap(True)
 
+    def _build_layout(self) -> None:
         form = QFormLayout()
         form.addRow("N (context-phones)", self.n)
         form.addRow("C (context)", self.c)
@@ -108,7 +114,7 @@ class SynthSettingsPanel(QWidget):
         lay.addWidget(self.status)
         lay.addStretch(1)
 
-        self.set_config(self._base)
+    def _connect(self) -> None:
         for w in (self.n, self.c):
             w.valueChanged.connect(self._changed)
         self.xi.valueChanged.connect(self._changed)

@@ -12,9 +12,9 @@ import numpy as np
 
 from engine.config import SynthConfig
 from engine.data import Utterance
-from engine.evaluation import speech_mask
-from engine.model import Model
-from engine.pipeline import Synthesis, resmooth, synthesize
+from engine.evaluation.scores import speech_mask
+from engine.method.model import Model
+from engine.method.pipeline import Synthesis, resmooth, synthesize
 
 
 def frame_index(t: float, rate: float, n_frames: int, step: int = 0) -> int:

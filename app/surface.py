@@ -11,9 +11,9 @@ import logging
 
 import numpy as np
 
-from engine.cachedir import cache_dir
 from engine.errors import InputError
-from engine.formats import atomic_write
+from engine.io.cachedir import cache_dir
+from engine.io.files import atomic_write
 
 log = logging.getLogger(__name__)
 

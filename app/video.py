@@ -18,9 +18,10 @@ from pathlib import Path
 import numpy as np
 
 from engine.data import PhoneSegment, Utterance
-from engine.formats import atomic_write, write_audio
-from engine.model import Model
-from engine.pipeline import Synthesis
+from engine.io.audio import write_audio
+from engine.io.files import atomic_write
+from engine.method.model import Model
+from engine.method.pipeline import Synthesis
 
 from .style import BACKGROUND, CURSOR_COLOR, ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
 from .surface import face_triangles, lip_contours

@@ -15,7 +15,7 @@ from PyQt6.QtCore import QPoint
 from PyQt6.QtGui import QCursor, QImage, QPainter, QPixmap
 from PyQt6.QtWidgets import QToolTip, QVBoxLayout, QWidget
 
-from engine.model import Model
+from engine.method.model import Model
 
 from .plotter_widget import is_native, make_plotter
 from .state import UtteranceView

@@ -21,13 +21,13 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from engine.config import SynthConfig
-from engine.corpus import Corpus
 from engine.data import Utterance
 from engine.errors import FacetrajError
-from engine.evaluation import evaluate_utterance
-from engine.model import Model
-from engine.paper import FIGURE4_TEXT
-from engine.pipeline import mode_for
+from engine.evaluation.paper import FIGURE4_TEXT
+from engine.evaluation.scores import evaluate_utterance
+from engine.io.corpus import Corpus
+from engine.method.model import Model
+from engine.method.pipeline import mode_for
 from engine.progress import Progress
 
 from .phases import mark
@@ -67,7 +67,7 @@ class SynthRequest:
     def run(self, progress: Progress | None = None) -> UtteranceView:
         """Load and synthesize (slow: run in a worker). Without phone labels the synthesis is
         acoustic-only, and with labels not hand-checked robust unless the user chose the mode
-        (:func:`engine.pipeline.mode_for`)."""
+        (:func:`engine.method.pipeline.mode_for`)."""
         utt = self.load()
         mark(f"utterance {utt.name} read")
         if progress is not None:

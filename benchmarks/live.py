@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from engine.config import SynthConfig
-from engine.streaming import LIVE_BATCH_FRAMES, StreamConfig, StreamingSynthesizer
+from engine.streaming.synthesizer import LIVE_BATCH_FRAMES, StreamConfig, StreamingSynthesizer
 from engine.threads import one_blas_thread
 
 from .common import BenchContext, BenchRow, concatenate_input, load_context, markdown_table
@@ -102,7 +102,7 @@ def _run(ctx: BenchContext) -> list[BenchRow]:
 
 def _live_fps(ctx: BenchContext, seconds: float) -> list[BenchRow]:
     """Face updates per second of the Live window playing test speech in real time."""
-    from app.main import has_display
+    from app.display import has_display
 
     if not has_display():
         return [BenchRow("live", "Live window face updates", float("nan"), "fps",

@@ -5,7 +5,7 @@ codebook grows x1, x4, x16, with three ways of choosing the codewords each frame
 * exact prefilter: the K codewords nearest by eq 5, found by comparing every codeword
   (``SynthConfig(acoustic_probe=None)``), then eqs 6-8 over those K;
 * indexed (the default): the same K nearest looked up in the model's coarse k-means LSF index,
-  opening ``acoustic_probe`` cells (``engine.lsf_index``; time about sqrt(5L)).
+  opening ``acoustic_probe`` cells (``engine.method.lsf_index``; time about sqrt(5L)).
 
 The larger codebooks replicate the trained one with jitter (LSFs + N(0, 0.01 rad), re-sorted;
 PCs + 5 % of each PC's standard deviation), which keeps the codeword density realistic; their
@@ -25,11 +25,11 @@ from dataclasses import replace
 
 import numpy as np
 
-from engine.codebook import Codebook
 from engine.config import SynthConfig
-from engine.evaluation import speech_mask, trajectory_correlations
-from engine.model import Model
-from engine.pipeline import Synthesis, synthesize
+from engine.evaluation.scores import speech_mask, trajectory_correlations
+from engine.method.codebook import Codebook
+from engine.method.model import Model
+from engine.method.pipeline import Synthesis, synthesize
 
 from .common import BenchContext, BenchRow, Timing, best_time, concatenate_input, timed
 
@@ -156,6 +156,26 @@ def run(ctx: BenchContext, factors: Sequence[int] | None = None,
                 aim=">= 50x" if is_default and factor == 1 else "",
                 ok=judged and seconds / tm.wall >= 50 if is_default and factor == 1 else None)
         log.info("scaling x%d (%d codewords): full %.2f s", factor, size, tm_full.wall)
+    rows += _growth_rows(wall, cpu, factors, prefilters, k_exact, k_default, judged)
+    # accuracy against the original markers (x1 codebook)
+    if ctx.test_utts:
+        n = min(len(ctx.test_utts), N_TEST_UTTS)
+        c_full = original_correlation(base, ctx, FULL)
+        rows.append(BenchRow("scaling", "test whole-face correlation, acoustic full search (paper)",
+                             c_full, "corr", note=f"first {n} test utterances, triangular"))
+        for label, cfg in ((f"exact prefilter K={k_exact}",
+                            default.with_(acoustic_prefilter=k_exact, acoustic_probe=None)),
+                           (f"indexed K={k_default} (default)", default)):
+            c = original_correlation(base, ctx, cfg)
+            rows.append(BenchRow("scaling", f"test whole-face correlation, acoustic {label}", c,
+                                 "corr", note=f"change {c - c_full:+.4f} vs full search"))
+    return rows
+
+
+def _growth_rows(wall: dict[tuple, float], cpu: dict[tuple, float], factors: Sequence[int],
+                 prefilters: Sequence[int], k_exact: int, k_default: int, judged: bool) -> list[BenchRow]:
+    """The growth exponent of each search's time with the codebook's size."""
+    rows: list[BenchRow] = []
     lo, hi = min(factors), max(factors)
     if hi > lo:
         span = f"x{lo}..x{hi}"
@@ -172,16 +192,4 @@ def run(ctx: BenchContext, factors: Sequence[int] | None = None,
                                  aim="< 1" if is_default else "",
                                  ok=(judged and e < 1) if is_default else None,
                                  cpu=_exponent(cpu, (*key, lo), (*key, hi), lo, hi)))
-    # accuracy against the original markers (x1 codebook)
-    if ctx.test_utts:
-        n = min(len(ctx.test_utts), N_TEST_UTTS)
-        c_full = original_correlation(base, ctx, FULL)
-        rows.append(BenchRow("scaling", "test whole-face correlation, acoustic full search (paper)",
-                             c_full, "corr", note=f"first {n} test utterances, triangular"))
-        for label, cfg in ((f"exact prefilter K={k_exact}",
-                            default.with_(acoustic_prefilter=k_exact, acoustic_probe=None)),
-                           (f"indexed K={k_default} (default)", default)):
-            c = original_correlation(base, ctx, cfg)
-            rows.append(BenchRow("scaling", f"test whole-face correlation, acoustic {label}", c,
-                                 "corr", note=f"change {c - c_full:+.4f} vs full search"))
     return rows

@@ -5,7 +5,7 @@ user's second start) timed as a whole process, from launch to exit after the fir
 rendered and written; and ``import app.main_window`` alone. Each is the median of several runs
 in new processes (the first start, which may train and cache the model, is not counted).
 
-Evaluation: ``engine.evaluation.evaluate`` over the whole default corpus (train and test,
+Evaluation: ``engine.evaluation.scores.evaluate`` over the whole default corpus (train and test,
 phonetic and acoustic-only, both smoothings, as ``facetraj eval --acoustic`` runs it), serially
 and with one worker process per core; the two results are checked equal.
 """
@@ -72,7 +72,7 @@ def cold_start(ctx: BenchContext) -> list[BenchRow]:
 def evaluation(ctx: BenchContext) -> list[BenchRow]:
     """``evaluate()`` on the whole corpus, serially and in one process per core."""
     from engine.config import SynthConfig
-    from engine.evaluation import default_workers, evaluate
+    from engine.evaluation.scores import default_workers, evaluate
 
     configs = [SynthConfig(), SynthConfig(mode="acoustic")]
     workers = default_workers()

@@ -1,4 +1,4 @@
-"""Synthesis benchmark (paper section 2.3): real-time factor of :func:`engine.pipeline.synthesize` for
+"""Synthesis benchmark (paper section 2.3): real-time factor of :func:`engine.method.pipeline.synthesize` for
 1 s, 10 s and 60 s of input, phonetic (N = 3) and acoustic-only, both with the default settings
 (acoustic-only: eqs 6-8 over the K = 128 codewords nearest by eq 5, found in the model's LSF index;
 the whole-codebook search of the paper is timed by the scaling benchmark).
@@ -19,11 +19,11 @@ import time
 from collections.abc import Iterator, Sequence
 from unittest import mock
 
-from engine import lsf, pipeline
 from engine.config import SynthConfig
-from engine.lsf_index import LsfIndex
-from engine.model import Model
-from engine.pipeline import Synthesis, synthesize
+from engine.method import lsf, pipeline
+from engine.method.lsf_index import LsfIndex
+from engine.method.model import Model
+from engine.method.pipeline import Synthesis, synthesize
 from engine.threads import frame_spans, frame_threads, limit_frame_threads
 
 from .common import BenchContext, BenchRow, Timing, best_time, concatenate_input, timed

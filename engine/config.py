@@ -35,8 +35,8 @@ class TrainConfig:
     distance_scale : how D (eq 2) is normalised before eq 3: ``max`` divides by the largest
         distance, ``median`` by the median off-diagonal distance, ``none`` leaves it in PC units.
     index_cells : cells of the coarse k-means index over the codebook LSFs used by acoustic-only
-        synthesis (``engine.lsf_index``); ``None`` takes ``round(sqrt(5L))``.
-    lsf_context_frames : the robust mode's acoustic context (``engine.selection``): each codeword
+        synthesis (``engine.method.lsf_index``); ``None`` takes ``round(sqrt(5L))``.
+    lsf_context_frames : the robust mode's acoustic context (``engine.method.selection``): each codeword
         also stores its LSF vectors this many marker frames before and after it (0: none).
     """
 
@@ -76,8 +76,8 @@ class SynthConfig:
     nu : override of eq 3's constant; ``None`` uses the model's.
     mode : ``phonetic`` (labels restrict the search, eq 4), ``acoustic`` (no labels) or
         ``robust`` (eq 4's and the acoustically nearest codewords together, the labels counting
-        as much as their confidence, with acoustic context: ``engine.selection``; the default for
-        labels that are not hand-checked, :func:`engine.pipeline.mode_for`).
+        as much as their confidence, with acoustic context: ``engine.method.selection``; the default for
+        labels that are not hand-checked, :func:`engine.method.pipeline.mode_for`).
     gamma_min, gamma_max, gamma_steps : the grid searched for gamma (eqs 6-7).
     smoothing : ``triangular`` (100 ms zero-phase window), ``spline`` or ``none``.
     triangle_s : the triangular window's total duration.
@@ -85,9 +85,9 @@ class SynthConfig:
     acoustic_prefilter : in acoustic mode, keep only the K codewords nearest to each frame by
         eq 5 before eqs 6-8; ``None`` weights all 5L codewords, as the paper does (slow).
     acoustic_probe : how the K nearest are found: among the members of this many cells of the
-        model's coarse LSF index (``engine.lsf_index``, fast, growth about sqrt(5L)); ``None``
+        model's coarse LSF index (``engine.method.lsf_index``, fast, growth about sqrt(5L)); ``None``
         compares every codeword (exact, linear in 5L).
-    speaker_warp : speaker normalisation of the input LSFs (``engine.speaker``): a warp factor
+    speaker_warp : speaker normalisation of the input LSFs (``engine.method.speaker``): a warp factor
         alpha (1.0: none; below 1 lowers the frequencies, for a voice with a shorter vocal tract
         than the training voice), or ``None`` to choose it per utterance (``choose_warp``).
     robust_candidates : robust mode: acoustically nearest codewords added to eq 4's (index search).

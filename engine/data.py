@@ -38,7 +38,7 @@ class Utterance:
     text : optional orthographic text.
     label_source : where ``phones`` came from: ``"file"`` (a label file), ``"aligned"`` (forced
         alignment of ``text``), ``"recognized"`` (phone recognition) or ``"none"``
-        (``engine.alignment`` / ``engine.labelling``).
+        (``engine.labels.alignment`` / ``engine.io.labelling``).
     """
 
     name: str

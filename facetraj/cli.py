@@ -13,7 +13,7 @@ import sys
 from collections.abc import Sequence
 
 from engine.errors import FacetrajError
-from engine.formats import write_problem
+from engine.io.files import write_problem
 
 from .commands import align, corpus, evaluate, gui, live, render, synth, train
 from .options import SECONDS

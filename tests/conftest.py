@@ -46,21 +46,21 @@ def toy_corpus_dir(tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="session")
 def toy_corpus(toy_corpus_dir):
-    from engine.corpus import load_corpus
+    from engine.io.corpus import load_corpus
 
     return load_corpus(toy_corpus_dir)
 
 
 @pytest.fixture(scope="session")
 def toy_model(toy_corpus):
-    from engine.training import train
+    from engine.method.training import train
 
     return train(toy_corpus)
 
 
 @pytest.fixture(scope="session")
 def default_corpus():
-    from engine.corpus import load_corpus
+    from engine.io.corpus import load_corpus
 
     assert (DEFAULT_CORPUS / "corpus.json").exists(), "the default corpus data_samples/ is missing"
     return load_corpus(DEFAULT_CORPUS)

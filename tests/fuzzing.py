@@ -103,8 +103,8 @@ class Workspace:
 def make_workspace(root: Path, toy_dir: Path | None = None, model_path: Path | None = None
                    ) -> Workspace:
     """A small corpus (3 utterances of the toy corpus) and a model trained on it, in ``root``."""
-    from engine.corpus import CorpusInfo, load_corpus, save_corpus_info
-    from engine.formats import read_labels
+    from engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
+    from engine.io.labelfiles import read_labels
 
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     if toy_dir is None:
@@ -123,7 +123,7 @@ def make_workspace(root: Path, toy_dir: Path | None = None, model_path: Path | N
     if model_path is not None:
         shutil.copy(model_path, model)
     else:
-        from engine.training import train
+        from engine.method.training import train
 
         train(load_corpus(toy_dir)).save(model)
     lab = root / "toy030.lab"
@@ -334,6 +334,48 @@ def _npy(arr) -> bytes:
     return buf.getvalue()
 
 
+def _mutated_meta(rng: random.Random, meta: dict) -> tuple[object, str]:
+    """A model's metadata with one field (or itself) replaced by a wrong value, and what changed."""
+    field_ = rng.choice([*list(meta), "config"])
+    value = rng.choice([None, [], {}, "x", -1, 0, 1e309, True, 3.5, [1, 2], "nan", 10**30])
+    if rng.random() < 0.15:
+        meta = rng.choice([[], "text", 5, None])
+        return meta, f"meta is {meta!r}"
+    if field_ == "config" and isinstance(meta.get("config"), dict) and rng.random() < 0.7:
+        key = rng.choice(list(meta["config"]))
+        meta["config"][key] = value
+        return meta, f"config {key} = {value!r}"
+    meta[field_] = value
+    return meta, f"meta {field_} = {value!r}"
+
+
+def _mutated_array(rng: random.Random, a):
+    """A model array with a NaN, another dtype or shape, emptied, doubled, text, transposed or
+    negated; and which."""
+    import numpy as np
+
+    how = rng.choice(["nan", "dtype", "shape", "empty", "big", "str", "transpose", "neg"])
+    if how == "nan":
+        b = a.astype(float)
+        if b.size:
+            b.flat[rng.randrange(b.size)] = rng.choice([np.nan, np.inf])
+    elif how == "dtype":
+        b = a.astype(rng.choice([np.int8, np.float32, np.complex64, np.bool_, np.uint64]))
+    elif how == "shape":
+        b = a.reshape(-1)[: max(a.size - 1, 0)]
+    elif how == "empty":
+        b = np.zeros((0, *a.shape[1:]), a.dtype)
+    elif how == "big":
+        b = np.concatenate([a, a]) if a.ndim else a
+    elif how == "str":
+        b = np.array(["x"] * max(a.size, 1))
+    elif how == "transpose":
+        b = a.T.copy()
+    else:
+        b = -np.abs(a) - 1 if a.dtype.kind in "iuf" else a
+    return b, how
+
+
 def _model_variant(rng: random.Random, src: Path, dst: Path) -> str:
     import numpy as np
 
@@ -344,43 +386,13 @@ def _model_variant(rng: random.Random, src: Path, dst: Path) -> str:
     kind = rng.choice(["meta", "meta", "array", "array", "header", "compression", "deflate",
                        "bytes", "missing", "pickle"])
     if kind == "meta":
-        field_ = rng.choice([*list(meta), "config"])
-        value = rng.choice([None, [], {}, "x", -1, 0, 1e309, True, 3.5, [1, 2], "nan", 10**30])
-        if rng.random() < 0.15:
-            meta = rng.choice([[], "text", 5, None])
-            desc = f"meta is {meta!r}"
-        elif field_ == "config" and isinstance(meta.get("config"), dict) and rng.random() < 0.7:
-            key = rng.choice(list(meta["config"]))
-            meta["config"][key] = value
-            desc = f"config {key} = {value!r}"
-        else:
-            meta[field_] = value
-            desc = f"meta {field_} = {value!r}"
+        meta, desc = _mutated_meta(rng, meta)
         members["meta.npy"] = _npy(np.array(json.dumps(meta).replace("Infinity", "1e999")))
         _write_npz(dst, members)
         return desc
     if kind == "array":
         name = rng.choice([k for k in arrays if k != "meta"])
-        a = arrays[name]
-        how = rng.choice(["nan", "dtype", "shape", "empty", "big", "str", "transpose", "neg"])
-        if how == "nan":
-            b = a.astype(float)
-            if b.size:
-                b.flat[rng.randrange(b.size)] = rng.choice([np.nan, np.inf])
-        elif how == "dtype":
-            b = a.astype(rng.choice([np.int8, np.float32, np.complex64, np.bool_, np.uint64]))
-        elif how == "shape":
-            b = a.reshape(-1)[: max(a.size - 1, 0)]
-        elif how == "empty":
-            b = np.zeros((0, *a.shape[1:]), a.dtype)
-        elif how == "big":
-            b = np.concatenate([a, a]) if a.ndim else a
-        elif how == "str":
-            b = np.array(["x"] * max(a.size, 1))
-        elif how == "transpose":
-            b = a.T.copy()
-        else:
-            b = -np.abs(a) - 1 if a.dtype.kind in "iuf" else a
+        b, how = _mutated_array(rng, arrays[name])
         members[f"{name}.npy"] = _npy(b)
         _write_npz(dst, members)
         return f"{name} {how}"
@@ -528,7 +540,7 @@ def c3d_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
             rate = rng.choice([1e6, 0.001, 0.0, -60.0, float("nan"), 1e30, 59.9, 240.0])
             data, how = _c3d_rate(src, rate), f"{rate:g} Hz"
         elif kind == "frames":
-            from engine.formats import read_c3d, write_c3d
+            from engine.io.markerfiles import read_c3d, write_c3d
 
             m = read_c3d(ws.c3d)
             n = rng.choice([0, 1, 2, 3])
@@ -560,7 +572,7 @@ def c3d_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
 # --------------------------------------------------------------------------- TSV / EMA markers
 def marker_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
     """Marker tables (TSV/CSV) and MOCHA EMA text in place of the C3D, damaged as text."""
-    from engine.formats import read_c3d, write_marker_tsv
+    from engine.io.markerfiles import read_c3d, write_marker_tsv
 
     m = read_c3d(ws.c3d)
     while True:

@@ -35,8 +35,8 @@ from engine.analysis.similarity import (
     write_similarity_csv,
 )
 from engine.data import PhoneSegment
-from engine.evaluation import EvalResult, UtteranceScore, evaluate_utterance
-from engine.pipeline import synthesize
+from engine.evaluation.scores import EvalResult, UtteranceScore, evaluate_utterance
+from engine.method.pipeline import synthesize
 
 
 def score(split, smoothing, n, wf, lo, up, mode="phonetic", utt="u"):

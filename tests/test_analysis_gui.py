@@ -29,8 +29,8 @@ from engine.analysis.pc_modes import describe_mode
 from engine.analysis.similarity import cluster_phones
 from engine.config import SynthConfig
 from engine.data import PhoneSegment
-from engine.evaluation import sweep_n, table2
-from engine.similarity import top_similar
+from engine.evaluation.scores import sweep_n, table2
+from engine.method.similarity import top_similar
 
 pytestmark = pytest.mark.gui
 WAIT_MS = 240_000   # a hang guard (a loaded machine is slow), not a speed limit
@@ -193,7 +193,7 @@ def test_inspector_robust_mode_explains_choice(qtbot, model, corpus, tmp_path):
     """Robust mode: the table gains target cost, label cost and origin columns, the label
     confidence is shown, and the numbers are the synthesis's."""
     from app.analysis.inspector import CodebookInspector
-    from engine.pipeline import synthesize
+    from engine.method.pipeline import synthesize
 
     utt = corpus.utterance(corpus.info.test[0])
     conf = np.full(len(utt.phones), 0.25)

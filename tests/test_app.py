@@ -289,7 +289,7 @@ def test_corrupt_file_shows_error_and_app_keeps_working(window, qtbot, tmp_path,
     import shutil
 
     from app.open_audio import SentenceDialog
-    from engine.corpus import audio_path
+    from engine.io.corpus import audio_path
 
     good = tmp_path / audio_path(win.corpus.root, win.corpus.info.test[-1]).name
     shutil.copy(audio_path(win.corpus.root, win.corpus.info.test[-1]), good)

@@ -8,6 +8,7 @@ import re
 import struct
 import tempfile
 import zipfile
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -17,27 +18,19 @@ from alignment_cases import alignment_cases
 from conftest import edited_model_file
 from fuzzing import _c3d_rate
 
-from app.main import require_display
+from app.display import require_display
 from engine.config import SynthConfig
-from engine.corpus import CorpusInfo, load_corpus, save_corpus_info
 from engine.data import PhoneSegment, Utterance
 from engine.errors import FacetrajError
-from engine.formats import (
-    atomic_write,
-    read_audio,
-    read_c3d,
-    read_lab,
-    read_labels,
-    read_markers,
-    read_mocha_ema,
-    read_textgrid,
-    validate_phones,
-    write_c3d,
-)
-from engine.labelmap import read_label_map
-from engine.model import Model
-from engine.pipeline import synthesize
-from engine.training import MarkerSetup, train
+from engine.io.audio import read_audio
+from engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
+from engine.io.files import atomic_write
+from engine.io.labelfiles import read_lab, read_labels, read_textgrid, validate_phones
+from engine.io.markerfiles import read_c3d, read_markers, read_mocha_ema, write_c3d
+from engine.labels.labelmap import read_label_map
+from engine.method.model import Model
+from engine.method.pipeline import synthesize
+from engine.method.training import MarkerSetup, train
 
 DOC = Path(__file__).resolve().parent.parent / "docs" / "bad-input.md"
 
@@ -56,150 +49,200 @@ def _copy_utt(src: Path, dst: Path, stem: str, utt_id: str = "u"):
         (dst / f"{utt_id}.{ext}").write_bytes((src / f"{stem}.{ext}").read_bytes())
 
 
-def produce(case: str, tmp: Path, toy_dir: Path, model: Model, caplog) -> str:
-    """Make the bad input of ``case`` happen; return the message (error or log)."""
-    wav = toy_dir / "toy030.wav"
-    audio, rate = read_audio(wav)
-    phones = read_labels(toy_dir / "toy030.TextGrid")
-    info = load_corpus(toy_dir).info
+class BadInputs:
+    """What the bad inputs are made from: the toy corpus's utterance ``toy030``, a model, and a
+    scratch folder ``tmp`` to write them in."""
 
-    def corpus_with(markers=None, names=None):
-        _copy_utt(toy_dir, tmp, "toy030")
+    def __init__(self, tmp: Path, toy_dir: Path, model: Model):
+        self.tmp, self.toy_dir, self.model = tmp, toy_dir, model
+        self.wav = toy_dir / "toy030.wav"
+        self.audio, self.rate = read_audio(self.wav)
+        self.phones = read_labels(toy_dir / "toy030.TextGrid")
+        self.info = load_corpus(toy_dir).info
+        self.toy_markers = read_c3d(toy_dir / "toy030.c3d").markers
+        self.setup = MarkerSetup(self.info.fixed_markers, self.info.upper_lip, self.info.lower_lip)
+        self.names = self.info.marker_names
+        self.lab1 = next(s.label for s in self.phones if s.label != "sil")
+        self.gappy = self.toy_markers.copy()
+        self.gappy[20:40] = np.nan
+        self.sparse = np.where(np.arange(len(self.toy_markers))[:, None, None] % 3 == 0,
+                               self.toy_markers, np.nan)
+        self.newer = {"format": "facetraj-model", "version": 9}
+
+    def corpus_with(self, markers=None, names=None):
+        _copy_utt(self.toy_dir, self.tmp, "toy030")
         if markers is not None:
-            write_c3d(tmp / "u.c3d", markers, 60.0, names or info.marker_names)
-        save_corpus_info(tmp, CorpusInfo(**{**info.__dict__, "train": ["u"], "test": []}))
-        return load_corpus(tmp).utterance("u")
+            write_c3d(self.tmp / "u.c3d", markers, 60.0, names or self.info.marker_names)
+        save_corpus_info(self.tmp, CorpusInfo(**{**self.info.__dict__, "train": ["u"], "test": []}))
+        return load_corpus(self.tmp).utterance("u")
 
-    toy_markers = read_c3d(toy_dir / "toy030.c3d").markers
-    setup = MarkerSetup(info.fixed_markers, info.upper_lip, info.lower_lip)
-    names = info.marker_names
-
-    def write(name: str, data: bytes | str) -> Path:
-        path = tmp / name
+    def write(self, name: str, data: bytes | str) -> Path:
+        path = self.tmp / name
         path.write_bytes(data if isinstance(data, bytes) else data.encode())
         return path
 
-    def with_phone(label: str):
-        return [PhoneSegment(s.start, s.end, label if i == 1 else s.label) for i, s in enumerate(phones)]
+    def with_phone(self, label: str):
+        return [PhoneSegment(s.start, s.end, label if i == 1 else s.label)
+                for i, s in enumerate(self.phones)]
 
-    lab1 = next(s.label for s in phones if s.label != "sil")
-    gappy = toy_markers.copy()
-    gappy[20:40] = np.nan
-    sparse = np.where(np.arange(len(toy_markers))[:, None, None] % 3 == 0, toy_markers, np.nan)
-    newer = {"format": "facetraj-model", "version": 9}
-    cases = {
-        "audio file missing": lambda: read_audio(tmp / "none.wav"),
-        "audio file of 0 bytes": lambda: read_audio(write("e.wav", b"")),
-        "corrupt or unreadable audio": lambda: read_audio(write("c.wav", b"RIFF....WAVEjunk" * 9)),
-        "audio with no samples": lambda: (sf.write(tmp / "n.wav", np.zeros(0), 16000),
-                                          read_audio(tmp / "n.wav")),
-        "sample rate below 8 kHz": lambda: (sf.write(tmp / "r.wav", np.zeros(100), 6000),
-                                            read_audio(tmp / "r.wav")),
-        "stereo or multi-channel audio": lambda: (sf.write(tmp / "s.wav", np.zeros((100, 2)), 16000),
-                                                  read_audio(tmp / "s.wav")),
-        "labels that end before or after the audio": lambda: validate_phones(
-            [PhoneSegment(0, 1, "a")], 2.0, "l.lab"),
-        "labels that start late": lambda: validate_phones([PhoneSegment(0.5, 2, "a")], 2.0, "l.lab"),
-        "overlapping or unsorted labels": lambda: validate_phones(
-            [PhoneSegment(0, 1.2, "a"), PhoneSegment(1, 2, "b")], 2.0, "l.lab"),
-        "a segment that ends before it starts": lambda: validate_phones(
-            [PhoneSegment(0, 1, "a"), PhoneSegment(1, 0.5, "b")], 2.0, "l.lab"),
-        "an empty label file": lambda: validate_phones([], 2.0, "l.lab"),
-        "unknown label format": lambda: read_labels(tmp / "x.seg"),
-        "a phone the model does not know": lambda: (synthesize(model, audio, rate, with_phone("ux")),
-                                                    synthesize(model, audio, rate, with_phone("zz"))),
-        "label text that is not UTF-8": lambda: read_lab(write("b.lab", b"0 1 \xe9\xff\xfe\xfa")),
-        "a C3D whose marker set differs from the corpus": lambda: corpus_with(
-            toy_markers[:, :11], names[:11]),
-        "a marker file that is not C3D": lambda: read_c3d(write("m.c3d", b"x" * 600)),
-        "markers shorter than the audio": lambda: corpus_with(toy_markers[:40]),
-        "markers mostly missing (NaN)": lambda: corpus_with(sparse),
-        "marker gaps longer than 100 ms": lambda: train(
-            [Utterance("g", audio, rate, phones, gappy, 60.0, names)], setup),
-        "training utterances with different marker sets": lambda: train(
-            [Utterance("a", audio, rate, phones, toy_markers, 60.0, names),
-             Utterance("b", audio, rate, phones, toy_markers[:, :11], 60.0, names[:11])], setup),
-        "a one-frame marker file": lambda: train(
-            [Utterance("a", audio, rate, phones, toy_markers[:1], 60.0, names)], setup),
-        "audio too short to synthesize (under two marker frames)": lambda: synthesize(
-            model, audio[:200], rate, None, SynthConfig(mode="acoustic")),
-        "phonetic synthesis without labels": lambda: synthesize(model, audio, rate, None),
-        "a model file that is not ours": lambda: (np.savez(tmp / "o.npz", a=np.zeros(2)),
-                                                  Model.load(tmp / "o.npz")),
-        "a truncated model file": lambda: Model.load(
-            write("t.npz", model.save(tmp / "full.npz").read_bytes()[:500])),
-        "a model file from a newer facetraj": lambda: (
-            np.savez(tmp / "n.npz", meta=np.array(json.dumps(newer))), Model.load(tmp / "n.npz")),
-        "a model file whose LSF index was damaged": lambda: Model.load(edited_model_file(
-            model.save(tmp / "full.npz"), tmp / "d.npz", ix_offsets=model.index.offsets[:-1])),
-        "a corpus folder without corpus.json": lambda: load_corpus(tmp),
-        "a corpus.json that is not JSON": lambda: (write("corpus.json", "{"), load_corpus(tmp)),
-        "a corpus.json naming an unknown marker": lambda: (
-            save_corpus_info(tmp, CorpusInfo(**{**info.__dict__, "lower_lip": "NOSE"})),
-            load_corpus(tmp)),
-        "an output file that exists": lambda: (write("o.tsv", "x"),
-                                               atomic_write(tmp / "o.tsv", overwrite=False).__enter__()),
-        "an unknown marker format": lambda: read_markers(tmp / "m.trc"),
-        "a MOCHA EMA file with the wrong column count": lambda: read_mocha_ema(
-            write("x.ema", "0 1 2 3\n1 1 2 3\n")),
-        "a label map line that is not a pair": lambda: read_label_map(write("map.txt", "a b c\n")),
-        "a label map that maps a label to a phone the model does not know": lambda: synthesize(
-            model, audio, rate, phones, label_map=read_label_map(write("m.tsv", f"{lab1}\tzz\n"))),
-        "a label file or label map given as a folder": lambda: (
-            (tmp / "f.lab").mkdir(), read_labels(tmp / "f.lab")),
-        "TextGrid intervals out of order or overlapping": lambda: read_textgrid(write(
-            "o.TextGrid", (toy_dir / "toy030.TextGrid").read_text().replace(
-                "xmin = 0.25", "xmin = 0.001", 1))),
-        "a .lab time that is not a finite number (`inf`, `nan`)": lambda: read_lab(
-            write("i.lab", "0 0.5 a\n0.5 inf b\n")),
-        "an empty phone tier": lambda: read_labels(write("e.lab", "# nothing\n")),
-        "a transcript (`<id>.txt`) that is not UTF-8": lambda: (
-            write("u.txt", b"caf\xe9"), corpus_with()),
-        "markers whose names differ from the corpus (same count)": lambda: corpus_with(
-            toy_markers, [n + "_X" if i == 3 else n for i, n in enumerate(names)]),
-        "marker table or EMA times that give no sane rate": lambda: read_markers(write(
-            "t.tsv", "time\ta_x\ta_y\ta_z\n0\t1\t2\t3\n0\t1\t2\t3\n")),
-        "a C3D whose header or parameters ask for more than the file holds": lambda: read_c3d(
-            write("h.c3d", (toy_dir / "toy030.c3d").read_bytes()[:3000])),
-        "a C3D whose parameter section is damaged": lambda: read_c3d(write(
-            "p.c3d", _damaged_parameter((toy_dir / "toy030.c3d").read_bytes()))),
-        "a C3D frame rate outside 1-10000 Hz": lambda: read_c3d(write(
-            "r.c3d", _c3d_rate((toy_dir / "toy030.c3d").read_bytes(), 1e6))),
-        "a model whose metadata has wrong types or values": lambda: Model.load(edited_model_file(
-            model.save(tmp / "full.npz"), tmp / "m.npz", meta=np.array(json.dumps(
-                {**_meta(tmp / "full.npz"), "marker_rate": "60"})))),
-        "a model array of the wrong shape or data type": lambda: Model.load(edited_model_file(
-            model.save(tmp / "full.npz"), tmp / "m.npz", cb_lsf=model.codebook.lsf[:, 1:])),
-        "a model array holding NaN or infinite values": lambda: Model.load(edited_model_file(
-            model.save(tmp / "full.npz"), tmp / "m.npz", means=model.means * np.nan)),
-        "a model entry whose .npy header asks for too much memory": lambda: Model.load(
-            _forged_header(model.save(tmp / "full.npz"), tmp / "m.npz")),
-        "a model entry with an unsupported zip compression method": lambda: Model.load(
-            _bzip2(model.save(tmp / "full.npz"), tmp / "m.npz")),
-        "a corpus.json that is not an object": lambda: (write("corpus.json", "[]"), load_corpus(tmp)),
-        "a corpus.json entry of the wrong type or range": lambda: (write("corpus.json", json.dumps(
-            {**info.to_json(), "marker_rate": 0})), load_corpus(tmp)),
-        "a corpus.json nested too deeply": lambda: (write("corpus.json", "[" * 10**5 + "]" * 10**5),
-                                                    load_corpus(tmp)),
-        "a corpus.json whose data folder is missing": lambda: (write("corpus.json", json.dumps(
-            {**info.to_json(), "data_dir": "gone"})), load_corpus(tmp)),
-        "an option value out of its range (`-N 0`, `--xi nan`, `--lpc-order 0`)": lambda: _parse(
-            ["synth", "m.npz", "a.wav", "-o", "o.tsv", "-N", "0"]),
-        "a folder at the output path (even with `--overwrite`)": lambda: (
-            (tmp / "o.tsv").mkdir(), atomic_write(tmp / "o.tsv").__enter__()),
-        "an output whose parent is a regular file": lambda: (
-            write("f", "x"), atomic_write(tmp / "f" / "o.tsv").__enter__()),
-        "an output name too long for the file system": lambda: atomic_write(
-            tmp / ("x" * 300)).__enter__(),
-        "an output folder without write permission": lambda: _patched(
-            os, "access", lambda *a: False, lambda: atomic_write(tmp / "o.tsv").__enter__()),
-        "an output on a read-only file system": lambda: _patched(
-            tempfile, "mkstemp", _erofs, lambda: atomic_write(tmp / "o.tsv").__enter__()),
-        "a window (`facetraj gui`, `facetraj live` without `-o`) on a machine without a display":
-            lambda: _patched(os, "environ", {k: v for k, v in os.environ.items() if k not in (
-                "DISPLAY", "WAYLAND_DISPLAY", "QT_QPA_PLATFORM")},
-                lambda: require_display("the Live window")),
+
+def audio_and_label_cases(f: BadInputs) -> dict[str, Callable[[], object]]:
+    """Audio and label files."""
+    return {
+    "audio file missing": lambda: read_audio(f.tmp / "none.wav"),
+    "audio file of 0 bytes": lambda: read_audio(f.write("e.wav", b"")),
+    "corrupt or unreadable audio": lambda: read_audio(f.write("c.wav", b"RIFF....WAVEjunk" * 9)),
+    "audio with no samples": lambda: (sf.write(f.tmp / "n.wav", np.zeros(0), 16000),
+                                      read_audio(f.tmp / "n.wav")),
+    "sample rate below 8 kHz": lambda: (sf.write(f.tmp / "r.wav", np.zeros(100), 6000),
+                                        read_audio(f.tmp / "r.wav")),
+    "stereo or multi-channel audio": lambda: (sf.write(f.tmp / "s.wav", np.zeros((100, 2)), 16000),
+                                              read_audio(f.tmp / "s.wav")),
+    "labels that end before or after the audio": lambda: validate_phones(
+        [PhoneSegment(0, 1, "a")], 2.0, "l.lab"),
+    "labels that start late": lambda: validate_phones([PhoneSegment(0.5, 2, "a")], 2.0, "l.lab"),
+    "overlapping or unsorted labels": lambda: validate_phones(
+        [PhoneSegment(0, 1.2, "a"), PhoneSegment(1, 2, "b")], 2.0, "l.lab"),
+    "a segment that ends before it starts": lambda: validate_phones(
+        [PhoneSegment(0, 1, "a"), PhoneSegment(1, 0.5, "b")], 2.0, "l.lab"),
+    "an empty label file": lambda: validate_phones([], 2.0, "l.lab"),
+    "unknown label format": lambda: read_labels(f.tmp / "x.seg"),
+    "a phone the model does not know": lambda: (synthesize(f.model, f.audio, f.rate, f.with_phone("ux")),
+                                                synthesize(f.model, f.audio, f.rate, f.with_phone("zz"))),
+    "label text that is not UTF-8": lambda: read_lab(f.write("b.lab", b"0 1 \xe9\xff\xfe\xfa")),
     }
+
+
+def marker_and_training_cases(f: BadInputs) -> dict[str, Callable[[], object]]:
+    """Marker files, training and synthesis."""
+    return {
+    "a C3D whose marker set differs from the corpus": lambda: f.corpus_with(
+        f.toy_markers[:, :11], f.names[:11]),
+    "a marker file that is not C3D": lambda: read_c3d(f.write("m.c3d", b"x" * 600)),
+    "markers shorter than the audio": lambda: f.corpus_with(f.toy_markers[:40]),
+    "markers mostly missing (NaN)": lambda: f.corpus_with(f.sparse),
+    "marker gaps longer than 100 ms": lambda: train(
+        [Utterance("g", f.audio, f.rate, f.phones, f.gappy, 60.0, f.names)], f.setup),
+    "training utterances with different marker sets": lambda: train(
+        [Utterance("a", f.audio, f.rate, f.phones, f.toy_markers, 60.0, f.names),
+         Utterance("b", f.audio, f.rate, f.phones, f.toy_markers[:, :11], 60.0, f.names[:11])], f.setup),
+    "a one-frame marker file": lambda: train(
+        [Utterance("a", f.audio, f.rate, f.phones, f.toy_markers[:1], 60.0, f.names)], f.setup),
+    "audio too short to synthesize (under two marker frames)": lambda: synthesize(
+        f.model, f.audio[:200], f.rate, None, SynthConfig(mode="acoustic")),
+    "phonetic synthesis without labels": lambda: synthesize(f.model, f.audio, f.rate, None),
+    }
+
+
+def model_and_corpus_cases(f: BadInputs) -> dict[str, Callable[[], object]]:
+    """Model files and corpus folders."""
+    return {
+    "a model file that is not ours": lambda: (np.savez(f.tmp / "o.npz", a=np.zeros(2)),
+                                              Model.load(f.tmp / "o.npz")),
+    "a truncated model file": lambda: Model.load(
+        f.write("t.npz", f.model.save(f.tmp / "full.npz").read_bytes()[:500])),
+    "a model file from a newer facetraj": lambda: (
+        np.savez(f.tmp / "n.npz", meta=np.array(json.dumps(f.newer))), Model.load(f.tmp / "n.npz")),
+    "a model file whose LSF index was damaged": lambda: Model.load(edited_model_file(
+        f.model.save(f.tmp / "full.npz"), f.tmp / "d.npz", ix_offsets=f.model.index.offsets[:-1])),
+    "a corpus folder without corpus.json": lambda: load_corpus(f.tmp),
+    "a corpus.json that is not JSON": lambda: (f.write("corpus.json", "{"), load_corpus(f.tmp)),
+    "a corpus.json naming an unknown marker": lambda: (
+        save_corpus_info(f.tmp, CorpusInfo(**{**f.info.__dict__, "lower_lip": "NOSE"})),
+        load_corpus(f.tmp)),
+    }
+
+
+def file_format_cases(f: BadInputs) -> dict[str, Callable[[], object]]:
+    """Label maps, label and marker file details."""
+    return {
+    "an output file that exists": lambda: (f.write("o.tsv", "x"),
+                                           atomic_write(f.tmp / "o.tsv", overwrite=False).__enter__()),
+    "an unknown marker format": lambda: read_markers(f.tmp / "m.trc"),
+    "a MOCHA EMA file with the wrong column count": lambda: read_mocha_ema(
+        f.write("x.ema", "0 1 2 3\n1 1 2 3\n")),
+    "a label map line that is not a pair": lambda: read_label_map(f.write("map.txt", "a b c\n")),
+    "a label map that maps a label to a phone the model does not know": lambda: synthesize(
+        f.model, f.audio, f.rate, f.phones, label_map=read_label_map(f.write("m.tsv", f"{f.lab1}\tzz\n"))),
+    "a label file or label map given as a folder": lambda: (
+        (f.tmp / "f.lab").mkdir(), read_labels(f.tmp / "f.lab")),
+    "TextGrid intervals out of order or overlapping": lambda: read_textgrid(f.write(
+        "o.TextGrid", (f.toy_dir / "toy030.TextGrid").read_text().replace(
+            "xmin = 0.25", "xmin = 0.001", 1))),
+    "a .lab time that is not a finite number (`inf`, `nan`)": lambda: read_lab(
+        f.write("i.lab", "0 0.5 a\n0.5 inf b\n")),
+    "an empty phone tier": lambda: read_labels(f.write("e.lab", "# nothing\n")),
+    "a transcript (`<id>.txt`) that is not UTF-8": lambda: (
+        f.write("u.txt", b"caf\xe9"), f.corpus_with()),
+    "markers whose names differ from the corpus (same count)": lambda: f.corpus_with(
+        f.toy_markers, [n + "_X" if i == 3 else n for i, n in enumerate(f.names)]),
+    "marker table or EMA times that give no sane rate": lambda: read_markers(f.write(
+        "t.tsv", "time\ta_x\ta_y\ta_z\n0\t1\t2\t3\n0\t1\t2\t3\n")),
+    }
+
+
+def model_detail_cases(f: BadInputs) -> dict[str, Callable[[], object]]:
+    """C3D details, damaged model entries, corpus.json details."""
+    return {
+    "a C3D whose header or parameters ask for more than the file holds": lambda: read_c3d(
+        f.write("h.c3d", (f.toy_dir / "toy030.c3d").read_bytes()[:3000])),
+    "a C3D whose parameter section is damaged": lambda: read_c3d(f.write(
+        "p.c3d", _damaged_parameter((f.toy_dir / "toy030.c3d").read_bytes()))),
+    "a C3D frame rate outside 1-10000 Hz": lambda: read_c3d(f.write(
+        "r.c3d", _c3d_rate((f.toy_dir / "toy030.c3d").read_bytes(), 1e6))),
+    "a model whose metadata has wrong types or values": lambda: Model.load(edited_model_file(
+        f.model.save(f.tmp / "full.npz"), f.tmp / "m.npz", meta=np.array(json.dumps(
+            {**_meta(f.tmp / "full.npz"), "marker_rate": "60"})))),
+    "a model array of the wrong shape or data type": lambda: Model.load(edited_model_file(
+        f.model.save(f.tmp / "full.npz"), f.tmp / "m.npz", cb_lsf=f.model.codebook.lsf[:, 1:])),
+    "a model array holding NaN or infinite values": lambda: Model.load(edited_model_file(
+        f.model.save(f.tmp / "full.npz"), f.tmp / "m.npz", means=f.model.means * np.nan)),
+    "a model entry whose .npy header asks for too much memory": lambda: Model.load(
+        _forged_header(f.model.save(f.tmp / "full.npz"), f.tmp / "m.npz")),
+    "a model entry with an unsupported zip compression method": lambda: Model.load(
+        _bzip2(f.model.save(f.tmp / "full.npz"), f.tmp / "m.npz")),
+    "a corpus.json that is not an object": lambda: (f.write("corpus.json", "[]"), load_corpus(f.tmp)),
+    "a corpus.json entry of the wrong type or range": lambda: (f.write("corpus.json", json.dumps(
+        {**f.info.to_json(), "marker_rate": 0})), load_corpus(f.tmp)),
+    "a corpus.json nested too deeply": lambda: (f.write("corpus.json", "[" * 10**5 + "]" * 10**5),
+                                                load_corpus(f.tmp)),
+    "a corpus.json whose data folder is missing": lambda: (f.write("corpus.json", json.dumps(
+        {**f.info.to_json(), "data_dir": "gone"})), load_corpus(f.tmp)),
+    }
+
+
+def output_cases(f: BadInputs) -> dict[str, Callable[[], object]]:
+    """Options, outputs and the display."""
+    return {
+    "an option value out of its range (`-N 0`, `--xi nan`, `--lpc-order 0`)": lambda: _parse(
+        ["synth", "m.npz", "a.wav", "-o", "o.tsv", "-N", "0"]),
+    "a folder at the output path (even with `--overwrite`)": lambda: (
+        (f.tmp / "o.tsv").mkdir(), atomic_write(f.tmp / "o.tsv").__enter__()),
+    "an output whose parent is a regular file": lambda: (
+        f.write("f", "x"), atomic_write(f.tmp / "f" / "o.tsv").__enter__()),
+    "an output name too long for the file system": lambda: atomic_write(
+        f.tmp / ("x" * 300)).__enter__(),
+    "an output folder without write permission": lambda: _patched(
+        os, "access", lambda *a: False, lambda: atomic_write(f.tmp / "o.tsv").__enter__()),
+    "an output on a read-only file system": lambda: _patched(
+        tempfile, "mkstemp", _erofs, lambda: atomic_write(f.tmp / "o.tsv").__enter__()),
+    "a window (`facetraj gui`, `facetraj live` without `-o`) on a machine without a display":
+        lambda: _patched(os, "environ", {k: v for k, v in os.environ.items() if k not in (
+            "DISPLAY", "WAYLAND_DISPLAY", "QT_QPA_PLATFORM")},
+            lambda: require_display("the Live window")),
+    }
+
+
+CASE_GROUPS = (audio_and_label_cases, marker_and_training_cases, model_and_corpus_cases,
+               file_format_cases, model_detail_cases, output_cases)
+
+
+def produce(case: str, tmp: Path, toy_dir: Path, model: Model, caplog) -> str:
+    """Make the bad input of ``case`` happen; return the message (error or log)."""
+    inputs = BadInputs(tmp, toy_dir, model)
+    cases: dict[str, Callable[[], object]] = {}
+    for group in CASE_GROUPS:
+        cases.update(group(inputs))
     cases.update(alignment_cases(tmp))
     caplog.clear()
     try:

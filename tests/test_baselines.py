@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from engine.baselines import (
+from engine.evaluation.baselines import (
     Baselines,
     FrameData,
     evaluate_baselines,

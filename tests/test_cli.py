@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from engine.formats import read_c3d, read_marker_table
+from engine.io.markerfiles import read_c3d, read_marker_table
 from facetraj.cli import main
 
 

@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engine import hash_memo
-from engine.corpus import load_corpus
 from engine.errors import InputError
+from engine.io import hash_memo
+from engine.io.corpus import load_corpus
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -23,8 +23,9 @@ ROOT = Path(__file__).resolve().parent.parent
 NOT_IN_FIRST_FRAME = (
     "scipy.signal", "scipy.stats", "scipy.interpolate", "scipy.optimize", "scipy.ndimage",
     "scipy.spatial", "multiprocessing", "concurrent.futures.process",
-    "engine.training", "engine.alignment", "engine.labelling", "engine.report", "engine.analysis",
-    "engine.kinematics", "engine.voice",
+    "engine.method.training", "engine.labels.alignment", "engine.io.labelling", "engine.report",
+    "engine.analysis",
+    "engine.evaluation.kinematics", "engine.evaluation.second_voice",
     "app.gallery", "app.video", "app.report_figures", "app.analysis.figures",
     "app.analysis.errors_view", "app.analysis.metrics_view", "app.analysis.pc_modes",
     "app.analysis.inspector", "app.analysis.similarity_view", "app.analysis.kinematics_panels",
@@ -45,13 +46,13 @@ def test_app_window_module_imports_nothing_the_first_frame_does_not_use():
 
 FIRST_FRAME = """
 import json, os, sys
-import engine.corpus
+import engine.io.corpus
 audio_reads = []
-read_audio = engine.corpus.read_audio
+read_audio = engine.io.corpus.read_audio
 def counted(path, *args, **kwargs):
     audio_reads.append(os.path.basename(str(path)))
     return read_audio(path, *args, **kwargs)
-engine.corpus.read_audio = counted
+engine.io.corpus.read_audio = counted
 from facetraj.cli import main
 rc = main(["-q", "gui", "data_samples", "--screenshot", sys.argv[1]])
 with open(sys.argv[2], "w") as fh:
@@ -169,14 +170,14 @@ def test_an_unreadable_memo_costs_only_the_recomputation(corpus_copy, reads, mon
 def test_an_utterance_is_read_and_checked_when_it_is_used(corpus_copy, monkeypatch):
     """Opening a corpus reads its description only; a broken utterance is found (with its file
     named) when it is loaded, and the others still load."""
-    import engine.corpus
+    import engine.io.corpus
 
     corpus = load_corpus(corpus_copy)
     bad, good = corpus.info.test[0], corpus.info.test[1]
     (corpus_copy / f"{bad}.c3d").write_bytes(b"not a c3d file")
     audio: list[str] = []
-    read_audio = engine.corpus.read_audio
-    monkeypatch.setattr(engine.corpus, "read_audio",
+    read_audio = engine.io.corpus.read_audio
+    monkeypatch.setattr(engine.io.corpus, "read_audio",
                         lambda path, *a, **k: audio.append(Path(path).stem) or read_audio(path, *a, **k))
     corpus = load_corpus(corpus_copy)
     assert audio == []
@@ -210,7 +211,7 @@ def test_spectrogram_equals_scipy(n, rate, offset):
 def test_convolve_nearest_equals_scipy(n, window):
     from scipy.ndimage import convolve1d
 
-    from engine.smoothing import convolve_nearest
+    from engine.method.smoothing import convolve_nearest
 
     w = np.array(window)
     w = (w + w[::-1]) / 2                                    # symmetric, as the smoothings use
@@ -224,7 +225,7 @@ def test_convolve_nearest_equals_scipy(n, window):
 def test_not_a_knot_spline_equals_scipy(n_knots, spacing):
     from scipy.interpolate import CubicSpline
 
-    from engine.smoothing import not_a_knot_spline
+    from engine.method.smoothing import not_a_knot_spline
 
     rng = np.random.default_rng(n_knots)
     knots = (np.arange(n_knots) * 6.0 if spacing == "even"
@@ -243,7 +244,7 @@ def test_spline_smooth_unchanged():
     from scipy.interpolate import CubicSpline
     from scipy.ndimage import convolve1d
 
-    from engine.smoothing import spline_smooth
+    from engine.method.smoothing import spline_smooth
 
     x = np.cumsum(np.random.default_rng(5).standard_normal((203, 6)), axis=0)
     knots = np.append(np.arange(0, 203, 6), 202)

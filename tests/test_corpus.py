@@ -10,8 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engine.corpus import load_corpus
-from engine.formats import read_audio, read_c3d, read_textgrid_tiers
+from engine.io.audio import read_audio
+from engine.io.corpus import load_corpus
+from engine.io.labelfiles import read_textgrid_tiers
+from engine.io.markerfiles import read_c3d
 
 ROOT = Path(__file__).resolve().parent.parent / "data_samples"
 ARPABET = (

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from engine.config import SynthConfig
-from engine.evaluation import evaluate, speech_mask, trajectory_correlations
-from engine.model import Model
-from engine.pipeline import synthesize
+from engine.evaluation.scores import evaluate, speech_mask, trajectory_correlations
+from engine.method.model import Model
+from engine.method.pipeline import synthesize
 
 
 def test_model_on_default_corpus(default_model, default_corpus):

@@ -6,24 +6,20 @@ import numpy as np
 import pytest
 import soundfile as sf
 
-from engine.corpus import CorpusInfo, load_corpus, save_corpus_info
 from engine.data import PhoneSegment
 from engine.errors import InputError
-from engine.formats import (
-    atomic_write,
-    read_audio,
-    read_c3d,
+from engine.io.audio import read_audio, write_audio
+from engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
+from engine.io.files import atomic_write
+from engine.io.labelfiles import (
     read_lab,
     read_labels,
-    read_marker_table,
     read_phn,
     read_textgrid,
     validate_phones,
-    write_audio,
-    write_c3d,
-    write_marker_tsv,
     write_textgrid,
 )
+from engine.io.markerfiles import read_c3d, read_marker_table, write_c3d, write_marker_tsv
 
 
 def test_audio_round_trip_and_stereo_mixdown(tmp_path, caplog):

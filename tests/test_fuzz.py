@@ -22,7 +22,7 @@ from conftest import edited_model_file
 from fuzzing import CATEGORIES, _c3d_rate, cases, make_workspace, run_forked, run_in_process, table
 
 from engine.errors import InputError
-from engine.formats import atomic_write
+from engine.io.files import atomic_write
 from facetraj.cli import main
 
 N_CASES = 420
@@ -226,7 +226,7 @@ def test_transcript_not_utf8(workspace, tmp_path, capsys):
 
 
 def test_two_frame_c3d_in_the_test_split_evaluates(workspace, tmp_path, capsys):
-    from engine.formats import read_c3d, write_c3d
+    from engine.io.markerfiles import read_c3d, write_c3d
 
     corpus = _corpus_copy(workspace, tmp_path)
     m = read_c3d(corpus / "toy030.c3d")
@@ -310,10 +310,10 @@ def test_corpus_init_needs_overwrite(workspace, tmp_path, capsys):
 
 
 def test_train_checks_output_before_training(workspace, tmp_path, capsys, monkeypatch):
-    import engine.training
+    import engine.method.training
 
     (tmp_path / "m.npz").write_bytes(b"mine")
-    monkeypatch.setattr(engine.training, "train", lambda *a, **k: pytest.fail("trained"))
+    monkeypatch.setattr(engine.method.training, "train", lambda *a, **k: pytest.fail("trained"))
     refused(["train", workspace.corpus, "-o", tmp_path / "m.npz"], capsys, "already exists")
 
 
@@ -348,7 +348,7 @@ def test_sigterm_during_a_write_removes_the_part_file(tmp_path):
 
 
 def test_label_map_to_unknown_phone_blames_the_map(workspace, tmp_path, capsys):
-    from engine.formats import read_labels
+    from engine.io.labelfiles import read_labels
 
     first = next(s.label for s in read_labels(workspace.textgrid) if s.label != "sil")
     (tmp_path / "map.tsv").write_text(f"{first}\tzz\n")
@@ -400,7 +400,7 @@ def test_lab_with_an_inf_time(workspace, tmp_path, capsys):
 
 
 def test_marker_names_that_differ_are_named(workspace, tmp_path, capsys):
-    from engine.formats import read_c3d, write_c3d
+    from engine.io.markerfiles import read_c3d, write_c3d
 
     corpus = _corpus_copy(workspace, tmp_path)
     m = read_c3d(corpus / "toy030.c3d")
@@ -412,7 +412,7 @@ def test_marker_names_that_differ_are_named(workspace, tmp_path, capsys):
 def test_c3d_reader_advice_is_not_shown(workspace, tmp_path):
     """ezc3d's own refusal (a flag bit in the parameter section, found by the fuzz run) is shown
     without its advice to set ignoreBadFormatting, which a user cannot."""
-    from engine.formats import read_c3d
+    from engine.io.markerfiles import read_c3d
 
     data = bytearray(workspace.c3d.read_bytes())
     data[553] ^= 1

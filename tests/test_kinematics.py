@@ -1,4 +1,4 @@
-"""Lip kinematics and gesture landmarks (engine/kinematics.py), hand-checked."""
+"""Lip kinematics and gesture landmarks (engine/evaluation/kinematics.py), hand-checked."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from engine.data import PhoneSegment
-from engine.kinematics import (
+from engine.evaluation.kinematics import (
     LANDMARKS,
     Gesture,
     compare_landmarks,

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from engine.config import SynthConfig
-from engine.formats import read_audio, read_marker_table
-from engine.pipeline import synthesize
+from engine.io.audio import read_audio
+from engine.io.markerfiles import read_marker_table
+from engine.method.pipeline import synthesize
 from facetraj.cli import main
 
 

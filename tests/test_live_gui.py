@@ -13,8 +13,9 @@ from app import live
 from app.main import build_window
 from engine.config import SynthConfig
 from engine.errors import FacetrajError
-from engine.formats import read_audio, read_c3d
-from engine.pipeline import synthesize
+from engine.io.audio import read_audio
+from engine.io.markerfiles import read_c3d
+from engine.method.pipeline import synthesize
 from facetraj.cli import main
 
 

@@ -1,4 +1,4 @@
-"""The coarse LSF index for acoustic-only synthesis (engine/lsf_index.py): k-means by hand, the
+"""The coarse LSF index for acoustic-only synthesis (engine/method/lsf_index.py): k-means by hand, the
 probed search against a brute-force eq 5 search written here, and its place in the model."""
 
 from dataclasses import replace
@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 from conftest import edited_model_file
 
-from engine.codebook import Codebook
 from engine.config import SynthConfig
-from engine.lsf_index import build_index, kmeans
-from engine.model import Model
-from engine.pipeline import synthesize
-from engine.synthesis import perceptual_weights
+from engine.method.codebook import Codebook
+from engine.method.lsf_index import build_index, kmeans
+from engine.method.model import Model
+from engine.method.pipeline import synthesize
+from engine.method.synthesis import perceptual_weights
 from facetraj.cli import build_parser
 from facetraj.options import synth_config
 

@@ -25,8 +25,8 @@ from app.own_data import (
     export_trajectories,
     guess_roles,
 )
-from engine.corpus import load_corpus
-from engine.formats import read_c3d, read_marker_table
+from engine.io.corpus import load_corpus
+from engine.io.markerfiles import read_c3d, read_marker_table
 
 pytestmark = pytest.mark.gui
 WAIT_MS = 240_000   # a hang guard (a loaded machine is slow), not a speed limit

@@ -3,13 +3,14 @@
 import numpy as np
 import pytest
 
-from engine.codebook import codeword_times, interpolate_frames
 from engine.data import PhoneSegment
 from engine.errors import InputError
-from engine.markers import fill_gaps, kabsch, reference_pose, remove_head_motion
-from engine.pca import fit_pca
-from engine.phones import context_ids, map_labels, normalise_label
-from engine.smoothing import smooth, spline_smooth, triangular_smooth, triangular_window
+from engine.labels.phoneset import map_labels, normalise_label
+from engine.method.codebook import codeword_times, interpolate_frames
+from engine.method.context import context_ids
+from engine.method.markers import fill_gaps, kabsch, reference_pose, remove_head_motion
+from engine.method.pca import fit_pca
+from engine.method.smoothing import smooth, spline_smooth, triangular_smooth, triangular_window
 
 
 def _rotation(rng):

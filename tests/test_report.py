@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 from toycorpus import build_toy_corpus
 
-from engine.paper import FIGURE4_TEXT, PAPER_TABLE2, paper_table1
+from engine.evaluation.paper import FIGURE4_TEXT, PAPER_TABLE2, paper_table1
+from engine.method.similarity import SimilarRow
 from engine.report import find_utterance, table1_agreement
-from engine.similarity import SimilarRow
 
 SECTIONS = (
     "## Table 2: correlation, original vs synthesized (N = 3)",
@@ -28,7 +28,7 @@ SECTIONS = (
 @pytest.fixture(scope="module")
 def small_corpus(tmp_path_factory) -> Path:
     root = build_toy_corpus(tmp_path_factory.mktemp("toy-report"), n_train=8, n_test=3, seed=3)
-    from engine.corpus import load_corpus
+    from engine.io.corpus import load_corpus
 
     test_id = load_corpus(root).info.test[1]
     (root / f"{test_id}.txt").write_text(FIGURE4_TEXT + ".\n", encoding="utf-8")
@@ -101,7 +101,7 @@ def test_only_report_files_are_written(report: Path) -> None:
 
 
 def test_find_utterance_and_paper_tables(small_corpus: Path) -> None:
-    from engine.corpus import load_corpus
+    from engine.io.corpus import load_corpus
 
     corpus = load_corpus(small_corpus)
     assert find_utterance(corpus) == (corpus.info.test[1], "test")

@@ -1,4 +1,4 @@
-"""The robust mode (issue 16, engine.selection): each new equation on a hand-checked example, the
+"""The robust mode (issue 16, engine.method.selection): each new equation on a hand-checked example, the
 fast kernels against plain loops, the mode rule, and the model file keeping its new parts."""
 
 from __future__ import annotations
@@ -9,9 +9,9 @@ from conftest import edited_model_file
 
 from engine.config import SynthConfig
 from engine.data import PhoneSegment
-from engine.model import Model
-from engine.pipeline import frame_confidence, mode_for, synthesize
-from engine.selection import (
+from engine.method.model import Model
+from engine.method.pipeline import frame_confidence, mode_for, synthesize
+from engine.method.selection import (
     candidate_union,
     context_distances,
     context_frames,
@@ -20,7 +20,7 @@ from engine.selection import (
     robust_frames,
     weight_costs,
 )
-from engine.synthesis import gamma_grid, perceptual_weights, weight_frames
+from engine.method.synthesis import gamma_grid, perceptual_weights, weight_frames
 
 
 def test_mean_normalise_hand_checked():

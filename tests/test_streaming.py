@@ -1,5 +1,5 @@
 """Streaming synthesis (engine.streaming) equals offline synthesis; its parts equal their batch
-forms; the speaker warp (engine.speaker)."""
+forms; the speaker warp (engine.method.speaker)."""
 
 from __future__ import annotations
 
@@ -7,18 +7,11 @@ import numpy as np
 import pytest
 
 from engine.config import SynthConfig
-from engine.lsf import (
-    ResampleStream,
-    analysis_frames,
-    frame_lsf,
-    lsf_at,
-    preemphasize,
-    resample_audio,
-)
-from engine.pipeline import synthesize
-from engine.smoothing import TriangularStream, triangular_smooth
-from engine.speaker import choose_warp, warp_lsf
-from engine.streaming import StreamConfig, StreamingSynthesizer, stream_synthesize
+from engine.method.lsf import ResampleStream, analysis_frames, frame_lsf, lsf_at, preemphasize, resample_audio
+from engine.method.pipeline import synthesize
+from engine.method.smoothing import TriangularStream, triangular_smooth
+from engine.method.speaker import choose_warp, warp_lsf
+from engine.streaming.synthesizer import StreamConfig, StreamingSynthesizer, stream_synthesize
 
 ACOUSTIC = SynthConfig(mode="acoustic")
 

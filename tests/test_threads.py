@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from engine.config import SynthConfig
-from engine.pipeline import synthesize
+from engine.method.pipeline import synthesize
 from engine.threads import (
     THREADS_ENV,
     frame_spans,
@@ -96,8 +96,8 @@ def test_an_error_in_a_span_reaches_the_caller(short_spans):
 def test_evaluation_synthesizes_on_one_frame_thread(default_model, default_corpus, monkeypatch):
     """evaluate() scores are independent of its worker processes to the bit: each utterance is
     synthesized on one frame thread, whatever the process would use."""
-    from engine import pipeline
-    from engine.evaluation import evaluate
+    from engine.evaluation.scores import evaluate
+    from engine.method import pipeline
 
     seen = []
     real = pipeline.frame_threads

@@ -25,7 +25,7 @@ def test_video_from_corpus_utterance(toy_corpus_dir, tmp_path, capsys):
     assert "Video: h264" in info and "Audio: aac" in info and "640x320" in info
     dur = next(ln for ln in info.splitlines() if "Duration" in ln)
     _h, _m, s = dur.split("Duration:")[1].split(",")[0].strip().split(":")
-    from engine.corpus import load_corpus
+    from engine.io.corpus import load_corpus
 
     utt = load_corpus(toy_corpus_dir).utterance("toy030")
     assert float(s) == pytest.approx(utt.duration, abs=0.15)
@@ -68,7 +68,7 @@ def test_video_frame_has_legend_surface_and_phone_tier_inside(default_model, def
     from app.style import ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
     from app.video import VideoFrames, VideoSettings
     from engine.config import SynthConfig
-    from engine.pipeline import mode_for, synthesize
+    from engine.method.pipeline import mode_for, synthesize
 
     utt = default_corpus.utterance(default_corpus.info.test[0])
     res = synthesize(default_model, utt.audio, utt.sample_rate, utt.phones,

@@ -1,5 +1,5 @@
-"""The second voice (engine.voice) and acoustic-only synthesis from it with and without speaker
-normalisation (engine.voice_eval, issue 13)."""
+"""The second voice (engine.evaluation.second_voice) and acoustic-only synthesis from it with and
+without speaker normalisation (engine.evaluation.voice_eval, issue 13)."""
 
 from __future__ import annotations
 
@@ -11,9 +11,8 @@ import pytest
 from scipy.signal import lfilter
 
 from engine.errors import InputError
-from engine.evaluation import METRICS
-from engine.speaker import warp_grid
-from engine.voice import (
+from engine.evaluation.scores import METRICS
+from engine.evaluation.second_voice import (
     VoiceSpec,
     all_pole_filter,
     f0_track,
@@ -24,7 +23,7 @@ from engine.voice import (
     second_voice,
     voice_ratios,
 )
-from engine.voice_eval import (
+from engine.evaluation.voice_eval import (
     NORMALISATIONS,
     VOICES,
     condition,
@@ -33,6 +32,7 @@ from engine.voice_eval import (
     read_voice_eval,
     write_voice_eval,
 )
+from engine.method.speaker import warp_grid
 
 RATE = 16000
 

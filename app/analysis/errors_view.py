@@ -39,8 +39,8 @@ from engine.analysis.errors import (
     worst_segments,
     write_error_csv,
 )
-from engine.corpus import Corpus
-from engine.model import Model
+from engine.io.corpus import Corpus
+from engine.method.model import Model
 
 from .common import (
     Canvas,

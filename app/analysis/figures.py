@@ -64,7 +64,7 @@ def make_figures(corpus_dir: Path, out: Path, per_split: int = 6,
     """Open the main window on ``corpus_dir`` with the analysis views and save their screenshots
     (``only``: just these views, e.g. ``{"errors"}``; ``"window"`` is the panel stack)."""
     from app.main_window import MainWindow
-    from engine.corpus import load_corpus
+    from engine.io.corpus import load_corpus
 
     from . import install
 

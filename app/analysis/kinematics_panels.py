@@ -32,7 +32,7 @@ from PyQt6.QtWidgets import (
 )
 
 from app.style import ORIGINAL_COLOR, SYNTH_COLOR
-from engine.kinematics import (
+from engine.evaluation.kinematics import (
     LABIAL_PHONES,
     LANDMARKS,
     GestureMeasurement,
@@ -44,7 +44,7 @@ from engine.kinematics import (
     write_landmarks_textgrid,
     write_landmarks_tsv,
 )
-from engine.model import Model
+from engine.method.model import Model
 
 from .common import Canvas, NumberItem, export_with_dialog, fill_table, text_item
 

@@ -34,10 +34,10 @@ from engine.analysis.metrics import (
     write_sweep_csv,
     write_table2_csv,
 )
-from engine.corpus import Corpus
-from engine.evaluation import METRICS, EvalResult, sweep_n, table2
-from engine.model import Model
-from engine.paper import TABLE2_N, table2_value
+from engine.evaluation.paper import TABLE2_N, table2_value
+from engine.evaluation.scores import METRICS, EvalResult, sweep_n, table2
+from engine.io.corpus import Corpus
+from engine.method.model import Model
 
 from .common import (
     Canvas,

@@ -30,7 +30,7 @@ from app.plotter_widget import make_plotter
 from app.style import BACKGROUND, SURFACE_COLOR, SYNTH_COLOR
 from app.surface import face_triangles, lip_contours
 from engine.analysis.pc_modes import describe_mode, mode_displacement, mode_sd, variance_shares
-from engine.model import Model
+from engine.method.model import Model
 
 from .common import Canvas
 

@@ -29,9 +29,9 @@ from engine.analysis.similarity import (
     similarity_in_order,
     write_similarity_csv,
 )
-from engine.model import Model
-from engine.paper import paper_table1
-from engine.similarity import top_similar
+from engine.evaluation.paper import paper_table1
+from engine.method.model import Model
+from engine.method.similarity import top_similar
 
 from .common import Canvas, export_with_dialog, fill_table, heat_item, text_item
 

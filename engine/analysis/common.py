@@ -10,8 +10,8 @@ from collections.abc import Iterable, Sequence
 from dataclasses import replace
 from pathlib import Path
 
-from ..corpus import Corpus
-from ..formats import atomic_write
+from ..io.corpus import Corpus
+from ..io.files import atomic_write
 
 
 def write_csv(path: str | os.PathLike[str], header: Sequence[str], rows: Iterable[Sequence],

@@ -11,12 +11,13 @@ from pathlib import Path
 import numpy as np
 
 from ..config import SynthConfig
-from ..corpus import Corpus
 from ..data import PhoneSegment, Utterance
-from ..evaluation import EvalConfig, pearson, speech_mask, trajectory_correlations
-from ..model import Model
-from ..phones import SILENCE, segment_index
-from ..pipeline import Synthesis, synthesize
+from ..evaluation.scores import EvalConfig, pearson, speech_mask, trajectory_correlations
+from ..io.corpus import Corpus
+from ..labels.phoneset import SILENCE
+from ..method.context import segment_index
+from ..method.model import Model
+from ..method.pipeline import Synthesis, synthesize
 from ..progress import Progress
 from .common import write_csv
 

@@ -8,10 +8,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model import Model
-from ..pipeline import Synthesis
-from ..selection import RobustFrames
-from ..synthesis import lsf_distances, perceptual_weights
+from ..method.model import Model
+from ..method.pipeline import Synthesis
+from ..method.selection import RobustFrames
+from ..method.synthesis import lsf_distances, perceptual_weights
 
 
 @dataclass
@@ -26,7 +26,7 @@ class CodewordRow:
     time: float             # its time in that utterance (s)
     distance: float         # d_i (eq 5)
     weight: float           # v_i (eq 6)
-    target_cost: float = float("nan")   # robust mode: eq 5 with acoustic context (engine.selection)
+    target_cost: float = float("nan")   # robust mode: eq 5 with acoustic context (engine.method.selection)
     label_cost: float = float("nan")    # robust mode: kappa * confidence if eq 4 did not choose it
     from_labels: bool = True            # chosen by eq 4 (always, in phonetic mode)
 

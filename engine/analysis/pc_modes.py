@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model import Model
+from ..method.model import Model
 
 
 def mode_sd(model: Model) -> np.ndarray:

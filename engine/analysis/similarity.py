@@ -12,7 +12,7 @@ import numpy as np
 from scipy.cluster import hierarchy
 from scipy.spatial.distance import squareform
 
-from ..model import Model
+from ..method.model import Model
 from .common import write_csv
 
 

@@ -20,9 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..corpus import CorpusInfo, save_corpus_info
 from ..data import PhoneSegment
-from ..formats import write_audio, write_c3d, write_textgrid
+from ..io.audio import write_audio
+from ..io.corpus import CorpusInfo, save_corpus_info
+from ..io.labelfiles import write_textgrid
+from ..io.markerfiles import write_c3d
 from ..progress import Progress
 from .durations import PAUSE, DurationModel, Segment, load_cmudict, pronounce, time_phones
 from .face import (

@@ -15,7 +15,7 @@ Pure engine: no plotting here. :func:`write_report` computes everything
 * :mod:`.markdown`: one function per section of ``results.md``;
 * :mod:`.text`: how numbers are written.
 
-The paper's own numbers (Tables 1 and 2, Figure 4's sentence) are in :mod:`engine.paper`.
+The paper's own numbers (Tables 1 and 2, Figure 4's sentence) are in :mod:`engine.evaluation.paper`.
 """
 
 from __future__ import annotations
@@ -25,11 +25,11 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
-from ..formats import atomic_write, write_json
-from ..label_eval import LABEL_EVAL_FILE, read_label_eval
-from ..model import Model
+from ..evaluation.label_eval import LABEL_EVAL_FILE, read_label_eval
+from ..evaluation.voice_eval import VOICE_EVAL_FILE, read_voice_eval
+from ..io.files import atomic_write, write_json
+from ..method.model import Model
 from ..progress import Progress
-from ..voice_eval import VOICE_EVAL_FILE, read_voice_eval
 from .compute import compute_report, figure4_data, find_utterance
 from .data import Figure4Data, FigureMaker, ReportData, at_a_glance
 from .discussion import discussion

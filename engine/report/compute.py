@@ -13,10 +13,10 @@ from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
-from ..baselines import Baselines, FrameData, evaluate_baselines, fit_baselines, frame_data
 from ..config import SynthConfig
-from ..corpus import Corpus, load_corpus
-from ..evaluation import (
+from ..evaluation.baselines import Baselines, FrameData, evaluate_baselines, fit_baselines, frame_data
+from ..evaluation.paper import FIGURE4_TEXT, paper_table1
+from ..evaluation.scores import (
     EvalResult,
     UtteranceScore,
     default_workers,
@@ -27,12 +27,12 @@ from ..evaluation import (
     table2,
     trajectory_correlations,
 )
-from ..model import Model
-from ..paper import FIGURE4_TEXT, paper_table1
-from ..pipeline import resmooth, synthesize
+from ..io.corpus import Corpus, load_corpus
+from ..method.model import Model
+from ..method.pipeline import resmooth, synthesize
+from ..method.similarity import top_similar
+from ..method.training import train
 from ..progress import Progress
-from ..similarity import top_similar
-from ..training import train
 from .data import Figure4Data, ReportData
 from .rows import ComparisonRow, CorpusSummary, ModelSummary, summarise, sweep_table
 
@@ -137,7 +137,7 @@ def _minutes(corpus: Corpus, ids: Sequence[str]) -> float:
         try:
             import soundfile
 
-            from ..corpus import audio_path
+            from ..io.corpus import audio_path
 
             total += soundfile.info(str(audio_path(corpus.root, utt_id))).duration
         except Exception:  # any reader problem: load it the normal way
@@ -166,9 +166,9 @@ def model_summary(model: Model, baselines: Baselines) -> ModelSummary:
 
 def _automatic_labels(corpus: Corpus, model: Model, comparisons: list[ComparisonRow],
                       progress: Progress) -> dict:
-    """The automatic-label section (``engine.label_accuracy``), with the MOCHA-TIMIT sample in
+    """The automatic-label section (``engine.report.labels``), with the MOCHA-TIMIT sample in
     ``../shared`` beside the repository when it is there."""
-    from ..label_accuracy import MOCHA_SAMPLE, label_section
+    from .labels import MOCHA_SAMPLE, label_section
 
     mocha = Path(__file__).resolve().parents[3] / "shared" / MOCHA_SAMPLE[0]
     return label_section(corpus, model, comparisons, mocha if mocha.is_dir() else None, progress)

@@ -12,11 +12,11 @@ import numpy as np
 
 from .. import __version__
 from ..data import PhoneSegment
-from ..evaluation import METRICS
-from ..label_eval import LabelEval
-from ..paper import LEVELS_OFF_AT_N, PAPER_TABLE2
-from ..similarity import SimilarRow
-from ..voice_eval import VoiceEval
+from ..evaluation.label_eval import LabelEval
+from ..evaluation.paper import LEVELS_OFF_AT_N, PAPER_TABLE2
+from ..evaluation.scores import METRICS
+from ..evaluation.voice_eval import VoiceEval
+from ..method.similarity import SimilarRow
 from .rows import (
     ComparisonRow,
     CorpusSummary,
@@ -78,7 +78,7 @@ class ReportData:
     comparisons : one row per method, split and smoothing.
     sweep : the N sweep (Figure 5, triangular).
     figure4 : the Figure-4 example (``None`` when the corpus has no test utterance).
-    labels : the automatic-label section (``engine.label_accuracy.label_section``), ``None``
+    labels : the automatic-label section (``engine.report.labels.label_section``), ``None``
         when the corpus has no transcripts.
     figures : figure name -> path relative to the report folder (filled by the figures callable).
     timings : seconds per stage.
@@ -96,8 +96,8 @@ class ReportData:
     timings: dict[str, float] = field(default_factory=dict)
     figures: dict[str, str] = field(default_factory=dict)
     created: str = ""
-    label_eval: LabelEval | None = None    # every mode with automatic labels (engine.label_eval)
-    voice_eval: VoiceEval | None = None    # acoustic-only from a second voice (engine.voice_eval)
+    label_eval: LabelEval | None = None    # every mode with automatic labels (engine.evaluation.label_eval)
+    voice_eval: VoiceEval | None = None    # acoustic-only from a second voice (engine.evaluation.voice_eval)
 
     def row(self, mode: str, split: str = "test", smoothing: str = "triangular") -> ComparisonRow | None:
         """The comparison row of one mode (``phonetic``, ``acoustic``, ``acoustic-indexed``,

@@ -7,7 +7,7 @@ import itertools
 from collections.abc import Callable
 
 from ..config import SynthConfig
-from ..paper import (
+from ..evaluation.paper import (
     LEVELS_OFF_AT_N,
     MARKER_RATE_HZ,
     N_MARKERS,

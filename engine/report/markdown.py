@@ -6,10 +6,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from .. import __version__
-from ..evaluation import METRICS
-from ..label_eval import format_markdown
-from ..paper import FIGURE4_TEXT, LEVELS_OFF_AT_N, TABLE2_N, table2_value
-from ..voice_eval import format_markdown as voice_markdown
+from ..evaluation.label_eval import format_markdown
+from ..evaluation.paper import FIGURE4_TEXT, LEVELS_OFF_AT_N, TABLE2_N, table2_value
+from ..evaluation.scores import METRICS
+from ..evaluation.voice_eval import format_markdown as voice_markdown
 from .data import ReportData, at_a_glance
 from .discussion import discussion
 from .rows import table1_agreement
@@ -113,7 +113,7 @@ def comparisons_section(data: ReportData) -> list[str]:
     lines = ["## Comparisons on the same split", "",
              "The paper's method with labels (phonetic, N = 3), without them (acoustic-only: eq 5 "
              "over the whole codebook, as the paper; and the default indexed search), and two "
-             "baselines fitted on the training split only (`engine/baselines.py`), all scored the "
+             "baselines fitted on the training split only (`engine/evaluation/baselines.py`), all scored the "
              "same way.", "", *_figure(data, "comparison", "Comparison"),
              "| Method | Split | Smoothing | Whole face | Lower lip | Upper lip | Utterances |",
              "|---|---|---|---:|---:|---:|---:|"]
@@ -128,7 +128,7 @@ def labels_section(data: ReportData) -> list[str]:
     """Automatic phone labels: their accuracy, and Table 2 with them (none without transcripts)."""
     if not data.labels:
         return []
-    from ..label_accuracy import render_section
+    from .labels import render_section
 
     return render_section(data.labels)[:-1]
 
@@ -160,7 +160,7 @@ def discussion_section(data: ReportData) -> list[str]:
 
 
 def automatic_labels_section(data: ReportData) -> list[str]:
-    """Every mode and baseline under exact, aligned and recognized labels (``engine.label_eval``),
+    """Every mode and baseline under exact, aligned and recognized labels (``engine.evaluation.label_eval``),
     when an evaluation was saved beside the report; else nothing."""
     if data.label_eval is None:
         return []
@@ -170,7 +170,7 @@ def automatic_labels_section(data: ReportData) -> list[str]:
 
 def second_voice_section(data: ReportData) -> list[str]:
     """Acoustic-only synthesis from a voice other than the training voice, with and without
-    speaker normalisation (``engine.voice_eval``), when an evaluation was saved beside the report;
+    speaker normalisation (``engine.evaluation.voice_eval``), when an evaluation was saved beside the report;
     else nothing."""
     if data.voice_eval is None:
         return []

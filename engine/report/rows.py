@@ -9,14 +9,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..evaluation import METRICS, ConditionScores, EvalResult, UtteranceScore
-from ..similarity import SimilarRow
+from ..evaluation.scores import METRICS, ConditionScores, EvalResult, UtteranceScore
+from ..method.similarity import SimilarRow
 
 
 @dataclass(kw_only=True)
 class ComparisonRow(ConditionScores):
     """One method's correlations on one split and smoothing: the means over utterances (the fields
-    of :class:`~engine.evaluation.ConditionScores`), their standard deviations over utterances
+    of :class:`~engine.evaluation.scores.ConditionScores`), their standard deviations over utterances
     (NaN under two utterances), the utterance count ``n`` and the ``method`` as the report names it.
     """
 

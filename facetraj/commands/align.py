@@ -1,8 +1,8 @@
 """``facetraj align``: phone and word labels for a recording, as a Praat TextGrid.
 
 Forced alignment of the sentence (``--text`` / ``--transcript``) or phone recognition
-(``--recognize``) with PocketSphinx (``engine.alignment``); the label source follows the one rule
-of ``engine.labelling.labels_for_audio``.
+(``--recognize``) with PocketSphinx (``engine.labels.alignment``); the label source follows the one rule
+of ``engine.io.labelling.labels_for_audio``.
 """
 
 from __future__ import annotations
@@ -28,14 +28,14 @@ def add_label_source_options(p: argparse.ArgumentParser, required: bool = False)
 
 
 def extra_dictionary(args: argparse.Namespace) -> dict[str, list[str]] | None:
-    from engine.alignment import read_dictionary
+    from engine.labels.alignment import read_dictionary
 
     return read_dictionary(args.dict) if getattr(args, "dict", None) else None
 
 
 def cmd_align(args: argparse.Namespace) -> int:
-    from engine.formats import read_audio
-    from engine.labelling import labels_for_audio, write_labels
+    from engine.io.audio import read_audio
+    from engine.io.labelling import labels_for_audio, write_labels
 
     audio, rate = read_audio(args.audio)
     if args.output.exists() and not args.overwrite:

@@ -32,7 +32,7 @@ def cmd_corpus_build(args: argparse.Namespace) -> int:
 
 
 def cmd_corpus_init(args: argparse.Namespace) -> int:
-    from engine.corpus import init_corpus
+    from engine.io.corpus import init_corpus
 
     out, info = init_corpus(args.data_dir, args.output, args.fixed, args.upper_lip,
                             args.lower_lip, args.lip_corners, args.label_map or "", args.rate,
@@ -45,7 +45,7 @@ def cmd_corpus_init(args: argparse.Namespace) -> int:
 
 
 def cmd_corpus_show(args: argparse.Namespace) -> int:
-    from engine.corpus import load_corpus
+    from engine.io.corpus import load_corpus
 
     corpus = load_corpus(args.corpus)
     info = corpus.info
@@ -61,13 +61,13 @@ def cmd_corpus_show(args: argparse.Namespace) -> int:
 
 
 def cmd_corpus_align(args: argparse.Namespace) -> int:
-    from engine.labelling import label_folder
+    from engine.io.labelling import label_folder
 
     from .align import extra_dictionary
 
     folder = args.folder
     if folder.is_file() or (folder / "corpus.json").is_file():
-        from engine.corpus import load_corpus
+        from engine.io.corpus import load_corpus
 
         folder = load_corpus(folder).data_root
     done = label_folder(folder, "recognized" if args.recognize else "aligned",

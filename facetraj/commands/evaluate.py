@@ -11,9 +11,9 @@ from ..progress import TerminalProgress
 
 
 def cmd_eval(args: argparse.Namespace) -> int:
-    from engine.corpus import load_corpus
-    from engine.evaluation import default_workers, evaluate, format_table2
-    from engine.model import Model
+    from engine.evaluation.scores import default_workers, evaluate, format_table2
+    from engine.io.corpus import load_corpus
+    from engine.method.model import Model
 
     model = Model.load(args.model)
     corpus = load_corpus(args.corpus)
@@ -28,9 +28,9 @@ def cmd_eval(args: argparse.Namespace) -> int:
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from engine.corpus import load_corpus
-    from engine.evaluation import default_workers, sweep_n
-    from engine.model import Model
+    from engine.evaluation.scores import default_workers, sweep_n
+    from engine.io.corpus import load_corpus
+    from engine.method.model import Model
 
     model = Model.load(args.model)
     corpus = load_corpus(args.corpus)
@@ -49,8 +49,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def cmd_similarity(args: argparse.Namespace) -> int:
-    from engine.model import Model
-    from engine.similarity import format_table1, top_similar
+    from engine.method.model import Model
+    from engine.method.similarity import format_table1, top_similar
 
     model = Model.load(args.model)
     s = model.similarity(args.nu)

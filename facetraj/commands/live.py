@@ -26,12 +26,12 @@ log = logging.getLogger("facetraj")
 
 def load_model(args: argparse.Namespace):
     """The model of ``--model``, or the default corpus's (trained and cached on first use)."""
-    from engine.model import Model
+    from engine.method.model import Model
 
     if args.model is not None:
         return Model.load(args.model)
     from app.cache import load_or_train
-    from engine.corpus import load_corpus
+    from engine.io.corpus import load_corpus
 
     return load_or_train(load_corpus(args.corpus or default_corpus()))
 
@@ -49,7 +49,7 @@ def stream_file(model, audio: np.ndarray, rate: int, cfg, block_s: float,
                 real_time: bool) -> tuple[np.ndarray, float]:
     """Markers ``(T, M, 3)`` of ``audio`` streamed in blocks of ``block_s`` seconds, paced to the
     audio clock when ``real_time``; and the wall time it took."""
-    from engine.streaming import LIVE_BATCH_FRAMES, StreamConfig, StreamingSynthesizer
+    from engine.streaming.synthesizer import LIVE_BATCH_FRAMES, StreamConfig, StreamingSynthesizer
     from engine.threads import one_blas_thread
 
     stream = StreamingSynthesizer(model, StreamConfig(rate, cfg, LIVE_BATCH_FRAMES))
@@ -68,14 +68,14 @@ def stream_file(model, audio: np.ndarray, rate: int, cfg, block_s: float,
 
 
 def cmd_live(args: argparse.Namespace) -> int:
-    from engine.formats import read_audio
+    from engine.io.audio import read_audio
 
     cfg = live_config(args)
     if args.output is not None:
         if args.from_file is None:
             raise FacetrajError("-o writes a take played from a file: add --from-file FILE "
                                 "(a microphone take is saved from the Live window)")
-        from engine.export import write_trajectories
+        from engine.io.export import write_trajectories
 
         if args.output.exists() and not args.overwrite:
             raise FileExistsError(f"{args.output} exists (use --overwrite to replace it)")
@@ -85,7 +85,8 @@ def cmd_live(args: argparse.Namespace) -> int:
                                     not args.as_fast_as_possible)
         if len(markers) == 0:
             raise FacetrajError(f"{args.from_file}: the audio is too short to synthesize")
-        out = write_trajectories(args.output, markers, model, None, args.overwrite)
+        out = write_trajectories(args.output, markers, model.marker_rate, model.marker_names,
+                                 overwrite=args.overwrite)
         log.info("%d frames streamed in %.2f s (%.1f x real time)", len(markers), wall,
                  len(audio) / rate / max(wall, 1e-9))
         print(out)
@@ -114,7 +115,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--block-ms", type=real(0.0625, 10000), default=10.0,
                    help="audio block size in ms (default 10)")
     p.add_argument("--warp", type=real(0.5, 2.0), default=1.0, metavar="ALPHA",
-                   help="speaker warp of the input LSFs (engine.speaker; 1 = none, below 1 for a "
+                   help="speaker warp of the input LSFs (engine.method.speaker; 1 = none, below 1 for a "
                         "shorter vocal tract than the training voice)")
     p.add_argument("--screenshot", metavar="OUT.png", help=argparse.SUPPRESS)
     p.add_argument("--quit-after", type=real(0, 1e6, lo_open=True), metavar="S",

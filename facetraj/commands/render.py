@@ -14,8 +14,8 @@ from ..progress import TerminalProgress
 
 
 def cmd_video(args: argparse.Namespace) -> int:
-    from engine.model import Model
-    from engine.pipeline import mode_for, synthesize
+    from engine.method.model import Model
+    from engine.method.pipeline import mode_for, synthesize
 
     try:
         from app.video import VideoSettings, render_video
@@ -25,7 +25,7 @@ def cmd_video(args: argparse.Namespace) -> int:
     original = None
     title = ""
     if args.corpus:
-        from engine.corpus import load_corpus
+        from engine.io.corpus import load_corpus
 
         if not args.utterance:
             raise FacetrajError("give --utterance ID with --corpus")
@@ -34,7 +34,8 @@ def cmd_video(args: argparse.Namespace) -> int:
         original = model.normalise_markers(utt.markers) if utt.markers is not None else None
         title, source = utt.text or utt.name, utt.name
     elif args.audio:
-        from engine.formats import read_audio, read_labels
+        from engine.io.audio import read_audio
+        from engine.io.labelfiles import read_labels
 
         audio, rate = read_audio(args.audio)
         phones = read_labels(args.labels, rate) if args.labels else None
@@ -53,7 +54,7 @@ def cmd_video(args: argparse.Namespace) -> int:
 
 
 def cmd_report(args: argparse.Namespace) -> int:
-    from engine.model import Model
+    from engine.method.model import Model
 
     try:
         from app.report_figures import make_report
@@ -61,16 +62,16 @@ def cmd_report(args: argparse.Namespace) -> int:
         raise FacetrajError(f"the report's figures need matplotlib: {exc}") from exc
     model = Model.load(args.model) if args.model else None
     if args.automatic_labels:
-        from engine.corpus import load_corpus
-        from engine.label_eval import LABEL_EVAL_FILE, evaluate_labels, write_label_eval
+        from engine.evaluation.label_eval import LABEL_EVAL_FILE, evaluate_labels, write_label_eval
+        from engine.io.corpus import load_corpus
 
         args.output.mkdir(parents=True, exist_ok=True)
         result = evaluate_labels(load_corpus(args.corpus or default_corpus()),
                                  progress=TerminalProgress("automatic labels"))
         write_label_eval(args.output / LABEL_EVAL_FILE, result)
     if args.second_voice:
-        from engine.corpus import load_corpus
-        from engine.voice_eval import VOICE_EVAL_FILE, evaluate_voices, write_voice_eval
+        from engine.evaluation.voice_eval import VOICE_EVAL_FILE, evaluate_voices, write_voice_eval
+        from engine.io.corpus import load_corpus
 
         args.output.mkdir(parents=True, exist_ok=True)
         voices = evaluate_voices(load_corpus(args.corpus or default_corpus()), model=model,

@@ -14,13 +14,13 @@ log = logging.getLogger("facetraj")
 
 def cmd_synth(args: argparse.Namespace) -> int:
     from engine.errors import InputError
-    from engine.export import write_trajectories
-    from engine.formats import read_audio
-    from engine.labelling import labels_for_audio
-    from engine.labelmap import read_label_map
-    from engine.model import Model
-    from engine.pipeline import mode_for, synthesize
-    from engine.tuning import TUNED_FIELDS, tuned_config
+    from engine.evaluation.tuning import TUNED_FIELDS, tuned_config
+    from engine.io.audio import read_audio
+    from engine.io.export import write_trajectories
+    from engine.io.labelling import labels_for_audio
+    from engine.labels.labelmap import read_label_map
+    from engine.method.model import Model
+    from engine.method.pipeline import mode_for, synthesize
 
     model = Model.load(args.model)
     audio, rate = read_audio(args.audio)
@@ -43,7 +43,8 @@ def cmd_synth(args: argparse.Namespace) -> int:
     res = synthesize(model, audio, rate, phones, cfg, label_map=label_map,
                      source=str(args.labels or args.audio), audio_source=str(args.audio),
                      confidence=confidence)
-    out = write_trajectories(args.output, res.markers, model, res, args.overwrite)
+    out = write_trajectories(args.output, res.markers, model.marker_rate, model.marker_names,
+                             res.arrays(), args.overwrite)
     log.info("%d frames (%.2f s) synthesized, %s mode (labels: %s), %s smoothing", len(res.times),
              res.times[-1], cfg.mode, labels.source if labels else "none", cfg.smoothing)
     print(out)

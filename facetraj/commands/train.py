@@ -13,15 +13,15 @@ log = logging.getLogger("facetraj")
 
 
 def cmd_train(args: argparse.Namespace) -> int:
-    from engine.corpus import load_corpus
-    from engine.formats import check_output_path
-    from engine.training import train
+    from engine.io.corpus import load_corpus
+    from engine.io.files import check_output_path
+    from engine.method.training import train
 
     check_output_path(args.output, args.overwrite)  # before training, not after
     corpus = load_corpus(args.corpus)
     model = train(corpus, config=train_config(args), progress=TerminalProgress("train"))
     if args.tune:
-        from engine.tuning import cross_validate
+        from engine.evaluation.tuning import cross_validate
 
         tuning = cross_validate(corpus, train_config(args), folds=args.tune,
                                 progress=TerminalProgress("cross-validation"))

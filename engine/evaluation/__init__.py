@@ -1,0 +1,29 @@
+"""Evaluation: the paper's section 3 and what we measure beyond it.
+
+- ``scores``: speech-only frames (energy, 112 ms median filter), the correlations of Table 2,
+  the N sweep of Figure 5;
+- ``baselines``: a viseme lookup and a ridge regression, scored the same way;
+- ``tuning``: the robust mode's settings cross-validated on the training split;
+- ``label_accuracy``, ``label_eval``: automatic labels, their accuracy and every mode with them;
+- ``second_voice``, ``voice_eval``: a second voice, and acoustic-only synthesis from it;
+- ``kinematics``: lip kinematics and gesture landmarks;
+- ``paper``: the paper's own numbers (Tables 1-2, Figure 4's sentence).
+
+Imports ``engine.method``, ``engine.streaming`` and below; ``engine.analysis`` and
+``engine.report`` build on it.
+"""
+
+from .. import lazy_exports
+
+__getattr__, __dir__, __all__ = lazy_exports(__name__, {
+    "scores": "METRICS EvalConfig short_time_energy_db median_filter speech_mask pearson "
+              "moving_coordinates trajectory_correlations ConditionScores UtteranceScore EvalResult "
+              "evaluate_utterance default_workers evaluate table2 sweep_n format_table2",
+    "baselines": "fit_baselines evaluate_baselines",
+    "tuning": "cross_validate tuned_config",
+    "label_eval": "evaluate_labels",
+    "voice_eval": "evaluate_voices",
+    "second_voice": "second_voice",
+    "kinematics": "lip_measures",
+    "paper": "PAPER_TABLE2 paper_table1",
+})

@@ -1,0 +1,354 @@
+"""Evaluation (paper section 3): speech-only frames by median-filtered energy, and the correlation
+between original and synthesized trajectories (Table 2, Figure 5).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from ..config import SynthConfig
+from ..data import Utterance
+from ..io.corpus import Corpus
+from ..method.model import Model
+from ..method.pipeline import Synthesis, resmooth, synthesize
+from ..threads import limit_frame_threads, one_blas_thread, usable_cores
+
+log = logging.getLogger(__name__)
+
+METRICS = ("whole_face", "lower_lip", "upper_lip")
+
+
+@dataclass(frozen=True)
+class EvalConfig:
+    """Evaluation settings.
+
+    Attributes
+    ----------
+    energy_window_s, energy_hop_s : short-time energy analysis (Hamming window, hop).
+    median_s : median filter over the energy contour (the paper: 112 ms) so that stop closures
+        inside speech are kept.
+    threshold_fraction : speech where the filtered energy in dB exceeds
+        ``floor + fraction * (peak - floor)``, floor and peak being the 5th and 99th percentiles of
+        the utterance's energy in dB.
+    moving_fraction : "whole face" averages over the coordinates whose training standard deviation
+        (head-normalised) is at least this fraction of the largest one.
+    """
+
+    energy_window_s: float = 0.02
+    energy_hop_s: float = 0.004
+    median_s: float = 0.112
+    threshold_fraction: float = 0.3
+    moving_fraction: float = 0.1
+
+
+def short_time_energy_db(audio: np.ndarray, rate: int, window_s: float = 0.02,
+                         hop_s: float = 0.004) -> tuple[np.ndarray, np.ndarray]:
+    """Short-time energy in dB and its frame-centre times."""
+    x = np.asarray(audio, dtype=np.float64)
+    n = max(1, int(round(window_s * rate)))
+    hop = max(1, int(round(hop_s * rate)))
+    pad = np.concatenate([np.zeros(n // 2), x, np.zeros(n)])
+    count = len(x) // hop + 1
+    idx = (np.arange(count) * hop)[:, None] + np.arange(n)[None, :]
+    frames = pad[idx] * np.hamming(n)
+    energy = (frames**2).sum(axis=1) / n
+    return 10 * np.log10(energy + 1e-12), np.arange(count) * hop / rate
+
+
+def median_filter(x: np.ndarray, k: int) -> np.ndarray:
+    """Running median of odd length ``k``, zero-padded at both ends (the values of
+    ``scipy.signal.medfilt``, tested; here so that the app's first frame does not wait 1-2 s for
+    scipy.signal to import).
+
+    >>> median_filter(np.array([3.0, 1.0, 2.0, 5.0, 4.0]), 3).tolist()
+    [1.0, 2.0, 2.0, 4.0, 4.0]
+    """
+    if k % 2 == 0:
+        raise ValueError("the median filter length must be odd")
+    x = np.asarray(x, dtype=np.float64)
+    half = k // 2
+    padded = np.concatenate([np.zeros(half), x, np.zeros(half)])
+    return np.median(np.lib.stride_tricks.sliding_window_view(padded, k), axis=1)
+
+
+def speech_mask(audio: np.ndarray, rate: int, times: np.ndarray,
+                config: EvalConfig | None = None) -> np.ndarray:
+    """Speech (True) or silence per time in ``times``: energy, 112 ms median filter, threshold.
+
+    Examples
+    --------
+    >>> rate = 16000
+    >>> x = np.zeros(rate); x[4000:12000] = np.sin(np.arange(8000) * 0.3)   # 0.25-0.75 s tone
+    >>> m = speech_mask(x, rate, np.array([0.1, 0.5, 0.9]))
+    >>> m.tolist()
+    [False, True, False]
+    """
+    config = config or EvalConfig()
+    e_db, _e_t = short_time_energy_db(audio, rate, config.energy_window_s, config.energy_hop_s)
+    k = int(round(config.median_s / config.energy_hop_s))
+    k = k + 1 if k % 2 == 0 else k
+    filtered = median_filter(e_db, k) if len(e_db) >= k else e_db
+    floor, peak = np.percentile(filtered, [5, 99])
+    threshold = floor + config.threshold_fraction * (peak - floor)
+    idx = np.clip(np.round(np.asarray(times) / config.energy_hop_s).astype(int), 0, len(e_db) - 1)
+    return filtered[idx] > threshold
+
+
+def pearson(a: np.ndarray, b: np.ndarray) -> float:
+    """Pearson correlation of two 1-D series; NaN when either is constant or shorter than 3.
+
+    Examples
+    --------
+    >>> round(pearson(np.array([1.0, 2, 3, 4]), np.array([2.0, 4, 6, 8.5])), 4)
+    0.9984
+    """
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    if len(a) < 3:
+        return float("nan")
+    a = a - a.mean()
+    b = b - b.mean()
+    den = np.sqrt((a * a).sum() * (b * b).sum())
+    return float((a * b).sum() / den) if den > 0 else float("nan")
+
+
+def moving_coordinates(model: Model, fraction: float = 0.1) -> np.ndarray:
+    """Flat indices (into ``M * 3``) of the coordinates that move: training std >= ``fraction`` of
+    the largest coordinate std. These make up the "whole face" average."""
+    std = model.coord_std
+    return np.flatnonzero(std >= fraction * std.max())
+
+
+def trajectory_correlations(original: np.ndarray, synthesized: np.ndarray, mask: np.ndarray,
+                            model: Model, config: EvalConfig | None = None) -> dict[str, float]:
+    """Correlations on the frames in ``mask``: whole face (mean over moving coordinates), lower
+    lip y and upper lip y. ``original`` and ``synthesized`` are ``(T, M, 3)`` head-normalised."""
+    config = config or EvalConfig()
+    ok = mask & np.isfinite(original).all(axis=(1, 2)) & np.isfinite(synthesized).all(axis=(1, 2))
+    width = int(np.prod(original.shape[1:]))    # explicit: no frame at all may be left
+    o = original[ok].reshape(int(ok.sum()), width)
+    s = synthesized[ok].reshape(int(ok.sum()), width)
+    coords = moving_coordinates(model, config.moving_fraction)
+    per = np.array([pearson(o[:, c], s[:, c]) for c in coords])
+    y = 1
+    return {
+        "whole_face": float(np.nanmean(per)) if np.isfinite(per).any() else float("nan"),
+        "lower_lip": pearson(o[:, model.lower_lip * 3 + y], s[:, model.lower_lip * 3 + y]),
+        "upper_lip": pearson(o[:, model.upper_lip * 3 + y], s[:, model.upper_lip * 3 + y]),
+    }
+
+
+@dataclass
+class ConditionScores:
+    """The three correlations of section 3 (whole face, lower lip, upper lip) under one condition:
+    split, synthesis mode, smoothing and N. One utterance's scores (:class:`UtteranceScore`) and a
+    mean over utterances (a Table 2 row) share these fields."""
+
+    split: str
+    mode: str
+    smoothing: str
+    n_context_phones: int
+    whole_face: float
+    lower_lip: float
+    upper_lip: float
+
+
+@dataclass(kw_only=True)
+class UtteranceScore(ConditionScores):
+    """Correlations of one utterance under one condition, on its ``speech_frames`` frames."""
+
+    utterance: str
+    speech_frames: int
+
+
+def _nanmean(values: Sequence[float]) -> float:
+    """Mean of the finite values; NaN (without numpy's warning) when there are none, e.g. an
+    utterance whose markers have no complete frame."""
+    v = np.asarray(values, dtype=np.float64)
+    v = v[np.isfinite(v)]
+    return float(v.mean()) if v.size else float("nan")
+
+
+@dataclass
+class EvalResult:
+    """Per-utterance scores and their averages per condition."""
+
+    scores: list[UtteranceScore] = field(default_factory=list)
+
+    def mean(self, split: str, smoothing: str, mode: str = "phonetic",
+             n: int | None = None) -> dict[str, float]:
+        """Mean correlation over utterances of one condition (the paper averages utterances)."""
+        rows = [r for r in self.scores if r.split == split and r.smoothing == smoothing
+                and r.mode == mode and (n is None or r.n_context_phones == n)]
+        return {m: _nanmean([getattr(r, m) for r in rows]) for m in METRICS}
+
+    def conditions(self) -> list[tuple[str, str, str, int]]:
+        seen: dict[tuple[str, str, str, int], None] = {}
+        for r in self.scores:
+            seen[(r.split, r.mode, r.smoothing, r.n_context_phones)] = None
+        return list(seen)
+
+    def table(self) -> list[dict]:
+        """One row per condition with the three mean correlations (Table 2 layout)."""
+        return [{"split": sp, "mode": mo, "smoothing": sm, "n_context_phones": n,
+                 **self.mean(sp, sm, mo, n)} for sp, mo, sm, n in self.conditions()]
+
+    def to_json(self) -> dict:
+        # the utterance first, as it reads
+        return {"table": self.table(),
+                "utterances": [{"utterance": r.utterance, **asdict(r)} for r in self.scores]}
+
+
+def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
+                       config: SynthConfig | None = None,
+                       smoothings: Sequence[str] = ("triangular", "spline"),
+                       eval_config: EvalConfig | None = None,
+                       synthesis: Synthesis | None = None, original: np.ndarray | None = None,
+                       speech: np.ndarray | None = None,
+                       lsf: np.ndarray | None = None) -> list[UtteranceScore]:
+    """Synthesize one utterance and score each smoothing against its original markers.
+
+    ``original`` (head-normalised markers), ``speech`` (the speech-frame mask) and ``lsf`` (the
+    input LSFs, :meth:`Model.input_lsf`) may be passed when already computed, e.g. when one
+    utterance is scored under several configs.
+    """
+    config = config or SynthConfig()
+    if utt.markers is None:
+        raise ValueError(f"{utt.name}: no original markers to compare with")
+    if original is None:
+        original = model.normalise_markers(utt.markers)
+    res = synthesis or synthesize(model, utt.audio, utt.sample_rate, utt.phones, config,
+                                  n_frames=utt.n_frames, source=utt.name, lsf=lsf)
+    mask = speech if speech is not None else speech_mask(utt.audio, utt.sample_rate, res.times,
+                                                         eval_config)
+    out = []
+    for sm in smoothings:
+        markers = resmooth(model, res, sm)
+        c = trajectory_correlations(original, markers, mask, model, eval_config)
+        out.append(UtteranceScore(split=split, mode=config.mode, smoothing=sm,
+                                  n_context_phones=config.n_context_phones, **c,
+                                  utterance=utt.name, speech_frames=int(mask.sum())))
+    return out
+
+
+def _score_utterance(model: Model, corpus: Corpus, split: str, utt_id: str,
+                     configs: Sequence[SynthConfig], smoothings: Sequence[str],
+                     eval_config: EvalConfig | None) -> list[UtteranceScore]:
+    """Every config's scores of one corpus utterance (its audio, markers and LSFs read once)."""
+    utt = corpus.utterance(utt_id)
+    original = model.normalise_markers(utt.markers)
+    speech = speech_mask(utt.audio, utt.sample_rate, utt.frame_times(), eval_config)
+    lsf = model.input_lsf(utt.audio, utt.sample_rate,                 # synthesize()'s frames
+                          np.arange(utt.n_frames) / model.marker_rate)
+    out: list[UtteranceScore] = []
+    for cfg in configs:
+        out.extend(evaluate_utterance(model, utt, split, cfg, smoothings, eval_config,
+                                      original=original, speech=speech, lsf=lsf))
+    return out
+
+
+#: what a worker process of :func:`evaluate` scores with, inherited by fork (not pickled)
+_WORKER_STATE: tuple | None = None
+
+
+def _worker_init(state: tuple) -> None:
+    global _WORKER_STATE
+    _WORKER_STATE = state
+    one_blas_thread()       # for the life of the worker process
+
+
+def _worker_score(split: str, utt_id: str) -> list[UtteranceScore]:
+    assert _WORKER_STATE is not None
+    with limit_frame_threads(1):        # as evaluate() does (the worker may run in a new context)
+        return _score_utterance(*_WORKER_STATE[:2], split, utt_id, *_WORKER_STATE[2:])
+
+
+def default_workers() -> int:
+    """Worker processes for :func:`evaluate` by default: the cores this process may use."""
+    return usable_cores()
+
+
+def evaluate(model: Model, corpus: Corpus, splits: Iterable[str] = ("train", "test"),
+             configs: Sequence[SynthConfig] | None = None,
+             smoothings: Sequence[str] = ("triangular", "spline"),
+             eval_config: EvalConfig | None = None,
+             progress: Callable[[float, str], None] | None = None,
+             workers: int = 1) -> EvalResult:
+    """Score every utterance of ``splits`` under each synthesis config (Table 2 and more).
+
+    With ``workers > 1`` the utterances are scored in that many processes (forked, so the model
+    is shared, not copied through pickle); each utterance is independent, and the scores come
+    back in corpus order, equal to the serial run's. BLAS runs on one thread either way
+    (:mod:`engine.threads`): the processes share the cores, and the serial run computes the same
+    sums in the same order; and each utterance is synthesized on one frame thread
+    (:func:`engine.threads.limit_frame_threads`), in the serial run too, so that the scores do not
+    depend on ``workers`` even at rounding level.
+    """
+    with one_blas_thread(), limit_frame_threads(1):
+        return _evaluate(model, corpus, list(splits), list(configs or [SynthConfig()]),
+                         list(smoothings), eval_config, progress, workers)
+
+
+def _evaluate(model: Model, corpus: Corpus, splits: list[str], configs: list[SynthConfig],
+              smoothings: list[str], eval_config: EvalConfig | None,
+              progress: Callable[[float, str], None] | None, workers: int) -> EvalResult:
+    ids = [(sp, u) for sp in splits for u in getattr(corpus.info, sp)]
+    result = EvalResult()
+    workers = min(workers, len(ids))
+    import multiprocessing as mp  # here: the app's first frame scores one utterance only
+
+    if workers > 1 and "fork" in mp.get_all_start_methods():
+        from concurrent.futures import ProcessPoolExecutor
+
+        state = (model, corpus, configs, smoothings, eval_config)
+        with ProcessPoolExecutor(workers, mp.get_context("fork"), initializer=_worker_init,
+                                 initargs=(state,)) as pool:
+            futures = [pool.submit(_worker_score, sp, u) for sp, u in ids]
+            for k, (fut, (sp, utt_id)) in enumerate(zip(futures, ids, strict=True)):
+                if progress:
+                    progress(k / len(ids), f"{sp}: {utt_id}")
+                result.scores.extend(fut.result())
+    else:
+        for k, (sp, utt_id) in enumerate(ids):
+            if progress:
+                progress(k / max(len(ids), 1), f"{sp}: {utt_id}")
+            result.scores.extend(_score_utterance(model, corpus, sp, utt_id, configs, smoothings,
+                                                  eval_config))
+    if progress:
+        progress(1.0, "done")
+    return result
+
+
+def table2(model: Model, corpus: Corpus, acoustic: bool = True,
+           eval_config: EvalConfig | None = None,
+           progress: Callable[[float, str], None] | None = None, workers: int = 1) -> EvalResult:
+    """The paper's Table 2 (train/test x triangular/spline, N = 3), plus acoustic-only rows
+    (the paper's whole-codebook search, ``acoustic_prefilter=None``)."""
+    configs = [SynthConfig(mode="phonetic")]
+    if acoustic:
+        configs.append(SynthConfig(mode="acoustic", acoustic_prefilter=None))
+    return evaluate(model, corpus, ("train", "test"), configs, ("triangular", "spline"),
+                    eval_config, progress, workers)
+
+
+def sweep_n(model: Model, corpus: Corpus, ns: Sequence[int] = tuple(range(1, 11)),
+            splits: Sequence[str] = ("train", "test"), eval_config: EvalConfig | None = None,
+            progress: Callable[[float, str], None] | None = None, workers: int = 1) -> EvalResult:
+    """Correlation against N (the paper's Figure 5), triangular smoothing."""
+    configs = [SynthConfig(n_context_phones=n) for n in ns]
+    return evaluate(model, corpus, splits, configs, ("triangular",), eval_config, progress,
+                    workers)
+
+
+def format_table2(result: EvalResult) -> str:
+    """Table 2 as text: one line per condition with whole face, lower lip, upper lip."""
+    lines = [f"{'Test condition':<34} {'Whole Face':>10} {'Lower Lip':>10} {'Upper Lip':>10}"]
+    for row in result.table():
+        name = f"{row['split'].title()} ({row['smoothing']}, {row['mode']}, N={row['n_context_phones']})"
+        lines.append(f"{name:<34} {row['whole_face']:>10.4f} {row['lower_lip']:>10.4f} "
+                     f"{row['upper_lip']:>10.4f}")
+    return "\n".join(lines)

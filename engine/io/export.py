@@ -1,0 +1,36 @@
+"""Writing trajectories: synthesized or original face points as C3D, TSV/CSV or NPZ."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from .files import atomic_write
+from .markerfiles import write_c3d, write_marker_tsv
+
+
+def write_trajectories(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
+                       names: Sequence[str], arrays: Mapping[str, np.ndarray] | None = None,
+                       overwrite: bool = True, which: str = "synthesized") -> Path:
+    """Write ``(T, M, 3)`` trajectories (``rate`` frames per second, marker ``names``, head frame)
+    as C3D, TSV/CSV or NPZ (by the suffix). The NPZ also holds ``arrays`` (for a synthesis, its
+    :meth:`~engine.method.pipeline.Synthesis.arrays`: times, smoothed and raw PCs, gamma, input LSF
+    and settings), and says ``which`` trajectories it holds (synthesized or original)."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".c3d":
+        write_c3d(path, markers, rate, list(names), overwrite)
+    elif suffix in (".tsv", ".txt", ".csv"):
+        write_marker_tsv(path, markers, rate, list(names), overwrite)
+    elif suffix == ".npz":
+        out = {"markers": markers, "marker_names": np.array(list(names)), "which": np.array(which)}
+        out.update(arrays or {})
+        with atomic_write(path, overwrite) as tmp, open(tmp, "wb") as handle:
+            np.savez_compressed(handle, **out)
+    else:
+        raise InputError(path, "unknown format (use .c3d, .tsv, .csv or .npz)")
+    return path

@@ -1,0 +1,192 @@
+"""Phone label files: Praat TextGrid, HTK/MOCHA ``.lab`` and TIMIT ``.phn``; their checks."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from ..data import PhoneSegment
+from ..errors import InputError
+from .files import atomic_write, read_text
+
+LABEL_SUFFIXES = (".textgrid", ".lab", ".phn")
+
+
+def read_textgrid_tiers(path: str | os.PathLike[str]) -> dict[str, list[PhoneSegment]]:
+    """Read every interval tier of a Praat TextGrid (long or short text form)."""
+    from praatio import textgrid
+
+    path = Path(path)
+    _check_interval_order(path, read_text(path))  # our own messages, before praatio's
+    try:
+        tg = textgrid.openTextgrid(str(path), includeEmptyIntervals=True)
+    except Exception as exc:
+        raise InputError(path, f"not a readable TextGrid ({exc})") from exc
+    tiers: dict[str, list[PhoneSegment]] = {}
+    for name in tg.tierNames:
+        tier = tg.getTier(name)
+        if tier.tierType != textgrid.INTERVAL_TIER:
+            continue
+        tiers[name] = [PhoneSegment(float(s), float(e), str(lab).strip())
+                       for s, e, lab in tier.entries]
+    return tiers
+
+
+def _check_interval_order(path: Path, text: str) -> None:
+    """Refuse interval tiers whose intervals are out of order, overlap or are not numbers (praatio
+    would sort them silently, or fail with its own text)."""
+    from praatio.utilities import textgrid_io
+
+    try:
+        parsed = textgrid_io.parseTextgridStr(text, includeEmptyIntervals=True)
+    except Exception as exc:  # praatio raises several types for malformed text
+        raise InputError(path, f"not a readable TextGrid ({exc})") from exc
+    for tier in parsed.get("tiers", []):
+        if tier.get("class") != "IntervalTier":
+            continue
+        prev_end = -np.inf
+        for i, (start, end, label) in enumerate(tier["entries"]):
+            try:
+                start, end = float(start), float(end)
+            except ValueError:
+                raise InputError(path, f"tier {tier['name']!r}: interval {i + 1} has a time that "
+                                       f"is not a number ({start} {end})") from None
+            if not (np.isfinite(start) and np.isfinite(end)):
+                raise InputError(path, f"tier {tier['name']!r}: interval {i + 1} has a time that "
+                                       f"is not a finite number ({start} {end})")
+            if start < prev_end - 1e-6:
+                raise InputError(path, f"tier {tier['name']!r}: interval {i + 1} ({label!r}) at "
+                                       f"{start:.3f} s overlaps or precedes the one before, "
+                                       f"ending {prev_end:.3f} s")
+            prev_end = max(prev_end, end)
+
+
+def read_textgrid(path: str | os.PathLike[str], tier: str = "phones") -> list[PhoneSegment]:
+    """Read one interval tier of a TextGrid; empty intervals become ``sil``."""
+    tiers = read_textgrid_tiers(path)
+    if tier not in tiers:
+        raise InputError(path, f"no interval tier named {tier!r} (tiers: {sorted(tiers)})")
+    return [PhoneSegment(s.start, s.end, s.label or "sil") for s in tiers[tier]]
+
+
+def write_textgrid(path: str | os.PathLike[str], tiers: dict[str, Sequence[PhoneSegment]],
+                   duration: float, overwrite: bool = True) -> None:
+    """Write interval tiers (name -> segments) as a long-form TextGrid."""
+    from praatio import textgrid
+
+    tg = textgrid.Textgrid()
+    duration = round(float(duration), 6)
+    for name, segs in tiers.items():
+        entries = [(round(s.start, 6), round(s.end, 6), s.label) for s in segs]
+        if entries and abs(entries[-1][1] - duration) < 1e-3:  # no rounding sliver at the end
+            entries[-1] = (entries[-1][0], duration, entries[-1][2])
+        tg.addTier(textgrid.IntervalTier(name, entries, 0.0, duration))
+    with atomic_write(path, overwrite) as tmp:
+        tg.save(str(tmp), format="long_textgrid", includeBlankSpaces=True)
+
+
+def _parse_columns(path: Path) -> list[list[str]]:
+    rows = []
+    for lineno, line in enumerate(read_text(path).splitlines(), 1):
+        parts = line.split()
+        if not parts or parts[0].startswith(("#", "!")) or parts[0] in {".", "MillisecondsPerFrame:"}:
+            continue
+        if len(parts) < 3:
+            raise InputError(path, f"line {lineno}: expected 'start end label', got {line!r}")
+        rows.append(parts)
+    return rows
+
+
+def read_lab(path: str | os.PathLike[str]) -> list[PhoneSegment]:
+    """Read an HTK label file (times in 100 ns units) or a MOCHA ``.lab`` (times in seconds).
+
+    The unit is told apart by the magnitude: integers above 10^4 are HTK units.
+    """
+    path = Path(path)
+    rows = _parse_columns(path)
+    try:
+        times = np.array([[float(r[0]), float(r[1])] for r in rows])
+    except ValueError as exc:
+        raise InputError(path, f"a start or end time is not a number ({exc})") from exc
+    if times.size and not np.all(np.isfinite(times)):
+        row = int(np.flatnonzero(~np.isfinite(times).all(axis=1))[0])
+        raise InputError(path, f"segment {row + 1} has a time that is not a finite number "
+                               f"({rows[row][0]} {rows[row][1]})")
+    scale = 1e-7 if times.size and times.max() > 1e4 else 1.0
+    return [PhoneSegment(a * scale, b * scale, r[2]) for (a, b), r in zip(times, rows, strict=True)]
+
+
+def read_phn(path: str | os.PathLike[str], sample_rate: int = 16000) -> list[PhoneSegment]:
+    """Read a TIMIT ``.phn`` file (sample indices at ``sample_rate``); ``h#``/``pau`` -> ``sil``."""
+    path = Path(path)
+    segs = []
+    for r in _parse_columns(path):
+        try:
+            a, b = int(r[0]), int(r[1])
+        except ValueError as exc:
+            raise InputError(path, f"sample index is not an integer ({exc})") from exc
+        lab = "sil" if r[2] in {"h#", "pau", "epi"} else r[2]
+        segs.append(PhoneSegment(a / sample_rate, b / sample_rate, lab))
+    return segs
+
+
+def read_labels(path: str | os.PathLike[str], sample_rate: int = 16000,
+                tier: str = "phones") -> list[PhoneSegment]:
+    """Read phone labels from a TextGrid, an HTK/MOCHA ``.lab`` or a TIMIT ``.phn``."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".textgrid":
+        segs = read_textgrid(path, tier)
+    elif suffix == ".lab":
+        segs = read_lab(path)
+    elif suffix == ".phn":
+        segs = read_phn(path, sample_rate)
+    else:
+        raise InputError(path, f"unknown label format {suffix!r} (use .TextGrid, .lab or .phn)")
+    if not segs:
+        raise InputError(path, "the label file holds no segments")
+    return segs
+
+
+def validate_phones(phones: Sequence[PhoneSegment], duration: float,
+                    path: str | os.PathLike[str] | None = None,
+                    tolerance: float = 0.05) -> list[PhoneSegment]:
+    """Check labels are sorted, do not overlap and cover ``[0, duration]``; return them tidied.
+
+    Gaps between segments are filled with ``sil``; slivers shorter than 1 ms (rounding left-overs)
+    are absorbed by the segment before; the first segment is extended to 0 and the last to
+    ``duration`` when they fall short by at most ``tolerance`` seconds.
+    """
+    if not phones:
+        raise InputError(path, "the label file holds no segments")
+    out: list[PhoneSegment] = []
+    for i, seg in enumerate(phones):
+        if out and 0 <= seg.end - seg.start < 1e-3 and seg.start >= out[-1].end - 1e-6:
+            out[-1] = PhoneSegment(out[-1].start, seg.end, out[-1].label)
+            continue
+        if not seg.end > seg.start:
+            raise InputError(path, f"segment {i + 1} ({seg.label!r}) ends at {seg.end:.3f} s, "
+                                   f"not after its start {seg.start:.3f} s")
+        if out and seg.start < out[-1].end - 1e-6:
+            raise InputError(path, f"segment {i + 1} ({seg.label!r}) at {seg.start:.3f} s overlaps "
+                                   f"or precedes the one before, ending {out[-1].end:.3f} s")
+        if out and seg.start > out[-1].end + 1e-6:
+            out.append(PhoneSegment(out[-1].end, seg.start, "sil"))
+        out.append(seg)
+    if out[0].start > tolerance:
+        raise InputError(path, f"labels start at {out[0].start:.3f} s, not at 0")
+    if abs(out[-1].end - duration) > max(tolerance, 0.02 * duration):
+        raise InputError(path, f"labels end at {out[-1].end:.3f} s but the audio lasts "
+                               f"{duration:.3f} s")
+    out[0] = PhoneSegment(0.0, out[0].end, out[0].label)
+    out[-1] = PhoneSegment(out[-1].start, max(duration, out[-1].start + 1e-3), out[-1].label)
+    return out
+
+
+def write_label_map(path: str | os.PathLike[str], table: dict[str, str]) -> None:
+    """Write a label map file (tab separated)."""
+    with atomic_write(path) as tmp:
+        tmp.write_text("".join(f"{k}\t{v}\n" for k, v in table.items()), encoding="utf-8")

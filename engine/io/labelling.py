@@ -1,0 +1,337 @@
+"""Which phone labels an input gets, and automatic labels for whole corpora (cached).
+
+- :func:`labels_for_audio` is THE rule for where the labels of an audio file come from, used by
+  the command line and the app: a label file given, else a sentence given (aligned), else
+  recognition asked for, else a label file beside the audio (same stem), else a ``.txt``
+  transcript beside it (aligned), else none -- and then :func:`engine.method.pipeline.mode_for` switches
+  to acoustic-only synthesis.
+- :func:`label_audio` labels one recording by ``"aligned"`` (from its text) or ``"recognized"``,
+  through a cache outside the repository (``engine.io.cachedir``), keyed by the audio's content, the
+  method, the text, extra pronunciations and the PocketSphinx version.
+- :func:`label_corpus` labels every utterance of a :class:`~engine.io.corpus.Corpus`;
+  :func:`relabelled` gives a corpus whose utterances carry those labels, which
+  :func:`engine.method.training.train` and :func:`engine.evaluation.scores.evaluate` take as they are (the
+  paper trained and tested on aligner labels, section 3).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from ..data import PhoneSegment, Utterance
+from ..errors import InputError
+from ..labels.alignment import Labels, align, pocketsphinx_version, recognize
+from ..progress import Progress
+from .cachedir import cache_dir
+from .corpus import Corpus
+from .files import atomic_write
+from .labelfiles import LABEL_SUFFIXES, read_labels, read_textgrid_tiers, validate_phones
+
+log = logging.getLogger(__name__)
+
+#: Automatic labelling methods (the :attr:`Labels.source` they produce).
+METHODS = ("aligned", "recognized")
+#: Bumped when this module's output for the same input changes (part of the cache key).
+LABELLER_VERSION = 1
+
+
+# --------------------------------------------------------------------------- one recording
+def label_cache_key(audio: np.ndarray, rate: int, method: str, text: str = "",
+                    extra_dict: Mapping[str, Sequence[str]] | None = None) -> str:
+    """A hash of the audio samples (as 16-bit PCM), the rate, the method, the text, extra
+    pronunciations, the PocketSphinx version and :data:`LABELLER_VERSION`."""
+    h = hashlib.sha256()
+    h.update((np.clip(np.asarray(audio, float), -1, 1) * 32767).astype("<i2").tobytes())
+    meta = {"rate": int(rate), "method": method, "text": text if method == "aligned" else "",
+            "dict": {k: list(v) for k, v in sorted((extra_dict or {}).items())},
+            "pocketsphinx": pocketsphinx_version(), "labeller": LABELLER_VERSION}
+    h.update(json.dumps(meta, sort_keys=True).encode())
+    return h.hexdigest()[:24]
+
+
+def label_cache_path(key: str) -> Path:
+    """The cache file of a label key."""
+    return cache_dir() / "labels" / f"labels-{key}.json"
+
+
+def label_audio(audio: np.ndarray, rate: int, method: str, text: str = "",
+                extra_dict: Mapping[str, Sequence[str]] | None = None,
+                source: str | os.PathLike[str] | None = None, use_cache: bool = True) -> Labels:
+    """Labels of one recording by ``method`` (``"aligned"`` needs ``text``), from the cache when
+    the same audio was labelled the same way before. Errors are not cached."""
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    path = label_cache_path(label_cache_key(audio, rate, method, text, extra_dict)) \
+        if use_cache else None
+    if path is not None and path.exists():
+        try:
+            return Labels.from_json(json.loads(path.read_text(encoding="utf-8")))
+        except (ValueError, KeyError, TypeError) as exc:
+            log.warning("ignoring unreadable cached labels %s: %s", path, exc)
+    if method == "aligned":
+        labels = align(audio, rate, text, extra_dict, source)
+    else:
+        labels = recognize(audio, rate, source)
+    if path is not None:
+        try:
+            with atomic_write(path) as tmp:
+                tmp.write_text(json.dumps(labels.to_json()), encoding="utf-8")
+        except OSError as exc:
+            log.warning("could not cache labels in %s: %s", path, exc)
+    return labels
+
+
+# --------------------------------------------------------------------------- the label source rule
+def beside(audio_path: str | os.PathLike[str]) -> tuple[Path | None, Path | None]:
+    """The label file (``.TextGrid``, ``.lab``, ``.phn``) and the ``.txt`` transcript beside an
+    audio file (same stem), each ``None`` when absent."""
+    audio_path = Path(audio_path)
+    label = next((p for suf in LABEL_SUFFIXES for p in audio_path.parent.glob(f"{audio_path.stem}.*")
+                  if p.suffix.lower() == suf and p.is_file()), None)
+    txt = audio_path.with_suffix(".txt")
+    return label, (txt if txt.is_file() else None)
+
+
+def read_transcript(path: str | os.PathLike[str]) -> str:
+    """The sentence of a ``.txt`` transcript (UTF-8)."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(path, "no such transcript file")
+    try:
+        return path.read_text(encoding="utf-8-sig").strip()
+    except UnicodeDecodeError:
+        raise InputError(path, "the transcript is not UTF-8 text") from None
+
+
+def file_labels(path: str | os.PathLike[str], rate: int, duration: float) -> Labels:
+    """Labels read from a label file (phones, and words from a TextGrid's ``words`` tier)."""
+    path = Path(path)
+    phones = validate_phones(read_labels(path, rate), duration, path)
+    words: list[PhoneSegment] = []
+    if path.suffix.lower() == ".textgrid":
+        words = [w for w in read_textgrid_tiers(path).get("words", []) if w.label]
+    return Labels(phones, words, "file")
+
+
+def labels_for_audio(audio_path: str | os.PathLike[str], audio: np.ndarray, rate: int, *,
+                     labels: str | os.PathLike[str] | None = None, text: str | None = None,
+                     transcript: str | os.PathLike[str] | None = None, recognize: bool = False,
+                     extra_dict: Mapping[str, Sequence[str]] | None = None,
+                     use_cache: bool = True) -> Labels | None:
+    """The phone labels of ``audio`` by THE rule (first that applies):
+
+    1. ``labels`` (a label file) -> ``source="file"``;
+    2. ``text``, or the sentence of ``transcript`` -> aligned;
+    3. ``recognize`` -> recognized;
+    4. a label file beside the audio (same stem) -> file;
+    5. a ``.txt`` beside the audio -> aligned;
+    6. otherwise ``None``: :func:`engine.method.pipeline.mode_for` then synthesizes acoustic-only.
+
+    The choice is logged. Errors of alignment (missing words, text that does not fit) propagate.
+    """
+    duration = len(audio) / float(rate)
+    if labels is not None:
+        log.info("phone labels from %s", labels)
+        return file_labels(labels, rate, duration)
+    if text is None and transcript is not None:
+        text = read_transcript(transcript)
+    if text is not None:
+        log.info("phone labels aligned from the sentence %r", text)
+        return label_audio(audio, rate, "aligned", text, extra_dict, transcript or audio_path,
+                           use_cache)
+    if recognize:
+        log.info("phone labels by phone recognition (no text)")
+        return label_audio(audio, rate, "recognized", source=audio_path, use_cache=use_cache)
+    label_file, txt = beside(audio_path)
+    if label_file is not None:
+        log.info("phone labels from %s (beside the audio)", label_file)
+        return file_labels(label_file, rate, duration)
+    if txt is not None:
+        sentence = read_transcript(txt)
+        log.info("phone labels aligned from %s: %r", txt.name, sentence)
+        return label_audio(audio, rate, "aligned", sentence, extra_dict, txt, use_cache)
+    log.info("no labels, no sentence and no .txt beside %s", audio_path)
+    return None
+
+
+# --------------------------------------------------------------------------- corpora
+@dataclass
+class CorpusLabels:
+    """Automatic labels of a corpus's utterances.
+
+    ``labels`` maps utterance id -> :class:`Labels` (``source`` says aligned or recognized: an
+    utterance without transcript, or whose alignment failed, is recognized when ``method`` is
+    ``"aligned"``); ``failed`` maps utterance id -> the error of an alignment that fell back to
+    recognition, or of an utterance left without labels (``missing``).
+    """
+
+    method: str
+    labels: dict[str, Labels] = field(default_factory=dict)
+    failed: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def missing(self) -> list[str]:
+        """Utterances with no automatic labels at all."""
+        return [u for u in self.failed if u not in self.labels]
+
+
+def label_utterance(utt: Utterance, method: str = "aligned",
+                    extra_dict: Mapping[str, Sequence[str]] | None = None,
+                    use_cache: bool = True) -> tuple[Labels, str | None]:
+    """Labels of one utterance and the alignment error that made it fall back to recognition."""
+    if method == "aligned" and utt.text:
+        try:
+            return label_audio(utt.audio, utt.sample_rate, "aligned", utt.text, extra_dict,
+                               utt.name, use_cache), None
+        except InputError as exc:
+            log.warning("%s; recognizing its phones instead", exc)
+            return label_audio(utt.audio, utt.sample_rate, "recognized", source=utt.name,
+                               use_cache=use_cache), str(exc)
+    return label_audio(utt.audio, utt.sample_rate, "recognized", source=utt.name,
+                       use_cache=use_cache), None
+
+
+def label_corpus(corpus: Corpus, method: str = "aligned", split: str = "all",
+                 extra_dict: Mapping[str, Sequence[str]] | None = None,
+                 progress: Progress | None = None, use_cache: bool = True) -> CorpusLabels:
+    """Label every utterance of ``split`` by ``method`` (cached per utterance: a second call
+    costs only reading the corpus)."""
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    ids = {"train": corpus.info.train, "test": corpus.info.test, "all": corpus.info.ids}[split]
+    out = CorpusLabels(method)
+    for k, utt_id in enumerate(ids):
+        if progress:
+            progress(k / max(len(ids), 1), f"labelling {utt_id}")
+        utt = corpus.utterance(utt_id)
+        try:
+            labels, error = label_utterance(utt, method, extra_dict, use_cache)
+        except InputError as exc:
+            out.failed[utt_id] = str(exc)
+            log.warning("%s: no automatic labels (%s)", utt_id, exc)
+            continue
+        out.labels[utt_id] = labels
+        if error:
+            out.failed[utt_id] = error
+    if progress:
+        progress(1.0, f"{len(out.labels)} utterances labelled")
+    return out
+
+
+def with_labels(utt: Utterance, labels: Labels) -> Utterance:
+    """``utt`` with its phones (and words, when any) replaced by ``labels``."""
+    return replace(utt, phones=list(labels.phones), words=list(labels.words) or utt.words,
+                   label_source=labels.source)
+
+
+@dataclass
+class RelabelledCorpus(Corpus):
+    """A corpus whose utterances carry automatic labels instead of their label files; utterances
+    left without labels are dropped from its splits."""
+
+    auto: CorpusLabels = field(default_factory=lambda: CorpusLabels("aligned"))
+
+    def utterance(self, utt_id: str) -> Utterance:
+        return with_labels(super().utterance(utt_id), self.auto.labels[utt_id])
+
+    def fingerprint(self) -> str:
+        h = hashlib.sha256(super().fingerprint().encode())
+        h.update(json.dumps({u: lab.to_json() for u, lab in sorted(self.auto.labels.items())},
+                            sort_keys=True).encode())
+        return h.hexdigest()[:16]
+
+
+def relabelled(corpus: Corpus, method: str = "aligned",
+               extra_dict: Mapping[str, Sequence[str]] | None = None,
+               progress: Progress | None = None, use_cache: bool = True,
+               split: str = "all") -> RelabelledCorpus:
+    """``corpus`` with every utterance of ``split`` labelled by ``method`` (see
+    :func:`label_corpus`); the other split is left out."""
+    auto = label_corpus(corpus, method, split, extra_dict, progress, use_cache)
+    keep = set(auto.labels)
+    info = replace(corpus.info, train=[u for u in corpus.info.train if u in keep],
+                   test=[u for u in corpus.info.test if u in keep])
+    if auto.missing:
+        log.warning("%d utterances without automatic labels left out: %s", len(auto.missing),
+                    ", ".join(auto.missing))
+    return RelabelledCorpus(corpus.root, info, auto=auto)
+
+
+# --------------------------------------------------------------------------- folders
+@dataclass
+class FolderLabelling:
+    """What :func:`label_folder` did: TextGrids written (and their source), existing ones kept,
+    files not labelled (``failed``) and transcripts that did not align (``fell_back``: recognized
+    instead), each with its error message."""
+
+    written: dict[str, Path] = field(default_factory=dict)
+    sources: dict[str, str] = field(default_factory=dict)
+    kept: list[str] = field(default_factory=list)
+    failed: dict[str, str] = field(default_factory=dict)
+    fell_back: dict[str, str] = field(default_factory=dict)
+
+    def summary(self) -> str:
+        n_al = sum(s == "aligned" for s in self.sources.values())
+        n_rec = sum(s == "recognized" for s in self.sources.values())
+        text = (f"{len(self.written)} TextGrids written ({n_al} aligned, {n_rec} recognized), "
+                f"{len(self.kept)} existing kept, {len(self.failed)} could not be labelled")
+        text += "".join(f"\n  not labelled: {why}" for why in self.failed.values())
+        return text + "".join(f"\n  recognized instead: {why}" for why in self.fell_back.values())
+
+
+def write_labels(path: str | os.PathLike[str], labels: Labels, duration: float,
+                 overwrite: bool = False) -> None:
+    """Write ``labels`` as a TextGrid (``words`` tier when any, then ``phones``)."""
+    from .labelfiles import write_textgrid
+
+    write_textgrid(path, labels.tiers(), duration, overwrite)
+
+
+def label_folder(folder: str | os.PathLike[str], method: str = "aligned",
+                 extra_dict: Mapping[str, Sequence[str]] | None = None, overwrite: bool = False,
+                 progress: Progress | None = None, use_cache: bool = True) -> FolderLabelling:
+    """Write ``<stem>.TextGrid`` beside every audio file of ``folder``: aligned from ``<stem>.txt``
+    (``method="aligned"``; recognized where the transcript is missing or does not align), or
+    recognized for all (``"recognized"``). Existing TextGrids are kept unless ``overwrite``."""
+    from .audio import AUDIO_SUFFIXES, read_audio
+
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise InputError(folder, "not a folder")
+    audio_files = sorted(p for p in folder.iterdir() if p.suffix.lower() in AUDIO_SUFFIXES)
+    if not audio_files:
+        raise InputError(folder, "no .wav or .flac audio files")
+    out = FolderLabelling()
+    for k, apath in enumerate(audio_files):
+        stem = apath.stem
+        if progress:
+            progress(k / len(audio_files), stem)
+        target = apath.with_suffix(".TextGrid")
+        if target.exists() and not overwrite:
+            out.kept.append(stem)
+            continue
+        try:
+            audio, rate = read_audio(apath)
+            text = read_transcript(apath.with_suffix(".txt")) \
+                if method == "aligned" and apath.with_suffix(".txt").is_file() else ""
+            utt = Utterance(stem, audio, rate, text=text)
+            labels, error = label_utterance(utt, method, extra_dict, use_cache)
+            write_labels(target, labels, len(audio) / rate, overwrite)
+        except (InputError, OSError) as exc:
+            out.failed[stem] = str(exc)
+            continue
+        out.written[stem] = target
+        out.sources[stem] = labels.source
+        if error:
+            out.fell_back[stem] = error
+    if progress:
+        progress(1.0, "done")
+    return out

@@ -1,0 +1,17 @@
+"""Phone labels: the phone set, other alphabets, and labels made by PocketSphinx.
+
+- ``phoneset``: ARPAbet and silence, label normalisation, mapping a label onto a model's phones;
+- ``labelmap``: other alphabets (MOCHA-TIMIT, a user's map file) onto ARPAbet;
+- ``alignment``: forced alignment of a transcript and phone recognition, with a score per phone.
+
+Imports only the shared modules (``engine.data``, ``engine.errors``): reading label files and
+deciding which labels an input gets is ``engine.io`` (``labelfiles``, ``labelling``).
+"""
+
+from .. import lazy_exports
+
+__getattr__, __dir__, __all__ = lazy_exports(__name__, {
+    "phoneset": "ARPABET SILENCE SILENCE_LABELS FALLBACK normalise_label apply_label_map map_labels",
+    "labelmap": "MOCHA_TO_ARPABET LabelMap read_label_map",
+    "alignment": "Labels align recognize pocketsphinx_version MissingWordsError UnalignableError",
+})

@@ -1,0 +1,92 @@
+"""The phone set: ARPAbet and silence, label normalisation, and mapping labels onto a model's
+phones (a user's label map first, then the nearest CMU phone for extended ARPAbet / TIMIT)."""
+
+from __future__ import annotations
+
+import logging
+import re
+from collections.abc import Mapping, Sequence
+
+from ..data import PhoneSegment
+from ..errors import InputError
+
+log = logging.getLogger(__name__)
+
+SILENCE = "sil"
+
+#: The 39 ARPAbet phones of the CMU Pronouncing Dictionary, plus silence.
+ARPABET = (
+    "aa ae ah ao aw ay b ch d dh eh er ey f g hh ih iy jh k l m n ng ow oy p r s sh t th "
+    "uh uw v w y z zh"
+).split()
+
+#: Labels read as silence.
+SILENCE_LABELS = frozenset({"", "sil", "sp", "pau", "h#", "#", "spn", "breath", "<p:>", "silence"})
+
+#: Extended ARPAbet / TIMIT symbols and the nearest CMU phone used when the model lacks them.
+FALLBACK = {
+    "ax": "ah", "axr": "er", "ax-h": "ah", "ix": "ih", "ux": "uw", "el": "l", "em": "m",
+    "en": "n", "eng": "ng", "nx": "n", "dx": "t", "hv": "hh", "q": "t",
+    "bcl": "b", "dcl": "d", "gcl": "g", "pcl": "p", "tcl": "t", "kcl": "k",
+}
+
+
+def normalise_label(label: str) -> str:
+    """Lower-case, strip ARPAbet stress digits, map silence labels to ``sil``.
+
+    Examples
+    --------
+    >>> [normalise_label(x) for x in ["AH0", "sp", "T", ""]]
+    ['ah', 'sil', 't', 'sil']
+    """
+    lab = re.sub(r"[012]$", "", label.strip().lower())
+    return SILENCE if lab in SILENCE_LABELS else lab
+
+
+def apply_label_map(label: str, table: Mapping[str, str] | None = None) -> str:
+    """A label normalised and mapped through ``table`` (looked up as written, then normalised).
+
+    Examples
+    --------
+    >>> apply_label_map("@", {"@": "AH0"}), apply_label_map("IY1", {"@": "ah"}), apply_label_map("T")
+    ('ah', 'iy', 't')
+    """
+    lab = normalise_label(label)
+    if table:
+        lab = normalise_label(table.get(label, table.get(lab, lab)))
+    return lab
+
+
+def map_labels(phones: Sequence[PhoneSegment], known: Sequence[str],
+               table: Mapping[str, str] | None = None, path: str | None = None,
+               strict: bool = False) -> list[PhoneSegment]:
+    """Normalise labels and map those the model does not know.
+
+    ``table`` (a user's label map, e.g. MOCHA -> ARPAbet) is applied first, then
+    :data:`FALLBACK`. A label still unknown raises :class:`InputError` listing the known phones.
+    With ``strict`` a fallback is an error too. Each fallback is logged as a warning.
+    """
+    known_set = set(known)
+    out = []
+    warned: set[str] = set()
+    for seg in phones:
+        raw = seg.label
+        lab = apply_label_map(raw, table)
+        if lab not in known_set:
+            alt = FALLBACK.get(lab)
+            if alt in known_set and not strict:
+                if lab not in warned:
+                    log.warning("%s: phone %r is not in the model; using %r", path or "labels",
+                                lab, alt)
+                    warned.add(lab)
+                lab = alt
+            elif table and (raw in table or normalise_label(raw) in table):
+                raise InputError(getattr(table, "source", None) or "the label map",
+                                 f"maps {raw!r} (at {seg.start:.3f} s in {path or 'the labels'}) "
+                                 f"to {lab!r}, which is not in the model; known phones: "
+                                 f"{' '.join(sorted(known_set))}")
+            else:
+                raise InputError(path, f"phone {raw!r} at {seg.start:.3f} s is not in the model; "
+                                       f"known phones: {' '.join(sorted(known_set))}")
+        out.append(PhoneSegment(seg.start, seg.end, lab))
+    return out

@@ -1,0 +1,224 @@
+"""The trained model: marker normalisation, PCA, codebook and similarity matrix, and its file
+(one ``.npz`` with a JSON metadata entry, never pickle).
+
+Training is :func:`engine.method.training.train`; synthesis :func:`engine.method.pipeline.synthesize`.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .. import __version__
+from ..config import TrainConfig
+from ..errors import ModelFileError
+from ..io.files import atomic_write
+from ..io.model_file import read_model_file
+from .codebook import Codebook
+from .lsf import lsf_at
+from .lsf_index import LsfIndex, build_index
+from .markers import fill_gaps, remove_head_motion
+from .pca import PCA
+from .similarity import similarity_matrix
+
+log = logging.getLogger(__name__)
+
+MODEL_FORMAT = "facetraj-model"
+MODEL_VERSION = 1
+
+
+@dataclass
+class Model:
+    """Everything synthesis needs, learnt from a training corpus.
+
+    Attributes
+    ----------
+    config : the training configuration.
+    phones : the phone set (ids index this list).
+    marker_names, marker_rate : the marker set and frame rate of the training data.
+    fixed : indices of the fixed (head) markers; ``reference`` their neutral pose ``(F, 3)``.
+    upper_lip, lower_lip : indices of the lip centre markers; ``lip_corners`` right and left.
+    pca : the PCA of the head-normalised marker vectors.
+    codebook : the audio-visual codebook.
+    means : ``(K, n_pc)`` eq 1 phone means; ``distances`` ``(K, K)`` eq 2; ``scale`` the divisor
+        applied to D before eq 3.
+    coord_std : ``(M * 3,)`` standard deviation of every head-normalised coordinate in training.
+    train_utterances : ids of the training utterances (codebook ``token_utt`` indexes it).
+    index : the coarse index over the codebook LSFs for acoustic-only synthesis; built by
+        :func:`train`, or on first use by :meth:`lsf_index` (older model files have none).
+    lsf_mean : ``(P,)`` the training speaker's mean codeword LSF (the robust mode's speaker mean
+        normalisation); older model files have none and it is computed from the codebook.
+    tuned : the synthesis settings chosen by cross-validation on the training split
+        (:func:`engine.evaluation.tuning.cross_validate`: ``{"settings": {...}, "scores": [...]}``), or empty.
+    """
+
+    config: TrainConfig
+    phones: list[str]
+    marker_names: list[str]
+    marker_rate: float
+    fixed: np.ndarray
+    reference: np.ndarray
+    upper_lip: int
+    lower_lip: int
+    pca: PCA
+    codebook: Codebook
+    means: np.ndarray
+    distances: np.ndarray
+    scale: float
+    coord_std: np.ndarray
+    lip_corners: list[int] = field(default_factory=list)
+    train_utterances: list[str] = field(default_factory=list)
+    corpus_fingerprint: str = ""
+    index: LsfIndex | None = None
+    tuned: dict = field(default_factory=dict)
+
+    # ------------------------------------------------------------------ derived quantities
+    @property
+    def n_markers(self) -> int:
+        return len(self.marker_names)
+
+    @property
+    def is_planar(self) -> bool:
+        """Whether the markers are midsagittal (2-D: every x coordinate of the neutral face is 0)."""
+        return not self.neutral_face()[:, 0].any()
+
+    def phone_id(self, label: str) -> int:
+        return self.phones.index(label)
+
+    def similarity(self, nu: float | None = None) -> np.ndarray:
+        """The visual phoneme similarity matrix S (eq 3) for ``nu`` (default: the trained one)."""
+        return similarity_matrix(self.distances, self.config.nu if nu is None else nu, self.scale)
+
+    def neutral_face(self) -> np.ndarray:
+        """The PCA mean face, ``(M, 3)``."""
+        return self.pca.mean.reshape(self.n_markers, 3)
+
+    def mode_shape(self, component: int, value: float) -> np.ndarray:
+        """The face with PC ``component`` set to ``value`` (others 0), ``(M, 3)`` (Figure 2)."""
+        coeffs = np.zeros(self.pca.n_components)
+        coeffs[component] = value
+        return self.pca.inverse(coeffs).reshape(self.n_markers, 3)
+
+    def input_lsf(self, audio: np.ndarray, sample_rate: int, times: np.ndarray,
+                  threads: int | None = 1) -> np.ndarray:
+        """The input LSF vectors w (eq 5) at ``times``, analysed as in training, ``(T, P)``, in
+        ``threads`` spans of frames (``None``: :func:`engine.threads.frame_threads`)."""
+        mc = self.config
+        return lsf_at(audio, sample_rate, times, mc.lpc_order, mc.window_s, mc.audio_rate,
+                      mc.preemphasis, threads)
+
+    def lsf_index(self) -> LsfIndex:
+        """The coarse LSF index of the codebook (``engine.method.lsf_index``), built here and kept if the
+        model has none or has one for a codebook of another size."""
+        if self.index is None or self.index.n_codewords != self.codebook.lsf.shape[0]:
+            self.index = build_index(self.codebook.lsf, self.config.index_cells)
+        return self.index
+
+    @property
+    def lsf_mean(self) -> np.ndarray:
+        """The training speaker's mean LSF vector (mean over the codewords), ``(P,)``."""
+        return self.codebook.lsf.mean(axis=0)
+
+    def normalise_markers(self, markers: np.ndarray) -> np.ndarray:
+        """Fill short gaps and remove head motion: ``(T, M, 3)`` in the model's head frame."""
+        markers = np.asarray(markers, dtype=np.float64)
+        if markers.ndim != 3 or markers.shape[1:] != (self.n_markers, 3):
+            raise ValueError(f"markers must be (frames, {self.n_markers}, 3), got {markers.shape}")
+        filled, _ = fill_gaps(markers, self.marker_rate, self.config.max_gap_s)
+        return remove_head_motion(filled, self.fixed, self.reference)
+
+    def to_pcs(self, normalised: np.ndarray) -> np.ndarray:
+        """PC coefficients ``(T, K)`` of head-normalised markers ``(T, M, 3)``."""
+        return self.pca.transform(normalised.reshape(normalised.shape[0], -1))
+
+    def to_markers(self, pcs: np.ndarray) -> np.ndarray:
+        """Marker coordinates ``(T, M, 3)`` from PC coefficients ``(T, K)``."""
+        return self.pca.inverse(pcs).reshape(-1, self.n_markers, 3)
+
+    # ------------------------------------------------------------------ persistence
+    def save(self, path: str | os.PathLike[str], overwrite: bool = True) -> Path:
+        """Write the model as one ``.npz`` (arrays + a JSON ``meta`` entry); never pickle.
+
+        The members are stored, not deflated: compression saved 5 % of the size and inflating
+        cost 0.1 s of every start (issue #15). Compressed files (older versions) still load."""
+        path = Path(path)
+        meta = {
+            "format": MODEL_FORMAT,
+            "version": MODEL_VERSION,
+            "facetraj": __version__,
+            "config": self.config.to_dict(),
+            "phones": self.phones,
+            "marker_names": self.marker_names,
+            "marker_rate": self.marker_rate,
+            "upper_lip": self.upper_lip,
+            "lower_lip": self.lower_lip,
+            "lip_corners": self.lip_corners,
+            "pca_total_variance": self.pca.total_variance,
+            "scale": self.scale,
+            "n_per_phone": self.codebook.n_per_phone,
+            "train_utterances": self.train_utterances,
+            "corpus_fingerprint": self.corpus_fingerprint,
+            "tuned": self.tuned,
+        }
+        arrays = {
+            "meta": np.array(json.dumps(meta)),
+            "fixed": self.fixed, "reference": self.reference,
+            "pca_mean": self.pca.mean, "pca_components": self.pca.components,
+            "pca_variances": self.pca.variances,
+            "cb_contexts": self.codebook.contexts, "cb_lsf": self.codebook.lsf,
+            "cb_pcs": self.codebook.pcs, "cb_token_utt": self.codebook.token_utt,
+            "cb_token_start": self.codebook.token_start, "cb_token_end": self.codebook.token_end,
+            "means": self.means, "distances": self.distances, "coord_std": self.coord_std,
+        }
+        if self.codebook.lsf_context is not None:
+            arrays["cb_lsf_context"] = self.codebook.lsf_context
+        if self.index is not None:
+            arrays.update(ix_centroids=self.index.centroids, ix_order=self.index.order,
+                          ix_offsets=self.index.offsets)
+        with atomic_write(path, overwrite) as tmp, open(tmp, "wb") as handle:
+            np.savez(handle, **arrays)
+        return path
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> Model:
+        """Read a model written by :meth:`save`; a wrong, truncated, damaged or newer file is
+        refused (:func:`engine.io.model_file.read_model_file` checks every entry first)."""
+        path = Path(path)
+        meta, a = read_model_file(path, MODEL_VERSION, MODEL_FORMAT)
+        try:
+            pca = PCA(a["pca_mean"], a["pca_components"], a["pca_variances"],
+                      float(meta["pca_total_variance"]))
+            cb = Codebook(a["cb_contexts"], a["cb_lsf"], a["cb_pcs"], a["cb_token_utt"],
+                          a["cb_token_start"], a["cb_token_end"], int(meta["n_per_phone"]),
+                          a.get("cb_lsf_context"))
+            index = (LsfIndex(a["ix_centroids"], a["ix_order"], a["ix_offsets"])
+                     if "ix_centroids" in a else None)
+            if index is not None and not _index_fits(index, cb.lsf):
+                raise ModelFileError(path, "its LSF index does not match its codebook (damaged file?)")
+            return cls(
+                config=TrainConfig.from_dict(meta["config"]), phones=list(meta["phones"]),
+                marker_names=list(meta["marker_names"]), marker_rate=float(meta["marker_rate"]),
+                fixed=a["fixed"], reference=a["reference"], upper_lip=int(meta["upper_lip"]),
+                lower_lip=int(meta["lower_lip"]), pca=pca, codebook=cb, means=a["means"],
+                distances=a["distances"], scale=float(meta["scale"]), coord_std=a["coord_std"],
+                lip_corners=list(meta.get("lip_corners", [])),
+                train_utterances=list(meta.get("train_utterances", [])),
+                corpus_fingerprint=meta.get("corpus_fingerprint", ""), index=index,
+                tuned=dict(meta.get("tuned") or {}),
+            )
+        except KeyError as exc:
+            raise ModelFileError(path, f"model file is incomplete: missing {exc}") from exc
+
+
+def _index_fits(index: LsfIndex, cb_lsf: np.ndarray) -> bool:
+    """Whether a stored LSF index partitions exactly this codebook."""
+    n, order, offsets = cb_lsf.shape[0], index.order, index.offsets
+    return (order.shape == (n,) and offsets.shape == (index.n_cells + 1,)
+            and index.centroids.shape[1:] == cb_lsf.shape[1:] and n > 0
+            and offsets[0] == 0 and offsets[-1] == n and bool(np.all(np.diff(offsets) >= 0))
+            and np.array_equal(np.sort(order), np.arange(n)))

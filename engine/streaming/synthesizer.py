@@ -1,0 +1,231 @@
+"""Streaming acoustic-only synthesis: audio blocks in, face frames out as soon as they are determined.
+
+The same computation as :func:`engine.method.pipeline.synthesize` in acoustic-only mode (paper section
+2.3: input LSFs, the LSF-index search, eqs 5-8, the triangular smoothing), with the state carried
+between blocks: the resampler's filter memory (``engine.method.lsf.ResampleStream``), the last sample
+for the pre-emphasis, the analysis samples not yet used by a frame, and the smoother's last raw
+frames (``engine.method.smoothing.TriangularStream``). Frame t (at ``t / marker_rate``) is emitted once
+the audio up to ``t / marker_rate + lookahead_s`` has arrived: half the analysis window (12.5 ms),
+the resampler's few samples and the smoothing window's second half (3 frames, 50 ms, at 60 Hz),
+plus up to ``batch_frames - 1`` frames when frames are analysed in batches (live mode: 3).
+The frames emitted by the blocks and :meth:`StreamingSynthesizer.flush` together equal the
+offline synthesis of the whole audio, frame for frame (to rounding).
+
+Spline smoothing needs the whole utterance and is not available here.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..config import SynthConfig
+from ..method.lsf import ResampleStream, frame_lsf, frame_start, frame_starts, preemphasize
+from ..method.model import Model
+from ..method.pipeline import acoustic_candidates
+from ..method.smoothing import TriangularStream
+from ..method.speaker import warp_lsf
+from ..method.synthesis import gamma_grid, weight_frames
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class StreamConfig:
+    """Settings of a stream.
+
+    Attributes
+    ----------
+    sample_rate : the rate of the audio blocks fed in.
+    synth : the synthesis settings (acoustic mode is used whatever ``synth.mode`` says; smoothing
+        ``triangular`` or ``none``; ``speaker_warp`` must be a number: a stream has no whole
+        utterance to choose it from).
+    batch_frames : analyse the determined frames once this many are waiting (1: each as soon as
+        it is determined). Larger batches make fewer, larger numpy calls (the per-call overhead
+        dominates one frame's LPC, index search and eqs 5-8) for up to ``batch_frames - 1``
+        frames more delay; the frames themselves are the same.
+    """
+
+    sample_rate: int = 16000
+    synth: SynthConfig = field(default_factory=lambda: SynthConfig(mode="acoustic"))
+    batch_frames: int = 1
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.batch_frames, int) and 1 <= self.batch_frames <= 60):
+            raise ValueError(f"batch_frames must be an integer from 1 to 60, not {self.batch_frames!r}")
+
+
+#: the frame batch of live mode (``facetraj live`` and the Live window): 5 frames at 60 Hz add
+#: at most 67 ms to the lookahead (129.2 ms in all, under the 150 ms aim of issue 13) and make the
+#: 10 ms-block stream about 3 times faster (docs/benchmarks.md)
+LIVE_BATCH_FRAMES = 5
+
+
+@dataclass
+class StreamFrames:
+    """Frames emitted by one call: ``index`` ``(n,)`` frame numbers (time ``index / rate``),
+    ``pcs`` ``(n, K)`` smoothed PCs, ``raw_pcs`` ``(n, K)`` unsmoothed ones (eq 8) and
+    ``markers`` ``(n, M, 3)``."""
+
+    index: np.ndarray
+    times: np.ndarray
+    pcs: np.ndarray
+    markers: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.index)
+
+
+class StreamingSynthesizer:
+    """Feed audio blocks of any size with :meth:`feed`, end with :meth:`flush`.
+
+    ``feed`` returns the face frames the block completed (possibly none); ``flush`` the rest,
+    padding the end as offline synthesis does. The input LSFs and raw PCs of every analysed frame
+    are kept (:attr:`lsf`, :attr:`raw_pcs`) for saving the take.
+    """
+
+    def __init__(self, model: Model, config: StreamConfig | None = None):
+        self.model = model
+        self.config = config or StreamConfig()
+        cfg = self.config.synth.with_(mode="acoustic")
+        if cfg.smoothing not in ("triangular", "none"):
+            raise ValueError(f"streaming supports triangular or no smoothing, not {cfg.smoothing!r}")
+        if cfg.speaker_warp is None:
+            raise ValueError("streaming needs a fixed speaker_warp (a number), not None")
+        self.synth = cfg
+        mc = model.config
+        self.rate = model.marker_rate
+        self._audio_rate = mc.audio_rate
+        self._resampler = ResampleStream(self.config.sample_rate, mc.audio_rate)
+        self._n = int(round(mc.window_s * mc.audio_rate))          # analysis window, samples
+        self._half = self._n // 2
+        self._hamming = np.hamming(self._n)
+        self._buffer = np.zeros(0)          # pre-emphasized analysis samples from self._first on
+        self._first = 0
+        self._analysed = 0                  # analysis samples received so far
+        self._previous: float | None = None
+        self._received = 0                  # input samples received so far
+        self._next = 0                      # the next frame to analyse
+        self._smoother = TriangularStream(self.rate, cfg.triangle_s if cfg.smoothing ==
+                                          "triangular" else 0.0)
+        self._emitted = 0
+        self._gammas = gamma_grid(cfg.gamma_min, cfg.gamma_max, cfg.gamma_steps)
+        self._lsf: list[np.ndarray] = []
+        self._raw: list[np.ndarray] = []
+        self._grouped = model.lsf_index().grouped(model.codebook.lsf)   # once, not per block
+
+    @property
+    def lookahead_s(self) -> float:
+        """Audio needed after a frame's time before the frame is emitted (the algorithm's delay;
+        with ``batch_frames > 1`` the most: the first frame of a batch waits for its last)."""
+        resampler = self._resampler.lookahead / self.config.sample_rate
+        window = (self._n - self._half) / self._audio_rate
+        batch = (self.config.batch_frames - 1) / self.rate
+        return window + resampler + batch + self._smoother.lookahead / self.rate
+
+    @property
+    def received_s(self) -> float:
+        """Seconds of audio fed so far."""
+        return self._received / self.config.sample_rate
+
+    @property
+    def lsf(self) -> np.ndarray:
+        """``(T, P)`` input LSFs (after the speaker warp) of the frames analysed so far."""
+        return np.concatenate(self._lsf) if self._lsf else np.zeros((0, self.model.config.lpc_order))
+
+    @property
+    def raw_pcs(self) -> np.ndarray:
+        """``(T, K)`` unsmoothed PCs (eq 8) of the frames analysed so far."""
+        k = self.model.codebook.pcs.shape[1]
+        return np.concatenate(self._raw) if self._raw else np.zeros((0, k))
+
+    def feed(self, block: np.ndarray) -> StreamFrames:
+        """Face frames completed by the next ``block`` of audio samples (mono)."""
+        block = np.asarray(block, dtype=np.float64).ravel()
+        self._received += len(block)
+        self._append(self._resampler.feed(block))
+        # frame t is complete once its window's last sample has arrived
+        last = self._next
+        while self._window_start(last) + self._n <= self._analysed:
+            last += 1
+        if last - self._next < self.config.batch_frames:
+            last = self._next                           # not a whole batch yet: wait
+        return self._emit(self._analyse(last, self._analysed), self._smoother.feed)
+
+    def flush(self) -> StreamFrames:
+        """The remaining frames, the audio ended: as many frames in all as offline synthesis makes
+        of the same audio (none if it is shorter than two frames)."""
+        self._append(self._resampler.flush())
+        duration = self._received / float(self.config.sample_rate)
+        total = int(np.floor(duration * self.rate + 1e-9)) + 1
+        if total < 2 or duration < 2.0 / self.rate:
+            return self._emit(np.zeros((0, self.model.codebook.pcs.shape[1])), self._smoother.feed)
+        raw = self._analyse(total, self._analysed)
+        frames = self._emit(raw, self._smoother.feed)
+        rest = self._emit(np.zeros((0, raw.shape[1])), lambda _: self._smoother.flush())
+        return StreamFrames(np.concatenate([frames.index, rest.index]),
+                            np.concatenate([frames.times, rest.times]),
+                            np.concatenate([frames.pcs, rest.pcs]),
+                            np.concatenate([frames.markers, rest.markers]))
+
+    # ------------------------------------------------------------------ the steps
+    def _append(self, samples: np.ndarray) -> None:
+        if len(samples) == 0:
+            return
+        coef = self.model.config.preemphasis
+        emphasized = preemphasize(samples, coef, self._previous)
+        self._previous = float(samples[-1])
+        self._buffer = np.concatenate([self._buffer, emphasized])
+        self._analysed += len(samples)
+
+    def _window_start(self, t: int) -> int:
+        """The first analysis sample of frame t's window (may be negative: zeros before)."""
+        return frame_start(t / self.rate, self._audio_rate) - self._half
+
+    def _analyse(self, stop: int, length: int) -> np.ndarray:
+        """Raw PCs (eqs 5-8) of frames ``self._next .. stop-1``; analysis samples at or beyond
+        ``length`` are zero (only at the end)."""
+        t = np.arange(self._next, stop)
+        k = self.model.codebook.pcs.shape[1]
+        if len(t) == 0:
+            return np.zeros((0, k))
+        starts = np.clip(frame_starts(t / self.rate, self._audio_rate), 0, length) - self._half
+        idx = starts[:, None] + np.arange(self._n)[None, :]
+        inside = (idx >= 0) & (idx < length)
+        local = np.clip(idx - self._first, 0, max(len(self._buffer) - 1, 0))
+        values = self._buffer[local] if len(self._buffer) else np.zeros(idx.shape)
+        frames = np.where(inside, values, 0.0) * self._hamming[None, :]
+        w = frame_lsf(frames, self.model.config.lpc_order)
+        if self.synth.speaker_warp != 1.0:
+            w = warp_lsf(w, self.synth.speaker_warp)
+        cb = self.model.codebook
+        fw = weight_frames(w, acoustic_candidates(self.model, w, self.synth, self._grouped), cb.lsf, cb.pcs,
+                           self._gammas)
+        self._lsf.append(w)
+        self._raw.append(fw.pcs)
+        self._next = stop
+        keep = self._window_start(stop)                 # samples before the next window: done
+        if keep > self._first:
+            self._buffer = self._buffer[keep - self._first:]
+            self._first = keep
+        return fw.pcs
+
+    def _emit(self, raw: np.ndarray, smoother) -> StreamFrames:
+        pcs = smoother(raw)
+        index = np.arange(self._emitted, self._emitted + len(pcs))
+        self._emitted += len(pcs)
+        return StreamFrames(index, index / self.rate, pcs, self.model.to_markers(pcs))
+
+
+def stream_synthesize(model: Model, audio: np.ndarray, sample_rate: int, block: int,
+                      synth: SynthConfig | None = None) -> StreamFrames:
+    """The whole of ``audio`` through a :class:`StreamingSynthesizer` in blocks of ``block``
+    samples; all the frames emitted (for tests and benchmarks)."""
+    cfg = StreamConfig(sample_rate, synth or SynthConfig(mode="acoustic"))
+    stream = StreamingSynthesizer(model, cfg)
+    parts = [stream.feed(audio[a:a + block]) for a in range(0, len(audio), block)]
+    parts.append(stream.flush())
+    return StreamFrames(*(np.concatenate([getattr(p, f) for p in parts])
+                          for f in ("index", "times", "pcs", "markers")))
