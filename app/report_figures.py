@@ -161,9 +161,10 @@ def make_figures(data: ReportData, fig_dir: Path) -> dict[str, Path]:
 
 def make_report(corpus_dir: str | os.PathLike[str], out_dir: str | os.PathLike[str],
                 model: Model | None = None, progress: Callable[[float, str], None] | None = None,
-                ns: Iterable[int] = range(1, 11)) -> Path:
+                ns: Iterable[int] = range(1, 11), **options) -> Path:
     """Write ``out_dir/results.md``, ``out_dir/results.json`` and ``out_dir/figures/results_*.png``
     for the corpus in ``corpus_dir`` (trained on its train split unless ``model`` is given).
-    Returns the path of ``results.md``."""
+    Returns the path of ``results.md``. ``options``: ``workers``, ``skip``
+    (:func:`engine.report.write_report`)."""
     return write_report(corpus_dir, out_dir, model=model, progress=progress, ns=ns,
-                        figures=make_figures)
+                        figures=make_figures, **options)

@@ -4,8 +4,8 @@ GUI-free: numpy, scipy and small format libraries only. Its folders are the pipe
 each imports only the stages listed before it (``tests/test_layering.py`` checks it):
 
 ==============  ===========================================================================
-shared          ``config`` (settings), ``data`` (an utterance), ``errors``, ``progress``,
-                ``threads``: small modules every stage uses
+shared          ``config`` (settings), ``data`` (an utterance), ``errors``, ``fanout`` (work
+                over processes), ``progress``, ``threads``: small modules every stage uses
 ``labels``      the phone set, other alphabets, PocketSphinx alignment and recognition
 ``io``          files in and out: audio, label and marker files, corpus folders, model files,
                 exports, caches, and which labels an input gets

@@ -45,6 +45,17 @@ _limit: ContextVar[int | None] = ContextVar("frame_thread_limit", default=None)
 _pool: tuple[ThreadPoolExecutor, int] | None = None
 
 
+def _forget_pool() -> None:
+    """In a forked child: the parent's pool threads do not exist there, and a task given to the
+    copied pool would wait for them for ever; the child makes its own when it needs one."""
+    global _pool
+    _pool = None
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forget_pool)
+
+
 def one_blas_thread() -> AbstractContextManager:
     """Limit BLAS to one thread: until the end of the ``with`` block, or (called on its own) for
     the rest of the process.

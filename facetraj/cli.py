@@ -79,6 +79,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return args.func(args)
     except FacetrajError as exc:
         print(f"facetraj: error: {exc}", file=sys.stderr)
+        if hasattr(exc, "item") and hasattr(args, "skip_bad"):
+            print("facetraj: (--skip-bad leaves out what has bad files and goes on)",
+                  file=sys.stderr)
         return EXIT_BAD_INPUT
     except OSError as exc:  # a file the commands did not check themselves: still one line
         where = exc.filename or exc.filename2

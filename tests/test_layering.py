@@ -17,7 +17,8 @@ import engine
 ROOT = Path(__file__).resolve().parent.parent
 
 #: The engine's top-level modules outside every stage: small things every stage uses.
-SHARED = {"engine.config", "engine.data", "engine.errors", "engine.progress", "engine.threads"}
+SHARED = {"engine.config", "engine.data", "engine.errors", "engine.fanout", "engine.progress",
+          "engine.threads"}
 
 # Run in a fresh interpreter in which every GUI package and the upper layers cannot be imported.
 PROBE = """

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..config import SynthConfig
 from ..data import Utterance
+from ..fanout import Skips, fan_out
 from ..io.corpus import Corpus
 from ..method.model import Model
 from ..method.pipeline import Synthesis, resmooth, synthesize
@@ -251,22 +252,6 @@ def _score_utterance(model: Model, corpus: Corpus, split: str, utt_id: str,
     return out
 
 
-#: what a worker process of :func:`evaluate` scores with, inherited by fork (not pickled)
-_WORKER_STATE: tuple | None = None
-
-
-def _worker_init(state: tuple) -> None:
-    global _WORKER_STATE
-    _WORKER_STATE = state
-    one_blas_thread()       # for the life of the worker process
-
-
-def _worker_score(split: str, utt_id: str) -> list[UtteranceScore]:
-    assert _WORKER_STATE is not None
-    with limit_frame_threads(1):        # as evaluate() does (the worker may run in a new context)
-        return _score_utterance(*_WORKER_STATE[:2], split, utt_id, *_WORKER_STATE[2:])
-
-
 def default_workers() -> int:
     """Worker processes for :func:`evaluate` by default: the cores this process may use."""
     return usable_cores()
@@ -277,71 +262,56 @@ def evaluate(model: Model, corpus: Corpus, splits: Iterable[str] = ("train", "te
              smoothings: Sequence[str] = ("triangular", "spline"),
              eval_config: EvalConfig | None = None,
              progress: Callable[[float, str], None] | None = None,
-             workers: int = 1) -> EvalResult:
+             workers: int = 1, skip: Skips | None = None) -> EvalResult:
     """Score every utterance of ``splits`` under each synthesis config (Table 2 and more).
 
-    With ``workers > 1`` the utterances are scored in that many processes (forked, so the model
-    is shared, not copied through pickle); each utterance is independent, and the scores come
-    back in corpus order, equal to the serial run's. BLAS runs on one thread either way
-    (:mod:`engine.threads`): the processes share the cores, and the serial run computes the same
-    sums in the same order; and each utterance is synthesized on one frame thread
-    (:func:`engine.threads.limit_frame_threads`), in the serial run too, so that the scores do not
-    depend on ``workers`` even at rounding level.
+    With ``workers > 1`` the utterances are scored in that many processes
+    (:func:`engine.fanout.fan_out`: forked, so the model is shared, not copied through pickle);
+    each utterance is independent, and the scores come back in corpus order, equal to the serial
+    run's. BLAS runs on one thread either way (:mod:`engine.threads`): the processes share the
+    cores, and the serial run computes the same sums in the same order; and each utterance is
+    synthesized on one frame thread (:func:`engine.threads.limit_frame_threads`), in the serial
+    run too, so that the scores do not depend on ``workers`` even at rounding level.
+
+    An utterance with a bad file stops the evaluation with that file's error, whatever
+    ``workers``; with ``skip`` it is left out and recorded there (``--skip-bad``).
     """
+    splits = list(splits)
+    configs = list(configs or [SynthConfig()])
+    split_of = {u: sp for sp in splits for u in getattr(corpus.info, sp)}
+
+    def score(utt_id: str) -> list[UtteranceScore]:
+        with limit_frame_threads(1):        # also in a worker, which may run in a new context
+            return _score_utterance(model, corpus, split_of[utt_id], utt_id, configs,
+                                    list(smoothings), eval_config)
+
     with one_blas_thread(), limit_frame_threads(1):
-        return _evaluate(model, corpus, list(splits), list(configs or [SynthConfig()]),
-                         list(smoothings), eval_config, progress, workers)
-
-
-def _evaluate(model: Model, corpus: Corpus, splits: list[str], configs: list[SynthConfig],
-              smoothings: list[str], eval_config: EvalConfig | None,
-              progress: Callable[[float, str], None] | None, workers: int) -> EvalResult:
-    ids = [(sp, u) for sp in splits for u in getattr(corpus.info, sp)]
-    result = EvalResult()
-    workers = min(workers, len(ids))
-    import multiprocessing as mp  # here: the app's first frame scores one utterance only
-
-    if workers > 1 and "fork" in mp.get_all_start_methods():
-        from concurrent.futures import ProcessPoolExecutor
-
-        state = (model, corpus, configs, smoothings, eval_config)
-        with ProcessPoolExecutor(workers, mp.get_context("fork"), initializer=_worker_init,
-                                 initargs=(state,)) as pool:
-            futures = [pool.submit(_worker_score, sp, u) for sp, u in ids]
-            for k, (fut, (sp, utt_id)) in enumerate(zip(futures, ids, strict=True)):
-                if progress:
-                    progress(k / len(ids), f"{sp}: {utt_id}")
-                result.scores.extend(fut.result())
-    else:
-        for k, (sp, utt_id) in enumerate(ids):
-            if progress:
-                progress(k / max(len(ids), 1), f"{sp}: {utt_id}")
-            result.scores.extend(_score_utterance(model, corpus, sp, utt_id, configs, smoothings,
-                                                  eval_config))
-    if progress:
-        progress(1.0, "done")
-    return result
+        done = fan_out(score, list(split_of), workers, skip=skip, progress=progress,
+                       describe=lambda u: f"{split_of[u]}: {u}")
+    return EvalResult([s for _, scores in done for s in scores])
 
 
 def table2(model: Model, corpus: Corpus, acoustic: bool = True,
            eval_config: EvalConfig | None = None,
-           progress: Callable[[float, str], None] | None = None, workers: int = 1) -> EvalResult:
+           progress: Callable[[float, str], None] | None = None, workers: int = 1,
+           skip: Skips | None = None) -> EvalResult:
     """The paper's Table 2 (train/test x triangular/spline, N = 3), plus acoustic-only rows
     (the paper's whole-codebook search, ``acoustic_prefilter=None``)."""
     configs = [SynthConfig(mode="phonetic")]
     if acoustic:
         configs.append(SynthConfig(mode="acoustic", acoustic_prefilter=None))
     return evaluate(model, corpus, ("train", "test"), configs, ("triangular", "spline"),
-                    eval_config, progress, workers)
+                    eval_config, progress, workers, skip)
 
 
 def sweep_n(model: Model, corpus: Corpus, ns: Sequence[int] = tuple(range(1, 11)),
             splits: Sequence[str] = ("train", "test"), eval_config: EvalConfig | None = None,
-            progress: Callable[[float, str], None] | None = None, workers: int = 1) -> EvalResult:
+            progress: Callable[[float, str], None] | None = None, workers: int = 1,
+            skip: Skips | None = None) -> EvalResult:
     """Correlation against N (the paper's Figure 5), triangular smoothing."""
     configs = [SynthConfig(n_context_phones=n) for n in ns]
     return evaluate(model, corpus, splits, configs, ("triangular",), eval_config, progress,
-                    workers)
+                    workers, skip)
 
 
 def format_table2(result: EvalResult) -> str:

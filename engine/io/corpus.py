@@ -10,8 +10,8 @@ import json
 import logging
 import math
 import os
-from collections.abc import Iterator
-from dataclasses import asdict, dataclass, field
+from collections.abc import Iterable, Iterator
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -260,6 +260,15 @@ class Corpus:
         ids = {"train": self.info.train, "test": self.info.test, "all": self.info.ids}[split]
         for utt_id in ids:
             yield self.utterance(utt_id)
+
+    def without(self, ids: Iterable[str]) -> Corpus:
+        """This corpus without the utterances ``ids`` (those skipped as bad, say)."""
+        drop = set(ids)
+        if not drop:
+            return self
+        return replace(self, info=replace(self.info,
+                                          train=[u for u in self.info.train if u not in drop],
+                                          test=[u for u in self.info.test if u not in drop]))
 
     def fingerprint(self) -> str:
         """A hash of the description and every data file (names and contents), for caching

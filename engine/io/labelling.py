@@ -28,6 +28,7 @@ import numpy as np
 
 from ..data import PhoneSegment, Utterance
 from ..errors import InputError
+from ..fanout import Skips, fan_out
 from ..labels.alignment import Labels, align, pocketsphinx_version, recognize
 from ..progress import Progress
 from .cachedir import cache_dir
@@ -201,26 +202,27 @@ def label_utterance(utt: Utterance, method: str = "aligned",
 
 def label_corpus(corpus: Corpus, method: str = "aligned", split: str = "all",
                  extra_dict: Mapping[str, Sequence[str]] | None = None,
-                 progress: Progress | None = None, use_cache: bool = True) -> CorpusLabels:
+                 progress: Progress | None = None, use_cache: bool = True,
+                 workers: int = 1) -> CorpusLabels:
     """Label every utterance of ``split`` by ``method`` (cached per utterance: a second call
-    costs only reading the corpus)."""
+    costs only reading the corpus), in ``workers`` processes. An utterance that cannot be
+    labelled is left out and named in ``failed``."""
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     ids = {"train": corpus.info.train, "test": corpus.info.test, "all": corpus.info.ids}[split]
     out = CorpusLabels(method)
-    for k, utt_id in enumerate(ids):
-        if progress:
-            progress(k / max(len(ids), 1), f"labelling {utt_id}")
-        utt = corpus.utterance(utt_id)
-        try:
-            labels, error = label_utterance(utt, method, extra_dict, use_cache)
-        except InputError as exc:
-            out.failed[utt_id] = str(exc)
-            log.warning("%s: no automatic labels (%s)", utt_id, exc)
-            continue
+    failed = Skips()
+
+    def label_one(utt_id: str) -> tuple[Labels, str | None]:
+        return label_utterance(corpus.utterance(utt_id), method, extra_dict, use_cache)
+
+    done = fan_out(label_one, list(ids), workers, skip=failed, progress=progress,
+                   describe=lambda u: f"labelling {u}")
+    for utt_id, (labels, error) in done:
         out.labels[utt_id] = labels
         if error:
             out.failed[utt_id] = error
+    out.failed.update(failed.bad)     # each logged as it was skipped
     if progress:
         progress(1.0, f"{len(out.labels)} utterances labelled")
     return out
@@ -283,7 +285,6 @@ class FolderLabelling:
         n_rec = sum(s == "recognized" for s in self.sources.values())
         text = (f"{len(self.written)} TextGrids written ({n_al} aligned, {n_rec} recognized), "
                 f"{len(self.kept)} existing kept, {len(self.failed)} could not be labelled")
-        text += "".join(f"\n  not labelled: {why}" for why in self.failed.values())
         return text + "".join(f"\n  recognized instead: {why}" for why in self.fell_back.values())
 
 
@@ -297,11 +298,17 @@ def write_labels(path: str | os.PathLike[str], labels: Labels, duration: float,
 
 def label_folder(folder: str | os.PathLike[str], method: str = "aligned",
                  extra_dict: Mapping[str, Sequence[str]] | None = None, overwrite: bool = False,
-                 progress: Progress | None = None, use_cache: bool = True) -> FolderLabelling:
+                 progress: Progress | None = None, use_cache: bool = True, workers: int = 1,
+                 skip: Skips | None = None) -> FolderLabelling:
     """Write ``<stem>.TextGrid`` beside every audio file of ``folder``: aligned from ``<stem>.txt``
     (``method="aligned"``; recognized where the transcript is missing or does not align), or
-    recognized for all (``"recognized"``). Existing TextGrids are kept unless ``overwrite``."""
-    from .audio import AUDIO_SUFFIXES, read_audio
+    recognized for all (``"recognized"``). Existing TextGrids are kept unless ``overwrite``.
+
+    The recordings are labelled in ``workers`` processes (:func:`engine.fanout.fan_out`). A
+    recording that cannot be labelled (a bad audio file or transcript, silence) stops the work
+    with its error, the TextGrids already written staying; with ``skip`` it is left out, recorded
+    there and in ``failed``."""
+    from .audio import AUDIO_SUFFIXES
 
     folder = Path(folder)
     if not folder.is_dir():
@@ -310,28 +317,43 @@ def label_folder(folder: str | os.PathLike[str], method: str = "aligned",
     if not audio_files:
         raise InputError(folder, "no .wav or .flac audio files")
     out = FolderLabelling()
-    for k, apath in enumerate(audio_files):
-        stem = apath.stem
-        if progress:
-            progress(k / len(audio_files), stem)
-        target = apath.with_suffix(".TextGrid")
-        if target.exists() and not overwrite:
-            out.kept.append(stem)
-            continue
-        try:
-            audio, rate = read_audio(apath)
-            text = read_transcript(apath.with_suffix(".txt")) \
-                if method == "aligned" and apath.with_suffix(".txt").is_file() else ""
-            utt = Utterance(stem, audio, rate, text=text)
-            labels, error = label_utterance(utt, method, extra_dict, use_cache)
-            write_labels(target, labels, len(audio) / rate, overwrite)
-        except (InputError, OSError) as exc:
-            out.failed[stem] = str(exc)
-            continue
-        out.written[stem] = target
-        out.sources[stem] = labels.source
+    todo = []
+    for apath in audio_files:
+        if apath.with_suffix(".TextGrid").exists() and not overwrite:
+            out.kept.append(apath.stem)
+        else:
+            todo.append(apath)
+    by_stem = {p.stem: p for p in todo}
+
+    def label_one(stem: str) -> tuple[str, str | None]:
+        return _label_file(by_stem[stem], method, extra_dict, overwrite, use_cache)
+
+    done = fan_out(label_one, list(by_stem), workers, skip=skip, progress=progress)
+    for stem, (source, error) in done:
+        out.written[stem] = by_stem[stem].with_suffix(".TextGrid")
+        out.sources[stem] = source
         if error:
             out.fell_back[stem] = error
-    if progress:
-        progress(1.0, "done")
+    if skip is not None:
+        out.failed.update({stem: msg for stem, msg in skip.bad.items() if stem in by_stem})
     return out
+
+
+def _label_file(apath: Path, method: str, extra_dict: Mapping[str, Sequence[str]] | None,
+                overwrite: bool, use_cache: bool) -> tuple[str, str | None]:
+    """Label one recording and write its TextGrid: the labels' source and the alignment error
+    that made it fall back to recognition."""
+    from .audio import read_audio
+
+    try:
+        audio, rate = read_audio(apath)
+        text = read_transcript(apath.with_suffix(".txt")) \
+            if method == "aligned" and apath.with_suffix(".txt").is_file() else ""
+        labels, error = label_utterance(Utterance(apath.stem, audio, rate, text=text), method,
+                                        extra_dict, use_cache)
+        write_labels(apath.with_suffix(".TextGrid"), labels, len(audio) / rate, overwrite)
+    except InputError:
+        raise
+    except OSError as exc:  # not one of ours: still the file and the problem
+        raise InputError(exc.filename or apath, exc.strerror or str(exc)) from exc
+    return labels.source, error

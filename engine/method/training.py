@@ -13,6 +13,7 @@ import numpy as np
 from ..config import TrainConfig
 from ..data import Utterance
 from ..errors import InputError
+from ..fanout import Skips, fan_out
 from ..io.corpus import Corpus
 from ..io.labelfiles import validate_phones
 from ..labels.phoneset import SILENCE, apply_label_map
@@ -60,32 +61,40 @@ def _check_utterance(utt: Utterance, names: Sequence[str]) -> None:
 
 
 def load_training_set(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None,
-                      progress: Progress) -> tuple[list[Utterance], MarkerSetup, str]:
+                      progress: Progress, workers: int = 1, skip: Skips | None = None
+                      ) -> tuple[list[Utterance], MarkerSetup, str]:
     """The training utterances, their marker roles and the corpus fingerprint ("" outside a
-    corpus). A :class:`~engine.io.corpus.Corpus` gives its ``train`` split and its ``corpus.json``
-    roles."""
+    corpus). A :class:`~engine.io.corpus.Corpus` gives its ``train`` split (read in ``workers``
+    processes) and its ``corpus.json`` roles. An utterance with a bad file stops training with its
+    error, or with ``skip`` is left out (recorded there)."""
     fingerprint = ""
     if isinstance(utterances, Corpus):
         corpus = utterances
         info = corpus.info
         setup = setup or MarkerSetup(info.fixed_markers, info.upper_lip, info.lower_lip,
                                      info.lip_corners)
-        ids = list(info.train)
         fingerprint = corpus.fingerprint()
-        loaded: list[Utterance] = []
-        for k, utt_id in enumerate(ids):
-            progress(0.3 * k / max(len(ids), 1), f"loading {utt_id}")
-            loaded.append(corpus.utterance(utt_id))
+        done = fan_out(corpus.utterance, list(info.train), workers, skip=skip,
+                       progress=lambda f, m: progress(0.3 * f, m), describe=lambda u: f"loading {u}")
+        loaded = [utt for _, utt in done]
     else:
         loaded = list(utterances)
     if setup is None:
         raise ValueError("pass a MarkerSetup (fixed markers and lips) when not training on a Corpus")
-    if not loaded:
-        raise InputError(None, "no training utterances")
-    names = list(loaded[0].marker_names)
+    checked: list[Utterance] = []
     for utt in loaded:
-        _check_utterance(utt, names)
-    return loaded, setup, fingerprint
+        try:
+            _check_utterance(utt, checked[0].marker_names if checked else utt.marker_names)
+        except InputError as exc:
+            if skip is None:
+                raise
+            skip.add(utt.name, exc)
+            continue
+        checked.append(utt)
+    if not checked:
+        raise InputError(None, "no training utterances" + (" left (every one was skipped)"
+                                                           if loaded or skip else ""))
+    return checked, setup, fingerprint
 
 
 def marker_roles(names: Sequence[str], setup: MarkerSetup) -> _MarkerRoles:
@@ -160,7 +169,8 @@ def codebook_part(utt: Utterance, normed: np.ndarray, k: int, pca: PCA, pid: Map
 
 def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = None,
           config: TrainConfig | None = None, progress: Progress | None = None,
-          label_map: Mapping[str, str] | None = None) -> Model:
+          label_map: Mapping[str, str] | None = None, workers: int = 1,
+          skip: Skips | None = None) -> Model:
     """Train a model (paper sections 2.1-2.2) on utterances with markers and phone labels.
 
     Given a :class:`~engine.io.corpus.Corpus`, its ``train`` split is used and the marker roles come
@@ -169,10 +179,14 @@ def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = 
     Steps: gap filling; head-motion removal against a Procrustes-mean neutral pose of the fixed
     markers; PCA; context-phones; LSF and PC vectors at 5 codeword times per phone; eq 1-2 phone
     means and distances; the coarse LSF index of acoustic-only synthesis.
+
+    The utterances are read, and their codewords computed, in ``workers`` processes
+    (:func:`engine.fanout.fan_out`; the model equals the serial run's). A bad file stops training
+    with its error, or with ``skip`` its utterance is left out (``--skip-bad``).
     """
     config = config or TrainConfig()
     progress = progress or no_progress
-    loaded, setup, fingerprint = load_training_set(utterances, setup, progress)
+    loaded, setup, fingerprint = load_training_set(utterances, setup, progress, workers, skip)
     names = list(loaded[0].marker_names)
     rate = float(loaded[0].marker_rate)
     roles = marker_roles(names, setup)
@@ -185,11 +199,11 @@ def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = 
     phone_set = sorted({SILENCE} | {apply_label_map(s.label, label_map)
                                     for utt in loaded for s in utt.phones})
     pid = {p: i for i, p in enumerate(phone_set)}
-    parts = []
-    for k, (utt, nm) in enumerate(zip(loaded, normed, strict=True)):
-        progress(0.45 + 0.5 * k / len(loaded), f"codebook: {utt.name}")
-        parts.append(codebook_part(utt, nm, k, pca, pid, rate, config, label_map))
-    cb = concatenate(parts)
+    parts = fan_out(lambda k: codebook_part(loaded[k], normed[k], k, pca, pid, rate, config,
+                                            label_map),
+                    range(len(loaded)), workers, progress=lambda f, m: progress(0.45 + 0.5 * f, m),
+                    describe=lambda k: f"codebook: {loaded[k].name}")
+    cb = concatenate([part for _, part in parts])
 
     # eqs 1-2 on the codeword PC vectors grouped by centre phone
     means = phone_means(cb.pcs, cb.codeword_phone(), len(phone_set))

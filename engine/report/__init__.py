@@ -27,6 +27,7 @@ from pathlib import Path
 
 from ..evaluation.label_eval import LABEL_EVAL_FILE, read_label_eval
 from ..evaluation.voice_eval import VOICE_EVAL_FILE, read_voice_eval
+from ..fanout import Skips
 from ..io.files import atomic_write, write_json
 from ..method.model import Model
 from ..progress import Progress
@@ -51,16 +52,19 @@ log = logging.getLogger(__name__)
 
 def write_report(corpus_dir: str | os.PathLike[str], out_dir: str | os.PathLike[str],
                  model: Model | None = None, progress: Progress | None = None,
-                 ns: Iterable[int] = range(1, 11), figures: FigureMaker | None = None) -> Path:
+                 ns: Iterable[int] = range(1, 11), figures: FigureMaker | None = None,
+                 workers: int | None = None, skip: Skips | None = None) -> Path:
     """Compute the report on ``corpus_dir`` and write ``out_dir/results.md``, ``results.json`` and
     (through ``figures``, drawn into ``out_dir/figures/``) its figures. Returns the ``.md`` path.
     The evaluation with automatic labels is read from ``out_dir/label_eval.json`` (written by
     ``facetraj report --automatic-labels``, about half an hour) when present, and the evaluation
     with a second voice from ``out_dir/voice_eval.json`` (``facetraj report --second-voice``).
+    ``workers`` and ``skip``: as :func:`~.compute.compute_report`'s. Nothing is written when the
+    computation fails.
     """
     out = Path(out_dir)
+    data = compute_report(corpus_dir, model, progress, ns, workers=workers, skip=skip)
     out.mkdir(parents=True, exist_ok=True)
-    data = compute_report(corpus_dir, model, progress, ns)
     data.label_eval = read_label_eval(out / LABEL_EVAL_FILE)
     data.voice_eval = read_voice_eval(out / VOICE_EVAL_FILE)
     if figures is not None:

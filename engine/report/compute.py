@@ -27,6 +27,7 @@ from ..evaluation.scores import (
     table2,
     trajectory_correlations,
 )
+from ..fanout import Skips
 from ..io.corpus import Corpus, load_corpus
 from ..method.model import Model
 from ..method.pipeline import resmooth, synthesize
@@ -176,26 +177,30 @@ def _automatic_labels(corpus: Corpus, model: Model, comparisons: list[Comparison
 
 def compute_report(corpus_dir: str | os.PathLike[str], model: Model | None = None,
                    progress: Progress | None = None, ns: Iterable[int] = range(1, 11),
-                   labels_section: bool = True) -> ReportData:
+                   labels_section: bool = True, workers: int | None = None,
+                   skip: Skips | None = None) -> ReportData:
     """Compute every number of the report on the corpus's own train/test split.
 
-    Trains a model on the train split when ``model`` is ``None``. The evaluations use every
-    core (:func:`default_workers`); their scores equal a serial run's. With ``labels_section`` and
-    a corpus with transcripts, adds the automatic-label section (PocketSphinx; slow on the first
-    run, then cached).
+    Trains a model on the train split when ``model`` is ``None``. The training and the
+    evaluations run in ``workers`` processes (default every core, :func:`default_workers`); their
+    scores equal a serial run's. With ``labels_section`` and a corpus with transcripts, adds the
+    automatic-label section (PocketSphinx; slow on the first run, then cached). A bad file stops
+    the report with its error; with ``skip`` its utterance is left out of every number (and
+    named in the corpus summary).
     """
     progress = progress or (lambda f, m: None)
-    workers = default_workers()
+    workers = workers or default_workers()
     corpus = load_corpus(corpus_dir)
     ns = list(ns)
     timings: dict[str, float] = {}
     if model is None:
         with _timed(timings, "train"):
-            model = train(corpus, progress=_stage(progress, 0.0, 0.1))
+            model = train(corpus, progress=_stage(progress, 0.0, 0.1), workers=workers, skip=skip)
     rows1 = top_similar(model.similarity(), model.phones, 3)          # Table 1 (eqs 1-3)
     with _timed(timings, "table2_and_acoustic"):                         # N = 3, both smoothings
         res2 = table2(model, corpus, acoustic=True, progress=_stage(progress, 0.1, 0.45),
-                      workers=workers)
+                      workers=workers, skip=skip)
+    corpus = corpus.without(skip.bad if skip else ())   # table2 has read every utterance
     indexed = SynthConfig(mode="acoustic")       # the default search of the app and `facetraj synth`
     with _timed(timings, "acoustic_indexed"):
         res_ix = evaluate(model, corpus, ("train", "test"), [indexed], ("triangular", "spline"),
@@ -214,6 +219,7 @@ def compute_report(corpus_dir: str | os.PathLike[str], model: Model | None = Non
         with _timed(timings, "automatic_labels"):
             labels = _automatic_labels(corpus, model, comparisons, _stage(progress, 0.97, 0.995))
     summary = corpus_summary(corpus)
+    summary.skipped = dict(skip.bad) if skip else {}
     progress(1.0, "done")
     return ReportData(corpus=summary, model=model_summary(model, base), table1=rows1,
                       paper_table1=paper_table1(),

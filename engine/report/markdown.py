@@ -36,8 +36,17 @@ def header_section(data: ReportData) -> list[str]:
         f"{m.n_phones} phones. All correlations are Pearson correlations between original and "
         f"synthesized head-normalised trajectories on speech frames only (section 3), averaged over "
         f"utterances (± one standard deviation over utterances). All numbers are in "
-        f"[`results.json`](results.json).",
+        f"[`results.json`](results.json)." + _skipped(c.skipped),
     ]
+
+
+def _skipped(skipped: dict[str, str]) -> str:
+    """The sentence naming the utterances left out as bad (``--skip-bad``), or nothing."""
+    if not skipped:
+        return ""
+    return (f" {len(skipped)} utterance{'s' if len(skipped) > 1 else ''} with bad files "
+            f"{'were' if len(skipped) > 1 else 'was'} left out (`--skip-bad`): "
+            + "; ".join(f"`{u}` ({msg})" for u, msg in skipped.items()) + ".")
 
 
 def glance_section(data: ReportData) -> list[str]:

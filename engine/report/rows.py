@@ -5,7 +5,7 @@ Table 1's agreement with the paper, and the corpus and model summaries."""
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -140,6 +140,7 @@ class CorpusSummary:
     n_test: int
     train_minutes: float
     test_minutes: float
+    skipped: dict[str, str] = field(default_factory=dict)   # utterance -> its bad file's message
 
 
 @dataclass

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from engine.errors import FacetrajError
 
+from ..corpus_work import add_corpus_work_options, finish, jobs, skips
 from ..options import FRACTION, RATE, integer
 from ..progress import TerminalProgress
 
@@ -70,11 +71,15 @@ def cmd_corpus_align(args: argparse.Namespace) -> int:
         from engine.io.corpus import load_corpus
 
         folder = load_corpus(folder).data_root
+    skipped = skips(args, "recordings")
     done = label_folder(folder, "recognized" if args.recognize else "aligned",
-                        extra_dictionary(args), args.overwrite, TerminalProgress("align"))
+                        extra_dictionary(args), args.overwrite, TerminalProgress("align"),
+                        workers=jobs(args), skip=skipped)
     log.info("%s", done.summary())
     print(folder)
-    return 0 if done.written or done.kept else 2
+    if skipped and not (done.written or done.kept):
+        raise FacetrajError(f"{folder}: no recording could be labelled ({skipped.summary()})")
+    return finish(skipped)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -112,4 +117,5 @@ def register(sub: argparse._SubParsersAction) -> None:
     a.add_argument("--dict", type=Path, metavar="FILE",
                    help="extra pronunciations, CMUdict lines 'WORD  PH1 PH2 ...'")
     a.add_argument("--overwrite", action="store_true", help="replace existing TextGrids")
+    add_corpus_work_options(a, "recordings")
     a.set_defaults(func=cmd_corpus_align)

@@ -6,12 +6,13 @@ import argparse
 import json
 from pathlib import Path
 
+from ..corpus_work import add_corpus_work_options, finish, jobs, skips
 from ..options import POSITIVE, TOP_N, add_synth_options, integer, synth_config
 from ..progress import TerminalProgress
 
 
 def cmd_eval(args: argparse.Namespace) -> int:
-    from engine.evaluation.scores import default_workers, evaluate, format_table2
+    from engine.evaluation.scores import evaluate, format_table2
     from engine.io.corpus import load_corpus
     from engine.method.model import Model
 
@@ -21,14 +22,15 @@ def cmd_eval(args: argparse.Namespace) -> int:
     configs = [synth_config(args)]
     if args.acoustic and configs[0].mode != "acoustic":
         configs.append(configs[0].with_(mode="acoustic"))
+    skipped = skips(args)
     res = evaluate(model, corpus, splits, configs, ("triangular", "spline"),
-                   progress=TerminalProgress("eval"), workers=args.jobs or default_workers())
+                   progress=TerminalProgress("eval"), workers=jobs(args), skip=skipped)
     print(json.dumps(res.to_json(), indent=2) if args.json else format_table2(res))
-    return 0
+    return finish(skipped)
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from engine.evaluation.scores import default_workers, sweep_n
+    from engine.evaluation.scores import sweep_n
     from engine.io.corpus import load_corpus
     from engine.method.model import Model
 
@@ -36,8 +38,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     corpus = load_corpus(args.corpus)
     ns = list(range(1, args.max_n + 1))
     splits = ("train", "test") if args.split == "all" else (args.split,)
+    skipped = skips(args)
     res = sweep_n(model, corpus, ns, splits, progress=TerminalProgress("sweep"),
-                  workers=args.jobs or default_workers())
+                  workers=jobs(args), skip=skipped)
     curve = {sp: [res.mean(sp, "triangular", n=n)["whole_face"] for n in ns] for sp in splits}
     if args.json:
         print(json.dumps({"n": ns, "whole_face": curve, "table": res.table()}, indent=2))
@@ -45,7 +48,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         print(f"{'N':>3} " + " ".join(f"{sp:>8}" for sp in splits))
         for i, n in enumerate(ns):
             print(f"{n:>3} " + " ".join(f"{curve[sp][i]:>8.4f}" for sp in splits))
-    return 0
+    return finish(skipped)
 
 
 def cmd_similarity(args: argparse.Namespace) -> int:
@@ -70,8 +73,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--split", choices=["train", "test", "all"], default="all")
     p.add_argument("--acoustic", action="store_true", help="add acoustic-only rows")
     p.add_argument("--json", action="store_true", help="JSON output with per-utterance scores")
-    p.add_argument("--jobs", "-j", type=integer(1, 256), metavar="N",
-                   help="utterances scored in N processes (default: every core)")
+    add_corpus_work_options(p)
     add_synth_options(p)
     p.set_defaults(func=cmd_eval)
 
@@ -81,8 +83,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--max-n", type=integer(1, 100), default=10)
     p.add_argument("--split", choices=["train", "test", "all"], default="all")
     p.add_argument("--json", action="store_true")
-    p.add_argument("--jobs", "-j", type=integer(1, 256), metavar="N",
-                   help="utterances scored in N processes (default: every core)")
+    add_corpus_work_options(p)
     p.set_defaults(func=cmd_sweep)
 
     p = sub.add_parser("similarity", help="visual phoneme similarity (Table 1)")

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from engine.errors import FacetrajError
 
+from ..corpus_work import add_corpus_work_options, finish, jobs, skips
 from ..options import FPS, add_synth_options, integer, synth_config, video_size
 from ..paths import default_corpus
 from ..progress import TerminalProgress
@@ -77,10 +78,11 @@ def cmd_report(args: argparse.Namespace) -> int:
         voices = evaluate_voices(load_corpus(args.corpus or default_corpus()), model=model,
                                  progress=TerminalProgress("second voice"))
         write_voice_eval(args.output / VOICE_EVAL_FILE, voices)
+    skipped = skips(args)
     out = make_report(args.corpus, args.output, model=model, progress=TerminalProgress("report"),
-                      ns=range(1, args.max_n + 1))
+                      ns=range(1, args.max_n + 1), workers=jobs(args), skip=skipped)
     print(out)
-    return 0
+    return finish(skipped)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -99,6 +101,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "test sentences (shorter vocal tract, higher pitch), with and without "
                         "speaker normalisation (about 8 minutes), saved as voice_eval.json beside "
                         "results.md and reported from it")
+    add_corpus_work_options(p)
     p.set_defaults(func=cmd_report)
 
     p = sub.add_parser("video", help="an MP4 of the face points and lip panels with the sound")

@@ -6,6 +6,7 @@ import argparse
 import logging
 from pathlib import Path
 
+from ..corpus_work import add_corpus_work_options, finish, jobs, skips
 from ..options import add_train_options, integer, train_config
 from ..progress import TerminalProgress
 
@@ -19,11 +20,14 @@ def cmd_train(args: argparse.Namespace) -> int:
 
     check_output_path(args.output, args.overwrite)  # before training, not after
     corpus = load_corpus(args.corpus)
-    model = train(corpus, config=train_config(args), progress=TerminalProgress("train"))
+    skipped = skips(args)
+    model = train(corpus, config=train_config(args), progress=TerminalProgress("train"),
+                  workers=jobs(args, 1), skip=skipped)
     if args.tune:
         from engine.evaluation.tuning import cross_validate
 
-        tuning = cross_validate(corpus, train_config(args), folds=args.tune,
+        tuning = cross_validate(corpus.without(skipped.bad if skipped else ()), train_config(args),
+                                folds=args.tune,
                                 progress=TerminalProgress("cross-validation"))
         model.tuned = tuning.to_json()
         log.info("robust-mode settings by %d-fold cross-validation on the training split: %s",
@@ -34,7 +38,7 @@ def cmd_train(args: argparse.Namespace) -> int:
              "variance), %d phones", len(model.train_utterances), cb.n_contexts, len(cb.lsf),
              model.pca.n_components, 100 * model.pca.explained_ratio.sum(), len(model.phones))
     print(out)
-    return 0
+    return finish(skipped)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -46,5 +50,6 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="choose the robust mode's N, xi, gamma range, label and context weights "
                         "and smoothing width by FOLDS-fold cross-validation (default 2) on the "
                         "training split, stored in the model (a few minutes)")
+    add_corpus_work_options(p, jobs_default="1")
     add_train_options(p)
     p.set_defaults(func=cmd_train)

@@ -1,0 +1,260 @@
+"""Work fanned out over processes (engine.fanout) and the corpus-wide commands that use it: a bad
+file gives the serial run's one-line error with any number of jobs, or with --skip-bad is left
+out with a summary and exit status 3; every facetraj error survives pickling."""
+
+from __future__ import annotations
+
+import importlib
+import json
+import logging
+import os
+import pickle
+import pkgutil
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import engine
+from engine.errors import FILE_WARNINGS, FacetrajError, InputError, warn_file
+from engine.fanout import Skips, fan_out
+from facetraj.cli import main
+
+
+# --------------------------------------------------------------------------- pickling
+def _engine_error_classes() -> list[type]:
+    for mod in pkgutil.walk_packages(engine.__path__, "engine."):
+        importlib.import_module(mod.name)
+    found, todo = [], [FacetrajError]
+    while todo:
+        cls = todo.pop()
+        found.append(cls)
+        todo.extend(cls.__subclasses__())
+    return sorted({c for c in found if c.__module__.startswith("engine.")}, key=lambda c: c.__name__)
+
+
+#: how to make each error class whose __init__ is not (path, problem) or (message,)
+SPECIAL = {"MissingWordsError": lambda cls: cls("a.txt", ["zorblax", "noizee"])}
+
+
+def test_every_engine_error_class_round_trips_through_pickle():
+    classes = _engine_error_classes()
+    assert {"InputError", "OutputError", "OutputExistsError", "ModelFileError",
+            "MissingWordsError", "UnalignableError"} <= {c.__name__ for c in classes}
+    for cls in classes:
+        if cls.__name__ in SPECIAL:
+            exc = SPECIAL[cls.__name__](cls)
+        elif issubclass(cls, InputError):
+            exc = cls("/data/a.c3d", "not a readable C3D file")
+        else:
+            exc = cls("something went wrong")
+        back = pickle.loads(pickle.dumps(exc))
+        assert type(back) is cls
+        assert str(back) == str(exc) and back.args == exc.args
+        assert back.__dict__ == exc.__dict__, cls
+        assert isinstance(back, OSError) == isinstance(exc, OSError)
+    missing = pickle.loads(pickle.dumps(SPECIAL["MissingWordsError"](
+        next(c for c in classes if c.__name__ == "MissingWordsError"))))
+    assert missing.words == ["zorblax", "noizee"]
+
+
+# --------------------------------------------------------------------------- fan_out
+def _bad_b(item: str) -> str:
+    if item == "b":
+        raise InputError(f"/data/{item}.c3d", "not a readable C3D file")
+    return item.upper()
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_first_bad_item_stops_the_work_with_its_own_error(workers):
+    with pytest.raises(InputError) as exc:
+        fan_out(_bad_b, ["a", "b", "c", "d"], workers)
+    assert str(exc.value) == "/data/b.c3d: not a readable C3D file"
+    assert exc.value.item == "b"
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_skipped_items_are_left_out_and_counted(workers):
+    skip = Skips("utterances")
+    seen: list[tuple[float, str]] = []
+    out = fan_out(_bad_b, ["a", "b", "c"], workers, skip=skip,
+                  progress=lambda f, m: seen.append((f, m)))
+    assert out == [("a", "A"), ("c", "C")]
+    assert skip.bad == {"b": "/data/b.c3d: not a readable C3D file"}
+    assert skip.summary() == "1 of 3 utterances skipped: /data/b.c3d: not a readable C3D file"
+    assert seen[0] == (0.0, "a") and seen[-1] == (1.0, "done")
+
+
+def _dies_on_b(item: str) -> str:
+    if item == "b":
+        os._exit(9)          # as a worker killed by the kernel, or a crash in a C library
+    return item
+
+
+def test_a_worker_that_dies_is_a_clean_error():
+    with pytest.raises(FacetrajError, match="a worker process stopped unexpectedly .* run with "
+                                            "--jobs 1 to see which file it was"):
+        fan_out(_dies_on_b, ["a", "b", "c"], 2)
+
+
+class _TwoArgError(Exception):
+    def __init__(self, a, b):
+        super().__init__(f"{a} and {b}")
+
+
+class _OddInputError(InputError):
+    def __init__(self, where):
+        super().__init__(where, "odd")
+        self.callback = lambda: None     # does not pickle
+
+
+def _raises_unpicklable(item: str) -> str:
+    if item == "x":
+        raise _TwoArgError("one", "two")
+    if item == "y":
+        raise _OddInputError("/data/y.wav")
+    return item
+
+
+def test_errors_that_do_not_pickle_still_come_back():
+    with pytest.raises(RuntimeError, match="_TwoArgError: one and two"):
+        fan_out(_raises_unpicklable, ["a", "x"], 2)
+    with pytest.raises(InputError, match="^/data/y.wav: odd$"):
+        fan_out(_raises_unpicklable, ["a", "y"], 2)
+
+
+def _warns(item: str) -> str:
+    warn_file(logging.getLogger("engine.test"), "/data/shared.c3d", "short markers",
+              "markers end at 1.00 s")
+    warn_file(logging.getLogger("engine.test"), f"/data/{item}.c3d", "short markers",
+              f"markers of {item} end early")
+    return item
+
+
+def test_file_warnings_of_workers_are_logged_once(caplog):
+    FILE_WARNINGS.clear()
+    with caplog.at_level(logging.WARNING, logger="engine.test"):
+        fan_out(_warns, ["a", "b", "c"], 2)
+        fan_out(_warns, ["a", "b", "c"], 1)      # a second pass: nothing new
+    lines = [r.getMessage() for r in caplog.records if r.name == "engine.test"]
+    assert lines.count("/data/shared.c3d: markers end at 1.00 s") == 1
+    assert sorted(lines) == sorted(["/data/shared.c3d: markers end at 1.00 s",
+                                    *[f"/data/{i}.c3d: markers of {i} end early" for i in "abc"]])
+    assert FILE_WARNINGS.counts()["short markers"] == 4
+
+
+# --------------------------------------------------------------------------- the commands
+@pytest.fixture
+def corpus_with_a_bad_file(tmp_path, toy_corpus_dir) -> Path:
+    """Three utterances of the toy corpus (two train, one test); toy001's C3D truncated."""
+    from engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
+
+    root = tmp_path / "corpus"
+    root.mkdir()
+    ids = ["toy000", "toy001", "toy030"]
+    for utt in ids:
+        for ext in ("wav", "TextGrid", "c3d"):
+            shutil.copy(toy_corpus_dir / f"{utt}.{ext}", root)
+    info = load_corpus(toy_corpus_dir).info
+    save_corpus_info(root, CorpusInfo(**{**info.__dict__, "train": ids[:2], "test": ids[2:]}))
+    (root / "toy001.c3d").write_bytes((root / "toy001.c3d").read_bytes()[:300])
+    return root
+
+
+def _run(argv, capsys) -> tuple[int, str, str]:
+    code = main([str(a) for a in argv])
+    cap = capsys.readouterr()
+    return code, cap.out, cap.err
+
+
+BAD = "toy001.c3d: not a readable C3D file (no C3D header)"
+
+
+def _refused_alike(argv, capsys) -> None:
+    """``argv`` with -j 1 and -j 2: exit 2, the same one error line naming the bad file."""
+    errs = []
+    for j in ("1", "2"):
+        code, _, err = _run([*argv, "-j", j, "-q"], capsys)
+        assert code == 2, err
+        assert "Traceback" not in err
+        lines = [ln for ln in err.splitlines() if ": error: " in ln]
+        assert len(lines) == 1 and lines[0].endswith(BAD), err
+        assert "--skip-bad" in err
+        errs.append(lines[0])
+    assert errs[0] == errs[1]
+
+
+def test_eval_and_sweep_with_a_bad_file(corpus_with_a_bad_file, toy_model, tmp_path, capsys):
+    from engine.evaluation.scores import evaluate
+    from engine.io.corpus import load_corpus
+
+    model = toy_model.save(tmp_path / "m.npz")
+    root = corpus_with_a_bad_file
+    _refused_alike(["eval", model, root], capsys)
+    _refused_alike(["sweep", model, root, "--max-n", "2"], capsys)
+    code, out, err = _run(["eval", model, root, "-j", "2", "--skip-bad", "--json", "-q"], capsys)
+    assert code == 3, err
+    assert f"facetraj: 1 of 3 utterances skipped: {root / BAD}" in err
+    expected = evaluate(toy_model, load_corpus(root).without(["toy001"]))
+    assert json.loads(out)["table"] == json.loads(json.dumps(expected.to_json()))["table"]
+    code, out, err = _run(["sweep", model, root, "--max-n", "2", "-j", "2", "--skip-bad"], capsys)
+    assert code == 3 and "1 of 3 utterances skipped" in err
+
+
+def test_train_with_a_bad_file(corpus_with_a_bad_file, tmp_path, capsys):
+    from engine.io.corpus import load_corpus
+    from engine.method.model import Model
+    from engine.method.training import train
+
+    root = corpus_with_a_bad_file
+    _refused_alike(["train", root, "-o", tmp_path / "m.npz"], capsys)
+    assert not (tmp_path / "m.npz").exists()
+    code, _, err = _run(["train", root, "-o", tmp_path / "m.npz", "-j", "2", "--skip-bad"], capsys)
+    assert code == 3 and "1 of 2 utterances skipped" in err
+    got = Model.load(tmp_path / "m.npz")
+    want = train(load_corpus(root).without(["toy001"]))
+    assert got.train_utterances == ["toy000"]
+    np.testing.assert_array_equal(got.codebook.lsf, want.codebook.lsf)
+    np.testing.assert_array_equal(got.pca.components, want.pca.components)
+
+
+def test_training_in_two_processes_equals_one(toy_corpus):
+    from engine.method.training import train
+
+    a, b = train(toy_corpus, workers=1), train(toy_corpus, workers=2)
+    for x, y in ((a.codebook.lsf, b.codebook.lsf), (a.codebook.pcs, b.codebook.pcs),
+                 (a.codebook.contexts, b.codebook.contexts), (a.means, b.means),
+                 (a.index.order, b.index.order)):
+        np.testing.assert_array_equal(x, y)
+
+
+def test_report_with_a_bad_file(corpus_with_a_bad_file, tmp_path, capsys):
+    root = corpus_with_a_bad_file
+    out = tmp_path / "report"
+    _refused_alike(["report", root, "-o", out, "--max-n", "2"], capsys)
+    assert not out.exists()             # nothing written
+    code, _, err = _run(["report", root, "-o", out, "--max-n", "2", "-j", "2", "--skip-bad", "-q"],
+                        capsys)
+    assert code == 3, err
+    text = (out / "results.md").read_text()
+    assert "1 utterance with bad files was left out (`--skip-bad`): `toy001`" in text
+    assert json.loads((out / "results.json").read_text())["corpus"]["n_train"] == 1
+
+
+def test_corpus_align_with_a_bad_recording(tmp_path, capsys):
+    from conftest import DEFAULT_CORPUS
+
+    for stem in ("s001", "s002"):
+        shutil.copy(DEFAULT_CORPUS / f"{stem}.flac", tmp_path)
+        shutil.copy(DEFAULT_CORPUS / f"{stem}.txt", tmp_path)
+    (tmp_path / "s000.wav").write_bytes(b"RIFF\x10\x00\x00\x00WAVEfmt garbage")
+    for j in ("1", "2"):
+        code, _, err = _run(["corpus", "align", tmp_path, "-j", j, "-q"], capsys)
+        assert code == 2 and "s000.wav: cannot read audio" in err, err
+    code, _, err = _run(["corpus", "align", tmp_path, "-j", "2", "--skip-bad", "--overwrite"],
+                        capsys)
+    assert code == 3, err
+    assert "facetraj: 1 of 3 recordings skipped: " in err and "s000.wav: cannot read" in err
+    assert (tmp_path / "s001.TextGrid").is_file() and (tmp_path / "s002.TextGrid").is_file()
+    assert not (tmp_path / "s000.TextGrid").exists()
