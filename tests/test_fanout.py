@@ -258,3 +258,28 @@ def test_corpus_align_with_a_bad_recording(tmp_path, capsys):
     assert "facetraj: 1 of 3 recordings skipped: " in err and "s000.wav: cannot read" in err
     assert (tmp_path / "s001.TextGrid").is_file() and (tmp_path / "s002.TextGrid").is_file()
     assert not (tmp_path / "s000.TextGrid").exists()
+
+
+def test_warnings_once_per_file_and_once_per_corpus(corpus_with_a_bad_file, toy_corpus_dir,
+                                                    toy_model, tmp_path, caplog, capsys):
+    """Markers shorter than the audio in two files: one warning per file, however often the
+    report reads them (training, three evaluations, the sweep, the baselines, in two processes),
+    and one line for the corpus with the count."""
+    from engine.io.markerfiles import read_c3d, write_c3d
+
+    root = corpus_with_a_bad_file
+    shutil.copy(toy_corpus_dir / "toy001.c3d", root)            # toy001 good again
+    for utt in ("toy000", "toy030"):
+        m = read_c3d(root / f"{utt}.c3d")
+        write_c3d(root / f"{utt}.c3d", m.markers[:-20], m.rate, m.names)
+    FILE_WARNINGS.clear()
+    caplog.set_level(logging.WARNING)
+    code, _, err = _run(["report", root, "-o", tmp_path / "r", "--max-n", "2", "-j", "2"], capsys)
+    assert code == 0, err
+    said = [r.getMessage() for r in caplog.records]
+    for utt in ("toy000", "toy030"):
+        hits = [m for m in said if f"{utt}.c3d: markers end at" in m]
+        assert len(hits) == 1, said
+        assert hits[0].endswith("later frames are treated as unseen")
+    assert said.count("markers shorter than the audio (later frames are treated as unseen): "
+                      "2 files") == 1

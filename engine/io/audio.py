@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, warn_file
 from .files import atomic_write
 
 log = logging.getLogger(__name__)
@@ -39,7 +39,8 @@ def read_audio(path: str | os.PathLike[str]) -> tuple[np.ndarray, int]:
     if rate < MIN_SAMPLE_RATE:
         raise InputError(path, f"sample rate {rate} Hz is below the {MIN_SAMPLE_RATE} Hz minimum")
     if data.shape[1] > 1:
-        log.warning("%s: %d channels mixed down to mono", path, data.shape[1])
+        warn_file(log, path, "channels mixed down to mono",
+                  f"{data.shape[1]} channels mixed down to mono")
     samples = data.mean(axis=1)
     if not np.all(np.isfinite(samples)):
         raise InputError(path, "the audio holds NaN or infinite samples")

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..data import PhoneSegment, Utterance
-from ..errors import InputError
+from ..errors import InputError, warn_file
 from .audio import read_audio
 from .files import atomic_write, check_output_path
 from .hash_memo import folder_key, memoized_hash
@@ -338,16 +338,18 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
     markers = mdata.markers
     n_audio = int(np.floor(len(audio) / rate * info.marker_rate + 1e-9)) + 1
     if markers.shape[0] < n_audio - 1:
-        log.warning("%s: markers end at %.2f s but the audio at %.2f s; later frames are treated "
-                    "as unseen", mpath, (markers.shape[0] - 1) / info.marker_rate, len(audio) / rate)
+        warn_file(log, mpath, "markers shorter than the audio (later frames are treated as unseen)",
+                  f"markers end at {(markers.shape[0] - 1) / info.marker_rate:.2f} s but the audio "
+                  f"at {len(audio) / rate:.2f} s; later frames are treated as unseen")
     if markers.shape[0] < n_audio:
         pad = np.full((n_audio - markers.shape[0], *markers.shape[1:]), np.nan)
         markers = np.concatenate([markers, pad])
     markers = markers[:n_audio]
     seen = marker_coverage(markers)
     if seen < 0.5:
-        log.warning("%s: only %.0f %% of the marker samples are seen; frames with gaps over "
-                    "%.0f ms are left out of training and evaluation", mpath, 100 * seen, 100)
+        warn_file(log, mpath, "markers mostly missing (frames with gaps are left out)",
+                  f"only {100 * seen:.0f} % of the marker samples are seen; frames with gaps over "
+                  f"100 ms are left out of training and evaluation")
     text = ""
     txt = root / f"{utt_id}.txt"
     if txt.is_file():

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, warn_file
 from .c3d_check import MAX_RATE as MAX_C3D_RATE
 from .c3d_check import MIN_RATE as MIN_C3D_RATE
 from .c3d_check import check_c3d
@@ -327,6 +327,7 @@ def read_markers(path: str | os.PathLike[str], rate: float | None = None) -> Mar
     if data.markers.shape[0] == 0 or data.markers.shape[1] == 0:
         raise InputError(path, "the marker file holds no frames or no markers")
     if rate is not None and abs(data.rate - rate) > 1e-6:
-        log.info("%s: markers resampled from %g Hz to %g Hz", path, data.rate, rate)
+        warn_file(log, path, "markers resampled to the corpus rate",
+                  f"markers resampled from {data.rate:g} Hz to {rate:g} Hz", logging.INFO)
         data = MarkerData(resample_markers(data.markers, data.rate, rate), float(rate), data.names)
     return data

@@ -8,7 +8,7 @@ import re
 from collections.abc import Mapping, Sequence
 
 from ..data import PhoneSegment
-from ..errors import InputError
+from ..errors import InputError, warn_file
 
 log = logging.getLogger(__name__)
 
@@ -68,17 +68,14 @@ def map_labels(phones: Sequence[PhoneSegment], known: Sequence[str],
     """
     known_set = set(known)
     out = []
-    warned: set[str] = set()
     for seg in phones:
         raw = seg.label
         lab = apply_label_map(raw, table)
         if lab not in known_set:
             alt = FALLBACK.get(lab)
             if alt in known_set and not strict:
-                if lab not in warned:
-                    log.warning("%s: phone %r is not in the model; using %r", path or "labels",
-                                lab, alt)
-                    warned.add(lab)
+                warn_file(log, path or "labels", "phones not in the model, the nearest used",
+                          f"phone {lab!r} is not in the model; using {alt!r}")
                 lab = alt
             elif table and (raw in table or normalise_label(raw) in table):
                 raise InputError(getattr(table, "source", None) or "the label map",

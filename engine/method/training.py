@@ -12,7 +12,7 @@ import numpy as np
 
 from ..config import TrainConfig
 from ..data import Utterance
-from ..errors import InputError
+from ..errors import InputError, warn_file
 from ..fanout import Skips, fan_out
 from ..io.corpus import Corpus
 from ..io.labelfiles import validate_phones
@@ -115,8 +115,9 @@ def normalise_head(loaded: Sequence[Utterance], fixed: np.ndarray, rate: float,
     for utt in loaded:
         f, valid = fill_gaps(utt.markers, rate, config.max_gap_s)
         if (~valid).any():
-            log.info("%s: %d frames with gaps over %.0f ms left out", utt.name, (~valid).sum(),
-                     config.max_gap_s * 1000)
+            warn_file(log, utt.name, "frames with marker gaps left out",
+                      f"{(~valid).sum()} frames with gaps over {config.max_gap_s * 1000:.0f} ms "
+                      f"left out", logging.INFO)
         filled.append(f)
     sample = np.concatenate([f[::5] for f in filled])
     reference = reference_pose(sample, fixed)
@@ -160,8 +161,8 @@ def codebook_part(utt: Utterance, normed: np.ndarray, k: int, pca: PCA, pid: Map
     ok = np.isfinite(cw_pcs).all(axis=1).reshape(-1, n).all(axis=1)
     ok &= times[:, -1] <= (normed.shape[0] - 1) / rate + 0.5 / rate
     if (~ok).any():
-        log.info("%s: %d phone tokens without complete marker data left out", utt.name,
-                 (~ok).sum())
+        warn_file(log, utt.name, "phone tokens without complete marker data left out",
+                  f"{(~ok).sum()} phone tokens without complete marker data left out", logging.INFO)
     keep = np.repeat(ok, n)
     return Codebook(ctx[ok], cw_lsf[keep], cw_pcs[keep], np.full(ok.sum(), k), starts[ok],
                     ends[ok], n, None if ctx_lsf is None else ctx_lsf[keep])
