@@ -2,9 +2,14 @@
 before anything is trusted.
 
 Every zip member's compression method and size, and every array's ``.npy`` header (dtype, shape)
-are checked before any array is allocated; then the metadata's types, and every array's dtype,
-shape (against the metadata and against the other arrays) and values (finite). Any problem is a
-:class:`~engine.errors.ModelFileError` naming the file.
+are checked before any array is allocated; then the metadata's types and ranges (the
+cross-validated settings too), and every array's data type (whole or floating-point numbers,
+returned as int64 and float64 whatever the file stored), shape (against the metadata and the
+other arrays), values (finite; LSFs in (0, pi) and in order, phone tokens ending after they
+start, orthonormal PCs, variances not negative, distances a distance matrix) and
+cross-references (marker, phone and utterance indices within their lists; the LSF index a
+partition of the codebook). Any problem is a :class:`~engine.errors.ModelFileError` naming the
+file, before anything uses the model.
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelFileError
+from ..labels.phoneset import SILENCE
 from .c3d_check import MAX_RATE, MIN_RATE
 
 #: Largest single array a model file may hold (a codebook of about 10^7 codewords).
@@ -135,6 +141,8 @@ def check_meta(path: Path, meta: dict, newest: int, fmt: str) -> None:
     for key in ("phones", "marker_names"):
         if not _str_list(meta[key]) or not meta[key] or len(set(meta[key])) != len(meta[key]):
             raise bad(key, "a list of distinct names")
+    if SILENCE not in meta["phones"]:
+        raise bad("phones", f"a phone set with silence ({SILENCE!r})")
     for key in ("marker_rate", "pca_total_variance", "scale"):
         if not _is_num(meta[key]) or meta[key] <= 0:
             raise bad(key, "a positive number")
@@ -153,10 +161,29 @@ def check_meta(path: Path, meta: dict, newest: int, fmt: str) -> None:
         raise bad("train_utterances", "a list of names")
     if not isinstance(meta.get("corpus_fingerprint", ""), str):
         raise bad("corpus_fingerprint", "text")
-    tuned = meta.get("tuned", {})
-    if not isinstance(tuned, dict) or not isinstance(tuned.get("settings", {}), dict) or \
-            not all(_is_num(v) for v in tuned.get("settings", {}).values()):
-        raise bad("tuned", "an object of cross-validated settings (numbers)")
+    _check_tuned(path, meta.get("tuned", {}))
+
+
+#: the cross-validated synthesis settings a model may hold, and their ranges (as the options')
+TUNED_RANGES = {"n_context_phones": (1, 1000, int), "robust_candidates": (1, 100000, int),
+                "xi": (1.0, 1e6, float), "label_weight": (0.0, 1e6, float),
+                "context_weight": (0.0, 1e6, float), "gamma_max": (1e-3, 1e3, float),
+                "triangle_s": (1e-3, 10.0, float)}
+
+
+def _check_tuned(path: Path, tuned) -> None:
+    settings = tuned.get("settings", {}) if isinstance(tuned, dict) else None
+    if not isinstance(settings, dict) or not all(_is_num(v) for v in settings.values()):
+        raise ModelFileError(path, f"metadata 'tuned' is {tuned!r:.60}, not an object of "
+                                   f"cross-validated settings (numbers)")
+    for key, value in settings.items():
+        if key not in TUNED_RANGES:
+            continue      # a setting of a newer facetraj: not used here
+        lo, hi, kind = TUNED_RANGES[key]
+        if not lo <= value <= hi or (kind is int and not _is_int(value)):
+            raise ModelFileError(path, f"metadata 'tuned' setting {key!r} is {value!r:.40}, not "
+                                       f"{'a whole number' if kind is int else 'a number'} "
+                                       f"from {lo:g} to {hi:g}")
 
 
 def check_config(path: Path, config: dict) -> None:
@@ -189,68 +216,136 @@ def check_config(path: Path, config: dict) -> None:
 
 
 # --------------------------------------------------------------------------- the arrays
-def check_arrays(path: Path, meta: dict, a: dict[str, np.ndarray]) -> None:
-    """Every array's kind, shape against the metadata and the other arrays, and finite values."""
-    required = ("fixed", "reference", "pca_mean", "pca_components", "pca_variances", "cb_contexts",
-                "cb_lsf", "cb_pcs", "cb_token_utt", "cb_token_start", "cb_token_end", "means",
-                "distances", "coord_std")
-    missing = [k for k in required if k not in a]
-    if missing:
-        raise ModelFileError(path, f"model file is incomplete: missing {', '.join(missing)}")
-    index_keys = ("ix_centroids", "ix_order", "ix_offsets")
-    present = [k for k in index_keys if k in a]
-    if present and len(present) != len(index_keys):
-        raise ModelFileError(path, "its LSF index does not match its codebook (damaged file?)")
-    m = len(meta["marker_names"])
-    n_phones = len(meta["phones"])
-    cfg = meta["config"]
-    p_order = cfg.get("lpc_order", 18)
-    ctx = 2 * cfg.get("context", 3) + 1
-    n_per = meta["n_per_phone"]
-    k = a["pca_components"].shape[0] if a["pca_components"].ndim == 2 else -1
-    n_ctx = a["cb_contexts"].shape[0] if a["cb_contexts"].ndim == 2 else -1
-    n_fixed = a["fixed"].shape[0] if a["fixed"].ndim == 1 else -1
-    n_cells = a["ix_centroids"].shape[0] if "ix_centroids" in a and a["ix_centroids"].ndim == 2 else -1
-    n_utt = len(meta.get("train_utterances", []))
-    # name: (kind "f" float / "i" integer, expected shape with -1 for "any")
-    expect = {
+REQUIRED = ("fixed", "reference", "pca_mean", "pca_components", "pca_variances", "cb_contexts",
+            "cb_lsf", "cb_pcs", "cb_token_utt", "cb_token_start", "cb_token_end", "means",
+            "distances", "coord_std")
+INDEX = ("ix_centroids", "ix_order", "ix_offsets")
+_DAMAGED_INDEX = "its LSF index does not match its codebook (damaged file?)"
+#: the tolerance of the structural checks (orthonormal PCs, symmetric distances)
+_TOL = 1e-6
+
+
+def _expected(meta: dict, a: dict[str, np.ndarray]) -> dict[str, tuple[str, tuple[int, ...]]]:
+    """Every array's kind ("f" floating point, "i" whole numbers) and shape, from the metadata
+    and the other arrays (-1 where the array sets the size itself)."""
+    def rows(name: str, ndim: int) -> int:
+        return a[name].shape[0] if name in a and a[name].ndim == ndim else -1
+
+    m, n_phones, cfg = len(meta["marker_names"]), len(meta["phones"]), meta["config"]
+    p_order, ctx = cfg.get("lpc_order", 18), 2 * cfg.get("context", 3) + 1
+    k, n_ctx, n_fixed = rows("pca_components", 2), rows("cb_contexts", 2), rows("fixed", 1)
+    n_cw, n_cells = n_ctx * meta["n_per_phone"], rows("ix_centroids", 2)
+    return {
         "fixed": ("i", (n_fixed,)), "reference": ("f", (n_fixed, 3)),
         "pca_mean": ("f", (3 * m,)), "pca_components": ("f", (k, 3 * m)),
         "pca_variances": ("f", (k,)),
-        "cb_contexts": ("i", (n_ctx, ctx)), "cb_lsf": ("f", (n_ctx * n_per, p_order)),
-        "cb_pcs": ("f", (n_ctx * n_per, k)), "cb_token_utt": ("i", (n_ctx,)),
+        "cb_contexts": ("i", (n_ctx, ctx)), "cb_lsf": ("f", (n_cw, p_order)),
+        "cb_pcs": ("f", (n_cw, k)), "cb_token_utt": ("i", (n_ctx,)),
         "cb_token_start": ("f", (n_ctx,)), "cb_token_end": ("f", (n_ctx,)),
         "means": ("f", (n_phones, k)), "distances": ("f", (n_phones, n_phones)),
         "coord_std": ("f", (3 * m,)),
-        "ix_centroids": ("f", (n_cells, p_order)), "ix_order": ("i", (n_ctx * n_per,)),
+        "ix_centroids": ("f", (n_cells, p_order)), "ix_order": ("i", (n_cw,)),
         "ix_offsets": ("i", (n_cells + 1,)),
-        "cb_lsf_context": ("f", (n_ctx * n_per, 2, p_order)),
+        "cb_lsf_context": ("f", (n_cw, 2, p_order)),
     }
-    for name, (kind, shape) in expect.items():
-        if name not in a:
-            continue
-        arr = a[name]
-        kinds = "iu" if kind == "i" else "fiu"
-        if arr.dtype.kind not in kinds:
-            raise ModelFileError(path, f"array {name!r} has data type {arr.dtype}, not "
-                                       f"{'integers' if kind == 'i' else 'numbers'}")
-        if name.startswith("ix_") and (arr.dtype.kind not in kinds or arr.shape != shape):
-            raise ModelFileError(path, "its LSF index does not match its codebook (damaged file?)")
-        if arr.shape != shape or min(shape) < 0:
-            raise ModelFileError(path, f"array {name!r} has shape {arr.shape}, {_shape(shape)} "
-                                       f"expected from the rest of the model")
-        if kind == "f" and not np.all(np.isfinite(arr)):
-            raise ModelFileError(path, f"array {name!r} holds NaN or infinite values")
+
+
+def _checked_array(path: Path, name: str, arr: np.ndarray, kind: str,
+                   shape: tuple[int, ...]) -> np.ndarray:
+    """One array's data type and shape checked, and the array as float64 or int64 (whatever
+    integer or floating-point type and byte order the file stored: the method computes in
+    these, and mixing others fails in numpy's in-place operations)."""
+    index = name.startswith("ix_")
+    if arr.dtype.kind not in ("iu" if kind == "i" else "f"):
+        raise ModelFileError(path, _DAMAGED_INDEX if index else
+                             f"array {name!r} has data type {arr.dtype}, not "
+                             f"{'whole numbers' if kind == 'i' else 'floating-point numbers'}")
+    if arr.shape != shape or min(shape, default=0) < 0:
+        raise ModelFileError(path, _DAMAGED_INDEX if index else
+                             f"array {name!r} has shape {arr.shape}, {_shape(shape)} expected "
+                             f"from the rest of the model")
+    if kind == "i":
+        if arr.dtype.kind == "u" and arr.size and arr.max() > np.iinfo(np.int64).max:
+            raise ModelFileError(path, f"array {name!r} holds indices outside 0..2^63")
+        return arr.astype(np.int64)
+    with np.errstate(over="ignore"):
+        out = arr.astype(np.float64)
+    if not np.all(np.isfinite(out)):
+        raise ModelFileError(path, f"array {name!r} holds NaN or infinite values")
+    return out
+
+
+def _check_indices(path: Path, meta: dict, a: dict[str, np.ndarray]) -> None:
+    """Indices within what they index: markers, phones, training utterances."""
+    n_utt = len(meta.get("train_utterances", []))
+    ranges = {"fixed": len(meta["marker_names"]), "cb_contexts": len(meta["phones"]),
+              "cb_token_utt": n_utt or np.iinfo(np.int64).max}
+    for name, hi in ranges.items():
+        if a[name].size and (a[name].min() < 0 or a[name].max() >= hi):
+            raise ModelFileError(path, f"array {name!r} holds indices outside 0..{hi - 1}")
+    if len(np.unique(a["fixed"])) != len(a["fixed"]):
+        raise ModelFileError(path, "array 'fixed' names a marker twice")
+
+
+def _check_values(path: Path, meta: dict, a: dict[str, np.ndarray]) -> None:
+    """Values in their ranges: LSFs in (0, pi) and in order, phone tokens that end after they
+    start, orthonormal PCs, variances and deviations not negative, a matrix of distances."""
+    for name in ("cb_lsf", "cb_lsf_context", "ix_centroids"):
+        lsf = a.get(name)
+        if lsf is not None and lsf.size and (lsf.min() < 0 or lsf.max() > np.pi
+                                             or np.any(np.diff(lsf, axis=-1) < 0)):
+            raise ModelFileError(path, f"array {name!r} holds LSFs outside 0..pi or out of order")
+    if np.any(a["cb_token_start"] < 0) or np.any(a["cb_token_end"] < a["cb_token_start"]):
+        raise ModelFileError(path, "arrays 'cb_token_start' and 'cb_token_end' hold a phone token "
+                                   "that starts before 0 s or ends before it starts")
+    c = a["pca_components"]
+    if np.abs(c @ c.T - np.eye(len(c))).max() > _TOL:
+        raise ModelFileError(path, "array 'pca_components' does not hold orthonormal components")
+    if np.any(a["pca_variances"] < 0) or np.any(a["coord_std"] < 0):
+        raise ModelFileError(path, "negative variances or deviations in the model")
+    if a["pca_variances"].sum() > meta["pca_total_variance"] * (1 + _TOL):
+        raise ModelFileError(path, "the PCs' variances add up to more than the total variance "
+                                   "(metadata 'pca_total_variance')")
+    d = a["distances"]
+    scale = max(float(np.abs(d).max()), 1.0)
+    if np.any(d < 0) or np.abs(d - d.T).max() > _TOL * scale or np.abs(np.diag(d)).max() > _TOL * scale:
+        raise ModelFileError(path, "array 'distances' is not a matrix of distances (negative, "
+                                   "not symmetric, or not 0 on its diagonal)")
+
+
+def _check_index(path: Path, a: dict[str, np.ndarray]) -> None:
+    """The stored LSF index partitions exactly the codebook: ``ix_order`` a permutation of the
+    codewords, ``ix_offsets`` from 0 to their number, never decreasing."""
+    present = [k for k in INDEX if k in a]
+    if not present:
+        return
+    if len(present) != len(INDEX):
+        raise ModelFileError(path, _DAMAGED_INDEX)
+    n, order, offsets = a["cb_lsf"].shape[0], a["ix_order"], a["ix_offsets"]
+    if not (n > 0 and offsets[0] == 0 and offsets[-1] == n and np.all(np.diff(offsets) >= 0)
+            and np.array_equal(np.sort(order), np.arange(n))):
+        raise ModelFileError(path, _DAMAGED_INDEX)
+
+
+def check_arrays(path: Path, meta: dict, a: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Every array's data type, shape against the metadata and the other arrays, values (finite,
+    in range) and cross-references (indices within what they index, the LSF index over the
+    codebook); the arrays returned as float64 and int64."""
+    missing = [k for k in REQUIRED if k not in a]
+    if missing:
+        raise ModelFileError(path, f"model file is incomplete: missing {', '.join(missing)}")
+    out = dict(a)
+    for name, (kind, shape) in _expected(meta, a).items():
+        if name in a:
+            out[name] = _checked_array(path, name, a[name], kind, shape)
+    k, n_ctx, n_fixed = len(out["pca_components"]), len(out["cb_contexts"]), len(out["fixed"])
     if k < 1 or n_ctx < 1 or n_fixed < 2:
         raise ModelFileError(path, f"the model is empty ({k} PCs, {n_ctx} context-phones, "
                                    f"{n_fixed} fixed markers)")
-    ranges = {"fixed": m, "cb_contexts": n_phones, "cb_token_utt": n_utt or np.iinfo(np.int64).max,
-              }
-    for name, hi in ranges.items():
-        if name in a and a[name].size and (a[name].min() < 0 or a[name].max() >= hi):
-            raise ModelFileError(path, f"array {name!r} holds indices outside 0..{hi - 1}")
-    if np.any(a["pca_variances"] < 0) or np.any(a["coord_std"] < 0):
-        raise ModelFileError(path, "negative variances or deviations in the model")
+    _check_indices(path, meta, out)
+    _check_values(path, meta, out)
+    _check_index(path, out)
+    return out
 
 
 def _shape(shape: tuple[int, ...]) -> str:
@@ -281,5 +376,4 @@ def read_model_file(path: str | os.PathLike[str], newest: int, fmt: str
     meta, arrays = read_members(path)
     check_meta(path, meta, newest, fmt)
     check_config(path, meta["config"])
-    check_arrays(path, meta, arrays)
-    return meta, arrays
+    return meta, check_arrays(path, meta, arrays)

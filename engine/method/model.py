@@ -198,8 +198,6 @@ class Model:
                           a.get("cb_lsf_context"))
             index = (LsfIndex(a["ix_centroids"], a["ix_order"], a["ix_offsets"])
                      if "ix_centroids" in a else None)
-            if index is not None and not _index_fits(index, cb.lsf):
-                raise ModelFileError(path, "its LSF index does not match its codebook (damaged file?)")
             return cls(
                 config=TrainConfig.from_dict(meta["config"]), phones=list(meta["phones"]),
                 marker_names=list(meta["marker_names"]), marker_rate=float(meta["marker_rate"]),
@@ -214,11 +212,3 @@ class Model:
         except KeyError as exc:
             raise ModelFileError(path, f"model file is incomplete: missing {exc}") from exc
 
-
-def _index_fits(index: LsfIndex, cb_lsf: np.ndarray) -> bool:
-    """Whether a stored LSF index partitions exactly this codebook."""
-    n, order, offsets = cb_lsf.shape[0], index.order, index.offsets
-    return (order.shape == (n,) and offsets.shape == (index.n_cells + 1,)
-            and index.centroids.shape[1:] == cb_lsf.shape[1:] and n > 0
-            and offsets[0] == 0 and offsets[-1] == n and bool(np.all(np.diff(offsets) >= 0))
-            and np.array_equal(np.sort(order), np.arange(n)))
