@@ -311,9 +311,12 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
     """Load ``<id>`` audio, labels (``phones`` and ``words`` tiers of a TextGrid, or a .lab /
     .phn file) and markers (C3D, TSV/CSV or MOCHA EMA, resampled to the corpus rate).
 
-    Labels are mapped onto ARPAbet with ``label_map``. Markers shorter than the audio are padded
-    with NaN (a warning); longer ones are cut at the audio's end.
+    Labels are mapped onto ARPAbet with ``label_map``, or without one from the alphabet they are
+    in (:func:`engine.labels.alphabets.to_arpabet`: labels in none is an error naming them).
+    Markers shorter than the audio are padded with NaN (a warning); longer ones are cut at the
+    audio's end.
     """
+    from ..labels.alphabets import to_arpabet
     from ..labels.phoneset import apply_label_map
 
     root = Path(root)
@@ -330,6 +333,8 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
     phones = validate_phones(raw, len(audio) / rate, lpath)
     if label_map:
         phones = [PhoneSegment(s.start, s.end, apply_label_map(s.label, label_map)) for s in phones]
+    else:
+        phones = to_arpabet(phones, str(lpath))
     mpath = marker_path(root, utt_id)
     mdata = read_markers(mpath, info.marker_rate)
     if mdata.names != info.marker_names:

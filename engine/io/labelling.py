@@ -30,6 +30,7 @@ from ..data import PhoneSegment, Utterance
 from ..errors import InputError
 from ..fanout import Skips, fan_out
 from ..labels.alignment import Labels, align, pocketsphinx_version, recognize
+from ..labels.alphabets import to_arpabet
 from ..progress import Progress
 from .cachedir import cache_dir
 from .corpus import Corpus
@@ -112,10 +113,16 @@ def read_transcript(path: str | os.PathLike[str]) -> str:
         raise InputError(path, "the transcript is not UTF-8 text") from None
 
 
-def file_labels(path: str | os.PathLike[str], rate: int, duration: float) -> Labels:
-    """Labels read from a label file (phones, and words from a TextGrid's ``words`` tier)."""
+def file_labels(path: str | os.PathLike[str], rate: int, duration: float,
+                detect_alphabet: bool = True) -> Labels:
+    """Labels read from a label file (phones, and words from a TextGrid's ``words`` tier); the
+    phones mapped onto ARPAbet from the alphabet they are in
+    (:func:`engine.labels.alphabets.to_arpabet`) unless ``detect_alphabet`` is off (a label map
+    given by the user maps them later)."""
     path = Path(path)
     phones = validate_phones(read_labels(path, rate), duration, path)
+    if detect_alphabet:
+        phones = to_arpabet(phones, str(path))
     words: list[PhoneSegment] = []
     if path.suffix.lower() == ".textgrid":
         words = [w for w in read_textgrid_tiers(path).get("words", []) if w.label]
@@ -126,7 +133,7 @@ def labels_for_audio(audio_path: str | os.PathLike[str], audio: np.ndarray, rate
                      labels: str | os.PathLike[str] | None = None, text: str | None = None,
                      transcript: str | os.PathLike[str] | None = None, recognize: bool = False,
                      extra_dict: Mapping[str, Sequence[str]] | None = None,
-                     use_cache: bool = True) -> Labels | None:
+                     use_cache: bool = True, detect_alphabet: bool = True) -> Labels | None:
     """The phone labels of ``audio`` by THE rule (first that applies):
 
     1. ``labels`` (a label file) -> ``source="file"``;
@@ -137,11 +144,13 @@ def labels_for_audio(audio_path: str | os.PathLike[str], audio: np.ndarray, rate
     6. otherwise ``None``: :func:`engine.method.pipeline.mode_for` then synthesizes acoustic-only.
 
     The choice is logged. Errors of alignment (missing words, text that does not fit) propagate.
+    A label file's alphabet is recognised and mapped onto ARPAbet unless ``detect_alphabet`` is
+    off (:func:`file_labels`).
     """
     duration = len(audio) / float(rate)
     if labels is not None:
         log.info("phone labels from %s", labels)
-        return file_labels(labels, rate, duration)
+        return file_labels(labels, rate, duration, detect_alphabet)
     if text is None and transcript is not None:
         text = read_transcript(transcript)
     if text is not None:
@@ -154,7 +163,7 @@ def labels_for_audio(audio_path: str | os.PathLike[str], audio: np.ndarray, rate
     label_file, txt = beside(audio_path)
     if label_file is not None:
         log.info("phone labels from %s (beside the audio)", label_file)
-        return file_labels(label_file, rate, duration)
+        return file_labels(label_file, rate, duration, detect_alphabet)
     if txt is not None:
         sentence = read_transcript(txt)
         log.info("phone labels aligned from %s: %r", txt.name, sentence)

@@ -1,7 +1,8 @@
 """Label maps: other phone alphabets onto ARPAbet (the model's phone set).
 
 A label map file is UTF-8 text, one ``label<TAB>arpabet`` pair per line (``#`` comments). The
-MOCHA-TIMIT (Edinburgh machine-readable) map ships with facetraj as :data:`MOCHA_TO_ARPABET`.
+alphabets facetraj knows (MOCHA-TIMIT, TIMIT, SAMPA, X-SAMPA, IPA: :mod:`.alphabets`) are label maps
+too, named by their key (``mocha``, ``sampa``, ...); :data:`MOCHA_TO_ARPABET` is MOCHA's table.
 """
 
 from __future__ import annotations
@@ -10,19 +11,9 @@ import os
 from pathlib import Path
 
 from ..errors import InputError
+from .alphabets import MOCHA_TO_ARPABET, Alphabet, alphabet
 
-#: MOCHA-TIMIT labels (southern British English, Edinburgh machine-readable) onto ARPAbet.
-#: Vowels go to the nearest General American vowel; centring diphthongs to their first element.
-MOCHA_TO_ARPABET: dict[str, str] = {
-    "i": "ih", "ii": "iy", "iy": "iy", "e": "eh", "a": "ae", "aa": "aa", "o": "aa", "oo": "ao",
-    "u": "uh", "uu": "uw", "uh": "ah", "@": "ah", "@@": "er", "ei": "ey", "ai": "ay",
-    "oi": "oy", "ou": "ow", "@u": "ow", "au": "aw", "i@": "ih", "e@": "eh", "u@": "uh",
-    "h": "hh", "j": "y", "y": "y", "p": "p", "b": "b", "t": "t", "d": "d", "k": "k", "g": "g",
-    "ch": "ch", "jh": "jh", "f": "f", "v": "v", "th": "th", "dh": "dh", "s": "s", "z": "z",
-    "sh": "sh", "zh": "zh", "m": "m", "n": "n", "ng": "ng", "l": "l", "r": "r", "w": "w",
-    "breath": "sil", "sil": "sil",
-}
-
+__all__ = ["MOCHA_TO_ARPABET", "AlphabetMap", "LabelMap", "read_label_map"]
 
 class LabelMap(dict):
     """A label map (label -> ARPAbet) that remembers where it was read from, so that a label it
@@ -33,11 +24,30 @@ class LabelMap(dict):
         self.source = source
 
 
+class AlphabetMap(LabelMap):
+    """A built-in alphabet as a label map: labels looked up as the alphabet writes them (its
+    case, stress and length marks)."""
+
+    def __init__(self, alpha: Alphabet):
+        super().__init__(dict(alpha.table), f"the built-in {alpha.name} label map")
+        self.alphabet = alpha
+
+    def get(self, label, default=None):
+        found = self.alphabet.lookup(label)
+        return default if found is None else found
+
+    def __contains__(self, label) -> bool:
+        return self.alphabet.lookup(label) is not None
+
+
 def read_label_map(path: str | os.PathLike[str]) -> LabelMap:
-    """Read a ``label<TAB>arpabet`` file (whitespace also separates); ``mocha`` names the built-in
-    MOCHA map."""
+    """Read a ``label<TAB>arpabet`` file (whitespace also separates); ``mocha``, ``timit``,
+    ``sampa``, ``x-sampa`` and ``ipa`` name the built-in alphabets."""
     if str(path).lower() == "mocha":
         return LabelMap(MOCHA_TO_ARPABET, "the built-in MOCHA label map")
+    named = alphabet(str(path)) if not Path(path).exists() else None
+    if named is not None:
+        return AlphabetMap(named)
     path = Path(path)
     if not path.exists():
         raise InputError(path, "no such label map")

@@ -37,9 +37,11 @@ def cmd_video(args: argparse.Namespace) -> int:
     elif args.audio:
         from engine.io.audio import read_audio
         from engine.io.labelfiles import read_labels
+        from engine.labels.alphabets import to_arpabet
 
         audio, rate = read_audio(args.audio)
-        phones = read_labels(args.labels, rate) if args.labels else None
+        phones = to_arpabet(read_labels(args.labels, rate), str(args.labels)) if args.labels \
+            else None
         n_frames, source, title = None, str(args.labels or args.audio), args.audio.name
     else:
         raise FacetrajError("give an AUDIO file, or --corpus and --utterance")

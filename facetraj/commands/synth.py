@@ -32,7 +32,8 @@ def cmd_synth(args: argparse.Namespace) -> int:
     if cfg.mode in ("phonetic", "robust"):
         labels = labels_for_audio(args.audio, audio, rate, labels=args.labels, text=args.text,
                                   transcript=args.transcript, recognize=args.recognize,
-                                  extra_dict=extra_dictionary(args))
+                                  extra_dict=extra_dictionary(args),
+                                  detect_alphabet=not args.label_map)
     phones = labels.phones if labels else None
     cfg = tuned_config(mode_for(cfg, phones, labels.source if labels else None,
                                 explicit=args.mode == "phonetic"), model.tuned,
@@ -58,7 +59,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--labels", type=Path, help="phone labels: .TextGrid, .lab or .phn (default: "
                    "one beside the audio, else the sentence of a .txt beside it, aligned)")
     add_label_source_options(p)
-    p.add_argument("--label-map", help="a label map (TSV: label<TAB>arpabet)")
+    p.add_argument("--label-map", metavar="FILE|ALPHABET",
+                   help="map the labels onto ARPAbet with this label map (TSV: label<TAB>arpabet) "
+                        "or alphabet (mocha, timit, sampa, x-sampa, ipa); without it a label "
+                        "file's alphabet is recognised (docs/labels.md)")
     p.add_argument("-o", "--output", type=Path, required=True, help=".c3d, .tsv, .csv or .npz")
     p.add_argument("--overwrite", action="store_true", help="replace an existing file")
     add_synth_options(p)
