@@ -431,3 +431,67 @@ def test_fuzz_table_counts(workspace):
     text = table(outcomes)
     assert text.splitlines()[-1].startswith("| **all** | 7 |")
     assert io.StringIO(text).read().count("\n") == 2 + len({o.case.category for o in outcomes})
+
+
+# --------------------------------------------------------------------------- sizes (issue #26)
+def _flac_claiming(src: Path, dst: Path, total: int) -> Path:
+    """``src`` (a FLAC) with STREAMINFO's 36-bit total sample count set to ``total``."""
+    d = bytearray(src.read_bytes())
+    off = 8 + 10 + 3             # 'fLaC', the block header, then 10 bytes before rate/ch/bps/total
+    d[off] = (d[off] & 0xF0) | ((total >> 32) & 0x0F)
+    d[off + 1:off + 5] = struct.pack(">I", total & 0xFFFFFFFF)
+    dst.write_bytes(bytes(d))
+    return dst
+
+
+def test_audio_header_claiming_too_much_is_refused_before_allocating(workspace, tmp_path):
+    """A FLAC whose header claims 2^36 samples (550 GB as float64): refused with the count, the
+    forked run staying far below the memory limit; a WAV whose data size field is damaged reads
+    the samples the file holds."""
+    from fuzzing import Case
+
+    from engine.io.audio import read_audio
+
+    x, rate = sf.read(workspace.wav)
+    sf.write(tmp_path / "a.flac", x, rate)
+    bad = _flac_claiming(tmp_path / "a.flac", tmp_path / "bad.flac", 2**36 - 1)
+    with pytest.raises(InputError, match="bad.flac: the header says it holds 68719476735 samples"):
+        read_audio(bad)
+    o = run_forked(Case("audio", "huge FLAC header", ["synth", str(workspace.model), str(bad), "-o",
+                                                      str(tmp_path / "o.tsv"), "-q"],
+                        cwd=tmp_path), timeout=60)
+    assert o.status == "refused" and 0 < o.max_rss < 512 << 20, (o.status, o.detail)
+    data = bytearray(workspace.wav.read_bytes())
+    i = data.find(b"data")
+    data[i + 4:i + 8] = struct.pack("<I", 0xFFFFFFF0)
+    (tmp_path / "size.wav").write_bytes(bytes(data))
+    np.testing.assert_array_equal(read_audio(tmp_path / "size.wav")[0], read_audio(workspace.wav)[0])
+
+
+def test_multichannel_audio_is_mixed_down_block_by_block(tmp_path, monkeypatch):
+    """Mixed down as the mean of the channels, the same as all at once, over several blocks."""
+    import engine.io.audio as audio
+
+    rng = np.random.default_rng(4)
+    x = rng.uniform(-0.5, 0.5, (50000, 3))
+    sf.write(tmp_path / "c.wav", x, 16000, subtype="DOUBLE")
+    monkeypatch.setattr(audio, "_BLOCK_SAMPLES", 3 * 7001)        # 8 blocks, the last short
+    samples, rate = audio.read_audio(tmp_path / "c.wav")
+    assert rate == 16000
+    np.testing.assert_array_equal(samples, x.mean(axis=1))
+
+
+def test_oversized_text_and_est_headers_are_refused(tmp_path):
+    from engine.io.files import MAX_TEXT_BYTES
+    from engine.io.labelfiles import read_labels
+    from engine.io.markerfiles import read_mocha_ema
+
+    big = tmp_path / "big.lab"
+    with open(big, "wb") as fh:
+        fh.truncate(MAX_TEXT_BYTES + 1)     # sparse: nothing is written
+    with pytest.raises(InputError, match="more than facetraj reads as a label file"):
+        read_labels(big)
+    (tmp_path / "e.ema").write_bytes(b"EST_File Track\nDataType binary\nNumFrames -5\n"
+                                     b"NumChannels 3\nEST_Header_End\n" + b"\0" * 64)
+    with pytest.raises(InputError, match="EST header gives -5 frames of 3 channels"):
+        read_mocha_ema(tmp_path / "e.ema")

@@ -17,11 +17,25 @@ MIN_SAMPLE_RATE = 8000
 AUDIO_SUFFIXES = (".wav", ".flac")
 
 
+#: the most samples (per channel) read from one file: 1 GiB as mono float64, 46 minutes at 48 kHz
+#: or 2.3 hours at 16 kHz; a header that claims more is refused before anything is allocated
+MAX_AUDIO_FRAMES = 1 << 27
+#: bytes per sample of the uncompressed encodings, whose sample count the file's length bounds
+_SAMPLE_BYTES = {"PCM_S8": 1, "PCM_U8": 1, "PCM_16": 2, "PCM_24": 3, "PCM_32": 4, "FLOAT": 4,
+                 "DOUBLE": 8, "ULAW": 1, "ALAW": 1}
+#: containers whose samples are compressed (their subtype names the decoded depth)
+_COMPRESSED = {"FLAC", "OGG", "MPEG"}
+#: samples (all channels) decoded per block while mixing down
+_BLOCK_SAMPLES = 1 << 20
+
+
 def read_audio(path: str | os.PathLike[str]) -> tuple[np.ndarray, int]:
     """Read a WAV or FLAC file as mono float64 samples and its rate.
 
-    Stereo and multi-channel files are mixed down (a note is logged). Raises
-    :class:`InputError` for a missing, unreadable, empty file or a rate below 8 kHz.
+    Stereo and multi-channel files are mixed down (a note is logged), block by block, so that
+    only the mono samples are held. The header's sample count is checked against the file's
+    length (uncompressed encodings) and :data:`MAX_AUDIO_FRAMES` before anything is allocated.
+    Raises :class:`InputError` for a missing, unreadable, empty file or a rate below 8 kHz.
     """
     import soundfile as sf
 
@@ -31,20 +45,46 @@ def read_audio(path: str | os.PathLike[str]) -> tuple[np.ndarray, int]:
     if path.stat().st_size == 0:
         raise InputError(path, "the audio file is empty (0 bytes)")
     try:
-        data, rate = sf.read(str(path), dtype="float64", always_2d=True)
+        with sf.SoundFile(str(path)) as f:
+            rate, channels, frames = int(f.samplerate), int(f.channels), int(f.frames)
+            _check_header(path, f.format, f.subtype, rate, channels, frames)
+            samples = np.empty(frames)
+            done = 0
+            for block in f.blocks(max(1, _BLOCK_SAMPLES // channels), dtype="float64",
+                                  always_2d=True, frames=frames):
+                samples[done:done + len(block)] = block.mean(axis=1)
+                done += len(block)
+    except InputError:
+        raise
     except Exception as exc:  # soundfile raises several types for corrupt data
         raise InputError(path, f"cannot read audio ({exc})") from exc
-    if data.shape[0] == 0:
+    if done == 0:
         raise InputError(path, "the audio file holds no samples")
-    if rate < MIN_SAMPLE_RATE:
-        raise InputError(path, f"sample rate {rate} Hz is below the {MIN_SAMPLE_RATE} Hz minimum")
-    if data.shape[1] > 1:
-        warn_file(log, path, "channels mixed down to mono",
-                  f"{data.shape[1]} channels mixed down to mono")
-    samples = data.mean(axis=1)
+    if channels > 1:
+        warn_file(log, path, "channels mixed down to mono", f"{channels} channels mixed down to mono")
+    samples = samples[:done]
     if not np.all(np.isfinite(samples)):
         raise InputError(path, "the audio holds NaN or infinite samples")
-    return samples, int(rate)
+    return samples, rate
+
+
+def _check_header(path: Path, container: str, subtype: str, rate: int, channels: int,
+                  frames: int) -> None:
+    """The header's rate and sample count, before the samples are allocated."""
+    if rate < MIN_SAMPLE_RATE:
+        raise InputError(path, f"sample rate {rate} Hz is below the {MIN_SAMPLE_RATE} Hz minimum")
+    if channels < 1:
+        raise InputError(path, "the audio file has no channels")
+    width = None if container in _COMPRESSED else _SAMPLE_BYTES.get(subtype)
+    if width is not None and frames * channels * width > path.stat().st_size:
+        raise InputError(path, f"the header says it holds {frames} samples of {channels} "
+                               f"channel(s), more than the file's {path.stat().st_size} bytes "
+                               f"hold (damaged or truncated?)")
+    if frames > MAX_AUDIO_FRAMES:
+        raise InputError(path, f"the header says it holds {frames} samples "
+                               f"({frames / rate / 60:.0f} minutes at {rate} Hz), more than "
+                               f"facetraj reads from one file ({MAX_AUDIO_FRAMES} samples; a "
+                               f"damaged header?)")
 
 
 def write_audio(path: str | os.PathLike[str], samples: np.ndarray, rate: int,

@@ -168,6 +168,11 @@ def read_json(path: str | os.PathLike[str]) -> object | None:
     return json.loads(path.read_text(encoding="utf-8"))
 
 
+#: the largest text file read (a label file, a marker table): its text and what is parsed from
+#: it stay well under the 2 GB that no input may make facetraj allocate
+MAX_TEXT_BYTES = 256 << 20
+
+
 def read_text(path: Path, what: str = "label file") -> str:
     """The text of a small file (UTF-8, or UTF-16 with a byte-order mark); ``what`` names the
     kind of file in the error for a missing one."""
@@ -175,6 +180,10 @@ def read_text(path: Path, what: str = "label file") -> str:
         raise InputError(path, f"no such {what}")
     if path.is_dir():
         raise InputError(path, "is a folder, not a file")
+    size = path.stat().st_size
+    if size > MAX_TEXT_BYTES:
+        raise InputError(path, f"is {size} bytes, more than facetraj reads as a {what} (at most "
+                               f"{MAX_TEXT_BYTES >> 20} MiB)")
     raw = path.read_bytes()
     try:
         if raw.startswith((b"\xff\xfe", b"\xfe\xff")):  # UTF-16 (Praat writes it) only with a BOM

@@ -15,7 +15,7 @@ from ..errors import InputError, warn_file
 from .c3d_check import MAX_RATE as MAX_C3D_RATE
 from .c3d_check import MIN_RATE as MIN_C3D_RATE
 from .c3d_check import check_c3d
-from .files import atomic_write, read_text
+from .files import MAX_TEXT_BYTES, atomic_write, read_text
 
 log = logging.getLogger(__name__)
 
@@ -217,6 +217,8 @@ def _read_est_track(path: Path, raw: bytes) -> tuple[np.ndarray, np.ndarray, lis
         n_frames, n_chan = int(fields["NumFrames"]), int(fields["NumChannels"])
     except (KeyError, ValueError) as exc:
         raise InputError(path, "EST header lacks NumFrames/NumChannels") from exc
+    if n_frames < 0 or not 1 <= n_chan <= 10000:
+        raise InputError(path, f"EST header gives {n_frames} frames of {n_chan} channels")
     width = 2 + n_chan
     if fields.get("DataType", "ascii") == "binary":
         order = ">" if fields.get("ByteOrder", "10") == "10" else "<"
@@ -245,6 +247,9 @@ def read_mocha_ema(path: str | os.PathLike[str]) -> MarkerData:
     path = Path(path)
     if not path.exists():
         raise InputError(path, "no such EMA file")
+    if path.is_file() and path.stat().st_size > MAX_TEXT_BYTES:
+        raise InputError(path, f"is {path.stat().st_size} bytes, more than facetraj reads as an "
+                               f"EMA file (at most {MAX_TEXT_BYTES >> 20} MiB)")
     raw = path.read_bytes()
     if not raw.strip():
         raise InputError(path, "the EMA file is empty")
