@@ -268,11 +268,15 @@ class AudioOpener(QObject):
         if self.window.model is None:
             self.window.show_error("no model yet: open a corpus first")
             return None
+        from engine.method.pipeline import check_length
+
         try:
-            return read_audio(audio_path)
+            audio, rate = read_audio(audio_path)
+            check_length(self.window.model, len(audio), rate, str(audio_path))
         except FacetrajError as exc:
             self.window.show_error(str(exc))
             return None
+        return audio, rate
 
     # -- opening
     def open(self, audio_path: Path, labels_path: Path | None = None, text: str | None = None,
@@ -288,7 +292,7 @@ class AudioOpener(QObject):
               labels_path: Path | None = None, text: str | None = None, recognize: bool = False,
               acoustic_only: bool = False,
               extra_dict: dict[str, list[str]] | None = None) -> None:
-        from engine.io.labelling import beside, labels_for_audio
+        from engine.io.labelling import beside, labels_for_audio, read_transcript
         from engine.labels.alignment import MissingWordsError
 
         win = self.window
@@ -302,7 +306,11 @@ class AudioOpener(QObject):
                              extra_dict=dict(extra_dict or {}))
         if sentence is None and labels_path is None and not recognize and label_file is None \
                 and txt is not None:
-            sentence = txt.read_text(encoding="utf-8-sig").strip()
+            try:
+                sentence = read_transcript(txt)
+            except FacetrajError as exc:       # not UTF-8 (found by make fuzz: it crashed the app)
+                win.show_error(str(exc))
+                return
         opened.text = sentence or ""
 
         def work(progress) -> tuple[OpenedAudio, str]:

@@ -45,7 +45,10 @@ PARSE_ONLY = {"gui", "report", "video", "build", None}
 BAD_NUMBERS = ["0", "-1", "-20", "nan", "inf", "-inf", "1e309", "1e-320", "abc", "", "3.5",
                "99999999999999999999", "0x10", "1e6", "-0", "1e-9", "2"]
 
-CATEGORIES = ("audio", "labels", "model", "corpus", "c3d", "markers", "options", "output")
+CATEGORIES = ("audio", "labels", "model", "corpus", "c3d", "markers", "options", "output",
+              "fanout", "alphabet", "app")
+#: Exit status of a corpus-wide command that left bad files out (--skip-bad): allowed only there.
+EXIT_INCOMPLETE = 3
 
 
 @dataclass
@@ -60,6 +63,10 @@ class Case:
     parse_only: bool = False
     keep_mode: int | None = None   # the mode an overwritten output must keep
     cwd: Path | None = None        # where it runs (relative output paths land there)
+    skip_bad: bool = False         # --skip-bad given: exit 3 with a summary is allowed
+    expect_ok: bool = False        # valid input (a label file in another alphabet): must exit 0
+    serial_argv: list[str] | None = None   # the same with -j 1: must end the same way
+    app: list[str] | None = None   # an app case: what the window opens (tests/fuzz_app.py)
 
 
 @dataclass
@@ -70,10 +77,11 @@ class Outcome:
     detail: str = ""
     seconds: float = 0.0
     max_rss: int = 0
+    error_line: str = ""   # the error (exit 2) or the skip summary (exit 3), for -j 1 vs -j 2
 
     @property
     def failed(self) -> bool:
-        return self.status not in ("ok", "refused")
+        return self.status not in ("ok", "refused", "skipped bad files")
 
 
 # --------------------------------------------------------------------------- the workspace
@@ -90,6 +98,7 @@ class Workspace:
     c3d: Path
     n: int = 0
     current: Path | None = None    # the folder of the case being made
+    quick: bool = False            # in-process runs: corpus-wide commands of a second or less
 
     def fresh(self, name: str) -> Path:
         """A new empty folder for one case."""
@@ -360,7 +369,12 @@ def _mutated_array(rng: random.Random, a):
         if b.size:
             b.flat[rng.randrange(b.size)] = rng.choice([np.nan, np.inf])
     elif how == "dtype":
-        b = a.astype(rng.choice([np.int8, np.float32, np.complex64, np.bool_, np.uint64]))
+        ints = a.dtype.kind in "iu"
+        b = a.astype(rng.choice(
+            [np.int8, np.int32, np.uint32, np.uint64, ">i8", np.float64, np.bool_, np.complex64]
+            if ints else
+            [np.float32, np.float16, ">f8", np.longdouble, np.int64, np.int8, np.complex64,
+             np.bool_, np.uint64]))
     elif how == "shape":
         b = a.reshape(-1)[: max(a.size - 1, 0)]
     elif how == "empty":
@@ -376,6 +390,47 @@ def _mutated_array(rng: random.Random, a):
     return b, how
 
 
+def _xref_damage(rng: random.Random, a: dict, meta: dict):
+    """One array damaged against what it refers to or how it is stored: ids beyond their lists,
+    the LSF index no partition of the codebook, LSFs out of range or order, tokens ending before
+    they start, other integer and float types (some of them valid). ``(name, array, how)``."""
+    import numpy as np
+
+    def swapped(x):
+        y = x.copy()
+        y[1], y[2] = y[2], y[1]
+        return y
+
+    def dup(x):
+        y = x.copy()
+        y[1] = y[0]
+        return y
+
+    damage = {
+        "cb_contexts": [("+phones", lambda x: x + len(meta["phones"])), ("-1", lambda x: x - 1),
+                        ("uint64", lambda x: x.astype(np.uint64)),
+                        ("uint64 max", lambda x: np.where(x == x.max(), 2**63, x).astype(np.uint64)),
+                        ("int16", lambda x: x.astype(np.int16)), ("float", lambda x: x + 0.5)],
+        "fixed": [("dup", dup), ("+markers", lambda x: x + len(meta["marker_names"]))],
+        "cb_token_utt": [("+utterances", lambda x: x + len(meta["train_utterances"]))],
+        "ix_order": [("dup", dup), ("+1", lambda x: x + 1), ("int32", lambda x: x.astype(np.int32)),
+                     ("reversed", lambda x: x[::-1].copy())],
+        "ix_offsets": [("swapped", swapped), ("end+1", lambda x: x + (np.arange(len(x)) ==
+                                                                      len(x) - 1))],
+        "cb_lsf": [("reversed", lambda x: x[:, ::-1].copy()), ("+pi", lambda x: x + np.pi),
+                   ("float32", lambda x: x.astype(np.float32)), (">f8", lambda x: x.astype(">f8"))],
+        "cb_token_end": [("before start", lambda x: x - 1e3)],
+        "distances": [("asymmetric", lambda x: x + np.triu(np.ones_like(x), 1))],
+        "pca_components": [("scaled", lambda x: 1.5 * x)],
+        "pca_variances": [("x1000", lambda x: 1000 * x)],
+        "means": [("float16", lambda x: x.astype(np.float16))],
+    }
+    name = rng.choice([n for n in damage if n in a])
+    how, fn = rng.choice(damage[name])
+    with np.errstate(all="ignore"):
+        return name, fn(a[name]), how
+
+
 def _model_variant(rng: random.Random, src: Path, dst: Path) -> str:
     import numpy as np
 
@@ -383,8 +438,8 @@ def _model_variant(rng: random.Random, src: Path, dst: Path) -> str:
     with np.load(src, allow_pickle=False) as z:
         arrays = {k: z[k] for k in z.files}
     meta = json.loads(str(arrays["meta"]))
-    kind = rng.choice(["meta", "meta", "array", "array", "header", "compression", "deflate",
-                       "bytes", "missing", "pickle"])
+    kind = rng.choice(["meta", "meta", "array", "array", "xref", "xref", "header", "compression",
+                       "deflate", "bytes", "missing", "pickle"])
     if kind == "meta":
         meta, desc = _mutated_meta(rng, meta)
         members["meta.npy"] = _npy(np.array(json.dumps(meta).replace("Infinity", "1e999")))
@@ -393,6 +448,11 @@ def _model_variant(rng: random.Random, src: Path, dst: Path) -> str:
     if kind == "array":
         name = rng.choice([k for k in arrays if k != "meta"])
         b, how = _mutated_array(rng, arrays[name])
+        members[f"{name}.npy"] = _npy(b)
+        _write_npz(dst, members)
+        return f"{name} {how}"
+    if kind == "xref":
+        name, b, how = _xref_damage(rng, arrays, meta)
         members[f"{name}.npy"] = _npy(b)
         _write_npz(dst, members)
         return f"{name} {how}"
@@ -727,17 +787,271 @@ def output_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
         yield Case("output", f"{kind} {out.name[:40]}", argv, protected, out, keep_mode=keep_mode)
 
 
+# --------------------------------------------------------------------------- corpora, 2 workers
+#: the corpus-wide commands and how often each is drawn (report and align take seconds)
+FANOUT_COMMANDS = ("eval", "eval", "eval", "sweep", "train", "train", "train", "align", "align",
+                   "report", "report")
+QUICK_FANOUT_COMMANDS = ("eval", "eval", "sweep", "train", "train")
+
+
+def _spoil(rng: random.Random, corpus: Path, utt: str, command: str) -> str:
+    """Damage one file of utterance ``utt`` in ``corpus`` (mostly its audio or transcript for
+    ``align``, which reads nothing else); what was done."""
+    kinds = (["wav", "wav", "wav-header", "txt"] if command == "align" else
+             ["c3d", "c3d", "c3d-cut", "wav", "wav-header", "labels", "alien", "missing", "short",
+              "tsv"])
+    kind = rng.choice(kinds)
+    if kind == "c3d":
+        src = corpus / f"{utt}.c3d"
+        data, how = mutate_bytes(rng, src.read_bytes())
+        src.write_bytes(data)
+        return f"{utt}.c3d {how}"
+    if kind == "c3d-cut":
+        src = corpus / f"{utt}.c3d"
+        src.write_bytes(src.read_bytes()[: rng.choice([0, 100, 512, 3000])])
+        return f"{utt}.c3d cut"
+    if kind == "wav":
+        src = corpus / f"{utt}.wav"
+        data, how = mutate_bytes(rng, src.read_bytes(), 0, rng.choice([64, None]))
+        src.write_bytes(data)
+        return f"{utt}.wav {how}"
+    if kind == "wav-header":
+        return f"{utt}.wav {_spoil_wav_header(rng, corpus / f'{utt}.wav')}"
+    if kind == "txt":
+        (corpus / f"{utt}.txt").write_bytes(rng.choice([b"caf\xe9 \xff", b"", b"\x00\x01",
+                                                         b"zorblax qwfp"]))
+        return f"{utt}.txt written"
+    if kind in ("labels", "alien"):
+        tg = corpus / f"{utt}.TextGrid"
+        if kind == "labels":
+            text, how = _mutate_text(rng, tg.read_text())
+        else:
+            text, how = tg.read_text().replace('"aa"', '"zz"').replace('"iy"', '"@@x"'), "alien"
+        tg.write_text(text)
+        return f"{utt}.TextGrid {how}"
+    if kind == "missing":
+        victim = corpus / f"{utt}.{rng.choice(['wav', 'TextGrid', 'c3d'])}"
+        victim.unlink()
+        return f"{victim.name} missing"
+    if kind == "short":
+        from engine.io.markerfiles import read_c3d, write_c3d
+
+        m = read_c3d(corpus / f"{utt}.c3d")
+        write_c3d(corpus / f"{utt}.c3d", m.markers[: rng.choice([1, 2, 30])], m.rate, m.names)
+        return f"{utt}.c3d short"
+    from engine.io.markerfiles import read_c3d, write_marker_tsv
+
+    m = read_c3d(corpus / f"{utt}.c3d")
+    (corpus / f"{utt}.c3d").unlink()
+    write_marker_tsv(corpus / f"{utt}.tsv", m.markers, m.rate, m.names)
+    text, how = _mutate_text(rng, (corpus / f"{utt}.tsv").read_text())
+    (corpus / f"{utt}.tsv").write_text(text)
+    return f"{utt}.tsv {how}"
+
+
+def _spoil_wav_header(rng: random.Random, wav: Path) -> str:
+    """A WAV whose data size, channel count, rate or bits field is damaged."""
+    d = bytearray(wav.read_bytes())
+    fmt, data = d.find(b"fmt "), d.find(b"data")
+    field_, off, size = rng.choice([("data size", data + 4, 4), ("RIFF size", 4, 4),
+                                    ("channels", fmt + 10, 2), ("rate", fmt + 12, 4),
+                                    ("bits", fmt + 22, 2), ("block align", fmt + 20, 2)])
+    value = rng.choice([0, 1, 3, 0xFFFF, 0xFFFFFFF0, 7, 2**31])
+    d[off:off + size] = (value % (1 << (8 * size))).to_bytes(size, "little")
+    wav.write_bytes(bytes(d))
+    return f"{field_} = {value}"
+
+
+def fanout_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
+    """eval, sweep, train, corpus align and report with 2 workers over a corpus with one bad file,
+    with or without --skip-bad; eval, sweep and train also with -j 1, which must end the same."""
+    while True:
+        d = ws.fresh("fanout")
+        corpus = d / "corpus"
+        shutil.copytree(ws.corpus, corpus)
+        command = rng.choice(QUICK_FANOUT_COMMANDS if ws.quick else FANOUT_COMMANDS)
+        how = _spoil(rng, corpus, rng.choice(["toy000", "toy001", "toy030"]), command)
+        skip = rng.random() < 0.5
+        out: Path | None = None
+        if command in ("eval", "sweep"):
+            argv = [command, str(ws.model), str(corpus)] + (["--max-n", "2"] if command == "sweep"
+                                                             else [])
+        elif command == "train":
+            out = d / "model.npz"
+            argv = ["train", str(corpus), "-o", str(out)]
+        elif command == "align":
+            argv = ["corpus", "align", str(corpus), "--overwrite", "--recognize"]
+        else:
+            out = d / "report" / "results.md"
+            argv = ["report", str(corpus), "-o", str(out.parent), "--max-n", "2"]
+        argv += ["-q"] + (["--skip-bad"] if skip else [])
+        serial = None
+        if command in ("eval", "sweep", "train"):   # -j 1 writes its own model, if any
+            serial = [str(d / "model-j1.npz") if a == str(out) else a for a in argv] + ["-j", "1"]
+        yield Case("fanout", f"{command}{' --skip-bad' if skip else ''}: {how}", [*argv, "-j", "2"],
+                   _protect(ws.model), out, skip_bad=skip, serial_argv=serial)
+
+
+# --------------------------------------------------------------------------- other alphabets
+#: the toy corpus's phones as each alphabet writes them (any of the spellings listed)
+SPELLINGS: dict[str, dict[str, list[str]]] = {
+    "ARPAbet": {"sil": ["sil", "sp", "SIL", "pau"], "aa": ["AA1", "aa", "AA0"],
+                "iy": ["IY1", "iy", "IY2"], "uw": ["UW1", "uw"], "m": ["M", "m"], "f": ["F", "f"],
+                "s": ["S", "s"], "t": ["T", "t"]},
+    "TIMIT": {"sil": ["h#", "pau", "epi"], "aa": ["aa"], "iy": ["iy"], "uw": ["uw"], "m": ["m"],
+              "f": ["f"], "s": ["s"], "t": ["tcl", "t"]},
+    "MOCHA-TIMIT": {"sil": ["sil", "breath"], "aa": ["aa"], "iy": ["ii"], "uw": ["uu"], "m": ["m"],
+                    "f": ["f"], "s": ["s"], "t": ["t"]},
+    "SAMPA": {"sil": ["sil", "#"], "aa": ["A:"], "iy": ["i:"], "uw": ["u:"], "m": ["m"],
+              "f": ["f"], "s": ["s"], "t": ["t"]},
+    "X-SAMPA": {"sil": ["sil"], "aa": ["a:", "A:"], "iy": ["i:"], "uw": ["u:"], "m": ["m"],
+                "f": ["f"], "s": ["s"], "t": ["t"]},
+    "IPA": {"sil": ["sil", ""], "aa": ["\u0251\u02d0", "\u02c8\u0251", "\u0251"],
+            "iy": ["i\u02d0", "\u02c8i\u02d0"], "uw": ["u\u02d0", "\u02c8u\u02d0", "\u02ccu"],
+            "m": ["m"], "f": ["f"], "s": ["s"], "t": ["t"]},
+}
+ALIEN_LABELS = ["zz", "Q\\", "\u014b\u030a", "AA9", "ph", "#1", "i::", "\u0251\u0303", "x-ray", "*"]
+
+
+def _write_label_file(path: Path, segs: list, rate: int = 16000) -> None:
+    if path.suffix == ".TextGrid":
+        from engine.io.labelfiles import write_textgrid
+
+        write_textgrid(path, {"phones": segs}, segs[-1].end)
+    elif path.suffix == ".phn":
+        path.write_text("".join(f"{round(s.start * rate)} {round(s.end * rate)} {s.label or 'h#'}\n"
+                                for s in segs), encoding="utf-8")
+    else:
+        path.write_text("".join(f"{s.start:.5f} {s.end:.5f} {s.label or 'sil'}\n" for s in segs),
+                        encoding="utf-8")
+
+
+def alphabet_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
+    """The toy labels written in each alphabet (must synthesize), or with labels in no alphabet,
+    alphabets mixed, case changed (refused or synthesized, never a traceback); given with
+    --labels or found beside the audio; sometimes with --label-map (a file or an alphabet)."""
+    from engine.data import PhoneSegment
+    from engine.io.labelfiles import read_labels
+
+    segs = read_labels(ws.textgrid)
+    while True:
+        d = ws.fresh("alphabet")
+        name = rng.choice(list(SPELLINGS))
+        table = SPELLINGS[name]
+        out_segs = [PhoneSegment(s.start, s.end, rng.choice(table[s.label])) for s in segs]
+        damage = rng.choice(["none", "none", "none", "alien", "mixed", "case", "stress"])
+        if damage == "alien":
+            k = rng.randrange(1, len(out_segs) - 1)
+            out_segs[k] = PhoneSegment(out_segs[k].start, out_segs[k].end, rng.choice(ALIEN_LABELS))
+        elif damage == "mixed":
+            other = SPELLINGS[rng.choice(list(SPELLINGS))]
+            out_segs = [PhoneSegment(a.start, a.end, rng.choice(other[s.label]))
+                        if rng.random() < 0.3 else a for a, s in zip(out_segs, segs, strict=True)]
+        elif damage == "case":
+            out_segs = [PhoneSegment(a.start, a.end, a.label.swapcase()) for a in out_segs]
+        elif damage == "stress":
+            out_segs = [PhoneSegment(a.start, a.end, a.label + rng.choice(["1", "'", ":", ""]))
+                        for a in out_segs]
+        suffix = rng.choice([".lab", ".lab", ".TextGrid", ".phn"])
+        beside = rng.random() < 0.4
+        audio = d / "u.wav" if beside else ws.wav
+        if beside:
+            shutil.copy(ws.wav, audio)
+        labels = d / f"u{suffix}"
+        _write_label_file(labels, out_segs)
+        extra = ["--mode", "phonetic"]
+        if rng.random() < 0.2:
+            extra += ["--label-map", rng.choice([name.lower().replace("-timit", ""),
+                                                 rng.choice(["sampa", "ipa", "mocha", "timit"])])]
+        out = d / "out.tsv"
+        argv = _synth_argv(ws, ws.model, audio, out, None if beside else labels, extra)
+        yield Case("alphabet", f"{name} {suffix}{' beside' if beside else ''}, {damage}"
+                               f"{', ' + extra[-1] if len(extra) > 2 else ''}", argv,
+                   _protect(ws.model, ws.wav), out,
+                   expect_ok=damage == "none" and len(extra) == 2)
+
+
+# --------------------------------------------------------------------------- the app
+def app_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
+    """What the window opens: a damaged audio file, damaged labels (given, beside the audio, in
+    another alphabet), a transcript beside the audio, a damaged model or corpus description, a
+    damaged marker file of the utterance shown (tests/fuzz_app.py)."""
+    from engine.io.labelfiles import read_labels
+
+    segs = read_labels(ws.textgrid)
+    while True:
+        d = ws.fresh("app")
+        kind = rng.choice(["audio", "audio", "labels", "labels", "alphabet", "beside",
+                           "transcript", "model", "model", "corpus", "c3d", "markers"])
+        if kind == "audio":
+            wav = d / "in.wav"
+            if rng.random() < 0.3:
+                shutil.copy(ws.wav, wav)
+                how = _spoil_wav_header(rng, wav)
+            else:
+                data, how = mutate_bytes(rng, ws.wav.read_bytes(), 0, rng.choice([64, None]))
+                wav.write_bytes(data)
+            action = ["audio", str(wav), ""]
+        elif kind in ("labels", "beside"):
+            src = rng.choice([ws.textgrid, ws.lab, ws.lab.with_suffix(".phn")])
+            audio = d / "in.wav" if kind == "beside" else ws.wav
+            if kind == "beside":
+                shutil.copy(ws.wav, audio)
+            path = d / f"in{src.suffix}"
+            text, how = _mutate_text(rng, src.read_text())
+            path.write_text(text)
+            action = ["audio", str(audio), "" if kind == "beside" else str(path)]
+        elif kind == "alphabet":
+            from engine.data import PhoneSegment
+
+            name = rng.choice(list(SPELLINGS))
+            lab = [PhoneSegment(s.start, s.end, rng.choice(SPELLINGS[name][s.label])) for s in segs]
+            if rng.random() < 0.4:
+                lab[3] = PhoneSegment(lab[3].start, lab[3].end, rng.choice(ALIEN_LABELS))
+                name += " with an unknown label"
+            path = d / "in.lab"
+            _write_label_file(path, lab)
+            action, how = ["audio", str(ws.wav), str(path)], name
+        elif kind == "transcript":
+            audio = d / "in.wav"
+            shutil.copy(ws.wav, audio)
+            raw = rng.choice([b"caf\xe9 \xff", b"", b"zorblax wibble", b"\xff\xfe\x00",
+                              b"the boy enjoyed the toy"])
+            (d / "in.txt").write_bytes(raw)
+            action, how = ["audio", str(audio), ""], f"transcript {raw[:12]!r}"
+        elif kind == "model":
+            path = d / "model.npz"
+            how = _model_variant(rng, ws.model, path)
+            action = ["corpus", str(ws.corpus), str(path)]
+        elif kind == "corpus":
+            corpus = d / "corpus"
+            shutil.copytree(ws.corpus, corpus)
+            info = json.loads((corpus / "corpus.json").read_text())
+            key = rng.choice([*list(info), "data_dir"])
+            info[key] = rng.choice(_VALUES)
+            (corpus / "corpus.json").write_text(json.dumps(info).replace("Infinity", "1e999"))
+            action, how = ["corpus", str(corpus), str(ws.model)], f"{key} = {info[key]!r}"[:40]
+        else:
+            corpus = d / "corpus"
+            shutil.copytree(ws.corpus, corpus)
+            how = _spoil(rng, corpus, "toy030", "eval")
+            action = ["utterance", str(corpus), str(ws.model), "toy030"]
+        yield Case("app", f"{kind}: {how}", [], app=action)
+
+
 GENERATORS: dict[str, Callable[[Workspace, random.Random], Iterator[Case]]] = {
     "audio": audio_cases, "labels": label_cases, "model": model_cases, "corpus": corpus_cases,
     "c3d": c3d_cases, "markers": marker_cases, "options": option_cases, "output": output_cases,
+    "fanout": fanout_cases, "alphabet": alphabet_cases, "app": app_cases,
 }
 
 
-def cases(ws: Workspace, n: int, seed: int) -> Iterator[Case]:
-    """``n`` cases, spread evenly over :data:`CATEGORIES`, reproducible from ``seed``."""
-    gens = {c: GENERATORS[c](ws, random.Random(f"{seed}-{c}")) for c in CATEGORIES}
+def cases(ws: Workspace, n: int, seed: int,
+          categories: tuple[str, ...] = CATEGORIES) -> Iterator[Case]:
+    """``n`` cases, spread evenly over ``categories``, reproducible from ``seed``."""
+    gens = {c: GENERATORS[c](ws, random.Random(f"{seed}-{c}")) for c in categories}
     for i in range(n):
-        case = next(gens[CATEGORIES[i % len(CATEGORIES)]])
+        case = next(gens[categories[i % len(categories)]])
         case.cwd = case.cwd or ws.current   # relative paths land in the case's own folder
         yield case
 
@@ -760,35 +1074,48 @@ def _judge(case: Case, code: int, err: str, status: str | None = None) -> Outcom
     if "Traceback (most recent call last)" in err or code == 1:
         return Outcome(case, "traceback", code, err.strip().splitlines()[-1][:300] if err.strip()
                        else "")
-    if code not in (0, 2):
+    if code not in (0, 2, *((EXIT_INCOMPLETE,) if case.skip_bad else ())):
         return Outcome(case, f"exit {code}", code, err[-300:])
     lines = [ln for ln in err.splitlines() if ln.strip()]
-    if code == 2:
-        errors = [ln for ln in lines if ln.startswith("facetraj") and ": error: " in ln]
-        if len(errors) != 1:
-            return Outcome(case, "unclear message", code, err[-300:])
+    errors = [ln for ln in lines if ln.startswith("facetraj") and ": error: " in ln]
+    summary = [ln for ln in lines if ln.startswith("facetraj: ") and " skipped" in ln]
+    if (code == 2 and len(errors) != 1) or (code == EXIT_INCOMPLETE and (errors or not summary)):
+        return Outcome(case, "unclear message", code, err[-300:])
+    if case.expect_ok and code != 0:
+        return Outcome(case, "refused valid input", code, err[-300:])
+    bad = _files_problem(case, code)
+    if bad is not None:
+        return Outcome(case, bad[0], code, bad[1])
+    return Outcome(case, {0: "ok", 2: "refused"}.get(code, "skipped bad files"), code,
+                   lines[-1][:200] if lines else "", error_line=(errors or summary or [""])[0])
+
+
+def _files_problem(case: Case, code: int) -> tuple[str, str] | None:
+    """A changed protected file, a partial output or NaN in one: (status, detail), else None."""
     for path, (data, mode) in case.protected.items():
         if not path.is_file() or _digest(path) != data:
-            return Outcome(case, "clobbered", code, f"{path} changed")
+            return "clobbered", f"{path} changed"
         if path.stat().st_mode != mode:
-            return Outcome(case, "clobbered", code, f"{path} mode changed")
+            return "clobbered", f"{path} mode changed"
     out = case.output
-    if out is not None:
-        with contextlib.suppress(OSError):
-            folder = out.parent
-            if folder.is_dir() and any(".part-" in p.name for p in folder.iterdir()):
-                return Outcome(case, "partial", code, f".part file left in {folder}")
-            if code != 0 and out.is_file() and out not in case.protected and \
-                    b"the user's file" not in out.read_bytes():
-                return Outcome(case, "partial", code, f"{out} written by a failed run")
-            if code == 0 and case.keep_mode is not None and \
-                    (out.stat().st_mode & 0o7777) != case.keep_mode:
-                return Outcome(case, "clobbered", code, f"{out} mode {out.stat().st_mode:o}, "
-                                                        f"{case.keep_mode:o} before")
-            if code == 0 and out.is_file() and out.suffix in (".tsv", ".csv") and \
-                    b"nan" in out.read_bytes().lower():
-                return Outcome(case, "nan output", code, f"{out} holds NaN")
-    return Outcome(case, "ok" if code == 0 else "refused", code, lines[-1][:200] if lines else "")
+    if out is None:
+        return None
+    with contextlib.suppress(OSError):
+        folder = out.parent
+        if folder.is_dir() and any(".part-" in p.name for p in folder.iterdir()):
+            return "partial", f".part file left in {folder}"
+        if code == 2 and out.is_file() and out not in case.protected and \
+                b"the user's file" not in out.read_bytes():
+            return "partial", f"{out} written by a failed run"
+        if code == EXIT_INCOMPLETE and not out.is_file():
+            return "partial", f"{out} not written by a run that only skipped bad files"
+        if code == 0 and case.keep_mode is not None and \
+                (out.stat().st_mode & 0o7777) != case.keep_mode:
+            return "clobbered", f"{out} mode {out.stat().st_mode:o}, {case.keep_mode:o} before"
+        if code == 0 and out.is_file() and out.suffix in (".tsv", ".csv") and \
+                b"nan" in out.read_bytes().lower():
+            return "nan output", f"{out} holds NaN"
+    return None
 
 
 def run_in_process(case: Case) -> Outcome:
@@ -832,6 +1159,8 @@ def run_forked(case: Case, timeout: float = TIMEOUT_S, memory: int = MEMORY_LIMI
             sys.stderr = os.fdopen(2, "w", buffering=1)
             sys.stdout = os.fdopen(1, "w")
             os.chdir(case_workdir(case))
+            for var in ("DISPLAY", "WAYLAND_DISPLAY"):  # the command line as on a server
+                os.environ.pop(var, None)
             limit = _vm_size() + memory
             resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
             try:
@@ -883,6 +1212,100 @@ def _vm_size() -> int:
     return 0
 
 
+def run_case(case: Case, runner: Callable[[Case], Outcome]) -> Outcome:
+    """``runner(case)``, and for a case with a ``serial_argv`` the same with -j 1: it must end with
+    the same exit status and the same error or skip summary (else "differs from -j 1")."""
+    outcome = runner(case)
+    if case.serial_argv is None or outcome.failed:
+        return outcome
+    argv = case.serial_argv
+    out = Path(argv[argv.index("-o") + 1]) if "-o" in argv else case.output
+    serial = runner(Case(case.category, case.name + " (-j 1)", argv, case.protected, out,
+                         cwd=case.cwd, skip_bad=case.skip_bad))
+    if serial.failed:
+        return serial
+    if (serial.code, serial.error_line) != (outcome.code, outcome.error_line):
+        outcome.status = "differs from -j 1"
+        outcome.detail = f"-j 2: {outcome.code} {outcome.error_line!r}; -j 1: {serial.code} " \
+                         f"{serial.error_line!r}"
+    outcome.seconds += serial.seconds
+    outcome.max_rss = max(outcome.max_rss, serial.max_rss)
+    return outcome
+
+
+#: app cases run in one window per batch (a crash ends the batch: the rest run in a new one)
+APP_BATCH = 40
+
+
+def run_app_cases(ws: Workspace, app_cases: list[Case], timeout: float = TIMEOUT_S
+                  ) -> list[Outcome]:
+    """The app cases, in batches, each in a forked child with a window on the workspace's corpus
+    (``tests/fuzz_app.py``); a case the child died on is a crash, one it did not finish a hang."""
+    results = ws.root / "app-results.jsonl"
+    done: dict[int, Outcome] = {}
+    todo = list(range(len(app_cases)))
+    while todo:
+        batch = todo[:APP_BATCH]
+        rss, code, seconds = _app_batch(ws, [(i, app_cases[i].app) for i in batch], results,
+                                        timeout * len(batch) + 120)
+        for line in results.read_text().splitlines() if results.exists() else []:
+            r = json.loads(line)
+            if r["index"] in batch and r["index"] not in done:
+                done[r["index"]] = _judge_app(app_cases[r["index"]], r, rss)
+        results.unlink(missing_ok=True)
+        left = [i for i in batch if i not in done]
+        if left:                            # the child died or hung on the first one left
+            status = "hang" if code is None else f"crash (exit {code})"
+            done[left[0]] = Outcome(app_cases[left[0]], status, -1, f"after {seconds:.0f} s",
+                                    max_rss=rss)
+        todo = [i for i in todo if i not in done]
+    return [done[i] for i in range(len(app_cases))]
+
+
+def _app_batch(ws: Workspace, actions: list, results: Path, timeout: float
+               ) -> tuple[int, int | None, float]:
+    """Fork a child that runs ``actions`` in one window; its peak memory, exit status (None when
+    killed for taking longer than ``timeout``) and seconds."""
+    t0 = time.perf_counter()
+    pid = os.fork()
+    if pid == 0:
+        code = 1
+        try:
+            null = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(null, 1)
+            from fuzz_app import run_batch
+
+            code = run_batch(str(ws.corpus), str(ws.model), actions, str(results))
+        except BaseException:
+            traceback.print_exc()
+        finally:
+            os._exit(code)
+    while True:
+        done, wstatus, usage = os.wait4(pid, os.WNOHANG)
+        if done:
+            return usage.ru_maxrss * 1024, os.waitstatus_to_exitcode(wstatus), \
+                time.perf_counter() - t0
+        if time.perf_counter() - t0 > timeout:
+            os.kill(pid, signal.SIGKILL)
+            _, wstatus, usage = os.wait4(pid, 0)
+            return usage.ru_maxrss * 1024, None, time.perf_counter() - t0
+        time.sleep(0.05)
+
+
+def _judge_app(case: Case, report: dict, rss: int) -> Outcome:
+    """An app case: a dialog naming a file the case opened ("refused"), or the file opened
+    ("ok"); anything else (an internal error, an exception, no answer, the window gone) fails."""
+    status, message = report["status"], report.get("message", "")
+    names = {Path(a).name for a in case.app[1:3] if a} | {Path(a).parent.name for a in case.app[1:3]
+                                                         if a}
+    if status == "dialog":
+        status = "refused" if any(n and n in message for n in names) else "unclear message"
+    elif status in ("opened", "asked"):     # a question (words to pronounce) is the app working
+        status = "ok"
+    return Outcome(case, status, 2 if status == "refused" else 0, message[:300],
+                   seconds=report.get("seconds", 0.0), max_rss=rss)
+
+
 # --------------------------------------------------------------------------- the table
 def table(outcomes: list[Outcome]) -> str:
     """Markdown table: per category the cases and their outcomes."""
@@ -894,7 +1317,8 @@ def table(outcomes: list[Outcome]) -> str:
         rss[o.case.category] = max(rss[o.case.category], o.max_rss)
         slow[o.case.category] = max(slow[o.case.category], o.seconds)
     failures = sorted({o.status for o in outcomes if o.failed})
-    head = ["category", "cases", "exit 0", "exit 2 (refused)", "tracebacks", "hangs",
+    head = ["category", "cases", "exit 0", "exit 2 (refused)", "exit 3 (skipped)", "tracebacks",
+            "hangs",
             "partial or clobbered", *[f for f in failures if f not in
                                       ("traceback", "hang", "partial", "clobbered")],
             "slowest run (s)", "peak memory (MiB)"]
@@ -907,12 +1331,14 @@ def table(outcomes: list[Outcome]) -> str:
         total.update(c)
         extra = [str(c[f]) for f in failures if f not in ("traceback", "hang", "partial",
                                                           "clobbered")]
-        rows.append(f"| {cat} | {sum(c.values())} | {c['ok']} | {c['refused']} | {c['traceback']} "
+        rows.append(f"| {cat} | {sum(c.values())} | {c['ok']} | {c['refused']} "
+                    f"| {c['skipped bad files']} | {c['traceback']} "
                     f"| {c['hang']} | {c['partial'] + c['clobbered']} | " + "".join(
                         f"{x} | " for x in extra) + f"{slow[cat]:.1f} | {rss[cat] / 2**20:.0f} |")
     extra = [str(total[f]) for f in failures if f not in ("traceback", "hang", "partial",
                                                           "clobbered")]
     rows.append(f"| **all** | {sum(total.values())} | {total['ok']} | {total['refused']} | "
+                f"{total['skipped bad files']} | "
                 f"{total['traceback']} | {total['hang']} | {total['partial'] + total['clobbered']} "
                 f"| " + "".join(f"{x} | " for x in extra)
                 + f"{max(slow.values(), default=0):.1f} | {max(rss.values(), default=0) / 2**20:.0f} |")
@@ -921,7 +1347,7 @@ def table(outcomes: list[Outcome]) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description="the long bad-input fuzz run (make fuzz)")
-    p.add_argument("--cases", type=int, default=2100)
+    p.add_argument("--cases", type=int, default=3300)
     p.add_argument("--seed", type=int, default=14)
     p.add_argument("--workdir", type=Path, help="keep the cases here (default a temporary folder)")
     p.add_argument("--timeout", type=float, default=TIMEOUT_S)
@@ -930,17 +1356,26 @@ def main(argv: list[str] | None = None) -> int:
 
     root = args.workdir or Path(tempfile.mkdtemp(prefix="facetraj-fuzz-"))
     root.mkdir(parents=True, exist_ok=True)
+    os.environ["FACETRAJ_CACHE_DIR"] = str(root / "cache")   # labels and models: never the user's
     ws = make_workspace(root)
-    outcomes = []
+    categories = CATEGORIES if os.environ.get("DISPLAY") else \
+        tuple(c for c in CATEGORIES if c != "app")
+    if "app" not in categories:
+        print("no display: the app cases are left out (make fuzz runs under xvfb-run)",
+              file=sys.stderr)
+    outcomes, app = [], []
     t0 = time.perf_counter()
-    for i, case in enumerate(cases(ws, args.cases, args.seed), 1):
-        o = run_forked(case, args.timeout)
-        outcomes.append(o)
-        if o.failed:
-            print(f"FAIL {o.status}: [{case.category}] {case.name}: facetraj {' '.join(case.argv)}"
-                  f"\n    {o.detail}", flush=True)
+    for i, case in enumerate(cases(ws, args.cases, args.seed, categories), 1):
+        if case.app is not None:
+            app.append(case)
+            continue
+        outcomes.append(run_case(case, lambda c: run_forked(c, args.timeout)))
+        _say(outcomes[-1])
         if i % 100 == 0:
             print(f"{i} cases, {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
+    for o in run_app_cases(ws, app, args.timeout):
+        outcomes.append(o)
+        _say(o)
     print(f"\n{len(outcomes)} cases (seed {args.seed}) in {time.perf_counter() - t0:.0f} s; "
           f"memory limit {MEMORY_LIMIT >> 20} MiB above the parent, timeout {args.timeout:g} s "
           f"per run\n")
@@ -948,6 +1383,13 @@ def main(argv: list[str] | None = None) -> int:
     if args.workdir is None:
         shutil.rmtree(root, ignore_errors=True)
     return 1 if any(o.failed for o in outcomes) else 0
+
+
+def _say(o: Outcome) -> None:
+    if o.failed:
+        what = f"facetraj {' '.join(o.case.argv)}" if o.case.app is None else f"app {o.case.app}"
+        print(f"FAIL {o.status}: [{o.case.category}] {o.case.name}: {what}\n    {o.detail}",
+              flush=True)
 
 
 if __name__ == "__main__":

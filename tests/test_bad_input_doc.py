@@ -21,11 +21,13 @@ from fuzzing import _c3d_rate
 from app.display import require_display
 from engine.config import SynthConfig
 from engine.data import PhoneSegment, Utterance
-from engine.errors import FacetrajError
+from engine.errors import FILE_WARNINGS, FacetrajError
+from engine.fanout import fan_out
 from engine.io.audio import read_audio
 from engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
 from engine.io.files import atomic_write
 from engine.io.labelfiles import read_lab, read_labels, read_textgrid, validate_phones
+from engine.io.labelling import file_labels
 from engine.io.markerfiles import read_c3d, read_markers, read_mocha_ema, write_c3d
 from engine.labels.labelmap import read_label_map
 from engine.method.model import Model
@@ -75,6 +77,22 @@ class BadInputs:
             write_c3d(self.tmp / "u.c3d", markers, 60.0, names or self.info.marker_names)
         save_corpus_info(self.tmp, CorpusInfo(**{**self.info.__dict__, "train": ["u"], "test": []}))
         return load_corpus(self.tmp).utterance("u")
+
+    def small_corpus(self, short: tuple[str, ...] = ()) -> Path:
+        """Three toy utterances in ``tmp/c``: toy001's C3D truncated, or the markers of the
+        utterances in ``short`` shorter than their audio."""
+        root = self.tmp / "c"
+        root.mkdir()
+        for utt in ("toy000", "toy001", "toy030"):
+            _copy_utt(self.toy_dir, root, utt, utt)
+        for utt in short:
+            write_c3d(root / f"{utt}.c3d", read_c3d(root / f"{utt}.c3d").markers[:-20], 60.0,
+                      self.names)
+        if not short:
+            (root / "toy001.c3d").write_bytes((root / "toy001.c3d").read_bytes()[:300])
+        save_corpus_info(root, CorpusInfo(**{**self.info.__dict__, "train": ["toy000", "toy001"],
+                                             "test": ["toy030"]}))
+        return root
 
     def write(self, name: str, data: bytes | str) -> Path:
         path = self.tmp / name
@@ -233,8 +251,88 @@ def output_cases(f: BadInputs) -> dict[str, Callable[[], object]]:
     }
 
 
+def model_value_cases(f: BadInputs) -> dict[str, Callable[[], object]]:
+    """Model arrays whose values or cross-references are wrong (issue 26)."""
+    def damaged(**arrays):
+        return lambda: Model.load(edited_model_file(f.model.save(f.tmp / "full.npz"),
+                                                    f.tmp / "m.npz", **arrays))
+
+    cb, meta = f.model.codebook, lambda: _meta(f.model.save(f.tmp / "full.npz"))
+    return {
+    "a model array of the wrong kind of numbers (fractions where ids belong)": damaged(
+        cb_contexts=cb.contexts.astype(float)),
+    "a model's ids beyond what they index (phones, markers, utterances)": damaged(
+        cb_contexts=cb.contexts + len(f.model.phones)),
+    "a model's LSFs outside 0 to pi or out of order": damaged(cb_lsf=cb.lsf[:, ::-1].copy()),
+    "a model's phone tokens that end before they start": damaged(
+        cb_token_start=cb.token_end + 1.0),
+    "a model's PCs that are not orthonormal": damaged(pca_components=2 * f.model.pca.components),
+    "a model's distances that are not a distance matrix": damaged(distances=-f.model.distances),
+    "a model's cross-validated settings out of range": lambda: Model.load(edited_model_file(
+        f.model.save(f.tmp / "full.npz"), f.tmp / "m.npz", meta=np.array(json.dumps(
+            {**meta(), "tuned": {"settings": {"n_context_phones": 10**9}}})))),
+    }
+
+
+def corpus_command_cases(f: BadInputs) -> dict[str, Callable[[], object]]:
+    """Corpus-wide commands with several jobs, label alphabets, sizes (issue 26)."""
+    return {
+    "a bad file in a corpus-wide command with several jobs (`-j 2`)":
+        lambda: _cli(["eval", str(f.model.save(f.tmp / "m.npz")), str(f.small_corpus()), "-j", "2"]),
+    "bad files left out with `--skip-bad`": lambda: _cli(
+        ["eval", str(f.model.save(f.tmp / "m.npz")), str(f.small_corpus()), "-j", "2", "--skip-bad"]),
+    "a worker process that dies (killed, out of memory)": lambda: fan_out(_exit_on_b, "abc", 2),
+    "the same problem in many files of a corpus": lambda: _cli(
+        ["eval", str(f.model.save(f.tmp / "m.npz")), str(f.small_corpus(short=("toy000", "toy030")))]),
+    "a label file in another phone alphabet (TIMIT, MOCHA-TIMIT, SAMPA, X-SAMPA, IPA)": lambda:
+        file_labels(f.write("s.lab", "".join(f"{s.start} {s.end} {_SAMPA.get(s.label, s.label)}\n"
+                                             for s in f.phones)), f.rate, f.phones[-1].end),
+    "labels in no phone alphabet facetraj knows": lambda: file_labels(
+        f.write("z.lab", "".join(f"{s.start} {s.end} {'zz' if i == 1 else s.label}\n"
+                                 for i, s in enumerate(f.phones))), f.rate, f.phones[-1].end),
+    "an audio header that claims more samples than the file holds": lambda: read_audio(
+        _huge_flac(f.tmp, f.audio, f.rate)),
+    "a label file or marker table over 256 MiB": lambda: (
+        open(f.tmp / "big.lab", "wb").truncate(300 << 20), read_labels(f.tmp / "big.lab")),
+    }
+
+
 CASE_GROUPS = (audio_and_label_cases, marker_and_training_cases, model_and_corpus_cases,
-               file_format_cases, model_detail_cases, output_cases)
+               file_format_cases, model_detail_cases, output_cases, model_value_cases,
+               corpus_command_cases)
+
+#: the toy phones in SAMPA
+_SAMPA = {"aa": "A:", "iy": "i:", "uw": "u:"}
+
+
+def _exit_on_b(item: str) -> str:
+    if item == "b":
+        os._exit(9)
+    return item
+
+
+def _cli(argv: list[str]) -> None:
+    """Run ``facetraj argv``; its stderr is the message (raised when the exit status is not 0)."""
+    import contextlib
+    import io
+
+    from facetraj.cli import main
+
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        code = main(argv)
+    if code != 0:
+        raise FacetrajError(f"exit {code}: {err.getvalue()}")
+    logging.getLogger("facetraj").info("%s", err.getvalue())
+
+
+def _huge_flac(tmp: Path, audio: np.ndarray, rate: int) -> Path:
+    sf.write(tmp / "a.flac", audio, rate)
+    d = bytearray((tmp / "a.flac").read_bytes())
+    d[21] |= 0x0F
+    d[22:26] = b"\xff\xff\xff\xff"
+    (tmp / "huge.flac").write_bytes(bytes(d))
+    return tmp / "huge.flac"
 
 
 def produce(case: str, tmp: Path, toy_dir: Path, model: Model, caplog) -> str:
@@ -245,6 +343,7 @@ def produce(case: str, tmp: Path, toy_dir: Path, model: Model, caplog) -> str:
         cases.update(group(inputs))
     cases.update(alignment_cases(tmp))
     caplog.clear()
+    FILE_WARNINGS.clear()       # each case counts its own files
     try:
         with caplog.at_level(logging.INFO):
             cases[case]()

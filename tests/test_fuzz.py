@@ -19,7 +19,16 @@ import numpy as np
 import pytest
 import soundfile as sf
 from conftest import edited_model_file
-from fuzzing import CATEGORIES, _c3d_rate, cases, make_workspace, run_forked, run_in_process, table
+from fuzzing import (
+    CATEGORIES,
+    _c3d_rate,
+    cases,
+    make_workspace,
+    run_case,
+    run_forked,
+    run_in_process,
+    table,
+)
 
 from engine.errors import InputError
 from engine.io.files import atomic_write
@@ -35,18 +44,24 @@ def workspace(tmp_path_factory, toy_corpus_dir, toy_model):
     return make_workspace(root, toy_corpus_dir, root / "toy-model.npz")
 
 
+#: the in-process run's categories: the app's are driven by tests/test_app_bad_input.py
+IN_PROCESS = tuple(c for c in CATEGORIES if c != "app")
+
+
 def test_bounded_fuzz_run(workspace):
-    """Seeded mutated inputs of every category: no traceback, exit 0 or 2 with one error line,
-    nothing partial or clobbered, no NaN written."""
+    """Seeded mutated inputs of every category but the app's: no traceback, exit 0 or 2 with one
+    error line (or 3 with a summary for --skip-bad), the same with -j 1 and -j 2, nothing partial
+    or clobbered, no NaN written, label files in other alphabets synthesized."""
     here = sorted(os.listdir("."))
-    outcomes = [run_in_process(c) for c in cases(workspace, N_CASES, seed=1)]
+    workspace.quick = True
+    outcomes = [run_case(c, run_in_process) for c in cases(workspace, N_CASES, 1, IN_PROCESS)]
     assert sorted(os.listdir(".")) == here, "a case wrote outside its own folder"
     report = table(outcomes)
     failures = [f"[{o.case.category}] {o.case.name}: {o.status} {o.detail}\n  facetraj "
                 f"{' '.join(o.case.argv)}" for o in outcomes if o.failed]
     assert not failures, "\n".join(failures) + "\n" + report
     seen = {o.case.category for o in outcomes}
-    assert seen == set(CATEGORIES)
+    assert seen == set(IN_PROCESS)
     # the run exercised both outcomes: real refusals and real successes
     assert sum(o.status == "refused" for o in outcomes) > N_CASES // 3
     assert sum(o.status == "ok" for o in outcomes) > 20
@@ -54,7 +69,7 @@ def test_bounded_fuzz_run(workspace):
 
 def test_forked_run_limits_memory_and_time(workspace):
     """The long run's forked mode on a few cases: same verdicts, memory measured."""
-    some = list(cases(workspace, 14, seed=5))
+    some = list(cases(workspace, 14, 5, IN_PROCESS))
     for case in some:
         o = run_forked(case, timeout=120)
         assert not o.failed, (o.status, o.detail, case.argv)
@@ -427,7 +442,7 @@ def test_error_messages_are_one_line():
 
 
 def test_fuzz_table_counts(workspace):
-    outcomes = [run_in_process(c) for c in cases(workspace, 7, seed=9)]
+    outcomes = [run_in_process(c) for c in cases(workspace, 7, 9, IN_PROCESS)]
     text = table(outcomes)
     assert text.splitlines()[-1].startswith("| **all** | 7 |")
     assert io.StringIO(text).read().count("\n") == 2 + len({o.case.category for o in outcomes})

@@ -109,6 +109,16 @@ class Synthesis:
                 "config": np.array(json.dumps(self.config.to_dict()))}
 
 
+def check_length(model: Model, n_samples: int, sample_rate: int, source: str | None,
+                 n_frames: int = 2) -> None:
+    """Refuse audio shorter than two of the model's marker frames (nothing to smooth or
+    interpolate), naming ``source``: before synthesis, and as soon as a file is read (the
+    command line, the app's Open audio)."""
+    duration = n_samples / float(sample_rate)
+    if n_frames < 2 or duration < 2.0 / model.marker_rate:
+        raise InputError(source, f"the audio is too short ({duration * 1000:.1f} ms) to synthesize")
+
+
 def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                phones: Sequence[PhoneSegment] | None = None, config: SynthConfig | None = None,
                n_frames: int | None = None, label_map: Mapping[str, str] | None = None,
@@ -137,9 +147,7 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     rate = model.marker_rate
     if n_frames is None:
         n_frames = int(np.floor(duration * rate + 1e-9)) + 1
-    if n_frames < 2 or duration < 2.0 / rate:
-        raise InputError(audio_source or source,
-                         f"the audio is too short ({duration * 1000:.1f} ms) to synthesize")
+    check_length(model, len(audio), sample_rate, audio_source or source, n_frames)
     times = np.arange(n_frames) / rate
     mc = model.config
     threads = frame_threads()

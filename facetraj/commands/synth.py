@@ -13,21 +13,18 @@ log = logging.getLogger("facetraj")
 
 
 def cmd_synth(args: argparse.Namespace) -> int:
-    from engine.errors import InputError
     from engine.evaluation.tuning import TUNED_FIELDS, tuned_config
     from engine.io.audio import read_audio
     from engine.io.export import write_trajectories
     from engine.io.labelling import labels_for_audio
     from engine.labels.labelmap import read_label_map
     from engine.method.model import Model
-    from engine.method.pipeline import mode_for, synthesize
+    from engine.method.pipeline import check_length, mode_for, synthesize
 
     model = Model.load(args.model)
     audio, rate = read_audio(args.audio)
     cfg = synth_config(args)
-    if len(audio) < 2.0 / model.marker_rate * rate:       # before the labels are checked against it
-        raise InputError(args.audio, f"the audio is too short ({len(audio) / rate * 1000:.1f} ms) "
-                                     "to synthesize")
+    check_length(model, len(audio), rate, str(args.audio))  # before the labels are checked
     labels = None
     if cfg.mode in ("phonetic", "robust"):
         labels = labels_for_audio(args.audio, audio, rate, labels=args.labels, text=args.text,

@@ -1,0 +1,98 @@
+"""The app opening each kind of bad file (issue 26): an error dialog naming the file appears and
+the window keeps running. The same probe as the fuzz run's app cases (tests/fuzz_app.py), in a
+real window under Xvfb with pytest-qt."""
+
+from __future__ import annotations
+
+import random
+import shutil
+from collections import Counter
+
+import pytest
+from fuzz_app import AppProbe
+from fuzzing import _judge_app, app_cases, make_workspace
+
+pytestmark = pytest.mark.gui
+
+WAIT_MS = 60_000
+
+
+@pytest.fixture(scope="module")
+def workspace(tmp_path_factory, toy_corpus_dir, toy_model):
+    root = tmp_path_factory.mktemp("appfuzz")
+    toy_model.save(root / "toy-model.npz")
+    return make_workspace(root, toy_corpus_dir, root / "toy-model.npz")
+
+
+@pytest.fixture
+def probe(qtbot, workspace):
+    from app.main import build_window
+
+    win = build_window(workspace.corpus, model=workspace.model, use_audio=False)
+    qtbot.addWidget(win)
+    win.set_correlation_sweep(False)
+    win.resize(1280, 800)
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        win.show()
+    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    yield AppProbe(win)
+    win.close()
+
+
+def test_each_kind_of_bad_file_gives_a_dialog_and_the_window_runs_on(probe, workspace, qtbot):
+    rng = random.Random(26)
+    gen = app_cases(workspace, rng)
+    outcomes = []
+    for _ in range(36):
+        case = next(gen)
+        report = probe.run(case.app)
+        outcomes.append((case, report, _judge_app(case, report, 0)))
+    failures = [(c.name, c.app, r) for c, r, o in outcomes if o.failed]
+    assert not failures, failures
+    kinds = Counter(c.name.split(":")[0] for c, _, o in outcomes if o.status == "refused")
+    # every kind of input gave at least one error dialog naming its file
+    assert set(kinds) >= {"audio", "labels", "model", "corpus", "c3d"}, kinds
+    # and the window still plays
+    win = probe.win
+    win.open_corpus(workspace.corpus, workspace.model)
+    qtbot.waitUntil(lambda: not win.busy and win.view is not None, timeout=WAIT_MS)
+    win.seek(0.0)
+    start = win.displayed_frame
+    win.play()
+    qtbot.waitUntil(lambda: win.displayed_frame >= start + 5, timeout=10_000)
+    win.pause()
+
+
+def test_transcript_that_is_not_utf8_beside_the_audio(probe, workspace, tmp_path):
+    """It ended the app (an exception escaping into Qt), found by the fuzz run; now a dialog."""
+    shutil.copy(workspace.wav, tmp_path / "speech.wav")
+    (tmp_path / "speech.txt").write_bytes(b"caf\xe9 \xff")
+    report = probe.run(["audio", str(tmp_path / "speech.wav"), ""])
+    assert report["status"] == "dialog"
+    assert report["message"] == f"{tmp_path / 'speech.txt'}: the transcript is not UTF-8 text"
+    assert probe.alive()
+
+
+def test_audio_too_short_names_the_file(probe, workspace, tmp_path):
+    import soundfile as sf
+
+    x, rate = sf.read(workspace.wav)
+    sf.write(tmp_path / "blip.wav", x[:100], rate)
+    report = probe.run(["audio", str(tmp_path / "blip.wav"), ""])
+    assert report["status"] == "dialog"
+    assert report["message"].startswith(f"{tmp_path / 'blip.wav'}: the audio is too short")
+
+
+def test_label_file_in_another_alphabet_opens(probe, workspace, tmp_path):
+    from fuzzing import SPELLINGS, _write_label_file
+
+    from engine.data import PhoneSegment
+    from engine.io.labelfiles import read_labels
+
+    segs = [PhoneSegment(s.start, s.end, SPELLINGS["IPA"][s.label][0])
+            for s in read_labels(workspace.textgrid)]
+    _write_label_file(tmp_path / "ipa.lab", segs)
+    report = probe.run(["audio", str(workspace.wav), str(tmp_path / "ipa.lab")])
+    assert report["status"] == "opened", report
+    utt = probe.win.view.utterance
+    assert [p.label for p in utt.phones] == [s.label for s in read_labels(workspace.textgrid)]
