@@ -59,6 +59,16 @@ def toy_model(toy_corpus):
 
 
 @pytest.fixture(scope="session")
+def fuzz_workspace(tmp_path_factory, toy_corpus_dir, toy_model):
+    """The fuzz suite's valid inputs (tests/fuzzing.py): three toy utterances and a toy model."""
+    from fuzzing import make_workspace
+
+    root = tmp_path_factory.mktemp("fuzz")
+    toy_model.save(root / "toy-model.npz")
+    return make_workspace(root, toy_corpus_dir, root / "toy-model.npz")
+
+
+@pytest.fixture(scope="session")
 def default_corpus():
     from engine.io.corpus import load_corpus
 

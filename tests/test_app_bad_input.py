@@ -10,7 +10,7 @@ from collections import Counter
 
 import pytest
 from fuzz_app import AppProbe
-from fuzzing import _judge_app, app_cases, make_workspace
+from fuzzing import _judge_app, app_cases
 
 pytestmark = pytest.mark.gui
 
@@ -18,10 +18,8 @@ WAIT_MS = 60_000
 
 
 @pytest.fixture(scope="module")
-def workspace(tmp_path_factory, toy_corpus_dir, toy_model):
-    root = tmp_path_factory.mktemp("appfuzz")
-    toy_model.save(root / "toy-model.npz")
-    return make_workspace(root, toy_corpus_dir, root / "toy-model.npz")
+def workspace(fuzz_workspace):
+    return fuzz_workspace
 
 
 @pytest.fixture

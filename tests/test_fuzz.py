@@ -23,7 +23,6 @@ from fuzzing import (
     CATEGORIES,
     _c3d_rate,
     cases,
-    make_workspace,
     run_case,
     run_forked,
     run_in_process,
@@ -38,10 +37,8 @@ N_CASES = 420
 
 
 @pytest.fixture(scope="module")
-def workspace(tmp_path_factory, toy_corpus_dir, toy_model):
-    root = tmp_path_factory.mktemp("fuzz")
-    toy_model.save(root / "toy-model.npz")
-    return make_workspace(root, toy_corpus_dir, root / "toy-model.npz")
+def workspace(fuzz_workspace):
+    return fuzz_workspace
 
 
 #: the in-process run's categories: the app's are driven by tests/test_app_bad_input.py
