@@ -1,6 +1,6 @@
 """The options and the end of the commands that work through a whole corpus (``eval``,
-``sweep``, ``train``, ``corpus align``, ``report``): ``--jobs`` and ``--skip-bad``, the summary of
-what was skipped, and the exit status.
+``sweep``, ``train``, ``corpus align``, ``report``, and ``corpus show``): ``--jobs`` and
+``--skip-bad``, the summary of what was skipped, and the exit status.
 
 Without ``--skip-bad`` the first bad file stops the command with its one-line error (exit status
 2), with any number of jobs. With it, each utterance (or recording) with a bad file is left out,
@@ -23,10 +23,12 @@ EXIT_INCOMPLETE = 3
 
 
 def add_corpus_work_options(p: argparse.ArgumentParser, noun: str = "utterances",
-                            jobs_default: str = "every core") -> None:
-    """``--jobs/-j N`` and ``--skip-bad`` (``noun``: what the command works through)."""
-    p.add_argument("--jobs", "-j", type=integer(1, 256), metavar="N",
-                   help=f"{noun} processed in N processes (default: {jobs_default})")
+                            jobs_default: str = "every core", jobs: bool = True) -> None:
+    """``--jobs/-j N`` (unless ``jobs`` is off) and ``--skip-bad`` (``noun``: what the command
+    works through)."""
+    if jobs:
+        p.add_argument("--jobs", "-j", type=integer(1, 256), metavar="N",
+                       help=f"{noun} processed in N processes (default: {jobs_default})")
     p.add_argument("--skip-bad", action="store_true",
                    help=f"leave out {noun} whose files are bad and go on: the command ends with "
                         f"a summary ('2 of 280 {noun} skipped: FILE: PROBLEM') and exit status 3, "

@@ -283,3 +283,12 @@ def test_warnings_once_per_file_and_once_per_corpus(corpus_with_a_bad_file, toy_
         assert hits[0].endswith("later frames are treated as unseen")
     assert said.count("markers shorter than the audio (later frames are treated as unseen): "
                       "2 files") == 1
+
+
+def test_corpus_show_lists_the_good_utterances_with_skip_bad(corpus_with_a_bad_file, capsys):
+    root = corpus_with_a_bad_file
+    code, out, err = _run(["corpus", "show", root, "--skip-bad", "-q"], capsys)
+    assert code == 3 and f"1 of 3 utterances skipped: {root / BAD}" in err
+    assert [ln.split()[1] for ln in out.splitlines()[2:]] == ["toy000", "toy030"]
+    code, out, err = _run(["corpus", "show", root, "-q"], capsys)
+    assert code == 2 and err.startswith(f"facetraj: error: {root / BAD}")

@@ -53,12 +53,14 @@ def cmd_corpus_show(args: argparse.Namespace) -> int:
     print(f"{info.name or corpus.root.name}: {len(info.train)} train, {len(info.test)} test, "
           f"{len(info.marker_names)} markers at {info.marker_rate:g} Hz ({info.dimensions}-D)")
     print(f"fixed: {' '.join(info.fixed_markers)}; lips: {info.upper_lip} / {info.lower_lip}")
+    from engine.fanout import fan_out
+
+    skipped = skips(args)
     for split in ("train", "test"):
-        for utt_id in getattr(info, split):
-            utt = corpus.utterance(utt_id)
+        for utt_id, utt in fan_out(corpus.utterance, getattr(info, split), skip=skipped):
             print(f"{split:<5} {utt_id:<12} {utt.duration:6.2f} s {len(utt.phones):4d} phones  "
                   f"{utt.text}")
-    return 0
+    return finish(skipped)
 
 
 def cmd_corpus_align(args: argparse.Namespace) -> int:
@@ -108,6 +110,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     i.set_defaults(func=cmd_corpus_init)
     sh = csub.add_parser("show", help="list a corpus's utterances")
     sh.add_argument("corpus", type=Path, help="corpus folder or description .json")
+    add_corpus_work_options(sh, jobs=False)
     sh.set_defaults(func=cmd_corpus_show)
     a = csub.add_parser("align", help="phone labels (TextGrids) for every recording of a folder, "
                                       "aligned from its .txt transcripts")
