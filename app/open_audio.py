@@ -31,7 +31,7 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from engine.data import Utterance
+from engine.data import Provenance, Utterance
 from engine.errors import FacetrajError, InputError
 from engine.io.audio import read_audio
 from engine.labels.phoneset import ARPABET
@@ -40,7 +40,7 @@ if TYPE_CHECKING:   # the labelling engine is imported when audio is opened (iss
     import numpy as np
 
     from engine.io.corpus import Corpus
-    from engine.labels.alignment import Labels
+    from engine.labels.provenance import Labels
     from engine.method.model import Model
 
     from .viewer_model import UtteranceView
@@ -152,7 +152,8 @@ class OpenedAudio:
 
     def labels_for(self, source: str) -> Labels | None:
         """Labels of ``source`` (computed on the first call: run in a worker)."""
-        from engine.io.labelling import file_labels, label_audio
+        from engine.io.labelfiles import read_label_file
+        from engine.io.labelling import label_audio
 
         if source not in self.labels:
             if source == "none":
@@ -160,7 +161,7 @@ class OpenedAudio:
             elif source == "file":
                 if self.label_file is None:
                     raise InputError(self.path, "no label file beside the audio")
-                self.labels[source] = file_labels(self.label_file, self.rate,
+                self.labels[source] = read_label_file(self.label_file, self.rate,
                                                   len(self.audio) / self.rate)
             elif source == "aligned":
                 if not self.text:
@@ -179,7 +180,9 @@ class OpenedAudio:
                          words=list(labels.words) if labels else [], markers=None,
                          marker_rate=marker_rate, marker_names=list(marker_names),
                          text=self.text or "",
-                         label_source=labels.source if labels else "none")
+                         label_source=labels.source if labels else "none",
+                         provenance=labels.provenance if labels else Provenance(),
+                         confidence=labels.trust() if labels else None)
 
 
 class LabelSourceBox(QWidget):

@@ -40,6 +40,7 @@ class UtteranceView:
     triangular, spline : ``(T, M, 3)`` the synthesis smoothed each way (paper Figure 4).
     speech : ``(T,)`` bool, speech frames (112 ms median-filtered energy, paper section 3).
     times : ``(T,)`` frame times in seconds.
+    mode_reason : why the synthesis runs in its mode (:func:`engine.method.modes.choose_mode`).
     """
 
     utterance: Utterance
@@ -50,6 +51,7 @@ class UtteranceView:
     spline: np.ndarray
     speech: np.ndarray
     times: np.ndarray
+    mode_reason: str = ""
 
     @property
     def shown(self) -> np.ndarray:
@@ -74,15 +76,19 @@ class UtteranceView:
         return frame_index(t, self.rate, self.n_frames, step)
 
 
-def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig) -> UtteranceView:
-    """Synthesize ``utt`` with ``config`` and derive every track the window shows (slow: run in a
-    worker). Raises the engine's :class:`~engine.errors.FacetrajError` on bad input."""
+def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig,
+               mode_reason: str = "") -> UtteranceView:
+    """Synthesize ``utt`` with ``config`` (its labels weighed by their confidence) and derive
+    every track the window shows (slow: run in a worker). Raises the engine's
+    :class:`~engine.errors.FacetrajError` on bad input."""
     n_frames = utt.n_frames or None
     res = synthesize(model, utt.audio, utt.sample_rate, utt.phones if utt.phones else None, config,
-                     n_frames=n_frames, source=utt.name)
+                     n_frames=n_frames, source=utt.name, confidence=utt.confidence,
+                     provenance=utt.provenance)
     original = model.normalise_markers(utt.markers) if utt.markers is not None else None
     triangular = res.markers if config.smoothing == "triangular" else resmooth(model, res, "triangular")
     spline = res.markers if config.smoothing == "spline" else resmooth(model, res, "spline")
     speech = speech_mask(utt.audio, utt.sample_rate, res.times)
     return UtteranceView(utterance=utt, split=split, synthesis=res, original=original,
-                         triangular=triangular, spline=spline, speech=speech, times=res.times)
+                         triangular=triangular, spline=spline, speech=speech, times=res.times,
+                         mode_reason=mode_reason)

@@ -95,6 +95,10 @@ class SynthConfig:
         times the label's confidence.
     context_weight : robust mode: rho, the weight of the context frames in the distance.
     mean_normalise : robust mode: move the input LSFs' mean to the training speaker's.
+    closure : after the smoothing, close the lips at the labelled /p b m/ and rest the face in
+        pauses (``engine.method.closure``, beyond the paper; the paper's tables run without it).
+    closure_taper_s : the closure's raised-cosine tapers outside each /p b m/.
+    rest_pause_s, rest_taper_s : pauses longer than this rest the face; the tapers inside them.
     """
 
     n_context_phones: int = 3
@@ -115,6 +119,10 @@ class SynthConfig:
     label_weight: float = 16.0
     context_weight: float = 1.0
     mean_normalise: bool = False
+    closure: bool = True
+    closure_taper_s: float = 0.05
+    rest_pause_s: float = 0.15
+    rest_taper_s: float = 0.05
 
     def with_(self, **changes) -> SynthConfig:
         """A copy with some fields changed."""
@@ -122,3 +130,34 @@ class SynthConfig:
 
     def to_dict(self) -> dict:
         return asdict(self)
+
+
+@dataclass(frozen=True)
+class EvalConfig:
+    """Evaluation settings.
+
+    Attributes
+    ----------
+    energy_window_s, energy_hop_s : short-time energy analysis (Hamming window, hop).
+    median_s : median filter over the energy contour (the paper: 112 ms) so that stop closures
+        inside speech are kept.
+    threshold_fraction : speech where the filtered energy in dB exceeds
+        ``floor + fraction * (peak - floor)``, floor and peak being the 5th and 99th percentiles of
+        the utterance's energy in dB.
+    moving_fraction : "whole face" averages over the coordinates whose training standard deviation
+        (head-normalised) is at least this fraction of the largest one.
+    by_labels : the synthesis mode follows each utterance's labels, as in every command
+        (:func:`engine.method.modes.choose_mode`: acoustic-only without labels, robust with the
+        model's cross-validated settings for labels that are not hand-checked); ``False``: each
+        config's mode is used as it is (the paper's tables, ablations).
+    keep : with ``by_labels``, the settings of the configs that the model's cross-validated ones
+        must not replace (set by the user; N in the N sweep).
+    """
+
+    energy_window_s: float = 0.02
+    energy_hop_s: float = 0.004
+    median_s: float = 0.112
+    threshold_fraction: float = 0.3
+    moving_fraction: float = 0.1
+    by_labels: bool = False
+    keep: tuple[str, ...] = ()

@@ -14,7 +14,8 @@ from engine.config import SynthConfig
 from engine.errors import InputError
 from engine.evaluation.label_eval import LabelEval, evaluate_kind, format_markdown
 from engine.evaluation.scores import UtteranceScore
-from engine.evaluation.tuning import cross_validate, fold_ids, tuned_config
+from engine.evaluation.tuning import cross_validate, fold_ids
+from engine.method.modes import tuned_config
 from facetraj.cli import main
 
 

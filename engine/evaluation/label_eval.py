@@ -24,11 +24,12 @@ from ..io.corpus import Corpus
 from ..io.files import read_json, write_json
 from ..io.labelling import RelabelledCorpus, relabelled
 from ..method.model import Model
+from ..method.modes import tuned_config
 from ..method.pipeline import synthesize
 from ..method.training import train
 from .baselines import evaluate_baselines, fit_baselines, frame_data
 from .scores import METRICS, UtteranceScore, evaluate_utterance, speech_mask
-from .tuning import Tuning, cross_validate, tuned_config
+from .tuning import Tuning, cross_validate
 
 log = logging.getLogger(__name__)
 
@@ -123,9 +124,11 @@ def evaluate_kind(corpus: Corpus, kind: str, train_config: TrainConfig | None = 
             progress(0.0, f"{kind}: training")
         model = train(lab, config=train_config)
     tuning = cross_validate(lab, train_config, conf) if tune else None
-    robust = tuned_config(SynthConfig(mode="robust"), tuning.to_json() if tuning else model.tuned)
-    configs = {"robust": robust, "phonetic": SynthConfig(mode="phonetic"),
-               "acoustic": SynthConfig(mode="acoustic"), "phonetic-tuned": phonetic_tuned(robust)}
+    robust = tuned_config(SynthConfig(mode="robust", closure=False),
+                          tuning.to_json() if tuning else model.tuned)
+    configs = {"robust": robust, "phonetic": SynthConfig(mode="phonetic", closure=False),
+               "acoustic": SynthConfig(mode="acoustic", closure=False),
+               "phonetic-tuned": phonetic_tuned(robust)}
     test = list(lab.info.test)
     if max_test is not None and len(test) > max_test:
         test = [test[int(i)] for i in np.linspace(0, len(test) - 1, max_test)]
@@ -160,7 +163,7 @@ def phonetic_tuned(robust: SynthConfig) -> SynthConfig:
     >>> (c.mode, c.n_context_phones, c.triangle_s, c.xi)
     ('phonetic', 6, 0.067, 20.0)
     """
-    return SynthConfig(mode="phonetic", n_context_phones=robust.n_context_phones,
+    return SynthConfig(mode="phonetic", closure=False, n_context_phones=robust.n_context_phones,
                        triangle_s=robust.triangle_s, xi=robust.xi, gamma_max=robust.gamma_max)
 
 

@@ -33,11 +33,6 @@ DEFAULT_GRID: tuple[dict, ...] = tuple(
     for n in (3, 6) for k in (4.0, 16.0) for c in (16, 32) for g in (2.0, 5.0))
 #: Triangular smoothing widths searched (seconds).
 DEFAULT_WIDTHS = (0.067, 0.1, 0.133)
-#: Settings a tuning stores (the SynthConfig fields it may change).
-TUNED_FIELDS = ("n_context_phones", "xi", "label_weight", "context_weight", "robust_candidates",
-                "gamma_max", "triangle_s")
-
-
 @dataclass
 class Tuning:
     """The result of :func:`cross_validate`: the chosen ``settings`` (SynthConfig fields), and
@@ -51,25 +46,6 @@ class Tuning:
     def to_json(self) -> dict:
         return {"settings": self.settings, "scores": self.scores, "folds": self.folds,
                 "utterances": self.utterances, "split": "train"}
-
-
-def tuned_config(config: SynthConfig, tuned: Mapping, keep: Sequence[str] = ()) -> SynthConfig:
-    """``config`` with a model's cross-validated settings (robust mode only; fields unknown to
-    this facetraj, and the fields in ``keep`` -- set by the user -- are left alone).
-
-    >>> tuned_config(SynthConfig(mode="robust"), {"settings": {"label_weight": 2.0}}).label_weight
-    2.0
-    >>> tuned_config(SynthConfig(), {"settings": {"label_weight": 2.0}}).label_weight
-    16.0
-    >>> tuned_config(SynthConfig(mode="robust"), {"settings": {"label_weight": 2.0}},
-    ...              keep=("label_weight",)).label_weight
-    16.0
-    """
-    if config.mode != "robust" or not tuned:
-        return config
-    kw = {k: v for k, v in dict(tuned.get("settings", {})).items()
-          if k in TUNED_FIELDS and k not in keep}
-    return config.with_(**kw)
 
 
 def fold_ids(ids: Sequence[str], folds: int) -> list[list[str]]:
@@ -117,7 +93,7 @@ def cross_validate(corpus: Corpus, train_config: TrainConfig | None = None,
             conf = None if confidences is None else confidences.get(utt_id)
             n_scored += 1
             for g, settings in enumerate(grid):
-                cfg = SynthConfig(mode="robust", smoothing="none", **settings)
+                cfg = SynthConfig(mode="robust", smoothing="none", closure=False, **settings)
                 res = synthesize(model, utt.audio, utt.sample_rate, utt.phones, cfg,
                                  n_frames=utt.n_frames, source=utt.name, lsf=lsf, confidence=conf)
                 for k, width in enumerate(widths):

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..data import LABEL_KINDS
 from ..errors import ModelFileError
 from .c3d_check import MAX_RATE, MIN_RATE
 
@@ -157,6 +158,16 @@ def check_meta(path: Path, meta: dict, newest: int, fmt: str) -> None:
     if not isinstance(tuned, dict) or not isinstance(tuned.get("settings", {}), dict) or \
             not all(_is_num(v) for v in tuned.get("settings", {}).values()):
         raise bad("tuned", "an object of cross-validated settings (numbers)")
+    closed, d0 = meta.get("closure_closed"), meta.get("voice_distance")
+    if closed is not None and (not _is_num(closed) or not abs(closed) < 1e6):
+        raise bad("closure_closed", "a lip aperture in mm")
+    if d0 is not None and (not _is_num(d0) or not 0 < d0 < 1e6):
+        raise bad("voice_distance", "a positive number")
+    kinds = meta.get("trained_labels", {})
+    if not isinstance(kinds, dict) or not all(k in LABEL_KINDS and _is_int(n) and n >= 0
+                                              for k, n in kinds.items()):
+        raise bad("trained_labels", f"an object of utterance counts by label kind "
+                                    f"({', '.join(LABEL_KINDS)})")
 
 
 def check_config(path: Path, config: dict) -> None:
@@ -225,7 +236,11 @@ def check_arrays(path: Path, meta: dict, a: dict[str, np.ndarray]) -> None:
         "ix_centroids": ("f", (n_cells, p_order)), "ix_order": ("i", (n_ctx * n_per,)),
         "ix_offsets": ("i", (n_cells + 1,)),
         "cb_lsf_context": ("f", (n_ctx * n_per, 2, p_order)),
+        "closure_direction": ("f", (k,)), "rest_pcs": ("f", (k,)),
     }
+    if ("closure_closed" in meta) != ("closure_direction" in a) or \
+            ("closure_direction" in a) != ("rest_pcs" in a):
+        raise ModelFileError(path, "its closure statistics are incomplete (damaged file?)")
     for name, (kind, shape) in expect.items():
         if name not in a:
             continue

@@ -4,6 +4,7 @@ face with its sound; the results report with its figures)."""
 from __future__ import annotations
 
 import argparse
+import logging
 from pathlib import Path
 
 from engine.errors import FacetrajError
@@ -12,10 +13,13 @@ from ..options import FPS, add_synth_options, integer, synth_config, video_size
 from ..paths import default_corpus
 from ..progress import TerminalProgress
 
+log = logging.getLogger("facetraj")
+
 
 def cmd_video(args: argparse.Namespace) -> int:
     from engine.method.model import Model
-    from engine.method.pipeline import mode_for, synthesize
+    from engine.method.modes import choose_mode
+    from engine.method.pipeline import synthesize
 
     try:
         from app.video import VideoSettings, render_video
@@ -31,20 +35,26 @@ def cmd_video(args: argparse.Namespace) -> int:
             raise FacetrajError("give --utterance ID with --corpus")
         utt = load_corpus(args.corpus).utterance(args.utterance)
         audio, rate, phones, n_frames = utt.audio, utt.sample_rate, utt.phones, utt.n_frames
+        provenance, confidence = utt.provenance, utt.confidence
         original = model.normalise_markers(utt.markers) if utt.markers is not None else None
         title, source = utt.text or utt.name, utt.name
     elif args.audio:
         from engine.io.audio import read_audio
-        from engine.io.labelfiles import read_labels
+        from engine.io.labelfiles import read_label_file
 
         audio, rate = read_audio(args.audio)
-        phones = read_labels(args.labels, rate) if args.labels else None
+        labels = read_label_file(args.labels, rate, len(audio) / rate) if args.labels else None
+        phones = labels.phones if labels else None
+        provenance, confidence = (labels.provenance, labels.trust()) if labels else (None, None)
         n_frames, source, title = None, str(args.labels or args.audio), args.audio.name
     else:
         raise FacetrajError("give an AUDIO file, or --corpus and --utterance")
-    cfg = mode_for(synth_config(args), phones)
-    res = synthesize(model, audio, rate, phones, cfg, n_frames=n_frames, source=source,
-                     audio_source=str(args.audio or source))
+    choice = choose_mode(synth_config(args), phones, provenance, explicit=args.mode is not None,
+                         tuned=model.tuned)
+    log.info("%s", choice.describe())
+    res = synthesize(model, audio, rate, phones, choice.config, n_frames=n_frames, source=source,
+                     audio_source=str(args.audio or source), confidence=confidence,
+                     provenance=provenance)
     w, h = args.size
     render_video(model, res, audio, rate, args.output, original=original,
                  settings=VideoSettings(w, h, args.fps), overwrite=args.overwrite,
