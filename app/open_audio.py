@@ -280,12 +280,14 @@ class AudioOpener(QObject):
     # -- opening
     def open(self, audio_path: Path, labels_path: Path | None = None, text: str | None = None,
              recognize: bool = False, acoustic_only: bool = False,
-             extra_dict: dict[str, list[str]] | None = None) -> None:
+             extra_dict: dict[str, list[str]] | None = None) -> bool:
         """Open ``audio_path`` for synthesis; labels by ``engine.io.labelling.labels_for_audio``
-        (alignment in a worker), none with ``acoustic_only``."""
+        (alignment or recognition in a worker), none with ``acoustic_only``. False when the
+        audio cannot be read (the error is shown)."""
         read = self._read(audio_path)
         if read is not None:
             self._open(audio_path, read, labels_path, text, recognize, acoustic_only, extra_dict)
+        return read is not None
 
     def _open(self, audio_path: Path, read: tuple[np.ndarray, int],
               labels_path: Path | None = None, text: str | None = None, recognize: bool = False,
@@ -313,7 +315,8 @@ class AudioOpener(QObject):
                 return opened, "none"
             progress(0.1, f"labelling {audio_path.name}")
             labels = labels_for_audio(audio_path, audio, rate, labels=labels_path, text=sentence,
-                                      recognize=recognize, extra_dict=opened.extra_dict)
+                                      recognize=recognize, extra_dict=opened.extra_dict,
+                                      fallback=True)
             source = labels.source if labels else "none"
             opened.labels[source] = labels
             return opened, source

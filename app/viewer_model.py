@@ -89,6 +89,7 @@ class ViewerModel:
     view: UtteranceView | None = None
     pending_utterance: str | None = None     # asked for before the model was ready
     pending_time: float | None = None        # where the first utterance starts
+    show_default: bool = True                # show a corpus utterance first (not: recordings)
     request: SynthRequest | None = None      # the latest utterance asked for
     generation: int = 0
     mode_chosen: bool = False                # the user picked a search mode in the settings
@@ -101,7 +102,7 @@ class ViewerModel:
         self.external.clear()
         self.view = None
         self.request = None
-        first = self.pending_utterance or self.default_utterance()
+        first = self.pending_utterance or (self.default_utterance() if self.show_default else None)
         self.pending_utterance = None
         return first
 
@@ -235,7 +236,8 @@ def view_summary(view: UtteranceView) -> str:
     """The status line of a new view: frames, rate, speech frames, and the mode and why."""
     text = (f"{view.utterance.name}: {view.n_frames} frames at {view.rate:g} Hz, "
             f"{int(view.speech.sum())} speech frames")
-    return f"{text}; {view.mode_reason}" if view.mode_reason else text
+    text = f"{text}; {view.mode_reason}" if view.mode_reason else text
+    return f"{text}; voice match {view.voice_match:.2f}" if math.isfinite(view.voice_match) else text
 
 
 def read_texts(corpus: Corpus) -> dict[str, str]:

@@ -41,7 +41,7 @@ log = logging.getLogger(__name__)
 #: Automatic labelling methods (the :attr:`Labels.source` they produce).
 METHODS = ("aligned", "recognized")
 #: Bumped when this module's output for the same input changes (part of the cache key).
-LABELLER_VERSION = 1
+LABELLER_VERSION = 2     # 2: the all-phone search's lw 4 (issue 25)
 
 
 # --------------------------------------------------------------------------- one recording

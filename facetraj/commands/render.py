@@ -10,7 +10,7 @@ from pathlib import Path
 from engine.errors import FacetrajError
 
 from ..options import FPS, add_synth_options, integer, synth_config, video_size
-from ..paths import default_corpus
+from ..paths import default_corpus, shared_path
 from ..progress import TerminalProgress
 
 log = logging.getLogger("facetraj")
@@ -87,6 +87,21 @@ def cmd_report(args: argparse.Namespace) -> int:
         voices = evaluate_voices(load_corpus(args.corpus or default_corpus()), model=model,
                                  progress=TerminalProgress("second voice"))
         write_voice_eval(args.output / VOICE_EVAL_FILE, voices)
+    if args.closure:
+        from engine.evaluation.closure_eval import (
+            ARCTIC_DIR,
+            CLOSURE_EVAL_FILE,
+            evaluate_closure,
+            write_closure_eval,
+        )
+        from engine.io.corpus import load_corpus
+        from engine.method.training import train
+
+        corpus = load_corpus(args.corpus or default_corpus())
+        args.output.mkdir(parents=True, exist_ok=True)
+        result = evaluate_closure(model or train(corpus), corpus, shared_path(ARCTIC_DIR),
+                                  progress=TerminalProgress("closure"))
+        write_closure_eval(args.output / CLOSURE_EVAL_FILE, result)
     out = make_report(args.corpus, args.output, model=model, progress=TerminalProgress("report"),
                       ns=range(1, args.max_n + 1))
     print(out)
@@ -109,6 +124,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "test sentences (shorter vocal tract, higher pitch), with and without "
                         "speaker normalisation (about 8 minutes), saved as voice_eval.json beside "
                         "results.md and reported from it")
+    p.add_argument("--closure", action="store_true",
+                   help="also measure how the lips close at /p b m/ in every mode, on the held-out "
+                        "sentences and on real voices (../shared/data/arctic_samples when present; "
+                        "a few minutes), saved as closure_eval.json beside results.md")
     p.set_defaults(func=cmd_report)
 
     p = sub.add_parser("video", help="an MP4 of the face points and lip panels with the sound")
