@@ -93,6 +93,9 @@ class SynthConfig:
     robust_candidates : robust mode: acoustically nearest codewords added to eq 4's (index search).
     label_weight : robust mode: kappa, the cost (eq 5 units) of a codeword eq 4 did not choose,
         times the label's confidence.
+    label_weight_by_voice : robust mode: kappa times the input voice's distance ratio ``D / D0``
+        (at least 1; ``engine.method.voice_match``): eq 5's distances grow on a voice the codebook
+        does not know, and the labels must keep their weight against them.
     context_weight : robust mode: rho, the weight of the context frames in the distance.
     mean_normalise : robust mode: move the input LSFs' mean to the training speaker's.
     closure : after the smoothing, close the lips at the labelled /p b m/ and rest the face in
@@ -117,6 +120,7 @@ class SynthConfig:
     speaker_warp: float | None = 1.0
     robust_candidates: int = 32
     label_weight: float = 16.0
+    label_weight_by_voice: bool = True
     context_weight: float = 1.0
     mean_normalise: bool = False
     closure: bool = True

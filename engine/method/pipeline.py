@@ -61,7 +61,7 @@ class Synthesis:
     warp : the speaker warp factor applied to the input LSFs (``config.speaker_warp``).
     closure : where the closure step acted (:mod:`engine.method.closure`), ``None`` when off.
     voice_match : the input's voice match (:func:`input_voice_match`) when the synthesis needed
-        it (recognized labels), else NaN.
+        it (the robust mode, recognized labels), else NaN.
     """
 
     times: np.ndarray
@@ -116,6 +116,7 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     times, w, warp = _input(model, audio, sample_rate, n_frames, lsf, config,
                             audio_source or source)
     segs: list[PhoneSegment] | None = None
+    ratio = _voice_ratio(model, audio, sample_rate, times, w, config, provenance)
     segments: list[SegmentChoice] = []
     frame_seg = None
     if config.mode in ("phonetic", "robust"):
@@ -127,16 +128,18 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         if config.mode == "robust":
             conf = frame_confidence(list(phones), confidence, times)
             conf[unlabelled[frame_seg]] = 0.0
-            fw = _robust(model, w, candidates, conf, config)
+            scale = max(1.0, ratio) if config.label_weight_by_voice and np.isfinite(ratio) else 1.0
+            fw = _robust(model, w, candidates, conf, config, scale)
         else:
             fw = _weighted(model, w, lambda a, b: candidates[a:b], config)
     elif config.mode == "acoustic":
         fw = _weighted(model, w, lambda a, b: acoustic_candidates(model, w[a:b], config), config)
     else:
         raise ValueError(f"unknown mode {config.mode!r} (phonetic, acoustic or robust)")
-    plan, match = plan_closure(model, audio, sample_rate, times, w, segs, provenance, config)
+    plan = plan_closure(model, audio, sample_rate, times, segs, provenance, voice_match(ratio, 1.0),
+                        config)
     res = _finish(model, times, w, fw, config, segments, frame_seg, warp, plan)
-    res.voice_match = match
+    res.voice_match = voice_match(ratio, 1.0)
     return res
 
 
@@ -193,12 +196,13 @@ def _eq4(model: Model, segs: list[PhoneSegment], times: np.ndarray, config: Synt
 
 
 def _robust(model: Model, w: np.ndarray, candidates: np.ndarray, conf: np.ndarray,
-            config: SynthConfig) -> FrameWeights:
-    """The robust mode's eqs 5-8 (``engine.method.selection``)."""
+            config: SynthConfig, scale: float = 1.0) -> FrameWeights:
+    """The robust mode's eqs 5-8 (``engine.method.selection``), its label weight times
+    ``scale`` (the voice's distance ratio: eq 5's distances grow with it)."""
     cb, mc = model.codebook, model.config
     near = model.lsf_index().nearest(w, cb.lsf, config.robust_candidates, config.acoustic_probe or 8)
     return robust_frames(w, candidates, near, conf, cb.lsf, cb.pcs, _gammas(config),
-                         config.label_weight, cb.lsf_context,
+                         config.label_weight * scale, cb.lsf_context,
                          np.array([-mc.lsf_context_frames, mc.lsf_context_frames]),
                          config.context_weight)
 
@@ -241,32 +245,37 @@ def _smoothed(model: Model, raw: np.ndarray, times: np.ndarray, config: SynthCon
 
 
 def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
-                 w: np.ndarray, segs: Sequence[PhoneSegment] | None,
-                 provenance: Provenance | None, config: SynthConfig
-                 ) -> tuple[ClosurePlan | None, float]:
+                 segs: Sequence[PhoneSegment] | None, provenance: Provenance | None,
+                 match: float, config: SynthConfig) -> ClosurePlan | None:
     """Where the closure step acts (``None``: off, or a model file without its statistics): the
-    labelled /p b m/, trusted as :func:`~engine.method.closure.closure_strengths` says, and the
-    pauses by energy; and the input's voice match (computed only for recognized labels, which
-    it weighs; else NaN)."""
-    match = float("nan")
+    labelled /p b m/, trusted as :func:`~engine.method.closure.closure_strengths` says (for
+    recognized labels by the voice ``match``; NaN: unknown, untrusted), and the pauses by
+    energy."""
     if not config.closure or model.closure is None:
-        return None, match
+        return None
     intervals, strengths = np.zeros((0, 2)), np.zeros(0)
     if segs:
-        kind = (provenance or Provenance()).kind
-        if kind == "recognized":
-            match = input_voice_match(model, audio, sample_rate, times, w)
-        trust = closure_strengths(len(segs), kind, match if np.isfinite(match) else 1.0)
+        trust = closure_strengths(len(segs), (provenance or Provenance()).kind,
+                                  match if np.isfinite(match) else 1.0)
         intervals, strengths = closure_intervals(segs, trust)
-    return ClosurePlan(intervals, strengths,
-                       pauses(audio, sample_rate, times, config.rest_pause_s)), match
+    return ClosurePlan(intervals, strengths, pauses(audio, sample_rate, times, config.rest_pause_s))
 
 
-def input_voice_match(model: Model, audio: np.ndarray, sample_rate: int,
+def _voice_ratio(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
+                 w: np.ndarray, config: SynthConfig, provenance: Provenance | None) -> float:
+    """The input's voice distance ratio when the synthesis weighs by it (the robust mode's label
+    weight, the closure step's trust in recognized labels), else NaN (not computed)."""
+    recognized = provenance is not None and provenance.kind == "recognized"
+    if (config.mode == "robust" and config.label_weight_by_voice) or (config.closure and recognized):
+        return input_voice_ratio(model, audio, sample_rate, times, w)
+    return float("nan")
+
+
+def input_voice_ratio(model: Model, audio: np.ndarray, sample_rate: int,
                       times: np.ndarray | None = None, w: np.ndarray | None = None) -> float:
-    """The voice match (:mod:`engine.method.voice_match`) of an input: how well the codebook
-    knows its voice, from the audio alone (its LSFs ``w`` at ``times`` when already computed;
-    NaN for a model file without the training voice's figure)."""
+    """``D / D0`` (:mod:`engine.method.voice_match`): how far an input's voice is from the
+    codebook's, relative to the training voice's own figure, from the audio alone (its LSFs ``w``
+    at ``times`` when already computed; NaN for a model file without ``D0``)."""
     if not np.isfinite(model.voice_distance):
         return float("nan")
     if times is None or w is None:
@@ -274,8 +283,14 @@ def input_voice_match(model: Model, audio: np.ndarray, sample_rate: int,
             / model.marker_rate
         w = model.input_lsf(audio, sample_rate, times)
     speech = speech_mask(audio, sample_rate, times)
-    d = voice_distance(w, speech, model.codebook.lsf, model.lsf_index())
-    return voice_match(d, model.voice_distance)
+    return voice_distance(w, speech, model.codebook.lsf, model.lsf_index()) / model.voice_distance
+
+
+def input_voice_match(model: Model, audio: np.ndarray, sample_rate: int,
+                      times: np.ndarray | None = None, w: np.ndarray | None = None) -> float:
+    """The voice match in [0, 1] of an input (:func:`input_voice_ratio` through
+    :func:`engine.method.voice_match.voice_match`)."""
+    return voice_match(input_voice_ratio(model, audio, sample_rate, times, w), 1.0)
 
 
 def normalise_speaker(model: Model, w: np.ndarray, config: SynthConfig) -> tuple[np.ndarray, float]:
