@@ -29,13 +29,19 @@ def test_fold_ids_cover_training_once():
 def test_cross_validate_uses_training_split_only(toy_corpus):
     """The test split is never read: the corpus is given test ids that do not exist."""
     corpus = replace(toy_corpus, info=replace(toy_corpus.info, test=["no-such-utterance"]))
-    grid = ({"label_weight": 1.0, "context_weight": 0.0}, {"label_weight": 4.0, "context_weight": 1.0})
-    tuning = cross_validate(corpus, grid=grid, widths=(0.05, 0.1), folds=2, max_per_fold=2)
+    ladders = {"label_weight": (1.0, 4.0, 16.0), "context_weight": (0.0, 1.0)}
+    tuning = cross_validate(corpus, ladders=ladders, start={"label_weight": 4.0, "context_weight": 1.0},
+                            widths=(0.05, 0.1), folds=2, max_per_fold=2)
     assert tuning.utterances == 4
-    assert len(tuning.scores) == 4
     best = max(tuning.scores, key=lambda s: s["score"])
     assert tuning.settings == {k: v for k, v in best.items() if k != "score"}
     assert all(np.isfinite(s["score"]) and -1 <= s["score"] <= 1 for s in tuning.scores)
+    # the chosen value has a worse one on either side, or is the end of its ladder
+    for name, curve in tuning.curves.items():
+        values = [v for v, _ in curve]
+        k = values.index(tuning.settings[name])
+        assert name in tuning.at_end or 0 < k < len(values) - 1
+        assert max(s for _, s in curve) == curve[k][1]
     cfg = tuned_config(SynthConfig(mode="robust"), tuning.to_json())
     assert cfg.triangle_s == tuning.settings["triangle_s"]
     assert cfg.label_weight == tuning.settings["label_weight"]

@@ -22,7 +22,7 @@ import numpy as np
 from ..config import SynthConfig, TrainConfig
 from ..io.corpus import Corpus
 from ..io.files import read_json, write_json
-from ..io.labelling import RelabelledCorpus, relabelled
+from ..io.labelling import relabelled
 from ..method.model import Model
 from ..method.modes import tuned_config
 from ..method.pipeline import synthesize
@@ -104,13 +104,6 @@ def labelled_corpus(corpus: Corpus, kind: str,
     return relabelled(corpus, kind, progress=progress)
 
 
-def confidences(corpus: Corpus) -> dict[str, np.ndarray] | None:
-    """Per utterance, its labels' per-phone confidence (automatic labels), else ``None``."""
-    if not isinstance(corpus, RelabelledCorpus):
-        return None
-    return {u: lab.confidence for u, lab in corpus.auto.labels.items()}
-
-
 def evaluate_kind(corpus: Corpus, kind: str, train_config: TrainConfig | None = None,
                   model: Model | None = None, tune: bool = True, max_test: int | None = None,
                   progress: Callable[[float, str], None] | None = None
@@ -118,12 +111,11 @@ def evaluate_kind(corpus: Corpus, kind: str, train_config: TrainConfig | None = 
     """Train (unless ``model`` is given), cross-validate and score every method on the test split
     of ``corpus`` labelled by ``kind``."""
     lab = labelled_corpus(corpus, kind)
-    conf = confidences(lab)
     if model is None:
         if progress:
             progress(0.0, f"{kind}: training")
         model = train(lab, config=train_config)
-    tuning = cross_validate(lab, train_config, conf) if tune else None
+    tuning = cross_validate(lab, train_config) if tune else None
     robust = tuned_config(SynthConfig(mode="robust", closure=False),
                           tuning.to_json() if tuning else model.tuned)
     configs = {"robust": robust, "phonetic": SynthConfig(mode="phonetic", closure=False),
@@ -143,10 +135,10 @@ def evaluate_kind(corpus: Corpus, kind: str, train_config: TrainConfig | None = 
         original = model.normalise_markers(utt.markers)
         speech = speech_mask(utt.audio, utt.sample_rate, utt.frame_times())
         lsf = model.input_lsf(utt.audio, utt.sample_rate, np.arange(utt.n_frames) / model.marker_rate)
-        c = None if conf is None else conf.get(utt_id)
         for name, cfg in configs.items():
             res = synthesize(model, utt.audio, utt.sample_rate, utt.phones, cfg,
-                             n_frames=utt.n_frames, source=utt.name, lsf=lsf, confidence=c)
+                             n_frames=utt.n_frames, source=utt.name, lsf=lsf,
+                             confidence=utt.confidence, provenance=utt.provenance)
             scores.extend(replace(r, mode=name) for r in evaluate_utterance(
                 model, utt, "test", cfg, ("triangular",), synthesis=res, original=original,
                 speech=speech))
