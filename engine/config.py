@@ -98,6 +98,8 @@ class SynthConfig:
         does not know, and the labels must keep their weight against them.
     context_weight : robust mode: rho, the weight of the context frames in the distance.
     mean_normalise : robust mode: move the input LSFs' mean to the training speaker's.
+    chain_beta : robust mode: beta, the join cost's weight of the chain over frames that makes
+        the codeword weights consistent over time (``engine.method.chain``; 0: eq 8 frame by frame).
     closure : after the smoothing, close the lips at the labelled /p b m/ and rest the face in
         pauses (``engine.method.closure``, beyond the paper; the paper's tables run without it).
     closure_taper_s : the closure's raised-cosine tapers outside each /p b m/.
@@ -123,6 +125,7 @@ class SynthConfig:
     label_weight_by_voice: bool = True
     context_weight: float = 1.0
     mean_normalise: bool = False
+    chain_beta: float = 0.1
     closure: bool = True
     closure_taper_s: float = 0.05
     rest_pause_s: float = 0.15

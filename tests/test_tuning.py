@@ -81,7 +81,7 @@ def test_evaluate_kind_on_toy_corpus(toy_corpus, toy_model):
     scores, tuning = evaluate_kind(toy_corpus, "exact", model=toy_model, tune=False, max_test=2)
     assert tuning is None
     methods = {s.mode for s in scores}
-    assert methods == {"robust", "phonetic", "phonetic-tuned", "acoustic", "ridge", "viseme"}
+    assert methods == {"default", "robust", "phonetic", "phonetic-tuned", "acoustic", "ridge", "viseme"}
     assert all(len([s for s in scores if s.mode == m]) == 2 for m in methods)
     assert all(-1 <= s.whole_face <= 1 for s in scores)
 
@@ -96,3 +96,14 @@ def test_label_eval_file_round_trip(tmp_path):
     assert back.summary("recognized", "robust") == res.summary("recognized", "robust")
     assert back.tunings == res.tunings
     assert "label_weight = 4" in format_markdown(back)
+
+
+def test_evaluate_kind_scores_the_second_voice_too(toy_corpus, toy_model):
+    scores, _, voice2 = evaluate_kind(toy_corpus, "exact", model=toy_model, tune=False, max_test=2,
+                                      second=True)
+    assert {s.mode for s in voice2} == {"default", "robust", "phonetic", "acoustic"}
+    assert [s.utterance for s in voice2 if s.mode == "default"] == \
+        [s.utterance for s in scores if s.mode == "default"]
+    by = {(s.mode, s.utterance): s.whole_face for s in scores}
+    assert any(abs(by[("acoustic", s.utterance)] - s.whole_face) > 1e-6     # another voice: other sounds
+               for s in voice2 if s.mode == "acoustic")

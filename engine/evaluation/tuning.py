@@ -38,6 +38,7 @@ LADDERS: dict[str, tuple] = {
     "label_weight": (0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0),
     "robust_candidates": (8, 16, 32, 64, 128),
     "gamma_max": (1.0, 2.0, 3.0, 5.0, 8.0, 12.0),
+    "chain_beta": (0.0, 0.03, 0.1, 0.2, 0.4, 0.8),
 }
 #: Where the search starts: the defaults of SynthConfig.
 START = {k: getattr(SynthConfig(), k) for k in LADDERS}

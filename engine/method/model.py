@@ -10,6 +10,7 @@ import json
 import logging
 import os
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +20,7 @@ from ..config import TrainConfig
 from ..errors import ModelFileError
 from ..io.files import atomic_write
 from ..io.model_file import read_model_file
+from .chain import join_scale
 from .closure import ClosureStats
 from .codebook import Codebook
 from .lsf import lsf_at
@@ -88,6 +90,13 @@ class Model:
     voice_distance: float = float("nan")
 
     # ------------------------------------------------------------------ derived quantities
+    @cached_property
+    def join_scale(self) -> float:
+        """``s^2`` of the chain's join cost (:func:`engine.method.chain.join_scale`), from the
+        codebook."""
+        cb = self.codebook
+        return join_scale(cb.pcs, cb.token_start, cb.token_end, cb.n_per_phone, self.marker_rate)
+
     @property
     def trained_on_hand_checked(self) -> bool:
         """Whether every training utterance's labels were hand-checked (older files: assumed)."""

@@ -22,7 +22,7 @@ from ..data import PhoneSegment, Provenance
 
 #: Settings a tuning stores and :func:`tuned_config` applies (the SynthConfig fields it may change).
 TUNED_FIELDS = ("n_context_phones", "xi", "label_weight", "context_weight", "robust_candidates",
-                "gamma_max", "triangle_s")
+                "gamma_max", "triangle_s", "chain_beta")
 
 
 @dataclass(frozen=True)

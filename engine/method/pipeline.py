@@ -21,6 +21,7 @@ from ..errors import InputError
 from ..io.labelfiles import validate_phones
 from ..labels.phoneset import SILENCE, map_labels, normalise_label
 from ..threads import frame_threads, map_spans
+from .chain import chain_pcs
 from .closure import ClosurePlan, aperture_functional, apply_closure, closure_intervals, closure_strengths
 from .context import context_ids, segment_index
 from .model import Model
@@ -198,13 +199,17 @@ def _eq4(model: Model, segs: list[PhoneSegment], times: np.ndarray, config: Synt
 def _robust(model: Model, w: np.ndarray, candidates: np.ndarray, conf: np.ndarray,
             config: SynthConfig, scale: float = 1.0) -> FrameWeights:
     """The robust mode's eqs 5-8 (``engine.method.selection``), its label weight times
-    ``scale`` (the voice's distance ratio: eq 5's distances grow with it)."""
+    ``scale`` (the voice's distance ratio: eq 5's distances grow with it), eq 8 over the frames'
+    chain (``engine.method.chain``)."""
     cb, mc = model.codebook, model.config
     near = model.lsf_index().nearest(w, cb.lsf, config.robust_candidates, config.acoustic_probe or 8)
-    return robust_frames(w, candidates, near, conf, cb.lsf, cb.pcs, _gammas(config),
-                         config.label_weight * scale, cb.lsf_context,
-                         np.array([-mc.lsf_context_frames, mc.lsf_context_frames]),
-                         config.context_weight)
+    fw = robust_frames(w, candidates, near, conf, cb.lsf, cb.pcs, _gammas(config),
+                       config.label_weight * scale, cb.lsf_context,
+                       np.array([-mc.lsf_context_frames, mc.lsf_context_frames]),
+                       config.context_weight)
+    if config.chain_beta > 0:                 # the weights made consistent over time
+        fw.pcs = chain_pcs(fw.weights, fw.candidates, cb.pcs, config.chain_beta, model.join_scale)
+    return fw
 
 
 def _weighted(model: Model, w: np.ndarray, candidates: Callable[[int, int], np.ndarray],
