@@ -274,12 +274,33 @@ def format_markdown(result: LabelEval) -> str:
             s = result.summary(kind, m)
             lines.append(f"| {m} ({METHOD_NOTES[m]}) | {mean_sd(s['whole_face'])} | "
                          f"{mean_sd(s['lower_lip'])} | {mean_sd(s['upper_lip'])} | {len(rows)} |")
-        tuned = result.tunings.get(kind, {}).get("settings")
-        if tuned:
-            lines += ["", "Robust settings chosen by cross-validation on the training split: "
-                      + ", ".join(f"{k} = {v:g}" for k, v in tuned.items()) + "."]
+        lines += tuning_lines(result.tunings.get(kind, {}))
     lines += ["", recommendation(result)]
     return "\n".join(lines)
+
+
+def tuning_lines(tuning: dict) -> list[str]:
+    """The settings cross-validation chose, and each one's curve: its held-out score at every
+    value tried with the others at their chosen values (the chosen value in bold).
+
+    >>> text = tuning_lines({"settings": {"chain_beta": 0.1, "triangle_s": 0.067},
+    ...                      "curves": {"chain_beta": [[0.03, 0.91], [0.1, 0.92], [0.2, 0.915]]}})[1]
+    >>> text.split(": ", 2)[2]
+    'chain_beta 0.03: 0.9100, **0.1: 0.9200**, 0.2: 0.9150.'
+    """
+    settings = tuning.get("settings")
+    if not settings:
+        return []
+    text = ("Settings chosen by cross-validation on the training split: "
+            + ", ".join(f"{k} = {v:g}" for k, v in settings.items()) + ".")
+    curves = tuning.get("curves") or {}
+    if curves:
+        text += " Cross-validation curves (mean held-out correlation): " + "; ".join(
+            f"{name} " + ", ".join(f"**{v:g}: {s:.4f}**" if v == settings.get(name) else f"{v:g}: {s:.4f}"
+                                   for v, s in curve) for name, curve in curves.items()) + "."
+    if tuning.get("at_end"):
+        text += f" At the end of their range: {', '.join(tuning['at_end'])}."
+    return ["", text]
 
 
 def recommendation(result: LabelEval) -> str:
