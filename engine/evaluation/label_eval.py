@@ -27,7 +27,7 @@ import numpy as np
 from ..config import SynthConfig, TrainConfig
 from ..io.corpus import Corpus
 from ..io.files import read_json, write_json
-from ..io.labelling import label_audio, relabelled, with_labels
+from ..io.labelling import label_utterance, relabelled, with_labels
 from ..method.model import Model
 from ..method.modes import choose_mode, tuned_config
 from ..method.pipeline import synthesize
@@ -180,18 +180,18 @@ def second_voice_scores(model: Model, lab: Corpus, kind: str, test: Sequence[str
                         progress: Callable[[float, str], None] | None = None
                         ) -> list[UtteranceScore]:
     """The test sentences spoken by the second voice (same timing, so the same markers), labelled
-    from their own audio as ``kind`` says (exact labels stay), under :data:`SECOND_VOICE_METHODS`."""
+    from their own audio as ``kind`` says (exact labels stay; a sentence that does not align is
+    recognized, as ``corpus align`` does), under :data:`SECOND_VOICE_METHODS`."""
     configs = {k: v for k, v in method_configs(model).items() if k in SECOND_VOICE_METHODS}
     out = []
     for j, utt_id in enumerate(test):
         if progress:
             progress(j / max(len(test), 1), f"{kind}, second voice: {utt_id}")
         utt = lab.utterance(utt_id)
-        audio = second_voice(utt.audio, utt.sample_rate)
+        utt = replace(utt, audio=second_voice(utt.audio, utt.sample_rate))
         if kind != "exact":
-            labels = label_audio(audio, utt.sample_rate, kind, utt.text)
-            utt = with_labels(utt, labels)
-        out.extend(score_methods(model, replace(utt, audio=audio), configs))
+            utt = with_labels(utt, label_utterance(utt, kind)[0])
+        out.extend(score_methods(model, utt, configs))
     return out
 
 
