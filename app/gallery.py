@@ -202,7 +202,8 @@ def video_figures(out: Path) -> list[Path]:
 
     from engine.config import SynthConfig
     from engine.io.corpus import load_corpus
-    from engine.method.pipeline import mode_for, synthesize
+    from engine.method.modes import choose_mode
+    from engine.method.pipeline import synthesize
 
     from .cache import load_or_train
     from .video import VideoFrames, VideoSettings
@@ -218,7 +219,7 @@ def video_figures(out: Path) -> list[Path]:
         ("video_frame_acoustic.png", (1280, 544), [])]
     for name, size, phones in cases:
         res = synthesize(model, utt.audio, utt.sample_rate, phones or None,
-                         mode_for(SynthConfig(), phones), n_frames=utt.n_frames)
+                         choose_mode(SynthConfig(), phones).config, n_frames=utt.n_frames)
         frames = VideoFrames(model, res, original, phones, VideoSettings(*size),
                              title=utt.text or utt.name)
         try:

@@ -82,8 +82,11 @@ def build_window(corpus: Path | str | None, model: Path | None = None, utterance
 
 
 def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | None = None,
-            time: float | None = None, model: Path | None = None) -> int:
-    """Open the main window on ``corpus``; with ``screenshot``, render it to that PNG and exit.
+            time: float | None = None, model: Path | None = None,
+            recordings: list[Path] | None = None) -> int:
+    """Open the main window on ``corpus`` (and ``recordings`` without face data, synthesized with
+    its model: :class:`app.recordings.RecordingQueue`); with ``screenshot``, render it to that
+    PNG and exit.
 
     Returns the process exit status (2 when the corpus, model or utterance cannot be used in
     screenshot mode).
@@ -103,6 +106,10 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
     mark("QApplication")
     with long_lived_objects():
         window = build_window(corpus, model=model, utterance=utterance, time=time)
+    if recordings:
+        from .recordings import RecordingQueue
+
+        window.add_extension("recordings", RecordingQueue(window, recordings))
     window.resize(*WINDOW_SIZE)
     status = {"code": 0}
     if screenshot:

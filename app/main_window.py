@@ -475,11 +475,11 @@ class MainWindow(QMainWindow):
             self.face.prepare_frame(self.view.frame_at(t))
 
     # ================================================================== files
-    def open_audio(self, audio_path: Path, labels_path: Path | None = None, **kw) -> None:
+    def open_audio(self, audio_path: Path, labels_path: Path | None = None, **kw) -> bool:
         """Synthesize from an audio file that has no original markers; phone labels from
         ``labels_path``, ``text=`` (aligned), ``recognize=True``, ``acoustic_only=True`` or the
         files beside the audio (``app.open_audio.AudioOpener.open``)."""
-        self.audio_opener.open(Path(audio_path), labels_path, **kw)
+        return self.audio_opener.open(Path(audio_path), labels_path, **kw)
 
     def show_external(self, utt: Utterance) -> None:
         """Show an utterance opened from files (listed under "opened" in the browser)."""

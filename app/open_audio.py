@@ -31,7 +31,7 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from engine.data import Utterance
+from engine.data import Provenance, Utterance
 from engine.errors import FacetrajError, InputError
 from engine.io.audio import read_audio
 from engine.labels.phoneset import ARPABET
@@ -40,7 +40,7 @@ if TYPE_CHECKING:   # the labelling engine is imported when audio is opened (iss
     import numpy as np
 
     from engine.io.corpus import Corpus
-    from engine.labels.alignment import Labels
+    from engine.labels.provenance import Labels
     from engine.method.model import Model
 
     from .viewer_model import UtteranceView
@@ -152,7 +152,8 @@ class OpenedAudio:
 
     def labels_for(self, source: str) -> Labels | None:
         """Labels of ``source`` (computed on the first call: run in a worker)."""
-        from engine.io.labelling import file_labels, label_audio
+        from engine.io.labelfiles import read_label_file
+        from engine.io.labelling import label_audio
 
         if source not in self.labels:
             if source == "none":
@@ -160,7 +161,7 @@ class OpenedAudio:
             elif source == "file":
                 if self.label_file is None:
                     raise InputError(self.path, "no label file beside the audio")
-                self.labels[source] = file_labels(self.label_file, self.rate,
+                self.labels[source] = read_label_file(self.label_file, self.rate,
                                                   len(self.audio) / self.rate)
             elif source == "aligned":
                 if not self.text:
@@ -179,7 +180,9 @@ class OpenedAudio:
                          words=list(labels.words) if labels else [], markers=None,
                          marker_rate=marker_rate, marker_names=list(marker_names),
                          text=self.text or "",
-                         label_source=labels.source if labels else "none")
+                         label_source=labels.source if labels else "none",
+                         provenance=labels.provenance if labels else Provenance(),
+                         confidence=labels.trust() if labels else None)
 
 
 class LabelSourceBox(QWidget):
@@ -281,12 +284,14 @@ class AudioOpener(QObject):
     # -- opening
     def open(self, audio_path: Path, labels_path: Path | None = None, text: str | None = None,
              recognize: bool = False, acoustic_only: bool = False,
-             extra_dict: dict[str, list[str]] | None = None) -> None:
+             extra_dict: dict[str, list[str]] | None = None) -> bool:
         """Open ``audio_path`` for synthesis; labels by ``engine.io.labelling.labels_for_audio``
-        (alignment in a worker), none with ``acoustic_only``."""
+        (alignment or recognition in a worker), none with ``acoustic_only``. False when the
+        audio cannot be read (the error is shown)."""
         read = self._read(audio_path)
         if read is not None:
             self._open(audio_path, read, labels_path, text, recognize, acoustic_only, extra_dict)
+        return read is not None
 
     def _open(self, audio_path: Path, read: tuple[np.ndarray, int],
               labels_path: Path | None = None, text: str | None = None, recognize: bool = False,
@@ -318,7 +323,8 @@ class AudioOpener(QObject):
                 return opened, "none"
             progress(0.1, f"labelling {audio_path.name}")
             labels = labels_for_audio(audio_path, audio, rate, labels=labels_path, text=sentence,
-                                      recognize=recognize, extra_dict=opened.extra_dict)
+                                      recognize=recognize, extra_dict=opened.extra_dict,
+                                      fallback=True)
             source = labels.source if labels else "none"
             opened.labels[source] = labels
             return opened, source

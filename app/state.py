@@ -14,7 +14,7 @@ from engine.config import SynthConfig
 from engine.data import Utterance
 from engine.evaluation.scores import speech_mask
 from engine.method.model import Model
-from engine.method.pipeline import Synthesis, resmooth, synthesize
+from engine.method.pipeline import Synthesis, input_voice_match, resmooth, synthesize
 
 
 def frame_index(t: float, rate: float, n_frames: int, step: int = 0) -> int:
@@ -40,6 +40,9 @@ class UtteranceView:
     triangular, spline : ``(T, M, 3)`` the synthesis smoothed each way (paper Figure 4).
     speech : ``(T,)`` bool, speech frames (112 ms median-filtered energy, paper section 3).
     times : ``(T,)`` frame times in seconds.
+    mode_reason : why the synthesis runs in its mode (:func:`engine.method.modes.choose_mode`).
+    voice_match : how well the recording's voice matches the training voice, in [0, 1]
+        (:mod:`engine.method.voice_match`; NaN for a model file without the figure).
     """
 
     utterance: Utterance
@@ -50,6 +53,8 @@ class UtteranceView:
     spline: np.ndarray
     speech: np.ndarray
     times: np.ndarray
+    mode_reason: str = ""
+    voice_match: float = float("nan")
 
     @property
     def shown(self) -> np.ndarray:
@@ -74,15 +79,21 @@ class UtteranceView:
         return frame_index(t, self.rate, self.n_frames, step)
 
 
-def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig) -> UtteranceView:
-    """Synthesize ``utt`` with ``config`` and derive every track the window shows (slow: run in a
-    worker). Raises the engine's :class:`~engine.errors.FacetrajError` on bad input."""
+def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig,
+               mode_reason: str = "") -> UtteranceView:
+    """Synthesize ``utt`` with ``config`` (its labels weighed by their confidence) and derive
+    every track the window shows (slow: run in a worker). Raises the engine's
+    :class:`~engine.errors.FacetrajError` on bad input."""
     n_frames = utt.n_frames or None
     res = synthesize(model, utt.audio, utt.sample_rate, utt.phones if utt.phones else None, config,
-                     n_frames=n_frames, source=utt.name)
+                     n_frames=n_frames, source=utt.name, confidence=utt.confidence,
+                     provenance=utt.provenance)
     original = model.normalise_markers(utt.markers) if utt.markers is not None else None
     triangular = res.markers if config.smoothing == "triangular" else resmooth(model, res, "triangular")
     spline = res.markers if config.smoothing == "spline" else resmooth(model, res, "spline")
     speech = speech_mask(utt.audio, utt.sample_rate, res.times)
+    match = res.voice_match if np.isfinite(res.voice_match) else \
+        input_voice_match(model, utt.audio, utt.sample_rate, res.times, res.lsf)
     return UtteranceView(utterance=utt, split=split, synthesis=res, original=original,
-                         triangular=triangular, spline=spline, speech=speech, times=res.times)
+                         triangular=triangular, spline=spline, speech=speech, times=res.times,
+                         mode_reason=mode_reason, voice_match=match)

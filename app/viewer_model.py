@@ -27,7 +27,7 @@ from engine.evaluation.paper import FIGURE4_TEXT
 from engine.evaluation.scores import evaluate_utterance
 from engine.io.corpus import Corpus
 from engine.method.model import Model
-from engine.method.pipeline import mode_for
+from engine.method.modes import choose_mode
 from engine.progress import Progress
 
 from .phases import mark
@@ -67,13 +67,14 @@ class SynthRequest:
     def run(self, progress: Progress | None = None) -> UtteranceView:
         """Load and synthesize (slow: run in a worker). Without phone labels the synthesis is
         acoustic-only, and with labels not hand-checked robust unless the user chose the mode
-        (:func:`engine.method.pipeline.mode_for`)."""
+        (:func:`engine.method.modes.choose_mode`)."""
         utt = self.load()
         mark(f"utterance {utt.name} read")
         if progress is not None:
             progress(0.3, f"synthesizing {utt.name}")
-        return build_view(self.model, utt, self.split, mode_for(self.config, utt.phones, utt.label_source,
-                                                                 explicit=self.mode_chosen))
+        choice = choose_mode(self.config, utt.phones, utt.provenance, explicit=self.mode_chosen,
+                             tuned=self.model.tuned)
+        return build_view(self.model, utt, self.split, choice.config, choice.describe())
 
 
 @dataclass
@@ -88,6 +89,7 @@ class ViewerModel:
     view: UtteranceView | None = None
     pending_utterance: str | None = None     # asked for before the model was ready
     pending_time: float | None = None        # where the first utterance starts
+    show_default: bool = True                # show a corpus utterance first (not: recordings)
     request: SynthRequest | None = None      # the latest utterance asked for
     generation: int = 0
     mode_chosen: bool = False                # the user picked a search mode in the settings
@@ -100,7 +102,7 @@ class ViewerModel:
         self.external.clear()
         self.view = None
         self.request = None
-        first = self.pending_utterance or self.default_utterance()
+        first = self.pending_utterance or (self.default_utterance() if self.show_default else None)
         self.pending_utterance = None
         return first
 
@@ -231,9 +233,11 @@ def view_title(view: UtteranceView) -> str:
 
 
 def view_summary(view: UtteranceView) -> str:
-    """The status line of a new view: frames, rate and speech frames."""
-    return (f"{view.utterance.name}: {view.n_frames} frames at {view.rate:g} Hz, "
+    """The status line of a new view: frames, rate, speech frames, and the mode and why."""
+    text = (f"{view.utterance.name}: {view.n_frames} frames at {view.rate:g} Hz, "
             f"{int(view.speech.sum())} speech frames")
+    text = f"{text}; {view.mode_reason}" if view.mode_reason else text
+    return f"{text}; voice match {view.voice_match:.2f}" if math.isfinite(view.voice_match) else text
 
 
 def read_texts(corpus: Corpus) -> dict[str, str]:

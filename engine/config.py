@@ -93,8 +93,17 @@ class SynthConfig:
     robust_candidates : robust mode: acoustically nearest codewords added to eq 4's (index search).
     label_weight : robust mode: kappa, the cost (eq 5 units) of a codeword eq 4 did not choose,
         times the label's confidence.
+    label_weight_by_voice : robust mode: kappa times the input voice's distance ratio ``D / D0``
+        (at least 1; ``engine.method.voice_match``): eq 5's distances grow on a voice the codebook
+        does not know, and the labels must keep their weight against them.
     context_weight : robust mode: rho, the weight of the context frames in the distance.
     mean_normalise : robust mode: move the input LSFs' mean to the training speaker's.
+    chain_beta : robust mode: beta, the join cost's weight of the chain over frames that makes
+        the codeword weights consistent over time (``engine.method.chain``; 0: eq 8 frame by frame).
+    closure : after the smoothing, close the lips at the labelled /p b m/ and rest the face in
+        pauses (``engine.method.closure``, beyond the paper; the paper's tables run without it).
+    closure_taper_s : the closure's raised-cosine tapers outside each /p b m/.
+    rest_pause_s, rest_taper_s : pauses longer than this rest the face; the tapers inside them.
     """
 
     n_context_phones: int = 3
@@ -113,8 +122,14 @@ class SynthConfig:
     speaker_warp: float | None = 1.0
     robust_candidates: int = 32
     label_weight: float = 16.0
+    label_weight_by_voice: bool = True
     context_weight: float = 1.0
     mean_normalise: bool = False
+    chain_beta: float = 0.1
+    closure: bool = True
+    closure_taper_s: float = 0.05
+    rest_pause_s: float = 0.15
+    rest_taper_s: float = 0.05
 
     def with_(self, **changes) -> SynthConfig:
         """A copy with some fields changed."""
@@ -122,3 +137,34 @@ class SynthConfig:
 
     def to_dict(self) -> dict:
         return asdict(self)
+
+
+@dataclass(frozen=True)
+class EvalConfig:
+    """Evaluation settings.
+
+    Attributes
+    ----------
+    energy_window_s, energy_hop_s : short-time energy analysis (Hamming window, hop).
+    median_s : median filter over the energy contour (the paper: 112 ms) so that stop closures
+        inside speech are kept.
+    threshold_fraction : speech where the filtered energy in dB exceeds
+        ``floor + fraction * (peak - floor)``, floor and peak being the 5th and 99th percentiles of
+        the utterance's energy in dB.
+    moving_fraction : "whole face" averages over the coordinates whose training standard deviation
+        (head-normalised) is at least this fraction of the largest one.
+    by_labels : the synthesis mode follows each utterance's labels, as in every command
+        (:func:`engine.method.modes.choose_mode`: acoustic-only without labels, robust with the
+        model's cross-validated settings for labels that are not hand-checked); ``False``: each
+        config's mode is used as it is (the paper's tables, ablations).
+    keep : with ``by_labels``, the settings of the configs that the model's cross-validated ones
+        must not replace (set by the user; N in the N sweep).
+    """
+
+    energy_window_s: float = 0.02
+    energy_hop_s: float = 0.004
+    median_s: float = 0.112
+    threshold_fraction: float = 0.3
+    moving_fraction: float = 0.1
+    by_labels: bool = False
+    keep: tuple[str, ...] = ()

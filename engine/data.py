@@ -1,4 +1,5 @@
-"""The data model: one utterance of synchronized speech, phone labels and face markers."""
+"""The data model: one utterance of synchronized speech, phone labels and face markers, and
+where its labels came from."""
 
 from __future__ import annotations
 
@@ -20,6 +21,58 @@ class PhoneSegment:
         return self.end - self.start
 
 
+#: How phone labels were made (:class:`Provenance`).
+LABEL_KINDS = ("hand-checked", "aligned", "recognized")
+
+
+@dataclass(frozen=True)
+class Provenance:
+    """How a set of phone labels was made; the record travels with them in their TextGrid
+    (``engine.labels.provenance``).
+
+    Attributes
+    ----------
+    kind : ``hand-checked`` (checked by a person: the paper's labels, and any label file from
+        elsewhere unless the user says otherwise), ``aligned`` (from a transcript) or
+        ``recognized`` (from speech alone).
+    tool : what made them (``PocketSphinx 5.1.1``), if known.
+    origin : what they were made from (a transcript file, ``--text``), if known.
+    corrected : phones corrected by hand after they were made (0: none).
+    """
+
+    kind: str = "hand-checked"
+    tool: str = ""
+    origin: str = ""
+    corrected: int = 0
+
+    def __post_init__(self) -> None:
+        if self.kind not in LABEL_KINDS:
+            raise ValueError(f"label provenance must be one of {', '.join(LABEL_KINDS)}, "
+                             f"got {self.kind!r}")
+
+    @property
+    def hand_checked(self) -> bool:
+        """Whether every phone was checked by a person (the paper's phonetic mode trusts them)."""
+        return self.kind == "hand-checked"
+
+    def describe(self) -> str:
+        """In words, for logs and the app.
+
+        >>> Provenance("aligned", "PocketSphinx 5.1.1", "s001.txt", corrected=2).describe()
+        'aligned from s001.txt (PocketSphinx 5.1.1), 2 phones corrected by hand'
+        >>> Provenance().describe()
+        'hand-checked'
+        """
+        text = self.kind
+        if self.origin:
+            text += f" from {self.origin}"
+        if self.tool:
+            text += f" ({self.tool})"
+        if self.corrected:
+            text += f", {self.corrected} phone{'s' if self.corrected != 1 else ''} corrected by hand"
+        return text
+
+
 @dataclass
 class Utterance:
     """Speech, phone labels and (optionally) 3-D face markers of one utterance.
@@ -39,6 +92,9 @@ class Utterance:
     label_source : where ``phones`` came from: ``"file"`` (a label file), ``"aligned"`` (forced
         alignment of ``text``), ``"recognized"`` (phone recognition) or ``"none"``
         (``engine.labels.alignment`` / ``engine.io.labelling``).
+    provenance : how ``phones`` were made (a label file records it; else hand-checked).
+    confidence : per phone, how sure their maker was, in (0, 1] (NaN: no score); ``None`` for
+        hand-checked labels.
     """
 
     name: str
@@ -51,6 +107,8 @@ class Utterance:
     words: list[PhoneSegment] = field(default_factory=list)
     text: str = ""
     label_source: str = "file"
+    provenance: Provenance = field(default_factory=Provenance)
+    confidence: np.ndarray | None = None
 
     @property
     def duration(self) -> float:

@@ -147,9 +147,13 @@ def add_synth_options(p: argparse.ArgumentParser, nu: bool = True) -> None:
         g.add_argument("--nu", type=POSITIVE, help="override eq 3's constant")
     g.add_argument("--synth-context", type=CONTEXT, help="context C used in eq 4 (default 3)")
     g.add_argument("--mode", choices=["phonetic", "acoustic", "robust"],
-                   help="phonetic: the paper's eq 4, labels trusted (default for label files); "
-                        "robust: eq 4 and acoustic candidates weighted by label confidence "
-                        "(default for aligned or recognized labels); acoustic: no labels")
+                   help="phonetic: the paper's eq 4, labels trusted (default for hand-checked "
+                        "labels); robust: eq 4 and acoustic candidates weighted by label "
+                        "confidence (default for aligned or recognized labels); acoustic: no "
+                        "labels (default: chosen by the labels, docs/labels.md)")
+    g.add_argument("--no-closure", dest="closure", action="store_false", default=None,
+                   help="no closure step: the lips are not closed at /p b m/ nor the face rested "
+                        "in pauses (the paper's synthesis as it is)")
     g.add_argument("--smoothing", choices=["triangular", "spline", "none"])
     g.add_argument("--acoustic-prefilter", type=count_or_all, metavar="K|all",
                    help="acoustic mode: weight the K codewords nearest to each frame (default "
@@ -175,7 +179,7 @@ def train_config(args: argparse.Namespace) -> TrainConfig:
 def synth_config(args: argparse.Namespace) -> SynthConfig:
     """The synthesis configuration the options ask for (defaults elsewhere)."""
     kw = {}
-    for name in ("n_context_phones", "xi", "nu", "mode", "smoothing"):
+    for name in ("n_context_phones", "xi", "nu", "mode", "smoothing", "closure"):
         val = getattr(args, name, None)
         if val is not None:
             kw[name] = val

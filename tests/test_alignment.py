@@ -14,7 +14,7 @@ from conftest import DEFAULT_CORPUS, MOCHA
 from engine.data import PhoneSegment
 from engine.evaluation.label_accuracy import boundary_errors, merged, phone_error_rate, summarise
 from engine.io.audio import read_audio
-from engine.io.labelfiles import read_lab, read_textgrid, read_textgrid_tiers
+from engine.io.labelfiles import read_lab, read_textgrid, read_textgrid_tiers, recorded_provenance
 from engine.io.labelling import label_audio, label_corpus, labels_for_audio, relabelled
 from engine.labels.alignment import MissingWordsError, UnalignableError, align, recognize
 from engine.labels.labelmap import read_label_map
@@ -161,7 +161,7 @@ def test_label_cache(tmp_path, monkeypatch, clip):
 
 def test_relabelled_corpus(toy_corpus, monkeypatch, tmp_path):
     """Every utterance labelled; the relabelled corpus trains and evaluates like any corpus."""
-    from engine.labels.alignment import Labels
+    from engine.labels.provenance import Labels
 
     calls = []
 
@@ -202,7 +202,9 @@ def test_align_command_writes_a_textgrid(tmp_path, clip):
     out = tmp_path / "a.TextGrid"
     assert main(["-q", "align", str(CLIP), "--text", text, "-o", str(out)]) == 0
     tiers = read_textgrid_tiers(out)
-    assert list(tiers) == ["words", "phones"]
+    assert list(tiers) == ["words", "phones", "provenance", "confidence"]
+    assert tiers["provenance"][0].label.startswith("source=aligned; tool=PocketSphinx ")
+    assert tiers["provenance"][0].label.endswith("; from=the sentence given")
     assert len([p for p in tiers["phones"] if p.label not in ("", "sil")]) == \
         len([p for p in truth if p.label != "sil"])
     assert main(["-q", "align", str(CLIP), "--text", text, "-o", str(out)]) == 2   # exists
@@ -211,7 +213,8 @@ def test_align_command_writes_a_textgrid(tmp_path, clip):
                  str(out), "--overwrite"]) == 0
     rec = tmp_path / "r.TextGrid"
     assert main(["-q", "align", str(CLIP), "--recognize", "-o", str(rec)]) == 0
-    assert list(read_textgrid_tiers(rec)) == ["phones"]
+    assert list(read_textgrid_tiers(rec)) == ["phones", "provenance", "confidence"]
+    assert recorded_provenance(rec).kind == "recognized"
 
 
 @pytest.mark.parametrize("args, message", [
@@ -248,22 +251,30 @@ def test_synth_with_text_aligns_then_synthesizes_robustly(tmp_path, default_mode
     text = CLIP.with_suffix(".txt").read_text()
     with caplog.at_level(logging.INFO, logger="facetraj"):
         assert main(["synth", str(model), str(wav), "-o", str(tmp_path / "a.c3d")]) == 0
-    assert "acoustic mode (labels: none)" in caplog.text
+    assert "labels recognized from u.flac" in caplog.text     # nothing beside it: recognition
+    assert "; robust mode: recognized labels are not hand-checked" in caplog.text
+    caplog.clear()
+    with caplog.at_level(logging.INFO, logger="facetraj"):
+        assert main(["synth", str(model), str(wav), "--mode", "acoustic",
+                     "-o", str(tmp_path / "b.c3d")]) == 0
+    assert "labels none; acoustic-only (indexed) mode: chosen" in caplog.text
     caplog.clear()
     with caplog.at_level(logging.INFO, logger="facetraj"):
         assert main(["synth", str(model), str(wav), "--text", text,
                      "-o", str(tmp_path / "p.c3d")]) == 0
-    assert "robust mode (labels: aligned)" in caplog.text
+    assert "labels aligned from the sentence given (PocketSphinx" in caplog.text
+    assert "; robust mode: aligned labels are not hand-checked" in caplog.text
     caplog.clear()
     with caplog.at_level(logging.INFO, logger="facetraj"):
         assert main(["synth", str(model), str(wav), "--text", text, "--mode", "phonetic",
                      "-o", str(tmp_path / "x.c3d")]) == 0
-    assert "phonetic mode (labels: aligned)" in caplog.text
+    assert "; phonetic mode: chosen, although the labels are aligned" in caplog.text
     (tmp_path / "u.txt").write_text(text)                  # the .txt beside is used
     caplog.clear()
     with caplog.at_level(logging.INFO, logger="facetraj"):
         assert main(["synth", str(model), str(wav), "-o", str(tmp_path / "t.c3d")]) == 0
-    assert "robust mode (labels: aligned)" in caplog.text
+    assert "labels aligned from u.txt (PocketSphinx" in caplog.text
+    assert "; robust mode: aligned labels are not hand-checked" in caplog.text
     from engine.io.markerfiles import read_c3d
 
     a, p, t = (read_c3d(tmp_path / f"{n}.c3d").markers for n in "apt")
@@ -292,7 +303,8 @@ def test_corpus_align_command(tmp_path, caplog):
     caplog.clear()
     assert main(["corpus", "align", str(tmp_path), "--recognize", "--overwrite"]) == 0
     assert "3 TextGrids written (0 aligned, 3 recognized)" in caplog.text
-    assert list(read_textgrid_tiers(tmp_path / "s001.TextGrid")) == ["phones"]
+    assert list(read_textgrid_tiers(tmp_path / "s001.TextGrid")) == ["phones", "provenance",
+                                                                     "confidence"]
     assert main(["corpus", "align", str(tmp_path / "nowhere")]) == 2
 
 

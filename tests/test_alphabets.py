@@ -11,8 +11,7 @@ import pytest
 from conftest import MOCHA
 
 from engine.errors import InputError
-from engine.io.labelfiles import read_labels
-from engine.io.labelling import file_labels
+from engine.io.labelfiles import read_label_file, read_labels
 from engine.labels.alphabets import ALPHABETS, detect, to_arpabet
 from engine.labels.labelmap import read_label_map
 from facetraj.cli import main
@@ -72,7 +71,7 @@ def test_label_files_in_other_alphabets_synthesize_as_arpabet(alphabet, toy_corp
                  str(tg), "-o", str(ref), "--mode", "phonetic", "-q"]) == 0
     lab = tmp_path / f"{alphabet}.lab"
     _toy_lab(tg, lab, alphabet)
-    got = file_labels(lab, 16000, read_labels(tg)[-1].end)
+    got = read_label_file(lab, 16000, read_labels(tg)[-1].end)
     assert [s.label.lower().rstrip("012") for s in got.phones] == \
         [s.label if s.label != "sil" else got.phones[i].label.lower()
          for i, s in enumerate(read_labels(tg))]
@@ -155,5 +154,5 @@ def test_mocha_sample_synthesizes_with_the_lab_beside_it(default_model, tmp_path
     assert main([*argv, "-o", str(out)]) == 0, capsys.readouterr().err
     assert main([*argv, "-o", str(forced), "--label-map", "mocha"]) == 0
     assert out.read_text() == forced.read_text()
-    phones = file_labels(MOCHA / "fsew0_001.lab", 16000, 2.2).phones
+    phones = read_label_file(MOCHA / "fsew0_001.lab", 16000, 2.2).phones
     assert [s.label for s in phones[3:7]] == ["dh", "ih", "s", "w"]     # dh i s w

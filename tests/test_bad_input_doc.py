@@ -26,8 +26,7 @@ from engine.fanout import fan_out
 from engine.io.audio import read_audio
 from engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
 from engine.io.files import atomic_write
-from engine.io.labelfiles import read_lab, read_labels, read_textgrid, validate_phones
-from engine.io.labelling import file_labels
+from engine.io.labelfiles import read_lab, read_label_file, read_labels, read_textgrid, validate_phones
 from engine.io.markerfiles import read_c3d, read_markers, read_mocha_ema, write_c3d
 from engine.labels.labelmap import read_label_map
 from engine.method.model import Model
@@ -285,9 +284,9 @@ def corpus_command_cases(f: BadInputs) -> dict[str, Callable[[], object]]:
     "the same problem in many files of a corpus": lambda: _cli(
         ["eval", str(f.model.save(f.tmp / "m.npz")), str(f.small_corpus(short=("toy000", "toy030")))]),
     "a label file in another phone alphabet (TIMIT, MOCHA-TIMIT, SAMPA, X-SAMPA, IPA)": lambda:
-        file_labels(f.write("s.lab", "".join(f"{s.start} {s.end} {_SAMPA.get(s.label, s.label)}\n"
+        read_label_file(f.write("s.lab", "".join(f"{s.start} {s.end} {_SAMPA.get(s.label, s.label)}\n"
                                              for s in f.phones)), f.rate, f.phones[-1].end),
-    "labels in no phone alphabet facetraj knows": lambda: file_labels(
+    "labels in no phone alphabet facetraj knows": lambda: read_label_file(
         f.write("z.lab", "".join(f"{s.start} {s.end} {'zz' if i == 1 else s.label}\n"
                                  for i, s in enumerate(f.phones))), f.rate, f.phones[-1].end),
     "an audio header that claims more samples than the file holds": lambda: read_audio(

@@ -79,7 +79,7 @@ def test_evaluate_in_two_processes_equals_serial(toy_model, toy_corpus):
 def test_median_filter_equals_scipy_medfilt(k):
     from scipy.signal import medfilt
 
-    from engine.evaluation.scores import median_filter
+    from engine.method.speech import median_filter
 
     x = np.random.default_rng(k).standard_normal(500) * 20 - 40      # an energy contour in dB
     np.testing.assert_array_equal(median_filter(x, k), medfilt(x, k))

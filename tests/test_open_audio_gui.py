@@ -142,3 +142,38 @@ def test_empty_sentence_recognizes_and_wrong_sentence_is_refused(window, qtbot, 
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
         win.action_open_audio.trigger()
     assert win.view.utterance.label_source == "aligned"
+
+
+def test_recordings_from_the_command_line_open_one_after_another(qtbot, trained_cache, tmp_path):
+    """``facetraj gui FOLDER`` (a folder of recordings without face data): each recording is
+    synthesized with the default corpus's model, its phones recognized (nothing beside it), the
+    one after the other; an unreadable file is reported and skipped."""
+    from app.recordings import RecordingQueue, recordings_in
+    from engine.errors import InputError
+
+    folder = tmp_path / "talker"
+    folder.mkdir()
+    shutil.copy(CLIP, folder / "a.flac")
+    shutil.copy(ROOT / "data_samples" / "s001.flac", folder / "c.flac")
+    (folder / "b.wav").write_bytes(b"RIFF....WAVEjunk" * 9)         # corrupt: skipped, reported
+    assert [p.name for p in recordings_in(folder)] == ["a.flac", "b.wav", "c.flac"]
+    assert recordings_in(default_corpus()) == []                       # a corpus opens as one
+    with pytest.raises(InputError, match="neither a corpus"):
+        recordings_in(tmp_path / "talker" / "..")
+    errors = []
+    win = build_window(default_corpus(), use_audio=False)
+    qtbot.addWidget(win)
+    win.set_error_handler(errors.append)
+    shown = []
+    win.utteranceChanged.connect(shown.append)
+    win.add_extension("recordings", RecordingQueue(win, recordings_in(folder)))
+    win.resize(1600, 1000)
+    win.show()
+    qtbot.waitUntil(lambda: "c" in shown, timeout=WAIT_MS)
+    assert shown == ["a", "c"]                           # no corpus utterance first
+    assert len(errors) == 1 and "b.wav" in errors[0]
+    view = win.view
+    assert view.split == "external" and view.original is None
+    assert view.utterance.provenance.kind == "recognized"
+    assert view.synthesis.config.mode == "robust" and "voice match" in win.status_label.text()
+    win.close()

@@ -8,9 +8,10 @@ import pytest
 from conftest import edited_model_file
 
 from engine.config import SynthConfig
-from engine.data import PhoneSegment
+from engine.data import PhoneSegment, Provenance
 from engine.method.model import Model
-from engine.method.pipeline import frame_confidence, mode_for, synthesize
+from engine.method.modes import choose_mode
+from engine.method.pipeline import frame_confidence, synthesize
 from engine.method.selection import (
     candidate_union,
     context_distances,
@@ -128,12 +129,21 @@ def test_robust_frames_limits(toy_model):
 
 def test_mode_rule():
     segs = [PhoneSegment(0.0, 0.2, "sil")]
-    assert mode_for(SynthConfig(), segs, "file").mode == "phonetic"
-    assert mode_for(SynthConfig(), segs, "aligned").mode == "robust"
-    assert mode_for(SynthConfig(), segs, "recognized").mode == "robust"
-    assert mode_for(SynthConfig(), segs, "recognized", explicit=True).mode == "phonetic"
-    assert mode_for(SynthConfig(mode="robust"), None).mode == "acoustic"
-    assert mode_for(SynthConfig(mode="acoustic"), segs, "aligned").mode == "acoustic"
+    aligned, recognized = Provenance("aligned"), Provenance("recognized")
+    assert choose_mode(SynthConfig(), segs).mode == "phonetic"
+    assert choose_mode(SynthConfig(), segs, Provenance()).mode == "phonetic"
+    assert choose_mode(SynthConfig(), segs, aligned).mode == "robust"
+    assert choose_mode(SynthConfig(), segs, recognized).mode == "robust"
+    assert choose_mode(SynthConfig(), segs, recognized, explicit=True).mode == "phonetic"
+    assert choose_mode(SynthConfig(mode="robust"), None).mode == "acoustic"
+    assert choose_mode(SynthConfig(mode="acoustic"), segs, aligned, explicit=True).mode == "acoustic"
+    assert choose_mode(SynthConfig(mode="robust"), segs, explicit=True).mode == "robust"
+    # the robust mode takes the model's cross-validated settings, but not those the user set
+    tuned = {"settings": {"label_weight": 2.0, "n_context_phones": 6}}
+    got = choose_mode(SynthConfig(), segs, aligned, tuned=tuned, keep=("n_context_phones",))
+    assert (got.config.label_weight, got.config.n_context_phones) == (2.0, 3)
+    assert "cross-validated" in got.reason and "aligned" in got.reason
+    assert choose_mode(SynthConfig(), segs, tuned=tuned).config.label_weight == 16.0
 
 
 def test_robust_synthesis_and_model_file(toy_model, toy_corpus, tmp_path):

@@ -13,7 +13,7 @@ from engine.method.smoothing import TriangularStream, triangular_smooth
 from engine.method.speaker import choose_warp, warp_lsf
 from engine.streaming.synthesizer import StreamConfig, StreamingSynthesizer, stream_synthesize
 
-ACOUSTIC = SynthConfig(mode="acoustic")
+ACOUSTIC = SynthConfig(mode="acoustic", closure=False)   # live mode has no closure step yet
 
 
 def _in_blocks(stream, x, sizes):

@@ -14,7 +14,8 @@ from engine.config import SynthConfig
 from engine.errors import InputError
 from engine.evaluation.label_eval import LabelEval, evaluate_kind, format_markdown
 from engine.evaluation.scores import UtteranceScore
-from engine.evaluation.tuning import cross_validate, fold_ids, tuned_config
+from engine.evaluation.tuning import cross_validate, fold_ids
+from engine.method.modes import tuned_config
 from facetraj.cli import main
 
 
@@ -28,13 +29,19 @@ def test_fold_ids_cover_training_once():
 def test_cross_validate_uses_training_split_only(toy_corpus):
     """The test split is never read: the corpus is given test ids that do not exist."""
     corpus = replace(toy_corpus, info=replace(toy_corpus.info, test=["no-such-utterance"]))
-    grid = ({"label_weight": 1.0, "context_weight": 0.0}, {"label_weight": 4.0, "context_weight": 1.0})
-    tuning = cross_validate(corpus, grid=grid, widths=(0.05, 0.1), folds=2, max_per_fold=2)
+    ladders = {"label_weight": (1.0, 4.0, 16.0), "context_weight": (0.0, 1.0)}
+    tuning = cross_validate(corpus, ladders=ladders, start={"label_weight": 4.0, "context_weight": 1.0},
+                            widths=(0.05, 0.1), folds=2, max_per_fold=2)
     assert tuning.utterances == 4
-    assert len(tuning.scores) == 4
     best = max(tuning.scores, key=lambda s: s["score"])
     assert tuning.settings == {k: v for k, v in best.items() if k != "score"}
     assert all(np.isfinite(s["score"]) and -1 <= s["score"] <= 1 for s in tuning.scores)
+    # the chosen value has a worse one on either side, or is the end of its ladder
+    for name, curve in tuning.curves.items():
+        values = [v for v, _ in curve]
+        k = values.index(tuning.settings[name])
+        assert name in tuning.at_end or 0 < k < len(values) - 1
+        assert max(s for _, s in curve) == curve[k][1]
     cfg = tuned_config(SynthConfig(mode="robust"), tuning.to_json())
     assert cfg.triangle_s == tuning.settings["triangle_s"]
     assert cfg.label_weight == tuning.settings["label_weight"]
@@ -74,7 +81,7 @@ def test_evaluate_kind_on_toy_corpus(toy_corpus, toy_model):
     scores, tuning = evaluate_kind(toy_corpus, "exact", model=toy_model, tune=False, max_test=2)
     assert tuning is None
     methods = {s.mode for s in scores}
-    assert methods == {"robust", "phonetic", "phonetic-tuned", "acoustic", "ridge", "viseme"}
+    assert methods == {"default", "robust", "phonetic", "phonetic-tuned", "acoustic", "ridge", "viseme"}
     assert all(len([s for s in scores if s.mode == m]) == 2 for m in methods)
     assert all(-1 <= s.whole_face <= 1 for s in scores)
 
@@ -89,3 +96,14 @@ def test_label_eval_file_round_trip(tmp_path):
     assert back.summary("recognized", "robust") == res.summary("recognized", "robust")
     assert back.tunings == res.tunings
     assert "label_weight = 4" in format_markdown(back)
+
+
+def test_evaluate_kind_scores_the_second_voice_too(toy_corpus, toy_model):
+    scores, _, voice2 = evaluate_kind(toy_corpus, "exact", model=toy_model, tune=False, max_test=2,
+                                      second=True)
+    assert {s.mode for s in voice2} == {"default", "robust", "phonetic", "acoustic"}
+    assert [s.utterance for s in voice2 if s.mode == "default"] == \
+        [s.utterance for s in scores if s.mode == "default"]
+    by = {(s.mode, s.utterance): s.whole_face for s in scores}
+    assert any(abs(by[("acoustic", s.utterance)] - s.whole_face) > 1e-6     # another voice: other sounds
+               for s in voice2 if s.mode == "acoustic")

@@ -68,11 +68,12 @@ def test_video_frame_has_legend_surface_and_phone_tier_inside(default_model, def
     from app.style import ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
     from app.video import VideoFrames, VideoSettings
     from engine.config import SynthConfig
-    from engine.method.pipeline import mode_for, synthesize
+    from engine.method.modes import choose_mode
+    from engine.method.pipeline import synthesize
 
     utt = default_corpus.utterance(default_corpus.info.test[0])
     res = synthesize(default_model, utt.audio, utt.sample_rate, utt.phones,
-                     mode_for(SynthConfig(), utt.phones), n_frames=utt.n_frames)
+                     choose_mode(SynthConfig(), utt.phones).config, n_frames=utt.n_frames)
     original = default_model.normalise_markers(utt.markers)
     frames = VideoFrames(default_model, res, original, utt.phones, VideoSettings(*size),
                          title=utt.text or utt.name)

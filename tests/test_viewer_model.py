@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 
 from app.viewer_model import SynthRequest, ViewerModel, correlation_sweep, load_model, read_texts
+from engine.data import Provenance
 from engine.errors import FacetrajError, InputError
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -102,7 +103,8 @@ def test_opened_audio_without_labels_is_synthesized_acoustic_only(state, toy_cor
 
 def test_aligned_labels_are_synthesized_robust_unless_the_user_chose_a_mode(state, toy_corpus):
     utt = toy_corpus.utterance(toy_corpus.info.test[0])
-    name = state.add_external(replace(utt, markers=None, label_source="aligned"))
+    name = state.add_external(replace(utt, markers=None, label_source="aligned",
+                                      provenance=Provenance("aligned")))
     assert state.request_utterance(name).run().synthesis.config.mode == "robust"
     # the user picks phonetic in the settings (away and back): eq 4 trusts the labels, as asked
     state.set_config(state.synth_config.with_(mode="acoustic"))

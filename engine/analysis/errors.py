@@ -10,9 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config import SynthConfig
+from ..config import EvalConfig, SynthConfig
 from ..data import PhoneSegment, Utterance
-from ..evaluation.scores import EvalConfig, pearson, speech_mask, trajectory_correlations
+from ..evaluation.scores import pearson, speech_mask, trajectory_correlations
 from ..io.corpus import Corpus
 from ..labels.phoneset import SILENCE
 from ..method.context import segment_index

@@ -16,11 +16,11 @@ Imports ``engine.method``, ``engine.streaming`` and below; ``engine.analysis`` a
 from .. import lazy_exports
 
 __getattr__, __dir__, __all__ = lazy_exports(__name__, {
-    "scores": "METRICS EvalConfig short_time_energy_db median_filter speech_mask pearson "
+    "scores": "METRICS EvalConfig speech_mask pearson "
               "moving_coordinates trajectory_correlations ConditionScores UtteranceScore EvalResult "
               "evaluate_utterance default_workers evaluate table2 sweep_n format_table2",
     "baselines": "fit_baselines evaluate_baselines",
-    "tuning": "cross_validate tuned_config",
+    "tuning": "cross_validate",
     "label_eval": "evaluate_labels",
     "voice_eval": "evaluate_voices",
     "second_voice": "second_voice",

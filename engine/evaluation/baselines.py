@@ -20,12 +20,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..config import EvalConfig
 from ..data import Utterance
 from ..labels.phoneset import normalise_label
 from ..method.context import segment_index
 from ..method.model import Model
 from ..method.smoothing import smooth
-from .scores import EvalConfig, UtteranceScore, speech_mask, trajectory_correlations
+from .scores import UtteranceScore, speech_mask, trajectory_correlations
 
 log = logging.getLogger(__name__)
 

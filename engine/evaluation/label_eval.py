@@ -6,7 +6,12 @@ For each label kind: a model trained on the training split with those labels; it
 settings cross-validated on the training split (``engine.evaluation.tuning``); then on the test split, with
 the same kind of labels, the paper's phonetic mode (N = 3), acoustic-only (default index search),
 the robust mode, and the two baselines of ``engine.evaluation.baselines`` (viseme lookup, ridge regression),
-all scored as Table 2 (triangular smoothing, speech frames).
+all scored as Table 2 (triangular smoothing, speech frames); and ``default``, what the documented
+workflow does (``corpus align``, ``corpus init``, ``train``, ``eval``): the mode by the one rule
+(:func:`engine.method.modes.choose_mode`), with every default of synthesis (the chain, the label
+weight by voice, the closure step). The same test sentences spoken by a second voice
+(:mod:`engine.evaluation.second_voice`; for automatic labels, labelled from its own audio) are
+scored too, under ``"<kind>, second voice"``.
 """
 
 from __future__ import annotations
@@ -22,13 +27,15 @@ import numpy as np
 from ..config import SynthConfig, TrainConfig
 from ..io.corpus import Corpus
 from ..io.files import read_json, write_json
-from ..io.labelling import RelabelledCorpus, relabelled
+from ..io.labelling import label_utterance, relabelled, with_labels
 from ..method.model import Model
+from ..method.modes import choose_mode, tuned_config
 from ..method.pipeline import synthesize
 from ..method.training import train
 from .baselines import evaluate_baselines, fit_baselines, frame_data
 from .scores import METRICS, UtteranceScore, evaluate_utterance, speech_mask
-from .tuning import Tuning, cross_validate, tuned_config
+from .second_voice import second_voice
+from .tuning import cross_validate
 
 log = logging.getLogger(__name__)
 
@@ -37,11 +44,15 @@ LABEL_EVAL_FILE = "label_eval.json"
 #: Label kinds: the corpus's own (exact) labels, and the two automatic ones.
 LABEL_KINDS = ("exact", "aligned", "recognized")
 #: Methods compared, in table order.
-METHODS = ("robust", "phonetic", "phonetic-tuned", "acoustic", "ridge", "viseme")
+METHODS = ("default", "robust", "phonetic", "phonetic-tuned", "acoustic", "ridge", "viseme")
+#: The methods scored on the second voice too.
+SECOND_VOICE_METHODS = ("default", "robust", "phonetic", "acoustic")
 #: One line per method for the reader.
 METHOD_NOTES = {
-    "robust": "eq 4 and acoustic candidates, label confidence weighting, acoustic context, "
-              "cross-validated settings",
+    "default": "the documented workflow: the mode the labels get, every default of synthesis, "
+               "settings cross-validated at training",
+    "robust": "issue 16's robust mode: eq 4 and acoustic candidates, label confidence weighting, "
+              "acoustic context, cross-validated settings; frame by frame, no closure step",
     "phonetic": "the paper's method, N = 3",
     "phonetic-tuned": "the paper's method with the robust mode's cross-validated N and smoothing "
                       "width",
@@ -103,29 +114,21 @@ def labelled_corpus(corpus: Corpus, kind: str,
     return relabelled(corpus, kind, progress=progress)
 
 
-def confidences(corpus: Corpus) -> dict[str, np.ndarray] | None:
-    """Per utterance, its labels' per-phone confidence (automatic labels), else ``None``."""
-    if not isinstance(corpus, RelabelledCorpus):
-        return None
-    return {u: lab.confidence for u, lab in corpus.auto.labels.items()}
-
-
 def evaluate_kind(corpus: Corpus, kind: str, train_config: TrainConfig | None = None,
                   model: Model | None = None, tune: bool = True, max_test: int | None = None,
-                  progress: Callable[[float, str], None] | None = None
-                  ) -> tuple[list[UtteranceScore], Tuning | None]:
+                  progress: Callable[[float, str], None] | None = None, second: bool = False):
     """Train (unless ``model`` is given), cross-validate and score every method on the test split
-    of ``corpus`` labelled by ``kind``."""
+    of ``corpus`` labelled by ``kind``: ``(scores, tuning)``, and with ``second`` the second
+    voice's scores as a third item."""
     lab = labelled_corpus(corpus, kind)
-    conf = confidences(lab)
     if model is None:
         if progress:
             progress(0.0, f"{kind}: training")
         model = train(lab, config=train_config)
-    tuning = cross_validate(lab, train_config, conf) if tune else None
-    robust = tuned_config(SynthConfig(mode="robust"), tuning.to_json() if tuning else model.tuned)
-    configs = {"robust": robust, "phonetic": SynthConfig(mode="phonetic"),
-               "acoustic": SynthConfig(mode="acoustic"), "phonetic-tuned": phonetic_tuned(robust)}
+    tuning = cross_validate(lab, train_config) if tune else None
+    if tuning is not None:
+        model = replace(model, tuned=tuning.to_json())       # as `facetraj train` stores it
+    configs = method_configs(model)
     test = list(lab.info.test)
     if max_test is not None and len(test) > max_test:
         test = [test[int(i)] for i in np.linspace(0, len(test) - 1, max_test)]
@@ -137,19 +140,59 @@ def evaluate_kind(corpus: Corpus, kind: str, train_config: TrainConfig | None = 
         if progress:
             progress(j / max(len(test), 1), f"{kind}: {utt_id}")
         utt = lab.utterance(utt_id)
-        original = model.normalise_markers(utt.markers)
-        speech = speech_mask(utt.audio, utt.sample_rate, utt.frame_times())
-        lsf = model.input_lsf(utt.audio, utt.sample_rate, np.arange(utt.n_frames) / model.marker_rate)
-        c = None if conf is None else conf.get(utt_id)
-        for name, cfg in configs.items():
-            res = synthesize(model, utt.audio, utt.sample_rate, utt.phones, cfg,
-                             n_frames=utt.n_frames, source=utt.name, lsf=lsf, confidence=c)
-            scores.extend(replace(r, mode=name) for r in evaluate_utterance(
-                model, utt, "test", cfg, ("triangular",), synthesis=res, original=original,
-                speech=speech))
+        scores.extend(score_methods(model, utt, configs))
         test_frames.append(frame_data(model, utt))
     scores.extend(evaluate_baselines(model, baselines, {"test": test_frames}, ("triangular",)))
+    if second:
+        return scores, tuning, second_voice_scores(model, lab, kind, test, progress)
     return scores, tuning
+
+
+def method_configs(model: Model) -> dict[str, SynthConfig | None]:
+    """The synthesis of each method (``None``: the documented workflow's, by the mode rule)."""
+    robust = tuned_config(SynthConfig(mode="robust", closure=False, chain_beta=0.0,   # issue 16's
+                                      label_weight_by_voice=False), model.tuned, keep=("chain_beta",))
+    return {"default": None, "robust": robust,
+            "phonetic": SynthConfig(mode="phonetic", closure=False),
+            "acoustic": SynthConfig(mode="acoustic", closure=False),
+            "phonetic-tuned": phonetic_tuned(robust)}
+
+
+def score_methods(model: Model, utt, configs: dict[str, SynthConfig | None]) -> list[UtteranceScore]:
+    """One utterance's scores under every method of ``configs`` (triangular smoothing)."""
+    original = model.normalise_markers(utt.markers)
+    speech = speech_mask(utt.audio, utt.sample_rate, utt.frame_times())
+    lsf = model.input_lsf(utt.audio, utt.sample_rate, np.arange(utt.n_frames) / model.marker_rate)
+    out = []
+    for name, cfg in configs.items():
+        if cfg is None:
+            cfg = choose_mode(SynthConfig(), utt.phones, utt.provenance, tuned=model.tuned).config
+        res = synthesize(model, utt.audio, utt.sample_rate, utt.phones, cfg, n_frames=utt.n_frames,
+                         source=utt.name, lsf=lsf, confidence=utt.confidence,
+                         provenance=utt.provenance)
+        out.extend(replace(r, mode=name) for r in evaluate_utterance(
+            model, utt, "test", cfg, ("triangular",), synthesis=res, original=original,
+            speech=speech))
+    return out
+
+
+def second_voice_scores(model: Model, lab: Corpus, kind: str, test: Sequence[str],
+                        progress: Callable[[float, str], None] | None = None
+                        ) -> list[UtteranceScore]:
+    """The test sentences spoken by the second voice (same timing, so the same markers), labelled
+    from their own audio as ``kind`` says (exact labels stay; a sentence that does not align is
+    recognized, as ``corpus align`` does), under :data:`SECOND_VOICE_METHODS`."""
+    configs = {k: v for k, v in method_configs(model).items() if k in SECOND_VOICE_METHODS}
+    out = []
+    for j, utt_id in enumerate(test):
+        if progress:
+            progress(j / max(len(test), 1), f"{kind}, second voice: {utt_id}")
+        utt = lab.utterance(utt_id)
+        utt = replace(utt, audio=second_voice(utt.audio, utt.sample_rate))
+        if kind != "exact":
+            utt = with_labels(utt, label_utterance(utt, kind)[0])
+        out.extend(score_methods(model, utt, configs))
+    return out
 
 
 def phonetic_tuned(robust: SynthConfig) -> SynthConfig:
@@ -160,7 +203,7 @@ def phonetic_tuned(robust: SynthConfig) -> SynthConfig:
     >>> (c.mode, c.n_context_phones, c.triangle_s, c.xi)
     ('phonetic', 6, 0.067, 20.0)
     """
-    return SynthConfig(mode="phonetic", n_context_phones=robust.n_context_phones,
+    return SynthConfig(mode="phonetic", closure=False, n_context_phones=robust.n_context_phones,
                        triangle_s=robust.triangle_s, xi=robust.xi, gamma_max=robust.gamma_max)
 
 
@@ -174,9 +217,11 @@ def evaluate_labels(corpus: Corpus, kinds: Sequence[str] = LABEL_KINDS,
     for k, kind in enumerate(kinds):
         if progress:
             progress(k / len(kinds), f"{kind} labels")
-        scores, tuning = evaluate_kind(corpus, kind, train_config,
-                                       exact_model if kind == "exact" else None, tune, max_test)
+        scores, tuning, voice2 = evaluate_kind(corpus, kind, train_config,
+                                               exact_model if kind == "exact" else None, tune,
+                                               max_test, second=True)
         out.scores[kind] = scores
+        out.scores[f"{kind}, second voice"] = voice2
         if tuning is not None:
             out.tunings[kind] = tuning.to_json()
     if progress:
@@ -213,7 +258,11 @@ def format_markdown(result: LabelEval) -> str:
              "settings are cross-validated on the training split (`engine.evaluation.tuning`), and every "
              "method is scored on the test split as in Table 2 (triangular smoothing, speech "
              "frames), mean ± one standard deviation over utterances (the corpus has one speaker, "
-             "so the spread is over utterances). Computed by `engine.evaluation.label_eval`."]
+             "so the spread is over utterances). *Second voice*: the same test sentences spoken by "
+             "a voice with a shorter vocal tract and a higher pitch (`engine.evaluation.second_voice`, "
+             "the same timing, so the same markers), its automatic labels made from its own audio, "
+             "synthesized with the same model. Computed by `engine.evaluation.label_eval` "
+             "(`facetraj report --automatic-labels`)."]
     for kind in result.scores:
         lines += ["", f"**{kind.title()} labels** (train and test labelled the same way)", "",
                   "| Method | Whole face | Lower lip | Upper lip | Utterances |",
@@ -225,12 +274,33 @@ def format_markdown(result: LabelEval) -> str:
             s = result.summary(kind, m)
             lines.append(f"| {m} ({METHOD_NOTES[m]}) | {mean_sd(s['whole_face'])} | "
                          f"{mean_sd(s['lower_lip'])} | {mean_sd(s['upper_lip'])} | {len(rows)} |")
-        tuned = result.tunings.get(kind, {}).get("settings")
-        if tuned:
-            lines += ["", "Robust settings chosen by cross-validation on the training split: "
-                      + ", ".join(f"{k} = {v:g}" for k, v in tuned.items()) + "."]
+        lines += tuning_lines(result.tunings.get(kind, {}))
     lines += ["", recommendation(result)]
     return "\n".join(lines)
+
+
+def tuning_lines(tuning: dict) -> list[str]:
+    """The settings cross-validation chose, and each one's curve: its held-out score at every
+    value tried with the others at their chosen values (the chosen value in bold).
+
+    >>> text = tuning_lines({"settings": {"chain_beta": 0.1, "triangle_s": 0.067},
+    ...                      "curves": {"chain_beta": [[0.03, 0.91], [0.1, 0.92], [0.2, 0.915]]}})[1]
+    >>> text.split(": ", 2)[2]
+    'chain_beta 0.03: 0.9100, **0.1: 0.9200**, 0.2: 0.9150.'
+    """
+    settings = tuning.get("settings")
+    if not settings:
+        return []
+    text = ("Settings chosen by cross-validation on the training split: "
+            + ", ".join(f"{k} = {v:g}" for k, v in settings.items()) + ".")
+    curves = tuning.get("curves") or {}
+    if curves:
+        text += " Cross-validation curves (mean held-out correlation): " + "; ".join(
+            f"{name} " + ", ".join(f"**{v:g}: {s:.4f}**" if v == settings.get(name) else f"{v:g}: {s:.4f}"
+                                   for v, s in curve) for name, curve in curves.items()) + "."
+    if tuning.get("at_end"):
+        text += f" At the end of their range: {', '.join(tuning['at_end'])}."
+    return ["", text]
 
 
 def recommendation(result: LabelEval) -> str:

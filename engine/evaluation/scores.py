@@ -6,97 +6,23 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
-from ..config import SynthConfig
+from ..config import EvalConfig, SynthConfig
 from ..data import Utterance
 from ..fanout import Skips, fan_out
 from ..io.corpus import Corpus
 from ..method.model import Model
+from ..method.modes import choose_mode
 from ..method.pipeline import Synthesis, resmooth, synthesize
+from ..method.speech import speech_mask
 from ..threads import limit_frame_threads, one_blas_thread, usable_cores
 
 log = logging.getLogger(__name__)
 
 METRICS = ("whole_face", "lower_lip", "upper_lip")
-
-
-@dataclass(frozen=True)
-class EvalConfig:
-    """Evaluation settings.
-
-    Attributes
-    ----------
-    energy_window_s, energy_hop_s : short-time energy analysis (Hamming window, hop).
-    median_s : median filter over the energy contour (the paper: 112 ms) so that stop closures
-        inside speech are kept.
-    threshold_fraction : speech where the filtered energy in dB exceeds
-        ``floor + fraction * (peak - floor)``, floor and peak being the 5th and 99th percentiles of
-        the utterance's energy in dB.
-    moving_fraction : "whole face" averages over the coordinates whose training standard deviation
-        (head-normalised) is at least this fraction of the largest one.
-    """
-
-    energy_window_s: float = 0.02
-    energy_hop_s: float = 0.004
-    median_s: float = 0.112
-    threshold_fraction: float = 0.3
-    moving_fraction: float = 0.1
-
-
-def short_time_energy_db(audio: np.ndarray, rate: int, window_s: float = 0.02,
-                         hop_s: float = 0.004) -> tuple[np.ndarray, np.ndarray]:
-    """Short-time energy in dB and its frame-centre times."""
-    x = np.asarray(audio, dtype=np.float64)
-    n = max(1, int(round(window_s * rate)))
-    hop = max(1, int(round(hop_s * rate)))
-    pad = np.concatenate([np.zeros(n // 2), x, np.zeros(n)])
-    count = len(x) // hop + 1
-    idx = (np.arange(count) * hop)[:, None] + np.arange(n)[None, :]
-    frames = pad[idx] * np.hamming(n)
-    energy = (frames**2).sum(axis=1) / n
-    return 10 * np.log10(energy + 1e-12), np.arange(count) * hop / rate
-
-
-def median_filter(x: np.ndarray, k: int) -> np.ndarray:
-    """Running median of odd length ``k``, zero-padded at both ends (the values of
-    ``scipy.signal.medfilt``, tested; here so that the app's first frame does not wait 1-2 s for
-    scipy.signal to import).
-
-    >>> median_filter(np.array([3.0, 1.0, 2.0, 5.0, 4.0]), 3).tolist()
-    [1.0, 2.0, 2.0, 4.0, 4.0]
-    """
-    if k % 2 == 0:
-        raise ValueError("the median filter length must be odd")
-    x = np.asarray(x, dtype=np.float64)
-    half = k // 2
-    padded = np.concatenate([np.zeros(half), x, np.zeros(half)])
-    return np.median(np.lib.stride_tricks.sliding_window_view(padded, k), axis=1)
-
-
-def speech_mask(audio: np.ndarray, rate: int, times: np.ndarray,
-                config: EvalConfig | None = None) -> np.ndarray:
-    """Speech (True) or silence per time in ``times``: energy, 112 ms median filter, threshold.
-
-    Examples
-    --------
-    >>> rate = 16000
-    >>> x = np.zeros(rate); x[4000:12000] = np.sin(np.arange(8000) * 0.3)   # 0.25-0.75 s tone
-    >>> m = speech_mask(x, rate, np.array([0.1, 0.5, 0.9]))
-    >>> m.tolist()
-    [False, True, False]
-    """
-    config = config or EvalConfig()
-    e_db, _e_t = short_time_energy_db(audio, rate, config.energy_window_s, config.energy_hop_s)
-    k = int(round(config.median_s / config.energy_hop_s))
-    k = k + 1 if k % 2 == 0 else k
-    filtered = median_filter(e_db, k) if len(e_db) >= k else e_db
-    floor, peak = np.percentile(filtered, [5, 99])
-    threshold = floor + config.threshold_fraction * (peak - floor)
-    idx = np.clip(np.round(np.asarray(times) / config.energy_hop_s).astype(int), 0, len(e_db) - 1)
-    return filtered[idx] > threshold
 
 
 def pearson(a: np.ndarray, b: np.ndarray) -> float:
@@ -213,17 +139,25 @@ def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
                        lsf: np.ndarray | None = None) -> list[UtteranceScore]:
     """Synthesize one utterance and score each smoothing against its original markers.
 
+    With ``eval_config.by_labels`` the mode follows the utterance's labels as in every command;
+    otherwise ``config`` is used as it is. Robust synthesis weighs each label by the utterance's
+    ``confidence``.
+
     ``original`` (head-normalised markers), ``speech`` (the speech-frame mask) and ``lsf`` (the
     input LSFs, :meth:`Model.input_lsf`) may be passed when already computed, e.g. when one
     utterance is scored under several configs.
     """
     config = config or SynthConfig()
+    if eval_config is not None and eval_config.by_labels:
+        config = choose_mode(config, utt.phones, utt.provenance, tuned=model.tuned,
+                             keep=eval_config.keep).config
     if utt.markers is None:
         raise ValueError(f"{utt.name}: no original markers to compare with")
     if original is None:
         original = model.normalise_markers(utt.markers)
     res = synthesis or synthesize(model, utt.audio, utt.sample_rate, utt.phones, config,
-                                  n_frames=utt.n_frames, source=utt.name, lsf=lsf)
+                                  n_frames=utt.n_frames, source=utt.name, lsf=lsf,
+                                  confidence=utt.confidence, provenance=utt.provenance)
     mask = speech if speech is not None else speech_mask(utt.audio, utt.sample_rate, res.times,
                                                          eval_config)
     out = []
@@ -297,9 +231,9 @@ def table2(model: Model, corpus: Corpus, acoustic: bool = True,
            skip: Skips | None = None) -> EvalResult:
     """The paper's Table 2 (train/test x triangular/spline, N = 3), plus acoustic-only rows
     (the paper's whole-codebook search, ``acoustic_prefilter=None``)."""
-    configs = [SynthConfig(mode="phonetic")]
+    configs = [SynthConfig(mode="phonetic", closure=False)]          # the paper's, as it is
     if acoustic:
-        configs.append(SynthConfig(mode="acoustic", acoustic_prefilter=None))
+        configs.append(SynthConfig(mode="acoustic", acoustic_prefilter=None, closure=False))
     return evaluate(model, corpus, ("train", "test"), configs, ("triangular", "spline"),
                     eval_config, progress, workers, skip)
 
@@ -309,7 +243,9 @@ def sweep_n(model: Model, corpus: Corpus, ns: Sequence[int] = tuple(range(1, 11)
             progress: Callable[[float, str], None] | None = None, workers: int = 1,
             skip: Skips | None = None) -> EvalResult:
     """Correlation against N (the paper's Figure 5), triangular smoothing."""
-    configs = [SynthConfig(n_context_phones=n) for n in ns]
+    configs = [SynthConfig(n_context_phones=n, closure=False) for n in ns]
+    if eval_config is not None and eval_config.by_labels:       # the sweep sets N, not the tuning
+        eval_config = replace(eval_config, keep=(*eval_config.keep, "n_context_phones"))
     return evaluate(model, corpus, splits, configs, ("triangular",), eval_config, progress,
                     workers, skip)
 

@@ -1,17 +1,22 @@
-"""Cross-validated synthesis settings (issue 16): gamma's range, N, the robust mode's label
-weight and acoustic candidate count, and the smoothing width (any other SynthConfig field, e.g.
-xi or the context weight, can be put in the grid), chosen on the *training* split only (never the test
-split) and stored in the model (:attr:`engine.method.model.Model.tuned`).
+"""Cross-validated synthesis settings (issues 16, 24): the robust mode's N, label weight,
+acoustic candidates and gamma's range, and the smoothing width, chosen on the *training* split
+only (never the test split) and stored in the model (:attr:`engine.method.model.Model.tuned`).
 
-K folds of the training utterances: a model trained on K-1 folds synthesizes the held-out fold
-under every candidate setting; the setting with the best mean correlation (whole face, lower lip
-and upper lip averaged, triangular smoothing, speech frames: as Table 2) over all held-out
-utterances wins. The smoothing width is scored on the same syntheses (only re-smoothed).
+K folds of the training utterances: a model trained on K-1 folds synthesizes (up to
+``max_per_fold`` utterances of) the held-out fold; a setting's score is the mean correlation
+(whole face, lower lip and upper lip averaged, triangular smoothing, speech frames: as Table 2)
+over all held-out utterances, at the best of the smoothing widths (scored on the same
+syntheses, only re-smoothed). The settings are searched one at a time along ordered ladders of
+values (:func:`coordinate_search`), from the defaults, each moved to its best neighbour and the
+search widened past an edge until the best value has a worse one on either side (or is the
+ladder's last): so a chosen value sits inside what was searched, and its curve -- the score of
+every value tried with the others at their chosen values -- is kept with the choice.
 """
 
 from __future__ import annotations
 
 import logging
+import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
@@ -27,49 +32,92 @@ from .scores import speech_mask, trajectory_correlations
 
 log = logging.getLogger(__name__)
 
-#: The settings searched (robust mode): one dict of SynthConfig fields per candidate.
-DEFAULT_GRID: tuple[dict, ...] = tuple(
-    {"n_context_phones": n, "label_weight": k, "robust_candidates": c, "gamma_max": g}
-    for n in (3, 6) for k in (4.0, 16.0) for c in (16, 32) for g in (2.0, 5.0))
-#: Triangular smoothing widths searched (seconds).
-DEFAULT_WIDTHS = (0.067, 0.1, 0.133)
-#: Settings a tuning stores (the SynthConfig fields it may change).
-TUNED_FIELDS = ("n_context_phones", "xi", "label_weight", "context_weight", "robust_candidates",
-                "gamma_max", "triangle_s")
+#: The settings searched, each an ordered ladder of values (robust mode).
+LADDERS: dict[str, tuple] = {
+    "n_context_phones": (1, 2, 3, 4, 6, 8, 12, 16),
+    "label_weight": (0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0),
+    "robust_candidates": (8, 16, 32, 64, 128),
+    "gamma_max": (1.0, 2.0, 3.0, 5.0, 8.0, 12.0),
+    "chain_beta": (0.0, 0.03, 0.1, 0.2, 0.4, 0.8),
+}
+#: Where the search starts: the defaults of SynthConfig.
+START = {k: getattr(SynthConfig(), k) for k in LADDERS}
+#: Triangular smoothing widths scored on every synthesis (seconds).
+WIDTHS = (0.033, 0.05, 0.067, 0.083, 0.1, 0.133, 0.167, 0.2)
 
 
 @dataclass
 class Tuning:
-    """The result of :func:`cross_validate`: the chosen ``settings`` (SynthConfig fields), and
-    every candidate's mean held-out ``scores`` (``settings`` + ``score``)."""
+    """The result of :func:`cross_validate`: the chosen ``settings`` (SynthConfig fields), each
+    searched setting's ``curves`` (``[value, score]`` with the others at their chosen values),
+    the settings left at the end of their ladder (``at_end``), and every setting scored."""
 
     settings: dict
     scores: list[dict] = field(default_factory=list)
     folds: int = 2
     utterances: int = 0
+    curves: dict = field(default_factory=dict)
+    at_end: list[str] = field(default_factory=list)
+    seconds: float = 0.0
 
     def to_json(self) -> dict:
         return {"settings": self.settings, "scores": self.scores, "folds": self.folds,
-                "utterances": self.utterances, "split": "train"}
+                "utterances": self.utterances, "split": "train", "curves": self.curves,
+                "at_end": self.at_end, "seconds": round(self.seconds, 1)}
 
 
-def tuned_config(config: SynthConfig, tuned: Mapping, keep: Sequence[str] = ()) -> SynthConfig:
-    """``config`` with a model's cross-validated settings (robust mode only; fields unknown to
-    this facetraj, and the fields in ``keep`` -- set by the user -- are left alone).
+def coordinate_search(score: Callable[[dict], float], ladders: Mapping[str, Sequence],
+                      start: Mapping, rounds: int = 3) -> tuple[dict, dict, list[str]]:
+    """The settings maximising ``score`` one at a time along their ``ladders``, from ``start``:
+    each moves to its best neighbour, the window widened past an edge until the best value has a
+    worse one on either side or is the ladder's last; until a round changes nothing. Returns the
+    settings, each one's curve (``[[value, score], ...]`` at the final settings) and the settings
+    left at the end of their ladder. ``score`` is called once per distinct settings.
 
-    >>> tuned_config(SynthConfig(mode="robust"), {"settings": {"label_weight": 2.0}}).label_weight
-    2.0
-    >>> tuned_config(SynthConfig(), {"settings": {"label_weight": 2.0}}).label_weight
-    16.0
-    >>> tuned_config(SynthConfig(mode="robust"), {"settings": {"label_weight": 2.0}},
-    ...              keep=("label_weight",)).label_weight
-    16.0
+    >>> best, curves, ends = coordinate_search(lambda s: -(s["a"] - 3) ** 2 - (s["b"] - 1) ** 2,
+    ...                                        {"a": (0, 1, 2, 3, 4, 5), "b": (1, 2, 3)}, {"a": 1, "b": 2})
+    >>> best, ends, [v for v, _ in curves["a"]]
+    ({'a': 3, 'b': 1}, ['b'], [2, 3, 4])
     """
-    if config.mode != "robust" or not tuned:
-        return config
-    kw = {k: v for k, v in dict(tuned.get("settings", {})).items()
-          if k in TUNED_FIELDS and k not in keep}
-    return config.with_(**kw)
+    memo: dict[tuple, float] = {}
+
+    def scored(settings: dict) -> float:
+        key = tuple(sorted(settings.items()))
+        if key not in memo:
+            memo[key] = float(score(dict(settings)))
+        return memo[key]
+
+    current = dict(start)
+    for _ in range(rounds):
+        changed = False
+        for name, ladder in ladders.items():
+            best = _line_search(lambda v, name=name: scored({**current, name: v}), list(ladder),
+                                ladder.index(current[name]))
+            changed |= best != current[name]
+            current[name] = best
+        if not changed:
+            break
+    curves = {name: [[v, memo[k]] for v in ladder
+                     if (k := tuple(sorted({**current, name: v}.items()))) in memo]
+              for name, ladder in ladders.items()}
+    ends = [name for name, ladder in ladders.items() if current[name] in (ladder[0], ladder[-1])]
+    return current, curves, ends
+
+
+def _line_search(f: Callable[[object], float], ladder: list, i: int) -> object:
+    """The best value of ``ladder`` near index ``i``, widening past an edge while it improves."""
+    lo, hi = max(i - 1, 0), min(i + 1, len(ladder) - 1)
+    values = {j: f(ladder[j]) for j in range(lo, hi + 1)}
+    while True:
+        best = max(values, key=lambda j: (values[j], -abs(j - i)))
+        if best == lo and lo > 0:
+            lo -= 1
+            values[lo] = f(ladder[lo])
+        elif best == hi and hi < len(ladder) - 1:
+            hi += 1
+            values[hi] = f(ladder[hi])
+        else:
+            return ladder[best]
 
 
 def fold_ids(ids: Sequence[str], folds: int) -> list[list[str]]:
@@ -81,59 +129,87 @@ def fold_ids(ids: Sequence[str], folds: int) -> list[list[str]]:
     return [list(ids[k::folds]) for k in range(folds)]
 
 
+@dataclass
+class _Held:
+    """A held-out utterance of a fold, with what every setting's synthesis reuses."""
+
+    model: object
+    utt: object
+    original: np.ndarray
+    mask: np.ndarray
+    lsf: np.ndarray
+
+
+def _fold_data(corpus: Corpus, train_config: TrainConfig | None, folds: int,
+               max_per_fold: int | None, progress: Callable[[float, str], None]) -> list[_Held]:
+    ids = list(corpus.info.train)
+    held_all = []
+    for f, held in enumerate(fold_ids(ids, folds)):
+        rest = [u for u in ids if u not in set(held)]
+        sub = replace(corpus, info=replace(corpus.info, train=rest, test=[]))
+        progress(0.3 * f / folds, f"fold {f + 1}/{folds}: training")
+        model = train(sub, config=train_config)
+        if max_per_fold is not None and len(held) > max_per_fold:
+            held = [held[int(i)] for i in np.linspace(0, len(held) - 1, max_per_fold)]
+        for utt_id in held:
+            utt = corpus.utterance(utt_id)
+            held_all.append(_Held(model, utt, model.normalise_markers(utt.markers),
+                                  speech_mask(utt.audio, utt.sample_rate, utt.frame_times()),
+                                  model.input_lsf(utt.audio, utt.sample_rate,
+                                                  np.arange(utt.n_frames) / model.marker_rate)))
+    return held_all
+
+
+def _width_scores(held: list[_Held], settings: Mapping, widths: Sequence[float]) -> np.ndarray:
+    """The mean held-out correlation of ``settings`` at each smoothing width."""
+    totals, counts = np.zeros(len(widths)), np.zeros(len(widths))
+    for h in held:
+        cfg = SynthConfig(mode="robust", smoothing="none", closure=False, **settings)
+        res = synthesize(h.model, h.utt.audio, h.utt.sample_rate, h.utt.phones, cfg,
+                         n_frames=h.utt.n_frames, source=h.utt.name, lsf=h.lsf,
+                         confidence=h.utt.confidence, provenance=h.utt.provenance)
+        for k, width in enumerate(widths):
+            pcs = smooth(res.raw_pcs, h.model.marker_rate, "triangular", width)
+            c = trajectory_correlations(h.original, h.model.to_markers(pcs), h.mask, h.model)
+            score = np.nanmean(list(c.values()))
+            if np.isfinite(score):
+                totals[k] += score
+                counts[k] += 1
+    return np.where(counts > 0, totals / np.maximum(counts, 1), -np.inf)
+
+
 def cross_validate(corpus: Corpus, train_config: TrainConfig | None = None,
-                   confidences: Mapping[str, np.ndarray] | None = None,
-                   grid: Sequence[Mapping] = DEFAULT_GRID, widths: Sequence[float] = DEFAULT_WIDTHS,
-                   folds: int = 2, max_per_fold: int | None = 12,
+                   ladders: Mapping[str, Sequence] = LADDERS, start: Mapping | None = None,
+                   widths: Sequence[float] = WIDTHS, folds: int = 2, max_per_fold: int | None = 12,
                    progress: Callable[[float, str], None] | None = None) -> Tuning:
     """Choose the robust mode's settings by ``folds``-fold cross-validation on ``corpus``'s
-    training split (see the module docstring). ``confidences`` maps utterance id -> per-phone
-    label confidence (automatic labels); ``max_per_fold`` held-out utterances are scored per fold
-    (evenly spread) to bound the time."""
+    training split (see the module docstring): :func:`coordinate_search` over ``ladders`` from
+    ``start`` (default :data:`START`), the smoothing width the best of ``widths`` for each
+    setting. The utterances' labels are weighed by their own confidence; ``max_per_fold``
+    held-out utterances are scored per fold (evenly spread) to bound the time."""
     ids = list(corpus.info.train)
     if not 2 <= folds <= len(ids):
         raise InputError(corpus.root, f"{folds}-fold cross-validation needs 2 to {len(ids)} folds "
                                       f"(one per training utterance at most)")
-    parts = fold_ids(ids, folds)
-    totals = np.zeros((len(grid), len(widths)))
-    counts = np.zeros((len(grid), len(widths)))
-    n_scored = 0
-    for f, held in enumerate(parts):
-        rest = [u for u in ids if u not in set(held)]
-        sub = replace(corpus, info=replace(corpus.info, train=rest, test=[]))
-        if progress:
-            progress(f / folds, f"fold {f + 1}/{folds}: training")
-        model = train(sub, config=train_config)
-        if max_per_fold is not None and len(held) > max_per_fold:
-            held = [held[int(i)] for i in np.linspace(0, len(held) - 1, max_per_fold)]
-        for j, utt_id in enumerate(held):
-            if progress:
-                progress((f + (j + 1) / (len(held) + 1)) / folds, f"fold {f + 1}: {utt_id}")
-            utt = corpus.utterance(utt_id)
-            original = model.normalise_markers(utt.markers)
-            mask = speech_mask(utt.audio, utt.sample_rate, utt.frame_times())
-            lsf = model.input_lsf(utt.audio, utt.sample_rate,
-                                  np.arange(utt.n_frames) / model.marker_rate)
-            conf = None if confidences is None else confidences.get(utt_id)
-            n_scored += 1
-            for g, settings in enumerate(grid):
-                cfg = SynthConfig(mode="robust", smoothing="none", **settings)
-                res = synthesize(model, utt.audio, utt.sample_rate, utt.phones, cfg,
-                                 n_frames=utt.n_frames, source=utt.name, lsf=lsf, confidence=conf)
-                for k, width in enumerate(widths):
-                    pcs = smooth(res.raw_pcs, model.marker_rate, "triangular", width)
-                    c = trajectory_correlations(original, model.to_markers(pcs), mask, model)
-                    score = np.nanmean(list(c.values()))
-                    if np.isfinite(score):
-                        totals[g, k] += score
-                        counts[g, k] += 1
-    mean = totals / np.maximum(counts, 1)
-    g, k = np.unravel_index(np.argmax(mean), mean.shape)
-    settings = {**dict(grid[g]), "triangle_s": float(widths[k])}
-    scores = [{**dict(grid[a]), "triangle_s": float(widths[b]), "score": float(mean[a, b])}
-              for a in range(len(grid)) for b in range(len(widths))]
-    log.info("cross-validated robust settings: %s (mean held-out correlation %.4f)", settings,
-             mean[g, k])
-    if progress:
-        progress(1.0, "cross-validation done")
-    return Tuning(settings, scores, folds, n_scored)
+    progress = progress or (lambda f, m: None)
+    t0 = time.monotonic()
+    held = _fold_data(corpus, train_config, folds, max_per_fold, progress)
+    tried: list[dict] = []
+    expected = 3 * len(ladders) + 2            # a typical search: about three values a setting
+
+    def score(settings: dict) -> float:
+        progress(min(0.3 + 0.7 * len(tried) / expected, 0.99),
+                 "setting " + ", ".join(f"{k}={v:g}" for k, v in settings.items()))
+        per_width = _width_scores(held, settings, widths)
+        k = int(np.argmax(per_width))
+        tried.append({**settings, "triangle_s": float(widths[k]), "score": float(per_width[k])})
+        return float(per_width[k])
+
+    best, curves, ends = coordinate_search(score, ladders, START if start is None else start)
+    chosen = next(s for s in tried if all(s[k] == v for k, v in best.items()))
+    settings = {k: v for k, v in chosen.items() if k != "score"}
+    log.info("cross-validated robust settings: %s (mean held-out correlation %.4f, %d settings "
+             "scored)%s", settings, chosen["score"], len(tried),
+             f"; at the end of their range: {', '.join(ends)}" if ends else "")
+    progress(1.0, "cross-validation done")
+    return Tuning(settings, tried, folds, len(held), curves, ends, time.monotonic() - t0)

@@ -122,7 +122,7 @@ def evaluate_voices(corpus: Corpus, model: Model | None = None, spec: VoiceSpec 
             progress(0.0, "training")
         model = train(corpus, config=train_config)
     test = held_out_ids(corpus, max_test)
-    base = SynthConfig(mode="acoustic")
+    base = SynthConfig(mode="acoustic", closure=False)
     prepared, ratios = [], []
     for j, utt_id in enumerate(test):
         if progress:

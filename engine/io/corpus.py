@@ -16,12 +16,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ..data import PhoneSegment, Utterance
+from ..data import LABEL_KINDS, PhoneSegment, Utterance
 from ..errors import InputError, warn_file
 from .audio import read_audio
 from .files import atomic_write, check_output_path
 from .hash_memo import folder_key, memoized_hash
-from .labelfiles import read_labels, read_textgrid, read_textgrid_tiers, validate_phones
+from .labelfiles import read_label_file, read_labels, read_textgrid, recorded_provenance
 from .markerfiles import MARKER_SUFFIXES, read_markers
 
 log = logging.getLogger(__name__)
@@ -47,6 +47,9 @@ class CorpusInfo:
     label_set : the phone alphabet of the ``phones`` tier (``arpabet``).
     label_map : ``""`` (labels are ARPAbet), ``"mocha"`` or a label map file (relative to the
         description) mapping the labels onto ARPAbet when utterances are loaded.
+    label_provenance : how label files without a record of their own (any file facetraj did not
+        write) were made: ``hand-checked`` (the default), ``aligned`` or ``recognized``
+        (``engine.labels.provenance``).
     data_dir : where the utterance files are, relative to the description's folder (``""``: the
         same folder). Lets a description point at a read-only folder of someone else's data.
     dimensions : 3, or 2 for midsagittal data (x = 0 for every marker).
@@ -66,6 +69,7 @@ class CorpusInfo:
         default_factory=lambda: {"x": "right", "y": "up", "z": "forward"})
     label_set: str = "arpabet"
     label_map: str = ""
+    label_provenance: str = "hand-checked"
     data_dir: str = ""
     dimensions: int = 3
     name: str = ""
@@ -160,6 +164,7 @@ SCHEMA: dict[str, tuple] = {
              "an object of axis names"),
     "label_set": (_text, "text"),
     "label_map": (_text, "text (\"\", \"mocha\" or a label map file)"),
+    "label_provenance": (lambda v: v in LABEL_KINDS, " or ".join(f'"{k}"' for k in LABEL_KINDS)),
     "data_dir": (_text, "text (a folder relative to the description)"),
     "dimensions": (lambda v: v in (2, 3) and not isinstance(v, bool), "2 or 3"),
     "name": (_text, "text"),
@@ -316,25 +321,17 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
     Markers shorter than the audio are padded with NaN (a warning); longer ones are cut at the
     audio's end.
     """
-    from ..labels.alphabets import to_arpabet
     from ..labels.phoneset import apply_label_map
 
     root = Path(root)
     apath = audio_path(root, utt_id)
     audio, rate = read_audio(apath)
     lpath = label_path(root, utt_id)
-    words: list[PhoneSegment] = []
-    if lpath.suffix.lower() == ".textgrid":
-        tiers = read_textgrid_tiers(lpath)
-        raw = read_textgrid(lpath, "phones")
-        words = [w for w in tiers.get("words", []) if w.label]
-    else:
-        raw = read_labels(lpath, rate)
-    phones = validate_phones(raw, len(audio) / rate, lpath)
+    labels = read_label_file(lpath, rate, len(audio) / rate, info.label_provenance,
+                             detect_alphabet=not label_map)
+    phones = labels.phones
     if label_map:
         phones = [PhoneSegment(s.start, s.end, apply_label_map(s.label, label_map)) for s in phones]
-    else:
-        phones = to_arpabet(phones, str(lpath))
     mpath = marker_path(root, utt_id)
     mdata = read_markers(mpath, info.marker_rate)
     if mdata.names != info.marker_names:
@@ -364,7 +361,8 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
             raise InputError(txt, "the transcript is not UTF-8 text") from None
     return Utterance(name=utt_id, audio=audio, sample_rate=rate, phones=phones,
                      markers=markers, marker_rate=info.marker_rate,
-                     marker_names=list(mdata.names), words=words, text=text)
+                     marker_names=list(mdata.names), words=labels.words, text=text,
+                     provenance=labels.provenance, confidence=labels.trust())
 
 
 @dataclass
@@ -416,7 +414,8 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
                 lip_corners: list[str] | None = None, label_map: str = "",
                 marker_rate: float = 60.0, test: list[str] | None = None,
                 test_fraction: float = 1 / 3, name: str = "",
-                overwrite: bool = True) -> tuple[Path, CorpusInfo]:
+                overwrite: bool = True, label_provenance: str = "hand-checked"
+                ) -> tuple[Path, CorpusInfo]:
     """Describe a folder of someone's own recordings as a corpus and write the description.
 
     Utterances are the file stems that have audio, labels and markers. The marker roles (fixed
@@ -424,6 +423,7 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
     ``round(1 / test_fraction)``-th utterance. ``output`` defaults to ``data_dir/corpus.json``;
     when it lies elsewhere (a read-only data folder), the description records ``data_dir``
     relative to it. An existing description is replaced only with ``overwrite``.
+    ``label_provenance`` says how label files without a record of their own were made.
     """
     data_dir = Path(data_dir).resolve()
     out = Path(output) if output else data_dir / "corpus.json"
@@ -445,10 +445,22 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
     info = CorpusInfo(marker_names=names, marker_rate=float(marker_rate), fixed_markers=list(fixed or []),
                       upper_lip=upper_lip, lower_lip=lower_lip, train=train_ids, test=list(test),
                       lip_corners=list(lip_corners or []), label_map=label_map, data_dir=rel,
-                      dimensions=2 if planar else 3, name=name or data_dir.name)
+                      dimensions=2 if planar else 3, name=name or data_dir.name,
+                      label_provenance=label_provenance)
     CorpusInfo.from_json(info.to_json(), out)  # the same checks as on loading
     save_corpus_info(out, info, overwrite)
     return out, info
+
+
+def label_kinds(corpus: Corpus) -> dict[str, int]:
+    """How the labels of a corpus were made: utterances per kind (the record of each label file,
+    else the corpus's ``label_provenance``), read from the label files alone."""
+    counts: dict[str, int] = {}
+    for utt_id in corpus.info.ids:
+        found = recorded_provenance(label_path(corpus.data_root, utt_id))
+        kind = found.kind if found else corpus.info.label_provenance
+        counts[kind] = counts.get(kind, 0) + 1
+    return counts
 
 
 def marker_set_difference(found: list[str], expected: list[str]) -> str:

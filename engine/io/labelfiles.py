@@ -8,8 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..data import PhoneSegment
+from ..data import PhoneSegment, Provenance
 from ..errors import InputError
+from ..labels.alphabets import to_arpabet
+from ..labels.provenance import PROVENANCE_TIER, Labels, labels_from_tiers, parse_provenance
 from .files import atomic_write, read_text
 
 LABEL_SUFFIXES = (".textgrid", ".lab", ".phn")
@@ -190,3 +192,43 @@ def write_label_map(path: str | os.PathLike[str], table: dict[str, str]) -> None
     """Write a label map file (tab separated)."""
     with atomic_write(path) as tmp:
         tmp.write_text("".join(f"{k}\t{v}\n" for k, v in table.items()), encoding="utf-8")
+
+
+def read_label_file(path: str | os.PathLike[str], rate: int, duration: float,
+                    declared: str | None = None, detect_alphabet: bool = True) -> Labels:
+    """The labels of a label file, checked against the audio's ``duration``: its phones, a
+    TextGrid's ``words`` tier, and where they came from (the record a TextGrid written by
+    facetraj holds, :func:`engine.labels.provenance.labels_from_tiers`; else ``declared``,
+    hand-checked by default). The phones are mapped onto ARPAbet from the alphabet they are in
+    (:func:`engine.labels.alphabets.to_arpabet`) unless ``detect_alphabet`` is off (a label map
+    given by the user maps them later)."""
+    path = Path(path)
+    if path.suffix.lower() != ".textgrid":
+        phones = validate_phones(read_labels(path, rate), duration, path)
+        if detect_alphabet:
+            phones = to_arpabet(phones, str(path))
+        return labels_from_tiers(phones, [], {}, declared)
+    tiers = read_textgrid_tiers(path)                     # read once: phones, words, record
+    if "phones" not in tiers:
+        raise InputError(path, f"no interval tier named 'phones' (tiers: {sorted(tiers)})")
+    raw = [PhoneSegment(s.start, s.end, s.label or "sil") for s in tiers["phones"]]
+    if not raw:
+        raise InputError(path, "the label file holds no segments")
+    phones = validate_phones(raw, duration, path)
+    if detect_alphabet:
+        phones = to_arpabet(phones, str(path))
+    words = [w for w in tiers.get("words", []) if w.label]
+    return labels_from_tiers(phones, words, tiers, declared)
+
+
+def recorded_provenance(path: str | os.PathLike[str]) -> Provenance | None:
+    """The provenance a label file records (a TextGrid facetraj wrote), ``None`` when it records
+    none; a missing or unreadable file records none either (reading it for synthesis says why)."""
+    path = Path(path)
+    if path.suffix.lower() != ".textgrid" or not path.is_file():
+        return None
+    try:
+        tier = read_textgrid_tiers(path).get(PROVENANCE_TIER)
+    except InputError:
+        return None
+    return parse_provenance(tier[0].label) if tier else None

@@ -26,23 +26,23 @@ from pathlib import Path
 
 import numpy as np
 
-from ..data import PhoneSegment, Utterance
+from ..data import Utterance
 from ..errors import InputError
 from ..fanout import Skips, fan_out
-from ..labels.alignment import Labels, align, pocketsphinx_version, recognize
-from ..labels.alphabets import to_arpabet
+from ..labels.alignment import align, pocketsphinx_version, recognize
+from ..labels.provenance import Labels
 from ..progress import Progress
 from .cachedir import cache_dir
 from .corpus import Corpus
 from .files import atomic_write
-from .labelfiles import LABEL_SUFFIXES, read_labels, read_textgrid_tiers, validate_phones
+from .labelfiles import LABEL_SUFFIXES, read_label_file
 
 log = logging.getLogger(__name__)
 
 #: Automatic labelling methods (the :attr:`Labels.source` they produce).
 METHODS = ("aligned", "recognized")
 #: Bumped when this module's output for the same input changes (part of the cache key).
-LABELLER_VERSION = 1
+LABELLER_VERSION = 2     # 2: the all-phone search's lw 4 (issue 25)
 
 
 # --------------------------------------------------------------------------- one recording
@@ -113,27 +113,12 @@ def read_transcript(path: str | os.PathLike[str]) -> str:
         raise InputError(path, "the transcript is not UTF-8 text") from None
 
 
-def file_labels(path: str | os.PathLike[str], rate: int, duration: float,
-                detect_alphabet: bool = True) -> Labels:
-    """Labels read from a label file (phones, and words from a TextGrid's ``words`` tier); the
-    phones mapped onto ARPAbet from the alphabet they are in
-    (:func:`engine.labels.alphabets.to_arpabet`) unless ``detect_alphabet`` is off (a label map
-    given by the user maps them later)."""
-    path = Path(path)
-    phones = validate_phones(read_labels(path, rate), duration, path)
-    if detect_alphabet:
-        phones = to_arpabet(phones, str(path))
-    words: list[PhoneSegment] = []
-    if path.suffix.lower() == ".textgrid":
-        words = [w for w in read_textgrid_tiers(path).get("words", []) if w.label]
-    return Labels(phones, words, "file")
-
-
 def labels_for_audio(audio_path: str | os.PathLike[str], audio: np.ndarray, rate: int, *,
                      labels: str | os.PathLike[str] | None = None, text: str | None = None,
                      transcript: str | os.PathLike[str] | None = None, recognize: bool = False,
                      extra_dict: Mapping[str, Sequence[str]] | None = None,
-                     use_cache: bool = True, detect_alphabet: bool = True) -> Labels | None:
+                     use_cache: bool = True, declared: str | None = None,
+                     fallback: bool = False, detect_alphabet: bool = True) -> Labels | None:
     """The phone labels of ``audio`` by THE rule (first that applies):
 
     1. ``labels`` (a label file) -> ``source="file"``;
@@ -141,35 +126,58 @@ def labels_for_audio(audio_path: str | os.PathLike[str], audio: np.ndarray, rate
     3. ``recognize`` -> recognized;
     4. a label file beside the audio (same stem) -> file;
     5. a ``.txt`` beside the audio -> aligned;
-    6. otherwise ``None``: :func:`engine.method.pipeline.mode_for` then synthesizes acoustic-only.
+    6. otherwise, with ``fallback``, recognized (synthesis: on every voice measured the robust mode
+       with recognized labels beats acoustic-only, and only labels can close the lips), when
+       recognition fails or without ``fallback`` ``None``: :func:`engine.method.modes.choose_mode`
+       then synthesizes acoustic-only.
+
+    A label file's provenance is the record it holds (a TextGrid facetraj wrote), else
+    ``declared`` (``--label-provenance``), else hand-checked.
 
     The choice is logged. Errors of alignment (missing words, text that does not fit) propagate.
     A label file's alphabet is recognised and mapped onto ARPAbet unless ``detect_alphabet`` is
-    off (:func:`file_labels`).
+    off (:func:`engine.io.labelfiles.read_label_file`).
     """
     duration = len(audio) / float(rate)
     if labels is not None:
         log.info("phone labels from %s", labels)
-        return file_labels(labels, rate, duration, detect_alphabet)
+        return read_label_file(labels, rate, duration, declared, detect_alphabet)
     if text is None and transcript is not None:
         text = read_transcript(transcript)
     if text is not None:
         log.info("phone labels aligned from the sentence %r", text)
-        return label_audio(audio, rate, "aligned", text, extra_dict, transcript or audio_path,
-                           use_cache)
+        return _made_from(label_audio(audio, rate, "aligned", text, extra_dict,
+                                      transcript or audio_path, use_cache),
+                          Path(transcript).name if transcript else "the sentence given")
     if recognize:
         log.info("phone labels by phone recognition (no text)")
-        return label_audio(audio, rate, "recognized", source=audio_path, use_cache=use_cache)
+        return _made_from(label_audio(audio, rate, "recognized", source=audio_path,
+                                      use_cache=use_cache), Path(audio_path).name)
     label_file, txt = beside(audio_path)
     if label_file is not None:
         log.info("phone labels from %s (beside the audio)", label_file)
-        return file_labels(label_file, rate, duration, detect_alphabet)
+        return read_label_file(label_file, rate, duration, declared, detect_alphabet)
     if txt is not None:
         sentence = read_transcript(txt)
         log.info("phone labels aligned from %s: %r", txt.name, sentence)
-        return label_audio(audio, rate, "aligned", sentence, extra_dict, txt, use_cache)
+        return _made_from(label_audio(audio, rate, "aligned", sentence, extra_dict, txt, use_cache),
+                          txt.name)
+    if fallback:
+        log.info("no labels, no sentence and no .txt beside %s: phone recognition", audio_path)
+        try:
+            return _made_from(label_audio(audio, rate, "recognized", source=audio_path,
+                                          use_cache=use_cache), Path(audio_path).name)
+        except InputError as exc:
+            log.warning("%s; acoustic-only synthesis", exc)
+            return None
     log.info("no labels, no sentence and no .txt beside %s", audio_path)
     return None
+
+
+def _made_from(labels: Labels, origin: str) -> Labels:
+    """``labels`` with what they were made from in their provenance."""
+    labels.provenance = replace(labels.provenance, origin=origin)
+    return labels
 
 
 # --------------------------------------------------------------------------- corpora
@@ -240,7 +248,8 @@ def label_corpus(corpus: Corpus, method: str = "aligned", split: str = "all",
 def with_labels(utt: Utterance, labels: Labels) -> Utterance:
     """``utt`` with its phones (and words, when any) replaced by ``labels``."""
     return replace(utt, phones=list(labels.phones), words=list(labels.words) or utt.words,
-                   label_source=labels.source)
+                   label_source=labels.source, provenance=labels.provenance,
+                   confidence=labels.trust())
 
 
 @dataclass
@@ -299,7 +308,8 @@ class FolderLabelling:
 
 def write_labels(path: str | os.PathLike[str], labels: Labels, duration: float,
                  overwrite: bool = False) -> None:
-    """Write ``labels`` as a TextGrid (``words`` tier when any, then ``phones``)."""
+    """Write ``labels`` as a TextGrid: ``words`` when any, ``phones``, and for automatic labels
+    their record (``provenance``, ``confidence``: :meth:`Labels.tiers`)."""
     from .labelfiles import write_textgrid
 
     write_textgrid(path, labels.tiers(), duration, overwrite)
@@ -360,6 +370,8 @@ def _label_file(apath: Path, method: str, extra_dict: Mapping[str, Sequence[str]
             if method == "aligned" and apath.with_suffix(".txt").is_file() else ""
         labels, error = label_utterance(Utterance(apath.stem, audio, rate, text=text), method,
                                         extra_dict, use_cache)
+        labels = _made_from(labels, apath.with_suffix(".txt").name if labels.source == "aligned"
+                            else apath.name)
         write_labels(apath.with_suffix(".TextGrid"), labels, len(audio) / rate, overwrite)
     except InputError:
         raise

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..data import LABEL_KINDS
 from ..errors import ModelFileError
 from ..labels.phoneset import SILENCE
 from .c3d_check import MAX_RATE, MIN_RATE
@@ -162,13 +163,23 @@ def check_meta(path: Path, meta: dict, newest: int, fmt: str) -> None:
     if not isinstance(meta.get("corpus_fingerprint", ""), str):
         raise bad("corpus_fingerprint", "text")
     _check_tuned(path, meta.get("tuned", {}))
+    closed, d0 = meta.get("closure_closed"), meta.get("voice_distance")
+    if closed is not None and (not _is_num(closed) or not abs(closed) < 1e6):
+        raise bad("closure_closed", "a lip aperture in mm")
+    if d0 is not None and (not _is_num(d0) or not 0 < d0 < 1e6):
+        raise bad("voice_distance", "a positive number")
+    kinds = meta.get("trained_labels", {})
+    if not isinstance(kinds, dict) or not all(k in LABEL_KINDS and _is_int(n) and n >= 0
+                                              for k, n in kinds.items()):
+        raise bad("trained_labels", f"an object of utterance counts by label kind "
+                                    f"({', '.join(LABEL_KINDS)})")
 
 
 #: the cross-validated synthesis settings a model may hold, and their ranges (as the options')
 TUNED_RANGES = {"n_context_phones": (1, 1000, int), "robust_candidates": (1, 100000, int),
                 "xi": (1.0, 1e6, float), "label_weight": (0.0, 1e6, float),
                 "context_weight": (0.0, 1e6, float), "gamma_max": (1e-3, 1e3, float),
-                "triangle_s": (1e-3, 10.0, float)}
+                "triangle_s": (1e-3, 10.0, float), "chain_beta": (0.0, 1e3, float)}
 
 
 def _check_tuned(path: Path, tuned) -> None:
@@ -247,6 +258,7 @@ def _expected(meta: dict, a: dict[str, np.ndarray]) -> dict[str, tuple[str, tupl
         "ix_centroids": ("f", (n_cells, p_order)), "ix_order": ("i", (n_cw,)),
         "ix_offsets": ("i", (n_cells + 1,)),
         "cb_lsf_context": ("f", (n_cw, 2, p_order)),
+        "closure_direction": ("f", (k,)), "rest_pcs": ("f", (k,)),
     }
 
 
@@ -334,6 +346,9 @@ def check_arrays(path: Path, meta: dict, a: dict[str, np.ndarray]) -> dict[str, 
     missing = [k for k in REQUIRED if k not in a]
     if missing:
         raise ModelFileError(path, f"model file is incomplete: missing {', '.join(missing)}")
+    if ("closure_closed" in meta) != ("closure_direction" in a) or \
+            ("closure_direction" in a) != ("rest_pcs" in a):
+        raise ModelFileError(path, "its closure statistics are incomplete (damaged file?)")
     out = dict(a)
     for name, (kind, shape) in _expected(meta, a).items():
         if name in a:

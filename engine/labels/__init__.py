@@ -16,5 +16,6 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "phoneset": "ARPABET SILENCE SILENCE_LABELS FALLBACK normalise_label apply_label_map map_labels",
     "alphabets": "ALPHABETS MOCHA_TO_ARPABET Alphabet detect to_arpabet",
     "labelmap": "LabelMap AlphabetMap read_label_map",
-    "alignment": "Labels align recognize pocketsphinx_version MissingWordsError UnalignableError",
+    "alignment": "align recognize pocketsphinx_version MissingWordsError UnalignableError",
+    "provenance": "Labels SCORE_SCALE provenance_text parse_provenance labels_from_tiers",
 })

@@ -8,7 +8,7 @@ Training (2.1-2.2): ``markers`` (gap filling, head motion removed with the fixed
 Synthesis (2.3): ``pipeline.synthesize``: input LSFs; candidates by eq 4 (``similarity``), by
 the LSF index (acoustic-only) or both (``selection``, the robust mode beyond the paper); eqs 5-8
 (``synthesis``); ``smoothing``; PCs back to face points. ``speaker`` warps another voice's LSFs.
-``pipeline.mode_for`` is the one rule for which mode the labels allow.
+``modes.choose_mode`` is the one rule for which mode the labels allow.
 
 Equation modules are plain array functions, each naming its equation, with doctests; fast
 kernels are tested against the reference formula. Imports shared modules, ``engine.labels`` and
@@ -20,7 +20,8 @@ from .. import lazy_exports
 __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "model": "Model",
     "training": "train",
-    "pipeline": "synthesize Synthesis mode_for resmooth",
+    "pipeline": "synthesize Synthesis resmooth",
+    "modes": "choose_mode ModeChoice tuned_config",
     "lsf": "lpc lsf_at poly2lsf lsf2poly",
     "pca": "PCA fit_pca",
     "codebook": "Codebook",

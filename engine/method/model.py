@@ -10,6 +10,7 @@ import json
 import logging
 import os
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +20,8 @@ from ..config import TrainConfig
 from ..errors import ModelFileError
 from ..io.files import atomic_write
 from ..io.model_file import read_model_file
+from .chain import join_scale
+from .closure import ClosureStats
 from .codebook import Codebook
 from .lsf import lsf_at
 from .lsf_index import LsfIndex, build_index
@@ -55,6 +58,12 @@ class Model:
         normalisation); older model files have none and it is computed from the codebook.
     tuned : the synthesis settings chosen by cross-validation on the training split
         (:func:`engine.evaluation.tuning.cross_validate`: ``{"settings": {...}, "scores": [...]}``), or empty.
+    trained_labels : how the training utterances' labels were made: utterances per kind
+        (``{"hand-checked": 186}``; ``engine.data.Provenance``); empty in older model files.
+    closure : the training talker's closed lip aperture, closing direction and rest face
+        (:mod:`engine.method.closure`); ``None`` in older model files (no closure step).
+    voice_distance : ``D0``, the training voice's distance to its own codebook
+        (:mod:`engine.method.voice_match`); NaN in older model files.
     """
 
     config: TrainConfig
@@ -76,8 +85,23 @@ class Model:
     corpus_fingerprint: str = ""
     index: LsfIndex | None = None
     tuned: dict = field(default_factory=dict)
+    trained_labels: dict = field(default_factory=dict)
+    closure: ClosureStats | None = None
+    voice_distance: float = float("nan")
 
     # ------------------------------------------------------------------ derived quantities
+    @cached_property
+    def join_scale(self) -> float:
+        """``s^2`` of the chain's join cost (:func:`engine.method.chain.join_scale`), from the
+        codebook."""
+        cb = self.codebook
+        return join_scale(cb.pcs, cb.token_start, cb.token_end, cb.n_per_phone, self.marker_rate)
+
+    @property
+    def trained_on_hand_checked(self) -> bool:
+        """Whether every training utterance's labels were hand-checked (older files: assumed)."""
+        return set(self.trained_labels) <= {"hand-checked"}
+
     @property
     def n_markers(self) -> int:
         return len(self.marker_names)
@@ -164,7 +188,11 @@ class Model:
             "train_utterances": self.train_utterances,
             "corpus_fingerprint": self.corpus_fingerprint,
             "tuned": self.tuned,
+            "trained_labels": self.trained_labels,
+            "voice_distance": self.voice_distance if np.isfinite(self.voice_distance) else None,
         }
+        if self.closure is not None:
+            meta["closure_closed"] = self.closure.closed
         arrays = {
             "meta": np.array(json.dumps(meta)),
             "fixed": self.fixed, "reference": self.reference,
@@ -177,6 +205,8 @@ class Model:
         }
         if self.codebook.lsf_context is not None:
             arrays["cb_lsf_context"] = self.codebook.lsf_context
+        if self.closure is not None:
+            arrays.update(closure_direction=self.closure.direction, rest_pcs=self.closure.rest)
         if self.index is not None:
             arrays.update(ix_centroids=self.index.centroids, ix_order=self.index.order,
                           ix_offsets=self.index.offsets)
@@ -208,6 +238,10 @@ class Model:
                 train_utterances=list(meta.get("train_utterances", [])),
                 corpus_fingerprint=meta.get("corpus_fingerprint", ""), index=index,
                 tuned=dict(meta.get("tuned") or {}),
+                trained_labels=dict(meta.get("trained_labels") or {}),
+                closure=ClosureStats(float(meta["closure_closed"]), a["closure_direction"],
+                                     a["rest_pcs"]) if "closure_closed" in meta else None,
+                voice_distance=float(meta.get("voice_distance") or "nan"),
             )
         except KeyError as exc:
             raise ModelFileError(path, f"model file is incomplete: missing {exc}") from exc

@@ -3,65 +3,37 @@
 (``engine.method.synthesis``; ``engine.method.selection`` for the robust mode), smoothing, and the PCs back to
 face points.
 
-The rule for which mode the labels allow lives here, once: :func:`mode_for`.
+Which mode the labels allow is :func:`engine.method.modes.choose_mode`, the one rule.
 """
 
 from __future__ import annotations
 
 import json
 import logging
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..config import SynthConfig
-from ..data import PhoneSegment
+from ..data import PhoneSegment, Provenance
 from ..errors import InputError
 from ..io.labelfiles import validate_phones
-from ..labels.phoneset import SILENCE, map_labels
+from ..labels.phoneset import SILENCE, map_labels, normalise_label
 from ..threads import frame_threads, map_spans
+from .chain import chain_pcs
+from .closure import ClosurePlan, aperture_functional, apply_closure, closure_intervals, closure_strengths
 from .context import context_ids, segment_index
 from .model import Model
 from .selection import mean_normalise, robust_frames
 from .similarity import top_context_phones
 from .smoothing import smooth
 from .speaker import choose_warp, warp_lsf
+from .speech import pauses, speech_mask
 from .synthesis import FrameWeights, gamma_grid, nearest_codewords, weight_frames
+from .voice_match import voice_distance, voice_match
 
 log = logging.getLogger(__name__)
-
-
-#: Label sources that are hand-checked (``engine.labels.alignment.Labels.source``): a label file is taken
-#: as hand-checked; aligned and recognized labels are not.
-HAND_CHECKED = ("file",)
-
-
-def mode_for(config: SynthConfig, phones: Sequence[PhoneSegment] | None,
-             source: str | None = "file", explicit: bool = False) -> SynthConfig:
-    """THE rule for the synthesis mode the labels allow: ``config``, switched
-
-    * to acoustic-only when a mode that needs labels (phonetic, robust) has none;
-    * from phonetic to ``robust`` when the labels are not hand-checked (``source`` not in
-      :data:`HAND_CHECKED`: aligned or recognized), unless the user chose phonetic
-      (``explicit``) -- the paper's eq 4 trusts its labels fully.
-
-    >>> mode_for(SynthConfig(), None).mode
-    'acoustic'
-    >>> mode_for(SynthConfig(), [PhoneSegment(0.0, 0.1, "sil")]).mode
-    'phonetic'
-    >>> mode_for(SynthConfig(), [PhoneSegment(0.0, 0.1, "sil")], "recognized").mode
-    'robust'
-    >>> mode_for(SynthConfig(), [PhoneSegment(0.0, 0.1, "sil")], "aligned", explicit=True).mode
-    'phonetic'
-    """
-    if config.mode in ("phonetic", "robust") and not phones:
-        log.info("no phone labels: acoustic-only synthesis")
-        return config.with_(mode="acoustic")
-    if config.mode == "phonetic" and source not in HAND_CHECKED and not explicit:
-        log.info("%s labels are not hand-checked: robust synthesis", source)
-        return config.with_(mode="robust")
-    return config
 
 
 @dataclass
@@ -88,6 +60,9 @@ class Synthesis:
     segments : per input phone, the chosen context-phones (phonetic mode), else empty.
     frame_segment : ``(T,)`` index into ``segments`` (phonetic mode), else -1.
     warp : the speaker warp factor applied to the input LSFs (``config.speaker_warp``).
+    closure : where the closure step acted (:mod:`engine.method.closure`), ``None`` when off.
+    voice_match : the input's voice match (:func:`input_voice_match`) when the synthesis needed
+        it (the robust mode, recognized labels), else NaN.
     """
 
     times: np.ndarray
@@ -100,6 +75,8 @@ class Synthesis:
     segments: list[SegmentChoice] = field(default_factory=list)
     frame_segment: np.ndarray | None = None
     warp: float = 1.0
+    closure: ClosurePlan | None = None
+    voice_match: float = float("nan")
 
     def arrays(self) -> dict[str, np.ndarray]:
         """What an ``.npz`` output keeps of the synthesis beside its markers
@@ -124,18 +101,22 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                n_frames: int | None = None, label_map: Mapping[str, str] | None = None,
                source: str | None = None, lsf: np.ndarray | None = None,
                audio_source: str | None = None,
-               confidence: Sequence[float] | np.ndarray | None = None) -> Synthesis:
+               confidence: Sequence[float] | np.ndarray | None = None,
+               provenance: Provenance | None = None) -> Synthesis:
     """Synthesize face point trajectories from speech (paper section 2.3).
 
     With ``phones`` and ``mode="phonetic"``: per input phone, the top-N context-phones by eq 4,
     and per frame eqs 5-8 over their 5N codewords. Otherwise (acoustic-only) eqs 5-8 over the
     ``config.acoustic_prefilter`` codewords nearest to each frame, found through the model's LSF
     index (``acoustic_probe`` cells), or over the whole codebook as the paper does
-    (``acoustic_prefilter=None``). With ``mode="robust"`` (``engine.method.selection``): eq 4's codewords
-    and the ``robust_candidates`` acoustically nearest together, the target cost eq 5 with acoustic
-    context plus ``label_weight`` times the label's ``confidence`` (one value in [0, 1] per phone,
-    e.g. :attr:`engine.labels.alignment.Labels.confidence`; ``None``: 1, hand-checked) for codewords eq 4
-    did not choose. Then smoothing, and the PCs back to ``(T, M, 3)`` markers.
+    (``acoustic_prefilter=None``). With ``mode="robust"`` (``engine.method.selection``): eq 4's
+    codewords and the ``robust_candidates`` acoustically nearest together, the target cost eq 5
+    with acoustic context plus ``label_weight`` times the label's ``confidence`` (one value in
+    [0, 1] per phone, e.g. :attr:`engine.labels.provenance.Labels.confidence`; ``None``: 1,
+    hand-checked) for codewords eq 4 did not choose. Then smoothing; with ``config.closure`` the
+    lips close at the labelled /p b m/ and the face rests in pauses (:mod:`engine.method.closure`,
+    trusting each label as its ``provenance`` says: ``None``, hand-checked); and the PCs back to
+    ``(T, M, 3)`` markers.
 
     ``n_frames`` defaults to every marker frame inside the audio. ``source`` names the input (the
     labels) in error messages, ``audio_source`` the audio (default ``source``).
@@ -143,59 +124,113 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     for these frames (when one utterance is synthesized under several configs).
     """
     config = config or SynthConfig()
+    times, w, warp = _input(model, audio, sample_rate, n_frames, lsf, config,
+                            audio_source or source)
+    segs: list[PhoneSegment] | None = None
+    ratio = _voice_ratio(model, audio, sample_rate, times, w, config, provenance)
+    segments: list[SegmentChoice] = []
+    frame_seg = None
+    if config.mode in ("phonetic", "robust"):
+        if not phones:
+            raise InputError(source, f"{config.mode} mode needs phone labels (or use acoustic mode)")
+        segs, unlabelled = _model_phones(model, phones, len(audio) / sample_rate, label_map,
+                                         source, config)
+        segments, frame_seg, candidates = _eq4(model, segs, times, config)
+        if config.mode == "robust":
+            conf = frame_confidence(list(phones), confidence, times)
+            conf[unlabelled[frame_seg]] = 0.0
+            scale = max(1.0, ratio) if config.label_weight_by_voice and np.isfinite(ratio) else 1.0
+            fw = _robust(model, w, candidates, conf, config, scale)
+        else:
+            fw = _weighted(model, w, lambda a, b: candidates[a:b], config)
+    elif config.mode == "acoustic":
+        fw = _weighted(model, w, lambda a, b: acoustic_candidates(model, w[a:b], config), config)
+    else:
+        raise ValueError(f"unknown mode {config.mode!r} (phonetic, acoustic or robust)")
+    plan = plan_closure(model, audio, sample_rate, times, segs, provenance, voice_match(ratio, 1.0),
+                        config)
+    res = _finish(model, times, w, fw, config, segments, frame_seg, warp, plan)
+    res.voice_match = voice_match(ratio, 1.0)
+    return res
+
+
+def _input(model: Model, audio: np.ndarray, sample_rate: int, n_frames: int | None,
+           lsf: np.ndarray | None, config: SynthConfig, source: str | None
+           ) -> tuple[np.ndarray, np.ndarray, float]:
+    """The frame times, the input LSFs (computed here unless given; speaker-normalised) and the
+    speaker warp."""
     duration = len(audio) / float(sample_rate)
     rate = model.marker_rate
     if n_frames is None:
         n_frames = int(np.floor(duration * rate + 1e-9)) + 1
-    check_length(model, len(audio), sample_rate, audio_source or source, n_frames)
+    check_length(model, len(audio), sample_rate, source, n_frames)
     times = np.arange(n_frames) / rate
-    mc = model.config
-    threads = frame_threads()
+    order = model.config.lpc_order
     if lsf is None:
-        w = model.input_lsf(audio, sample_rate, times, threads)
-    elif lsf.shape != (n_frames, mc.lpc_order):
-        raise ValueError(f"lsf must be ({n_frames}, {mc.lpc_order}) for these frames, got {lsf.shape}")
+        w = model.input_lsf(audio, sample_rate, times, frame_threads())
+    elif lsf.shape != (n_frames, order):
+        raise ValueError(f"lsf must be ({n_frames}, {order}) for these frames, got {lsf.shape}")
     else:
         w = lsf
     w, warp = normalise_speaker(model, w, config)
-    cb = model.codebook
-    segments: list[SegmentChoice] = []
-    frame_seg = None
     if config.mode == "robust" and config.mean_normalise:
         w = mean_normalise(w, model.lsf_mean)
-    if config.mode in ("phonetic", "robust"):
-        if not phones:
-            raise InputError(source, f"{config.mode} mode needs phone labels (or use acoustic mode)")
-        segs = validate_phones(list(phones), duration, source)
-        segs = map_labels(segs, model.phones, label_map, source)
-        pid = {p: i for i, p in enumerate(model.phones)}
-        ctx = context_ids([pid[s.label] for s in segs], mc.context, pid[SILENCE])
-        s = model.similarity(config.nu)
-        top, scores = top_context_phones(ctx, cb.contexts, s, config.xi,
-                                         min(config.context, mc.context), config.n_context_phones)
-        segments = [SegmentChoice(seg, ctx[i], top[i], scores[i]) for i, seg in enumerate(segs)]
-        frame_seg = segment_index(segs, times)
-        candidates = cb.codewords_of(top)[frame_seg]
-        if config.mode == "robust":
-            conf = frame_confidence(list(phones), confidence, times)
-            near = model.lsf_index().nearest(w, cb.lsf, config.robust_candidates,
-                                              config.acoustic_probe or 8)
-            fw = robust_frames(w, candidates, near, conf, cb.lsf, cb.pcs, _gammas(config),
-                               config.label_weight, cb.lsf_context,
-                               np.array([-mc.lsf_context_frames, mc.lsf_context_frames]),
-                               config.context_weight)
-            return _finish(model, times, w, fw, config, segments, frame_seg, warp)
+    return times, w, warp
 
-        def span(a: int, b: int) -> FrameWeights:
-            return weight_frames(w[a:b], candidates[a:b], cb.lsf, cb.pcs, _gammas(config))
-    elif config.mode == "acoustic":
-        def span(a: int, b: int) -> FrameWeights:
-            return weight_frames(w[a:b], acoustic_candidates(model, w[a:b], config), cb.lsf,
-                                 cb.pcs, _gammas(config))
-    else:
-        raise ValueError(f"unknown mode {config.mode!r} (phonetic, acoustic or robust)")
-    fw = FrameWeights.concatenate(map_spans(span, n_frames, threads))    # frames independent
-    return _finish(model, times, w, fw, config, segments, frame_seg, warp)
+
+def _model_phones(model: Model, phones: Sequence[PhoneSegment], duration: float,
+                  label_map: Mapping[str, str] | None, source: str | None, config: SynthConfig
+                  ) -> tuple[list[PhoneSegment], np.ndarray]:
+    """The labels checked against the audio and mapped onto the model's phones, and which are
+    unlabelled: in the robust mode, which weighs labels by trust, a phone the model lacks."""
+    segs = validate_phones(list(phones), duration, source)
+    raw = [normalise_label(s.label) for s in segs]
+    segs = map_labels(segs, model.phones, label_map, source,
+                      unknown_as=SILENCE if config.mode == "robust" else None)
+    unlabelled = np.array([s.label == SILENCE and r != SILENCE for s, r in zip(segs, raw, strict=True)])
+    return segs, unlabelled
+
+
+def _eq4(model: Model, segs: list[PhoneSegment], times: np.ndarray, config: SynthConfig
+         ) -> tuple[list[SegmentChoice], np.ndarray, np.ndarray]:
+    """Eq 4 per input phone: its chosen context-phones, each frame's phone, and each frame's
+    ``(T, 5N)`` candidate codewords."""
+    mc, cb = model.config, model.codebook
+    pid = {p: i for i, p in enumerate(model.phones)}
+    ctx = context_ids([pid[s.label] for s in segs], mc.context, pid[SILENCE])
+    top, scores = top_context_phones(ctx, cb.contexts, model.similarity(config.nu), config.xi,
+                                     min(config.context, mc.context), config.n_context_phones)
+    segments = [SegmentChoice(seg, ctx[i], top[i], scores[i]) for i, seg in enumerate(segs)]
+    frame_seg = segment_index(segs, times)
+    return segments, frame_seg, cb.codewords_of(top)[frame_seg]
+
+
+def _robust(model: Model, w: np.ndarray, candidates: np.ndarray, conf: np.ndarray,
+            config: SynthConfig, scale: float = 1.0) -> FrameWeights:
+    """The robust mode's eqs 5-8 (``engine.method.selection``), its label weight times
+    ``scale`` (the voice's distance ratio: eq 5's distances grow with it), eq 8 over the frames'
+    chain (``engine.method.chain``)."""
+    cb, mc = model.codebook, model.config
+    near = model.lsf_index().nearest(w, cb.lsf, config.robust_candidates, config.acoustic_probe or 8)
+    fw = robust_frames(w, candidates, near, conf, cb.lsf, cb.pcs, _gammas(config),
+                       config.label_weight * scale, cb.lsf_context,
+                       np.array([-mc.lsf_context_frames, mc.lsf_context_frames]),
+                       config.context_weight)
+    if config.chain_beta > 0:                 # the weights made consistent over time
+        fw.pcs = chain_pcs(fw.weights, fw.candidates, cb.pcs, config.chain_beta, model.join_scale)
+    return fw
+
+
+def _weighted(model: Model, w: np.ndarray, candidates: Callable[[int, int], np.ndarray],
+              config: SynthConfig) -> FrameWeights:
+    """Eqs 5-8 on each frame's candidates (``candidates(a, b)`` of frames ``a:b``), the frames
+    split between threads (they are independent)."""
+    cb = model.codebook
+
+    def span(a: int, b: int) -> FrameWeights:
+        return weight_frames(w[a:b], candidates(a, b), cb.lsf, cb.pcs, _gammas(config))
+
+    return FrameWeights.concatenate(map_spans(span, len(w), frame_threads()))
 
 
 def _gammas(config: SynthConfig) -> np.ndarray:
@@ -203,13 +238,73 @@ def _gammas(config: SynthConfig) -> np.ndarray:
 
 
 def _finish(model: Model, times: np.ndarray, w: np.ndarray, fw: FrameWeights, config: SynthConfig,
-            segments: list[SegmentChoice], frame_seg: np.ndarray | None, warp: float) -> Synthesis:
-    """Smoothing and the PCs back to markers."""
-    pcs = smooth(fw.pcs, model.marker_rate, config.smoothing, config.triangle_s,
-                 config.spline_knot_s)
+            segments: list[SegmentChoice], frame_seg: np.ndarray | None, warp: float,
+            plan: ClosurePlan | None) -> Synthesis:
+    """Smoothing, the closure step, and the PCs back to markers."""
+    pcs = _smoothed(model, fw.pcs, times, config, config.smoothing, plan)
     return Synthesis(times=times, lsf=w, raw_pcs=fw.pcs, pcs=pcs, markers=model.to_markers(pcs),
                      frames=fw, config=config, segments=segments, frame_segment=frame_seg,
-                     warp=warp)
+                     warp=warp, closure=plan)
+
+
+def _smoothed(model: Model, raw: np.ndarray, times: np.ndarray, config: SynthConfig, method: str,
+              plan: ClosurePlan | None) -> np.ndarray:
+    """Raw PCs smoothed by ``method``, then the closure step when there is a plan."""
+    pcs = smooth(raw, model.marker_rate, method, config.triangle_s, config.spline_knot_s)
+    if plan is None:
+        return pcs
+    a0, g = aperture_functional(model.pca, model.upper_lip, model.lower_lip)
+    return apply_closure(pcs, times, plan, model.closure, a0, g, config.closure_taper_s,
+                         config.rest_taper_s)
+
+
+def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
+                 segs: Sequence[PhoneSegment] | None, provenance: Provenance | None,
+                 match: float, config: SynthConfig) -> ClosurePlan | None:
+    """Where the closure step acts (``None``: off, or a model file without its statistics): the
+    labelled /p b m/, trusted as :func:`~engine.method.closure.closure_strengths` says (for
+    recognized labels by the voice ``match``; NaN: unknown, untrusted), and the pauses by
+    energy."""
+    if not config.closure or model.closure is None:
+        return None
+    intervals, strengths = np.zeros((0, 2)), np.zeros(0)
+    if segs:
+        trust = closure_strengths(len(segs), (provenance or Provenance()).kind,
+                                  match if np.isfinite(match) else 1.0)
+        intervals, strengths = closure_intervals(segs, trust)
+    return ClosurePlan(intervals, strengths, pauses(audio, sample_rate, times, config.rest_pause_s))
+
+
+def _voice_ratio(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
+                 w: np.ndarray, config: SynthConfig, provenance: Provenance | None) -> float:
+    """The input's voice distance ratio when the synthesis weighs by it (the robust mode's label
+    weight, the closure step's trust in recognized labels), else NaN (not computed)."""
+    recognized = provenance is not None and provenance.kind == "recognized"
+    if (config.mode == "robust" and config.label_weight_by_voice) or (config.closure and recognized):
+        return input_voice_ratio(model, audio, sample_rate, times, w)
+    return float("nan")
+
+
+def input_voice_ratio(model: Model, audio: np.ndarray, sample_rate: int,
+                      times: np.ndarray | None = None, w: np.ndarray | None = None) -> float:
+    """``D / D0`` (:mod:`engine.method.voice_match`): how far an input's voice is from the
+    codebook's, relative to the training voice's own figure, from the audio alone (its LSFs ``w``
+    at ``times`` when already computed; NaN for a model file without ``D0``)."""
+    if not np.isfinite(model.voice_distance):
+        return float("nan")
+    if times is None or w is None:
+        times = np.arange(int(np.floor(len(audio) / sample_rate * model.marker_rate)) + 1) \
+            / model.marker_rate
+        w = model.input_lsf(audio, sample_rate, times)
+    speech = speech_mask(audio, sample_rate, times)
+    return voice_distance(w, speech, model.codebook.lsf, model.lsf_index()) / model.voice_distance
+
+
+def input_voice_match(model: Model, audio: np.ndarray, sample_rate: int,
+                      times: np.ndarray | None = None, w: np.ndarray | None = None) -> float:
+    """The voice match in [0, 1] of an input (:func:`input_voice_ratio` through
+    :func:`engine.method.voice_match.voice_match`)."""
+    return voice_match(input_voice_ratio(model, audio, sample_rate, times, w), 1.0)
 
 
 def normalise_speaker(model: Model, w: np.ndarray, config: SynthConfig) -> tuple[np.ndarray, float]:
@@ -255,7 +350,7 @@ def frame_confidence(phones: Sequence[PhoneSegment], confidence: Sequence[float]
 
 
 def resmooth(model: Model, result: Synthesis, method: str) -> np.ndarray:
-    """Markers ``(T, M, 3)`` from ``result``'s raw PCs smoothed with another ``method``."""
-    cfg = result.config
-    return model.to_markers(smooth(result.raw_pcs, model.marker_rate, method, cfg.triangle_s,
-                                   cfg.spline_knot_s))
+    """Markers ``(T, M, 3)`` from ``result``'s raw PCs smoothed with another ``method`` (and its
+    closure step, when it had one)."""
+    return model.to_markers(_smoothed(model, result.raw_pcs, result.times, result.config, method,
+                                      result.closure))

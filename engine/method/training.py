@@ -5,6 +5,7 @@ PCA, the audio-visual codebook, the phone means and distances of eqs 1-2, and th
 from __future__ import annotations
 
 import logging
+from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -18,6 +19,7 @@ from ..io.corpus import Corpus
 from ..io.labelfiles import validate_phones
 from ..labels.phoneset import SILENCE, apply_label_map
 from ..progress import Progress, no_progress
+from .closure import ClosureStats, aperture_functional, closure_stats
 from .codebook import Codebook, codeword_times, concatenate, interpolate_frames
 from .context import context_ids
 from .lsf import lsf_at
@@ -26,6 +28,8 @@ from .markers import fill_gaps, reference_pose, remove_head_motion
 from .model import Model
 from .pca import PCA, fit_pca
 from .similarity import distance_scale, phone_distances, phone_means
+from .speech import speech_mask
+from .voice_match import training_voice_distance
 
 log = logging.getLogger(__name__)
 
@@ -210,12 +214,45 @@ def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = 
     means = phone_means(cb.pcs, cb.codeword_phone(), len(phone_set))
     dist = phone_distances(means)
     scale = distance_scale(dist, config.distance_scale)
-    progress(0.97, "LSF index")
+    progress(0.95, "LSF index")
     index = build_index(cb.lsf, config.index_cells)
+    model = Model(config=config, phones=phone_set, marker_names=names, marker_rate=rate,
+                  fixed=roles.fixed, reference=reference, upper_lip=roles.upper_lip,
+                  lower_lip=roles.lower_lip, pca=pca, codebook=cb, means=means, distances=dist,
+                  scale=scale, coord_std=coord_std, lip_corners=roles.lip_corners,
+                  train_utterances=[u.name for u in loaded], corpus_fingerprint=fingerprint,
+                  index=index, trained_labels=dict(Counter(u.provenance.kind for u in loaded)))
+    progress(0.97, "closure and voice statistics")
+    model.closure = closure_part(model, loaded, normed)
+    model.voice_distance = voice_part(model, loaded)
     progress(1.0, "done")
-    return Model(config=config, phones=phone_set, marker_names=names, marker_rate=rate,
-                 fixed=roles.fixed, reference=reference, upper_lip=roles.upper_lip,
-                 lower_lip=roles.lower_lip, pca=pca, codebook=cb, means=means, distances=dist,
-                 scale=scale, coord_std=coord_std, lip_corners=roles.lip_corners,
-                 train_utterances=[u.name for u in loaded], corpus_fingerprint=fingerprint,
-                 index=index)
+    return model
+
+
+def closure_part(model: Model, loaded: Sequence[Utterance], normed: Sequence[np.ndarray]
+                 ) -> ClosureStats:
+    """The closure step's statistics (:mod:`engine.method.closure`) of the training talker."""
+    a0, g = aperture_functional(model.pca, model.upper_lip, model.lower_lip)
+    pcs = [model.to_pcs(n) for n in normed]
+    return closure_stats(pcs, [u.phones for u in loaded], model.marker_rate, a0, g)
+
+
+def voice_part(model: Model, loaded: Sequence[Utterance], utterances: int = 40,
+               frames: int = 60) -> float:
+    """``D0`` of :mod:`engine.method.voice_match` on (up to ``utterances`` evenly spaced)
+    training utterances, ``frames`` speech frames each."""
+    pick = np.unique(np.linspace(0, len(loaded) - 1, min(len(loaded), utterances)).astype(int))
+    position = np.full(len(loaded), -1)
+    position[pick] = np.arange(len(pick))
+    cb = model.codebook
+    owner = position[cb.token_utt[np.arange(len(cb.lsf)) // cb.n_per_phone]]   # in lsf's order
+    lsf, speech = [], []
+    for k in pick:
+        utt = loaded[k]
+        times = utt.frame_times()
+        mask = speech_mask(utt.audio, utt.sample_rate, times)
+        keep = np.flatnonzero(mask)
+        keep = keep[np.linspace(0, keep.size - 1, min(keep.size, frames)).astype(int)] if keep.size else keep
+        lsf.append(model.input_lsf(utt.audio, utt.sample_rate, times[keep]))
+        speech.append(np.ones(keep.size, bool))
+    return training_voice_distance(lsf, speech, owner, cb.lsf)

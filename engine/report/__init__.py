@@ -25,6 +25,7 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
+from ..evaluation.closure_eval import CLOSURE_EVAL_FILE, read_closure_eval
 from ..evaluation.label_eval import LABEL_EVAL_FILE, read_label_eval
 from ..evaluation.voice_eval import VOICE_EVAL_FILE, read_voice_eval
 from ..fanout import Skips
@@ -58,7 +59,8 @@ def write_report(corpus_dir: str | os.PathLike[str], out_dir: str | os.PathLike[
     (through ``figures``, drawn into ``out_dir/figures/``) its figures. Returns the ``.md`` path.
     The evaluation with automatic labels is read from ``out_dir/label_eval.json`` (written by
     ``facetraj report --automatic-labels``, about half an hour) when present, and the evaluation
-    with a second voice from ``out_dir/voice_eval.json`` (``facetraj report --second-voice``).
+    with a second voice from ``out_dir/voice_eval.json`` (``facetraj report --second-voice``), and
+    the closure of the lips from ``out_dir/closure_eval.json`` (``facetraj report --closure``).
     ``workers`` and ``skip``: as :func:`~.compute.compute_report`'s. Nothing is written when the
     computation fails.
     """
@@ -67,6 +69,7 @@ def write_report(corpus_dir: str | os.PathLike[str], out_dir: str | os.PathLike[
     out.mkdir(parents=True, exist_ok=True)
     data.label_eval = read_label_eval(out / LABEL_EVAL_FILE)
     data.voice_eval = read_voice_eval(out / VOICE_EVAL_FILE)
+    data.closure_eval = read_closure_eval(out / CLOSURE_EVAL_FILE)
     if figures is not None:
         fig_dir = out / "figures"
         fig_dir.mkdir(exist_ok=True)

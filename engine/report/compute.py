@@ -68,8 +68,8 @@ def figure4_data(model: Model, corpus: Corpus, text: str = FIGURE4_TEXT) -> Figu
         hit = (ids[0], "test" if corpus.info.test else "train")
         log.warning("no utterance says %r; Figure 4 shows %s instead", text, hit[0])
     utt = corpus.utterance(hit[0])
-    res = synthesize(model, utt.audio, utt.sample_rate, utt.phones, SynthConfig(), n_frames=utt.n_frames,
-                     source=utt.name)
+    res = synthesize(model, utt.audio, utt.sample_rate, utt.phones, SynthConfig(closure=False),
+                     n_frames=utt.n_frames, source=utt.name)
     original = model.normalise_markers(utt.markers)
     synth = {"triangular": resmooth(model, res, "triangular"), "spline": resmooth(model, res, "spline")}
     mask = speech_mask(utt.audio, utt.sample_rate, res.times)
@@ -201,7 +201,7 @@ def compute_report(corpus_dir: str | os.PathLike[str], model: Model | None = Non
         res2 = table2(model, corpus, acoustic=True, progress=_stage(progress, 0.1, 0.45),
                       workers=workers, skip=skip)
     corpus = corpus.without(skip.bad if skip else ())   # table2 has read every utterance
-    indexed = SynthConfig(mode="acoustic")       # the default search of the app and `facetraj synth`
+    indexed = SynthConfig(mode="acoustic", closure=False)   # the default search, without the step
     with _timed(timings, "acoustic_indexed"):
         res_ix = evaluate(model, corpus, ("train", "test"), [indexed], ("triangular", "spline"),
                           progress=_stage(progress, 0.45, 0.47), workers=workers)

@@ -98,6 +98,7 @@ class ReportData:
     created: str = ""
     label_eval: LabelEval | None = None    # every mode with automatic labels (engine.evaluation.label_eval)
     voice_eval: VoiceEval | None = None    # acoustic-only from a second voice (engine.evaluation.voice_eval)
+    closure_eval: dict | None = None       # lips that close (engine.evaluation.closure_eval)
 
     def row(self, mode: str, split: str = "test", smoothing: str = "triangular") -> ComparisonRow | None:
         """The comparison row of one mode (``phonetic``, ``acoustic``, ``acoustic-indexed``,
@@ -128,6 +129,7 @@ class ReportData:
             "timings_s": self.timings, "figures": self.figures, "labels": self.labels,
             "automatic_labels": self.label_eval.to_json()["summary"] if self.label_eval else None,
             "second_voice": self.voice_eval.to_json()["summary"] if self.voice_eval else None,
+            "closure": self.closure_eval,
         })
 
 

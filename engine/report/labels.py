@@ -70,7 +70,7 @@ def aligned_table2(corpus, model_exact, progress=None, train_config=None) -> lis
     recognized = relabelled(corpus, "recognized", split="test")
     progress(0.05, "training on aligned labels")
     model_aligned = train(aligned, config=train_config)
-    phonetic = [SynthConfig(mode="phonetic")]
+    phonetic = [SynthConfig(mode="phonetic", closure=False)]
     runs = [
         ("aligned", "aligned", model_aligned, aligned, ("train", "test")),
         ("aligned", "recognized", model_aligned, recognized, ("test",)),

@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .. import __version__
+from ..evaluation.closure_eval import format_markdown as closure_markdown
 from ..evaluation.label_eval import format_markdown
 from ..evaluation.paper import FIGURE4_TEXT, LEVELS_OFF_AT_N, TABLE2_N, table2_value
 from ..evaluation.scores import METRICS
@@ -187,6 +188,12 @@ def second_voice_section(data: ReportData) -> list[str]:
             voice_markdown(data.voice_eval)]
 
 
+def closure_section(data: ReportData) -> list[str]:
+    """Lips that close, per mode and label source (``engine.evaluation.closure_eval``), when an
+    evaluation was saved beside the report; else nothing."""
+    return [] if data.closure_eval is None else closure_markdown(data.closure_eval)
+
+
 def reproducing_section(data: ReportData) -> list[str]:
     """The command that wrote the report, and how long each stage took."""
     return ["## Reproducing", "",
@@ -198,7 +205,7 @@ def reproducing_section(data: ReportData) -> list[str]:
 #: the sections of ``results.md``, in order
 SECTIONS = (header_section, glance_section, table2_section, figure5_section, figure4_section,
             comparisons_section, labels_section, table1_section, automatic_labels_section,
-            second_voice_section, discussion_section, reproducing_section)
+            second_voice_section, closure_section, discussion_section, reproducing_section)
 
 
 def render_markdown(data: ReportData) -> str:
@@ -211,7 +218,8 @@ def render_markdown(data: ReportData) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["COMPARISON_ORDER", "SECTIONS", "automatic_labels_section", "comparisons_section",
+__all__ = ["COMPARISON_ORDER", "SECTIONS", "automatic_labels_section", "closure_section",
+           "comparisons_section",
            "discussion_section", "figure4_section", "figure5_section", "glance_section",
            "header_section", "labels_section", "render_markdown", "reproducing_section",
            "second_voice_section", "table1_section", "table2_section"]

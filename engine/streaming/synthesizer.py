@@ -49,7 +49,7 @@ class StreamConfig:
     """
 
     sample_rate: int = 16000
-    synth: SynthConfig = field(default_factory=lambda: SynthConfig(mode="acoustic"))
+    synth: SynthConfig = field(default_factory=lambda: SynthConfig(mode="acoustic", closure=False))
     batch_frames: int = 1
 
     def __post_init__(self) -> None:
@@ -223,7 +223,7 @@ def stream_synthesize(model: Model, audio: np.ndarray, sample_rate: int, block: 
                       synth: SynthConfig | None = None) -> StreamFrames:
     """The whole of ``audio`` through a :class:`StreamingSynthesizer` in blocks of ``block``
     samples; all the frames emitted (for tests and benchmarks)."""
-    cfg = StreamConfig(sample_rate, synth or SynthConfig(mode="acoustic"))
+    cfg = StreamConfig(sample_rate, synth or SynthConfig(mode="acoustic", closure=False))
     stream = StreamingSynthesizer(model, cfg)
     parts = [stream.feed(audio[a:a + block]) for a in range(0, len(audio), block)]
     parts.append(stream.flush())

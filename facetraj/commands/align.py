@@ -27,6 +27,13 @@ def add_label_source_options(p: argparse.ArgumentParser, required: bool = False)
                    help="extra pronunciations, CMUdict lines 'WORD  PH1 PH2 ...'")
 
 
+def add_label_provenance_option(p: argparse.ArgumentParser) -> None:
+    """``--label-provenance``: how label files without a record of their own were made."""
+    p.add_argument("--label-provenance", choices=["hand-checked", "aligned", "recognized"],
+                   help="how label files facetraj did not write were made (default: "
+                        "hand-checked; files facetraj wrote record it themselves)")
+
+
 def extra_dictionary(args: argparse.Namespace) -> dict[str, list[str]] | None:
     from engine.labels.alignment import read_dictionary
 

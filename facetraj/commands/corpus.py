@@ -12,6 +12,7 @@ from engine.errors import FacetrajError
 from ..corpus_work import add_corpus_work_options, finish, jobs, skips
 from ..options import FRACTION, RATE, integer
 from ..progress import TerminalProgress
+from .align import add_label_provenance_option
 
 log = logging.getLogger("facetraj")
 
@@ -33,14 +34,19 @@ def cmd_corpus_build(args: argparse.Namespace) -> int:
 
 
 def cmd_corpus_init(args: argparse.Namespace) -> int:
-    from engine.io.corpus import init_corpus
+    from engine.io.corpus import init_corpus, label_kinds, load_corpus
 
     out, info = init_corpus(args.data_dir, args.output, args.fixed, args.upper_lip,
                             args.lower_lip, args.lip_corners, args.label_map or "", args.rate,
                             args.test, args.test_fraction, args.name or "",
-                            overwrite=args.overwrite)
+                            overwrite=args.overwrite,
+                            label_provenance=args.label_provenance or "hand-checked")
     log.info("%d train and %d test utterances, %d markers (%d-D)", len(info.train),
              len(info.test), len(info.marker_names), info.dimensions)
+    kinds = label_kinds(load_corpus(out))
+    log.info("labels: %s%s", ", ".join(f"{n} {k}" for k, n in sorted(kinds.items())),
+             "" if set(kinds) <= {"hand-checked"} else
+             " (train tunes the robust mode for them; synth and eval use it)")
     print(out)
     return 0
 
@@ -102,6 +108,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     i.add_argument("--lower-lip", required=True, metavar="MARKER")
     i.add_argument("--lip-corners", nargs=2, metavar=("RIGHT", "LEFT"))
     i.add_argument("--label-map", help="'mocha' or a label map file (label<TAB>arpabet)")
+    add_label_provenance_option(i)
     i.add_argument("--rate", type=RATE, default=60.0, help="marker rate to resample to (60 Hz)")
     i.add_argument("--test", nargs="+", metavar="ID", help="test utterances")
     i.add_argument("--test-fraction", type=FRACTION, default=1 / 3)

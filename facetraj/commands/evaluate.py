@@ -4,11 +4,49 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
+from collections import Counter
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..corpus_work import add_corpus_work_options, finish, jobs, skips
 from ..options import POSITIVE, TOP_N, add_synth_options, integer, synth_config
 from ..progress import TerminalProgress
+
+if TYPE_CHECKING:
+    from engine.config import EvalConfig
+
+log = logging.getLogger("facetraj")
+
+
+def mode_rule(args: argparse.Namespace, model, corpus, splits) -> EvalConfig:
+    """The evaluation settings of ``eval`` and ``sweep``: without ``--mode`` each utterance's mode
+    follows its labels, as in ``synth`` (logged with the reason, for the first utterance)."""
+    from engine.config import EvalConfig
+    from engine.errors import FacetrajError
+    from engine.method.modes import TUNED_FIELDS, choose_mode
+
+    explicit = getattr(args, "mode", None) is not None
+    keep = tuple(f for f in TUNED_FIELDS if getattr(args, f, None) is not None)
+    first = next((u for sp in splits for u in getattr(corpus.info, sp)), None)
+    try:
+        utt = corpus.utterance(first) if first is not None else None
+    except FacetrajError:       # a bad file: the evaluation reports it, or skips it
+        utt = None
+    if utt is not None:
+        choice = choose_mode(synth_config(args), utt.phones, utt.provenance, explicit=explicit,
+                             tuned=model.tuned, keep=keep)
+        log.info("%s (%s%s)", choice.describe(), first,
+                 "" if explicit else "; each utterance's mode follows its labels")
+    return EvalConfig(by_labels=not explicit, keep=keep)
+
+
+def log_modes(res) -> None:
+    """Which modes the evaluation ran, with how many utterances each."""
+    counts = Counter((s.mode, s.utterance) for s in res.scores)
+    modes = Counter(mode for mode, _ in counts)
+    log.info("synthesized in %s", ", ".join(f"{m} mode ({n} utterance{'s' * (n != 1)})"
+                                           for m, n in modes.items()))
 
 
 def cmd_eval(args: argparse.Namespace) -> int:
@@ -19,12 +57,14 @@ def cmd_eval(args: argparse.Namespace) -> int:
     model = Model.load(args.model)
     corpus = load_corpus(args.corpus)
     splits = ("train", "test") if args.split == "all" else (args.split,)
+    eval_config = mode_rule(args, model, corpus, splits)
     configs = [synth_config(args)]
     if args.acoustic and configs[0].mode != "acoustic":
         configs.append(configs[0].with_(mode="acoustic"))
     skipped = skips(args)
-    res = evaluate(model, corpus, splits, configs, ("triangular", "spline"),
+    res = evaluate(model, corpus, splits, configs, ("triangular", "spline"), eval_config,
                    progress=TerminalProgress("eval"), workers=jobs(args), skip=skipped)
+    log_modes(res)
     print(json.dumps(res.to_json(), indent=2) if args.json else format_table2(res))
     return finish(skipped)
 
@@ -39,8 +79,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     ns = list(range(1, args.max_n + 1))
     splits = ("train", "test") if args.split == "all" else (args.split,)
     skipped = skips(args)
-    res = sweep_n(model, corpus, ns, splits, progress=TerminalProgress("sweep"),
-                  workers=jobs(args), skip=skipped)
+    res = sweep_n(model, corpus, ns, splits, mode_rule(args, model, corpus, splits),
+                  progress=TerminalProgress("sweep"), workers=jobs(args), skip=skipped)
+    log_modes(res)
     curve = {sp: [res.mean(sp, "triangular", n=n)["whole_face"] for n in ns] for sp in splits}
     if args.json:
         print(json.dumps({"n": ns, "whole_face": curve, "table": res.table()}, indent=2))

@@ -4,19 +4,23 @@ face with its sound; the results report with its figures)."""
 from __future__ import annotations
 
 import argparse
+import logging
 from pathlib import Path
 
 from engine.errors import FacetrajError
 
 from ..corpus_work import add_corpus_work_options, finish, jobs, skips
 from ..options import FPS, add_synth_options, integer, synth_config, video_size
-from ..paths import default_corpus
+from ..paths import default_corpus, shared_path
 from ..progress import TerminalProgress
+
+log = logging.getLogger("facetraj")
 
 
 def cmd_video(args: argparse.Namespace) -> int:
     from engine.method.model import Model
-    from engine.method.pipeline import mode_for, synthesize
+    from engine.method.modes import choose_mode
+    from engine.method.pipeline import synthesize
 
     try:
         from app.video import VideoSettings, render_video
@@ -32,22 +36,26 @@ def cmd_video(args: argparse.Namespace) -> int:
             raise FacetrajError("give --utterance ID with --corpus")
         utt = load_corpus(args.corpus).utterance(args.utterance)
         audio, rate, phones, n_frames = utt.audio, utt.sample_rate, utt.phones, utt.n_frames
+        provenance, confidence = utt.provenance, utt.confidence
         original = model.normalise_markers(utt.markers) if utt.markers is not None else None
         title, source = utt.text or utt.name, utt.name
     elif args.audio:
         from engine.io.audio import read_audio
-        from engine.io.labelfiles import read_labels
-        from engine.labels.alphabets import to_arpabet
+        from engine.io.labelfiles import read_label_file
 
         audio, rate = read_audio(args.audio)
-        phones = to_arpabet(read_labels(args.labels, rate), str(args.labels)) if args.labels \
-            else None
+        labels = read_label_file(args.labels, rate, len(audio) / rate) if args.labels else None
+        phones = labels.phones if labels else None
+        provenance, confidence = (labels.provenance, labels.trust()) if labels else (None, None)
         n_frames, source, title = None, str(args.labels or args.audio), args.audio.name
     else:
         raise FacetrajError("give an AUDIO file, or --corpus and --utterance")
-    cfg = mode_for(synth_config(args), phones)
-    res = synthesize(model, audio, rate, phones, cfg, n_frames=n_frames, source=source,
-                     audio_source=str(args.audio or source))
+    choice = choose_mode(synth_config(args), phones, provenance, explicit=args.mode is not None,
+                         tuned=model.tuned)
+    log.info("%s", choice.describe())
+    res = synthesize(model, audio, rate, phones, choice.config, n_frames=n_frames, source=source,
+                     audio_source=str(args.audio or source), confidence=confidence,
+                     provenance=provenance)
     w, h = args.size
     render_video(model, res, audio, rate, args.output, original=original,
                  settings=VideoSettings(w, h, args.fps), overwrite=args.overwrite,
@@ -80,6 +88,21 @@ def cmd_report(args: argparse.Namespace) -> int:
         voices = evaluate_voices(load_corpus(args.corpus or default_corpus()), model=model,
                                  progress=TerminalProgress("second voice"))
         write_voice_eval(args.output / VOICE_EVAL_FILE, voices)
+    if args.closure:
+        from engine.evaluation.closure_eval import (
+            ARCTIC_DIR,
+            CLOSURE_EVAL_FILE,
+            evaluate_closure,
+            write_closure_eval,
+        )
+        from engine.io.corpus import load_corpus
+        from engine.method.training import train
+
+        corpus = load_corpus(args.corpus or default_corpus())
+        args.output.mkdir(parents=True, exist_ok=True)
+        result = evaluate_closure(model or train(corpus), corpus, shared_path(ARCTIC_DIR),
+                                  progress=TerminalProgress("closure"))
+        write_closure_eval(args.output / CLOSURE_EVAL_FILE, result)
     skipped = skips(args)
     out = make_report(args.corpus, args.output, model=model, progress=TerminalProgress("report"),
                       ns=range(1, args.max_n + 1), workers=jobs(args), skip=skipped)
@@ -103,6 +126,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "test sentences (shorter vocal tract, higher pitch), with and without "
                         "speaker normalisation (about 8 minutes), saved as voice_eval.json beside "
                         "results.md and reported from it")
+    p.add_argument("--closure", action="store_true",
+                   help="also measure how the lips close at /p b m/ in every mode, on the held-out "
+                        "sentences and on real voices (../shared/data/arctic_samples when present; "
+                        "a few minutes), saved as closure_eval.json beside results.md")
     add_corpus_work_options(p)
     p.set_defaults(func=cmd_report)
 

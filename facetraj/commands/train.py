@@ -23,15 +23,16 @@ def cmd_train(args: argparse.Namespace) -> int:
     skipped = skips(args)
     model = train(corpus, config=train_config(args), progress=TerminalProgress("train"),
                   workers=jobs(args, 1), skip=skipped)
-    if args.tune:
+    folds = tune_folds(args, model.trained_labels)
+    if folds:
         from engine.evaluation.tuning import cross_validate
 
         tuning = cross_validate(corpus.without(skipped.bad if skipped else ()), train_config(args),
-                                folds=args.tune,
+                                folds=folds,
                                 progress=TerminalProgress("cross-validation"))
         model.tuned = tuning.to_json()
         log.info("robust-mode settings by %d-fold cross-validation on the training split: %s",
-                 args.tune, tuning.settings)
+                 folds, tuning.settings)
     out = model.save(args.output, overwrite=args.overwrite)
     cb = model.codebook
     log.info("trained on %d utterances: %d context-phones, %d codewords, %d PCs (%.2f %% of "
@@ -41,15 +42,37 @@ def cmd_train(args: argparse.Namespace) -> int:
     return finish(skipped)
 
 
+def tune_folds(args: argparse.Namespace, trained_labels: dict[str, int]) -> int:
+    """How many folds the robust mode's settings are cross-validated on: ``--tune FOLDS``;
+    ``--no-tune`` none; by default 2 when the training labels are not all hand-checked (the
+    robust mode will synthesize from such labels, and its untuned settings lose to acoustic-only
+    on real talkers), else none."""
+    kinds = ", ".join(f"{n} {k}" for k, n in sorted(trained_labels.items()))
+    if args.tune is not None:
+        return args.tune
+    if set(trained_labels) <= {"hand-checked"}:
+        log.info("training labels: %s; the robust mode is not tuned (--tune to tune it)",
+                 kinds or "hand-checked")
+        return 0
+    log.info("training labels: %s, not all hand-checked: cross-validating the robust mode's "
+             "settings on the training split (--no-tune to skip)", kinds)
+    return 2
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("train", help="train a model on a corpus folder")
     p.add_argument("corpus", type=Path)
     p.add_argument("-o", "--output", type=Path, required=True, help="model file (.npz)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing file")
-    p.add_argument("--tune", type=integer(2, 100), nargs="?", const=2, default=0, metavar="FOLDS",
-                   help="choose the robust mode's N, xi, gamma range, label and context weights "
-                        "and smoothing width by FOLDS-fold cross-validation (default 2) on the "
-                        "training split, stored in the model (a few minutes)")
+    tune = p.add_mutually_exclusive_group()
+    tune.add_argument("--tune", type=integer(2, 100), nargs="?", const=2, default=None,
+                      metavar="FOLDS",
+                      help="choose the robust mode's N, gamma range, label weight, candidates "
+                           "and smoothing width by FOLDS-fold cross-validation (default 2) on the "
+                           "training split, stored in the model (minutes); the default when the "
+                           "training labels are not hand-checked")
+    tune.add_argument("--no-tune", dest="tune", action="store_const", const=0,
+                      help="do not cross-validate, even for automatic labels")
     add_corpus_work_options(p, jobs_default="1")
     add_train_options(p)
     p.set_defaults(func=cmd_train)

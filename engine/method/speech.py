@@ -1,0 +1,106 @@
+"""Speech and pauses by energy (paper section 3): short-time energy, a 112 ms median filter and a
+threshold between the utterance's floor and peak. The evaluation scores speech frames only; the
+closure step (:mod:`engine.method.closure`) rests the face in the long pauses."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..config import EvalConfig
+
+
+def short_time_energy_db(audio: np.ndarray, rate: int, window_s: float = 0.02,
+                         hop_s: float = 0.004) -> tuple[np.ndarray, np.ndarray]:
+    """Short-time energy in dB and its frame-centre times."""
+    x = np.asarray(audio, dtype=np.float64)
+    n = max(1, int(round(window_s * rate)))
+    hop = max(1, int(round(hop_s * rate)))
+    pad = np.concatenate([np.zeros(n // 2), x, np.zeros(n)])
+    count = len(x) // hop + 1
+    idx = (np.arange(count) * hop)[:, None] + np.arange(n)[None, :]
+    frames = pad[idx] * np.hamming(n)
+    energy = (frames**2).sum(axis=1) / n
+    return 10 * np.log10(energy + 1e-12), np.arange(count) * hop / rate
+
+
+def median_filter(x: np.ndarray, k: int) -> np.ndarray:
+    """Running median of odd length ``k``, zero-padded at both ends (the values of
+    ``scipy.signal.medfilt``, tested; here so that the app's first frame does not wait 1-2 s for
+    scipy.signal to import).
+
+    >>> median_filter(np.array([3.0, 1.0, 2.0, 5.0, 4.0]), 3).tolist()
+    [1.0, 2.0, 2.0, 4.0, 4.0]
+    """
+    if k % 2 == 0:
+        raise ValueError("the median filter length must be odd")
+    x = np.asarray(x, dtype=np.float64)
+    half = k // 2
+    padded = np.concatenate([np.zeros(half), x, np.zeros(half)])
+    return np.median(np.lib.stride_tricks.sliding_window_view(padded, k), axis=1)
+
+
+def filtered_energy_db(audio: np.ndarray, rate: int, config: EvalConfig | None = None
+                       ) -> np.ndarray:
+    """The short-time energy in dB, median-filtered over ``config.median_s`` (112 ms), one value
+    per ``config.energy_hop_s``."""
+    config = config or EvalConfig()
+    e_db, _e_t = short_time_energy_db(audio, rate, config.energy_window_s, config.energy_hop_s)
+    k = int(round(config.median_s / config.energy_hop_s))
+    k = k + 1 if k % 2 == 0 else k
+    return median_filter(e_db, k) if len(e_db) >= k else e_db
+
+
+def speech_mask(audio: np.ndarray, rate: int, times: np.ndarray,
+                config: EvalConfig | None = None, filtered: np.ndarray | None = None) -> np.ndarray:
+    """Speech (True) or silence per time in ``times``: energy, 112 ms median filter, threshold
+    (``filtered``: :func:`filtered_energy_db` when already computed).
+
+    Examples
+    --------
+    >>> rate = 16000
+    >>> x = np.zeros(rate); x[4000:12000] = np.sin(np.arange(8000) * 0.3)   # 0.25-0.75 s tone
+    >>> m = speech_mask(x, rate, np.array([0.1, 0.5, 0.9]))
+    >>> m.tolist()
+    [False, True, False]
+    """
+    config = config or EvalConfig()
+    if filtered is None:
+        filtered = filtered_energy_db(audio, rate, config)
+    floor, peak = np.percentile(filtered, [5, 99])
+    threshold = floor + config.threshold_fraction * (peak - floor)
+    idx = np.clip(np.round(np.asarray(times) / config.energy_hop_s).astype(int), 0,
+                  len(filtered) - 1)
+    return filtered[idx] > threshold
+
+
+def speech_runs(mask: np.ndarray, times: np.ndarray, min_s: float = 0.0) -> np.ndarray:
+    """``(J, 2)`` ``[start, end)`` times of the runs of True in ``mask`` longer than ``min_s``
+    (``times`` the frame times, equally spaced).
+
+    >>> speech_runs(np.array([1, 1, 1, 0, 0, 1], bool), np.arange(6) / 10, 0.25).round(6).tolist()
+    [[0.0, 0.3]]
+    """
+    m = np.concatenate([[False], np.asarray(mask, bool), [False]])
+    edges = np.flatnonzero(np.diff(m.astype(np.int8)))
+    step = times[1] - times[0] if len(times) > 1 else 1.0
+    runs = [(times[a], times[b - 1] + step) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+    return np.array([r for r in runs if r[1] - r[0] > min_s], dtype=np.float64).reshape(-1, 2)
+
+
+def pauses(audio: np.ndarray, rate: int, times: np.ndarray, min_s: float = 0.15,
+           min_range_db: float = 20.0, config: EvalConfig | None = None) -> np.ndarray:
+    """``(J, 2)`` pauses: runs of non-speech frames (:func:`speech_mask`) longer than ``min_s``;
+    none when the recording's energy range (99th minus 5th percentile, median-filtered) is under
+    ``min_range_db``, as in a recording without a pause, whose quiet speech would pass for one.
+
+    >>> rate = 16000
+    >>> x = np.zeros(rate); x[4000:12000] = np.sin(np.arange(8000) * 0.3)   # 0.25-0.75 s tone
+    >>> t = np.arange(60) / 60
+    >>> pauses(x, rate, t).round(2).tolist()
+    [[0.0, 0.25], [0.77, 1.0]]
+    """
+    filtered = filtered_energy_db(audio, rate, config)
+    floor, peak = np.percentile(filtered, [5, 99])
+    if peak - floor < min_range_db:
+        return np.zeros((0, 2))
+    return speech_runs(~speech_mask(audio, rate, times, config, filtered), times, min_s)
