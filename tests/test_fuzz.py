@@ -514,3 +514,13 @@ def test_oversized_text_and_est_headers_are_refused(tmp_path):
                                      b"NumChannels 3\nEST_Header_End\n" + b"\0" * 64)
     with pytest.raises(InputError, match="EST header gives -5 frames of 3 channels"):
         read_mocha_ema(tmp_path / "e.ema")
+
+
+def test_corpus_init_with_a_tiny_test_fraction(workspace, tmp_path, capsys):
+    """--test-fraction=1e-320 ended in an OverflowError (found by make fuzz): no test utterance."""
+    corpus = _corpus_copy(workspace, tmp_path)
+    code, err = run(["corpus", "init", corpus, "--fixed", "FH_L", "FH_R", "NB", "NT", "--upper-lip",
+                     "UL_C", "--lower-lip", "LL_C", "-o", tmp_path / "d.json",
+                     "--test-fraction=1e-320"], capsys)
+    assert code == 0, err
+    assert json.loads((tmp_path / "d.json").read_text())["test"] == []

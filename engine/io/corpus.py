@@ -436,7 +436,9 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
             raise InputError(scan.first_marker_file,
                              f"no marker named {role!r}; markers: {' '.join(names)}")
     if test is None:
-        step = max(2, round(1 / test_fraction)) if test_fraction > 0 else 0
+        # a fraction of 1e-320 gave 1 / 0-ish = inf (found by make fuzz); any step past the
+        # utterances' count means no test utterance, as 1e9 does
+        step = max(2, round(1 / max(test_fraction, 1e-9))) if test_fraction > 0 else 0
         test = [u for i, u in enumerate(ids) if step and i % step == step - 1]
     train_ids = [u for u in ids if u not in test]
     if not train_ids:
