@@ -128,8 +128,10 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         segments, frame_seg, candidates = _eq4(model, segs, times, config)
         if config.mode == "robust":
             conf = frame_confidence(list(phones), confidence, times)
+            scale = 1.0
+            if config.label_weight_by_voice and np.isfinite(ratio):
+                conf, scale = trust_by_voice(conf, ratio), max(1.0, ratio)
             conf[unlabelled[frame_seg]] = 0.0
-            scale = max(1.0, ratio) if config.label_weight_by_voice and np.isfinite(ratio) else 1.0
             fw = _robust(model, w, candidates, conf, config, scale)
         else:
             fw = _weighted(model, w, lambda a, b: candidates[a:b], config)
@@ -264,6 +266,21 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
                                   match if np.isfinite(match) else 1.0)
         intervals, strengths = closure_intervals(segs, trust)
     return ClosurePlan(intervals, strengths, pauses(audio, sample_rate, times, config.rest_pause_s))
+
+
+def trust_by_voice(confidence: np.ndarray, ratio: float) -> np.ndarray:
+    """Labels weighed by voice (issue 25): ``c' = 1 - (1 - c) m``, ``m`` the voice match of the
+    distance ``ratio``. On the training voice (``m = 1``) a label counts as much as its maker
+    trusted it; on a voice the codebook does not know (``m = 0``) the acoustic distances are the
+    untrustworthy part, and the labels count fully (the recognizer and the aligner were trained
+    on many voices, the codebook on one; their scores drop on such a voice for every phone).
+
+    >>> trust_by_voice(np.array([0.2, 1.0]), 1.0).round(9).tolist()
+    [0.2, 1.0]
+    >>> trust_by_voice(np.array([0.2]), 5.0).tolist()
+    [1.0]
+    """
+    return 1.0 - (1.0 - np.asarray(confidence, dtype=np.float64)) * voice_match(ratio, 1.0)
 
 
 def _voice_ratio(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
