@@ -34,6 +34,7 @@ def build_parser() -> argparse.ArgumentParser:
                     "Without a subcommand, opens the app on the default corpus.")
     parser.add_argument("-v", "--verbose", action="store_true", help="log details")
     parser.add_argument("-q", "--quiet", action="store_true", help="log only errors")
+    parser.add_argument("--version", action="version", version=f"facetraj {_version()}")
     parser.add_argument("--screenshot", metavar="OUT.png",
                         help="render the app window to a PNG and exit")
     parser.add_argument("--utterance", help="utterance shown first")
@@ -44,6 +45,16 @@ def build_parser() -> argparse.ArgumentParser:
     for subparser in subcommand_parsers(parser):
         _add_verbosity(subparser)
     return parser
+
+
+def _version() -> str:
+    """The installed package's version (the source tree's when it is not installed)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("facetraj")
+    except PackageNotFoundError:
+        return "(not installed)"
 
 
 def subcommand_parsers(parser: argparse.ArgumentParser) -> list[argparse.ArgumentParser]:
