@@ -64,12 +64,24 @@ class Outcome:
 # --------------------------------------------------------------------------- inputs and outputs
 def is_batch(inputs: Sequence[str], output: Path) -> bool:
     """Whether the command line asks for a batch: several inputs, a folder, a glob or a list
-    file, or an output that is a folder (exists as one, or has no suffix)."""
+    file, or an output that is a folder (exists as one, or has no suffix; a trajectory file's
+    suffix makes it one file's output, refused there if a folder is in the way)."""
     if len(inputs) != 1:
         return True
     one = inputs[0]
-    return (Path(one).is_dir() or (bool(_GLOB_CHARS & set(one)) and not Path(one).exists()) or
-            Path(one).suffix.lower() in LIST_SUFFIXES or output.is_dir() or not output.suffix)
+    named_file = output.suffix.lower().lstrip(".") in (*FORMATS, "txt")
+    return (_is_dir(Path(one)) or (bool(_GLOB_CHARS & set(one)) and not Path(one).exists()) or
+            Path(one).suffix.lower() in LIST_SUFFIXES or not output.suffix or
+            (not named_file and _is_dir(output)))
+
+
+def _is_dir(path: Path) -> bool:
+    """``path.is_dir()``, False where the system cannot tell (a name too long): the command then
+    reports the path's problem as it does for one file."""
+    try:
+        return path.is_dir()
+    except OSError:
+        return False
 
 
 def collect_inputs(specs: Iterable[str]) -> list[Path]:
