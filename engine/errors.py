@@ -6,6 +6,7 @@ The command line prints ``str(err)`` and exits with status 2; the app shows it i
 from __future__ import annotations
 
 from os import PathLike
+from typing import Any
 
 
 class FacetrajError(Exception):
@@ -25,6 +26,25 @@ class InputError(FacetrajError):
         self.path = None if path is None else str(path)
         self.problem = " ".join(str(problem).split())  # always one line (library texts may wrap)
         super().__init__(f"{self.path}: {self.problem}" if self.path else self.problem)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        """Pickled as its class, path, problem and attributes (a worker process's error comes
+        back as the same error; subclasses with other ``__init__`` arguments included).
+
+        >>> import pickle
+        >>> str(pickle.loads(pickle.dumps(OutputExistsError("o.tsv", "exists"))))
+        'o.tsv: exists'
+        """
+        return _rebuild, (type(self), self.path, self.problem, dict(self.__dict__))
+
+
+def _rebuild(cls: type[InputError], path: str | None, problem: str,
+             state: dict[str, Any]) -> InputError:
+    """An :class:`InputError` of class ``cls`` unpickled, without calling its ``__init__``."""
+    err = cls.__new__(cls)
+    InputError.__init__(err, path, problem)
+    err.__dict__.update(state)
+    return err
 
 
 class OutputError(InputError, OSError):
