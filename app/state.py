@@ -14,7 +14,7 @@ from engine.config import SynthConfig
 from engine.data import Utterance
 from engine.evaluation.scores import speech_mask
 from engine.method.model import Model
-from engine.method.pipeline import Synthesis, input_voice_match, resmooth, synthesize
+from engine.method.pipeline import Synthesis, resmooth, synthesize
 
 
 def frame_index(t: float, rate: float, n_frames: int, step: int = 0) -> int:
@@ -87,13 +87,11 @@ def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig,
     n_frames = utt.n_frames or None
     res = synthesize(model, utt.audio, utt.sample_rate, utt.phones if utt.phones else None, config,
                      n_frames=n_frames, source=utt.name, confidence=utt.confidence,
-                     provenance=utt.provenance)
+                     provenance=utt.provenance, voice=True)
     original = model.normalise_markers(utt.markers) if utt.markers is not None else None
     triangular = res.markers if config.smoothing == "triangular" else resmooth(model, res, "triangular")
     spline = res.markers if config.smoothing == "spline" else resmooth(model, res, "spline")
     speech = speech_mask(utt.audio, utt.sample_rate, res.times)
-    match = res.voice_match if np.isfinite(res.voice_match) else \
-        input_voice_match(model, utt.audio, utt.sample_rate, res.times, res.lsf)
     return UtteranceView(utterance=utt, split=split, synthesis=res, original=original,
                          triangular=triangular, spline=spline, speech=speech, times=res.times,
-                         mode_reason=mode_reason, voice_match=match)
+                         mode_reason=mode_reason, voice_match=res.voice_match)

@@ -23,7 +23,7 @@ from pathlib import Path
 
 from engine.threads import limit_frame_threads, one_blas_thread
 
-from . import labels, live, scaling, startup, synth, train
+from . import cli, labels, live, scaling, startup, synth, train
 from .common import (
     REPO,
     BenchContext,
@@ -38,7 +38,7 @@ from .common import (
 
 log = logging.getLogger("benchmarks")
 
-GROUPS = ("train", "synth", "scaling", "eval", "labels", "playback", "startup", "live")
+GROUPS = ("train", "synth", "cli", "scaling", "eval", "labels", "playback", "startup", "live")
 DEFAULT_OUT = REPO / "docs" / "benchmarks.md"
 #: hand-written profile notes (per stage, before and after a change), copied into the Markdown
 NOTES = REPO / "benchmarks" / "profile_notes.md"
@@ -86,6 +86,9 @@ def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS, factors: Sequence[i
         with one_blas_thread():                   # as the app, the CLI and the evaluation run it
             rows += synth.run(ctx)
             rows += synth.stages(ctx, 2.0 if ctx.smoke else synth.STAGE_SECONDS, 2 if ctx.smoke else 7)
+    if "cli" in only:
+        rows += cli.one_file(ctx)
+        rows += cli.batch(ctx)
     if "scaling" in only:
         with limit_frame_threads(1):              # how the search grows, on one core
             rows += scaling.run(ctx, factors, prefilters)

@@ -93,9 +93,11 @@ class SynthConfig:
     robust_candidates : robust mode: acoustically nearest codewords added to eq 4's (index search).
     label_weight : robust mode: kappa, the cost (eq 5 units) of a codeword eq 4 did not choose,
         times the label's confidence.
-    label_weight_by_voice : robust mode: kappa times the input voice's distance ratio ``D / D0``
-        (at least 1; ``engine.method.voice_match``): eq 5's distances grow on a voice the codebook
-        does not know, and the labels must keep their weight against them.
+    label_weight_by_voice : robust mode: the labels weighed by the input's voice
+        (``engine.method.voice_match``): kappa times the voice's distance ratio ``D / D0`` (at
+        least 1: eq 5's distances grow on a voice the codebook does not know), and each label's
+        confidence raised towards 1 as the voice match falls (:func:`engine.method.pipeline.
+        trust_by_voice`).
     context_weight : robust mode: rho, the weight of the context frames in the distance.
     mean_normalise : robust mode: move the input LSFs' mean to the training speaker's.
     chain_beta : robust mode: beta, the join cost's weight of the chain over frames that makes

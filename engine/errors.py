@@ -17,6 +17,7 @@ import logging
 from collections import Counter
 from dataclasses import dataclass
 from os import PathLike
+from typing import Any
 
 
 class FacetrajError(Exception):
@@ -39,18 +40,24 @@ class InputError(FacetrajError):
         self.problem = " ".join(str(problem).split())  # always one line (library texts may wrap)
         super().__init__(f"{self.path}: {self.problem}" if self.path else self.problem)
 
-    def __reduce__(self):
-        # pickled as path, problem and attributes, whatever a subclass's __init__ takes (the
-        # default, the class called with ``args``, fails on ``(path, problem)`` initialisers)
-        return _rebuild_input_error, (type(self), self.path, self.problem, dict(self.__dict__))
+    def __reduce__(self) -> tuple[Any, ...]:
+        """Pickled as its class, path, problem and attributes (a worker process's error comes
+        back as the same error; subclasses with other ``__init__`` arguments included).
+
+        >>> import pickle
+        >>> str(pickle.loads(pickle.dumps(OutputExistsError("o.tsv", "exists"))))
+        'o.tsv: exists'
+        """
+        return _rebuild, (type(self), self.path, self.problem, dict(self.__dict__))
 
 
-def _rebuild_input_error(cls: type[InputError], path: str | None, problem: str,
-                         state: dict) -> InputError:
-    exc = cls.__new__(cls)
-    InputError.__init__(exc, path, problem)
-    exc.__dict__.update(state)
-    return exc
+def _rebuild(cls: type[InputError], path: str | None, problem: str,
+             state: dict[str, Any]) -> InputError:
+    """An :class:`InputError` of class ``cls`` unpickled, without calling its ``__init__``."""
+    err = cls.__new__(cls)
+    InputError.__init__(err, path, problem)
+    err.__dict__.update(state)
+    return err
 
 
 class OutputError(InputError, OSError):

@@ -91,3 +91,20 @@ def test_smoke_eval_rows(toy: Path) -> None:
     assert [r.group for r in rows] == ["eval", "eval"]
     assert all(math.isfinite(r.value) and r.value > 0 for r in rows)
     assert "scores equal to the serial run: True" in rows[1].note
+
+
+def test_smoke_command_rows(toy: Path) -> None:
+    """The whole-command benchmark (issue 28) in smoke size: every row there, finite, unjudged."""
+    from benchmarks import cli
+    from benchmarks.common import load_context
+
+    ctx = load_context(toy, smoke=True)
+    rows = cli.one_file(ctx) + cli.batch(ctx)
+    names = [r.name for r in rows]
+    for want in ("facetraj synth, phonetic, 2 s to .npz", "facetraj synth, acoustic, 2 s to .npz",
+                 "facetraj synth, phonetic, 2 s to .tsv", "cold start: facetraj --version",
+                 "batch of 6 files of 3-5 s, 1 worker", "batch of 6 files of 3-5 s, 2 workers",
+                 "batch of 6 files: 2 workers against 1", "batch of 6 files: peak memory"):
+        assert any(n.startswith(want) for n in names), want
+    for r in rows:
+        assert math.isfinite(r.value) and r.value > 0 and r.ok is None, r

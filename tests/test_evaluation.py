@@ -83,3 +83,29 @@ def test_median_filter_equals_scipy_medfilt(k):
 
     x = np.random.default_rng(k).standard_normal(500) * 20 - 40      # an energy contour in dB
     np.testing.assert_array_equal(median_filter(x, k), medfilt(x, k))
+
+
+def test_median_filter_with_nan_is_nan_where_the_window_holds_it():
+    from engine.method.speech import median_filter
+
+    x = np.arange(9, dtype=float)
+    x[4] = np.nan
+    out = median_filter(x, 3)
+    assert np.isnan(out[3:6]).all() and out[[1, 2, 6, 7]].tolist() == [1.0, 2.0, 6.0, 7.0]
+
+
+@pytest.mark.parametrize("rate, n", [(16000, 48000), (16000, 5), (44100, 44100 * 2 + 7),
+                                     (8000, 8001), (22050, 1)])
+def test_short_time_energy_equals_the_sum_over_windowed_frames(rate, n):
+    """The block-product energy equals each frame's windowed sum of squares (the definition)."""
+    from engine.method.speech import short_time_energy_db
+
+    x = np.random.default_rng(n).standard_normal(n) * 0.1
+    win, hop = int(round(0.02 * rate)), int(round(0.004 * rate))
+    pad = np.concatenate([np.zeros(win // 2), x, np.zeros(win)])
+    count = n // hop + 1
+    frames = pad[(np.arange(count) * hop)[:, None] + np.arange(win)] * np.hamming(win)
+    want = 10 * np.log10((frames ** 2).sum(axis=1) / win + 1e-12)
+    got, times = short_time_energy_db(x, rate)
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(times, np.arange(count) * hop / rate)

@@ -292,3 +292,12 @@ def test_corpus_show_lists_the_good_utterances_with_skip_bad(corpus_with_a_bad_f
     assert [ln.split()[1] for ln in out.splitlines()[2:]] == ["toy000", "toy030"]
     code, out, err = _run(["corpus", "show", root, "-q"], capsys)
     assert code == 2 and err.startswith(f"facetraj: error: {root / BAD}")
+
+
+def test_a_dying_worker_of_the_synth_batch_is_a_clean_error():
+    """facetraj synth's batch (facetraj.batch, issue 28) fans out too: a worker killed is an
+    error of one line, not a BrokenProcessPool traceback."""
+    from facetraj.batch import fan_out as batch_fan_out
+
+    with pytest.raises(FacetrajError, match="a worker process stopped unexpectedly"):
+        list(batch_fan_out(_dies_on_b, ["a", "b", "c"], 2, lambda: None, ()))

@@ -152,3 +152,15 @@ def test_cli_acoustic_search_options():
     assert cfg.acoustic_prefilter == 64 and cfg.acoustic_probe is None
     with pytest.raises(SystemExit):
         parser.parse_args([*base, "--acoustic-probe", "0"])
+
+
+def test_the_nearest_alone_is_the_first_of_the_nearest_few():
+    """count=1 (the voice match) by argmin: the codeword the general search ranks first."""
+    lsf = random_lsf(600, seed=6)
+    ix = build_index(lsf)
+    w = random_lsf(50, seed=7)
+    one = ix.nearest(w, lsf, count=1, probe=4)[:, 0]
+    few = ix.nearest(w, lsf, count=5, probe=4)
+    h = perceptual_weights(w)
+    d = (np.abs(w[:, None, :] - lsf[few]) * h[:, None, :]).sum(axis=2)
+    np.testing.assert_array_equal(one, few[np.arange(len(w)), d.argmin(axis=1)])

@@ -198,10 +198,14 @@ def _smallest(d: np.ndarray, count: int) -> np.ndarray:
 
     >>> _smallest(np.array([[5.0, 1.0, 3.0, 1.0], [0.0, 9.0, 9.0, 9.0]]), 2).tolist()
     [[1, 3], [0, 1]]
+    >>> _smallest(np.array([[5.0, 1.0, 3.0, 1.0], [9.0, 9.0, 0.0, 0.0]]), 1).tolist()
+    [[1], [2]]
     """
     rows, width = d.shape
     if count >= width:
         return np.broadcast_to(np.arange(width), (rows, width))
+    if count == 1:                    # the nearest alone (the voice match): the first smallest
+        return d.argmin(axis=1)[:, None]
     kth = np.partition(d, count - 1, axis=1)[:, count - 1]
     r, cols = np.nonzero(d <= kth[:, None])
     if len(r) > rows * count:                                  # ties at the edge: the first ones

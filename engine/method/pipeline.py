@@ -8,6 +8,7 @@ Which mode the labels allow is :func:`engine.method.modes.choose_mode`, the one 
 
 from __future__ import annotations
 
+import functools
 import json
 import logging
 from collections.abc import Callable, Mapping, Sequence
@@ -29,7 +30,7 @@ from .selection import mean_normalise, robust_frames
 from .similarity import top_context_phones
 from .smoothing import smooth
 from .speaker import choose_warp, warp_lsf
-from .speech import pauses, speech_mask
+from .speech import filtered_energy_db, pauses, speech_mask
 from .synthesis import FrameWeights, gamma_grid, nearest_codewords, weight_frames
 from .voice_match import voice_distance, voice_match
 
@@ -102,7 +103,7 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                source: str | None = None, lsf: np.ndarray | None = None,
                audio_source: str | None = None,
                confidence: Sequence[float] | np.ndarray | None = None,
-               provenance: Provenance | None = None) -> Synthesis:
+               provenance: Provenance | None = None, voice: bool = False) -> Synthesis:
     """Synthesize face point trajectories from speech (paper section 2.3).
 
     With ``phones`` and ``mode="phonetic"``: per input phone, the top-N context-phones by eq 4,
@@ -121,13 +122,16 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     ``n_frames`` defaults to every marker frame inside the audio. ``source`` names the input (the
     labels) in error messages, ``audio_source`` the audio (default ``source``).
     ``lsf`` may pass the input LSFs already computed by :meth:`Model.input_lsf`
-    for these frames (when one utterance is synthesized under several configs).
+    for these frames (when one utterance is synthesized under several configs). ``voice``: the
+    input's voice match is computed even when the synthesis does not need it (to show it).
+    The input's speech energy (pauses, speech frames) is computed once for both.
     """
     config = config or SynthConfig()
     times, w, warp = _input(model, audio, sample_rate, n_frames, lsf, config,
                             audio_source or source)
     segs: list[PhoneSegment] | None = None
-    ratio = _voice_ratio(model, audio, sample_rate, times, w, config, provenance)
+    energy = SpeechEnergy(audio, sample_rate)
+    ratio = _voice_ratio(model, energy, times, w, config, provenance, voice)
     segments: list[SegmentChoice] = []
     frame_seg = None
     if config.mode in ("phonetic", "robust"):
@@ -138,8 +142,10 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         segments, frame_seg, candidates = _eq4(model, segs, times, config)
         if config.mode == "robust":
             conf = frame_confidence(list(phones), confidence, times)
+            scale = 1.0
+            if config.label_weight_by_voice and np.isfinite(ratio):
+                conf, scale = trust_by_voice(conf, ratio), max(1.0, ratio)
             conf[unlabelled[frame_seg]] = 0.0
-            scale = max(1.0, ratio) if config.label_weight_by_voice and np.isfinite(ratio) else 1.0
             fw = _robust(model, w, candidates, conf, config, scale)
         else:
             fw = _weighted(model, w, lambda a, b: candidates[a:b], config)
@@ -148,7 +154,7 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     else:
         raise ValueError(f"unknown mode {config.mode!r} (phonetic, acoustic or robust)")
     plan = plan_closure(model, audio, sample_rate, times, segs, provenance, voice_match(ratio, 1.0),
-                        config)
+                        config, energy.filtered if config.closure else None)
     res = _finish(model, times, w, fw, config, segments, frame_seg, warp, plan)
     res.voice_match = voice_match(ratio, 1.0)
     return res
@@ -260,11 +266,13 @@ def _smoothed(model: Model, raw: np.ndarray, times: np.ndarray, config: SynthCon
 
 def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
                  segs: Sequence[PhoneSegment] | None, provenance: Provenance | None,
-                 match: float, config: SynthConfig) -> ClosurePlan | None:
+                 match: float, config: SynthConfig, filtered: np.ndarray | None = None
+                 ) -> ClosurePlan | None:
     """Where the closure step acts (``None``: off, or a model file without its statistics): the
     labelled /p b m/, trusted as :func:`~engine.method.closure.closure_strengths` says (for
     recognized labels by the voice ``match``; NaN: unknown, untrusted), and the pauses by
-    energy."""
+    energy (``filtered``: :func:`~engine.method.speech.filtered_energy_db` of the audio, when
+    already computed)."""
     if not config.closure or model.closure is None:
         return None
     intervals, strengths = np.zeros((0, 2)), np.zeros(0)
@@ -272,31 +280,64 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
         trust = closure_strengths(len(segs), (provenance or Provenance()).kind,
                                   match if np.isfinite(match) else 1.0)
         intervals, strengths = closure_intervals(segs, trust)
-    return ClosurePlan(intervals, strengths, pauses(audio, sample_rate, times, config.rest_pause_s))
+    return ClosurePlan(intervals, strengths, pauses(audio, sample_rate, times, config.rest_pause_s,
+                                                    filtered=filtered))
 
 
-def _voice_ratio(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
-                 w: np.ndarray, config: SynthConfig, provenance: Provenance | None) -> float:
+def trust_by_voice(confidence: np.ndarray, ratio: float) -> np.ndarray:
+    """Labels weighed by voice (issue 25): ``c' = 1 - (1 - c) m``, ``m`` the voice match of the
+    distance ``ratio``. On the training voice (``m = 1``) a label counts as much as its maker
+    trusted it; on a voice the codebook does not know (``m = 0``) the acoustic distances are the
+    untrustworthy part, and the labels count fully (the recognizer and the aligner were trained
+    on many voices, the codebook on one; their scores drop on such a voice for every phone).
+
+    >>> trust_by_voice(np.array([0.2, 1.0]), 1.0).round(9).tolist()
+    [0.2, 1.0]
+    >>> trust_by_voice(np.array([0.2]), 5.0).tolist()
+    [1.0]
+    """
+    return 1.0 - (1.0 - np.asarray(confidence, dtype=np.float64)) * voice_match(ratio, 1.0)
+
+
+class SpeechEnergy:
+    """An input's filtered short-time energy (:func:`~engine.method.speech.filtered_energy_db`:
+    its speech frames and pauses), computed when first asked, once for every step that asks."""
+
+    def __init__(self, audio: np.ndarray, sample_rate: int):
+        self.audio, self.sample_rate = audio, sample_rate
+
+    @functools.cached_property
+    def filtered(self) -> np.ndarray:
+        return filtered_energy_db(self.audio, self.sample_rate)
+
+
+def _voice_ratio(model: Model, energy: SpeechEnergy, times: np.ndarray, w: np.ndarray,
+                 config: SynthConfig, provenance: Provenance | None, wanted: bool) -> float:
     """The input's voice distance ratio when the synthesis weighs by it (the robust mode's label
-    weight, the closure step's trust in recognized labels), else NaN (not computed)."""
+    weight, the closure step's trust in recognized labels) or it is ``wanted``, else NaN (not
+    computed)."""
     recognized = provenance is not None and provenance.kind == "recognized"
-    if (config.mode == "robust" and config.label_weight_by_voice) or (config.closure and recognized):
-        return input_voice_ratio(model, audio, sample_rate, times, w)
+    if wanted or (config.mode == "robust" and config.label_weight_by_voice) or \
+            (config.closure and recognized):
+        return input_voice_ratio(model, energy.audio, energy.sample_rate, times, w,
+                                 energy.filtered)
     return float("nan")
 
 
 def input_voice_ratio(model: Model, audio: np.ndarray, sample_rate: int,
-                      times: np.ndarray | None = None, w: np.ndarray | None = None) -> float:
+                      times: np.ndarray | None = None, w: np.ndarray | None = None,
+                      filtered: np.ndarray | None = None) -> float:
     """``D / D0`` (:mod:`engine.method.voice_match`): how far an input's voice is from the
     codebook's, relative to the training voice's own figure, from the audio alone (its LSFs ``w``
-    at ``times`` when already computed; NaN for a model file without ``D0``)."""
+    at ``times`` and its filtered energy when already computed; NaN for a model file without
+    ``D0``)."""
     if not np.isfinite(model.voice_distance):
         return float("nan")
     if times is None or w is None:
         times = np.arange(int(np.floor(len(audio) / sample_rate * model.marker_rate)) + 1) \
             / model.marker_rate
         w = model.input_lsf(audio, sample_rate, times)
-    speech = speech_mask(audio, sample_rate, times)
+    speech = speech_mask(audio, sample_rate, times, filtered=filtered)
     return voice_distance(w, speech, model.codebook.lsf, model.lsf_index()) / model.voice_distance
 
 

@@ -19,7 +19,7 @@ from ..labels.labelmap import read_label_map
 from ..labels.provenance import Labels
 from .model import Model
 from .modes import ModeChoice, choose_mode
-from .pipeline import Synthesis, check_length, input_voice_match, synthesize
+from .pipeline import Synthesis, check_length, synthesize
 
 
 @dataclass(frozen=True)
@@ -85,7 +85,5 @@ def synthesize_recording(model: Model, audio_path: str | os.PathLike[str],
     res = synthesize(model, samples, rate, labels.phones if labels else None, choice.config,
                      label_map=label_map, source=str(request.labels or audio_path),
                      audio_source=str(audio_path), confidence=labels.trust() if labels else None,
-                     provenance=labels.provenance if labels else None)
-    match = res.voice_match if np.isfinite(res.voice_match) else \
-        input_voice_match(model, samples, rate, res.times, res.lsf)
-    return RecordingSynthesis(res, labels, choice, match, audio_path)
+                     provenance=labels.provenance if labels else None, voice=True)
+    return RecordingSynthesis(res, labels, choice, res.voice_match, audio_path)

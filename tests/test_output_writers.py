@@ -1,0 +1,118 @@
+"""The trajectory writers (issue 28): TSV/CSV and C3D written without a Python loop over frames,
+their content unchanged (the bytes ``numpy.savetxt`` and ``c3d``'s frame-by-frame writer
+produced, and the values read back), and the NPZ's compression an option."""
+
+import io
+import warnings
+
+import numpy as np
+import pytest
+
+from engine.io.export import write_trajectories
+from engine.io.markerfiles import read_c3d, read_marker_table, write_c3d, write_marker_tsv
+from engine.io.numtext import fixed_point_lines
+
+NAMES = [f"M{i}" for i in range(7)]
+
+
+def _markers(frames=400, seed=0):
+    return np.random.default_rng(seed).standard_normal((frames, len(NAMES), 3)) * 40.0
+
+
+def _savetxt(table, decimals, sep="\t"):
+    out = io.BytesIO()
+    np.savetxt(out, table, delimiter=sep, fmt=[f"%.{d}f" for d in decimals])
+    return out.getvalue()
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_fixed_point_lines_equal_savetxt_byte_for_byte(seed):
+    """Random magnitudes, NaN, infinities, -0.0, exact halves, values near a half, huge ones."""
+    rng = np.random.default_rng(seed)
+    rows, cols = int(rng.integers(1, 150)), int(rng.integers(1, 10))
+    t = rng.standard_normal((rows, cols)) * 10.0 ** rng.integers(-6, 12, (rows, cols))
+    for value, share in ((np.nan, 0.02), (np.inf, 0.01), (-np.inf, 0.01), (-0.0, 0.02),
+                         (1e17, 0.01), (2.5, 0.02), (-0.03125, 0.02), (1.00005, 0.03)):
+        t[rng.random((rows, cols)) < share] = value
+    decimals = rng.integers(0, 10, cols).tolist()
+    assert fixed_point_lines(t, decimals) == _savetxt(t, decimals)
+    assert fixed_point_lines(t, decimals, ",") == _savetxt(t, decimals, ",")
+
+
+@pytest.mark.parametrize("suffix", [".tsv", ".csv"])
+def test_marker_table_is_what_savetxt_wrote_and_reads_back(tmp_path, suffix):
+    m = _markers()
+    m[3, 2] = np.nan
+    path = tmp_path / f"face{suffix}"
+    write_marker_tsv(path, m, 60.0, NAMES)
+    sep = "," if suffix == ".csv" else "\t"
+    table = np.column_stack([np.arange(len(m)) / 60.0, m.reshape(len(m), -1)])
+    header = sep.join(["time"] + [f"{n}_{a}" for n in NAMES for a in "xyz"])
+    want = header.encode() + b"\n" + _savetxt(table, [6] + [4] * (table.shape[1] - 1), sep)
+    assert path.read_bytes() == want
+    back = read_marker_table(path)
+    np.testing.assert_allclose(back.markers, m, atol=5e-5)
+    assert np.isnan(back.markers[3, 2]).all() and back.names == NAMES
+
+
+def _c3d_frame_by_frame(path, markers, rate, integer):
+    """``write_c3d`` as it was: every frame handed to ``c3d.Writer`` (the reference)."""
+    import c3d
+
+    from engine.io.markerfiles import C3D_INT_SCALE
+
+    finite = np.isfinite(markers).all(axis=2)
+    if integer:
+        q = np.round(markers / C3D_INT_SCALE) * C3D_INT_SCALE
+        markers = q + np.copysign(C3D_INT_SCALE * 1e-3, q)
+    writer = c3d.Writer(point_rate=float(rate), analog_rate=0.0,
+                        point_scale=C3D_INT_SCALE if integer else -1.0, point_units="mm  ")
+    frames = []
+    for t in range(markers.shape[0]):
+        p = np.zeros((markers.shape[1], 5))
+        p[:, :3] = np.where(finite[t, :, None], markers[t], 0.0)
+        p[:, 3] = np.where(finite[t], 0.0, -1.0)
+        frames.append((p, np.zeros((0, 0))))
+    writer.add_frames(frames)
+    writer.set_point_labels(list(NAMES))
+    with open(path, "wb") as handle, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        writer.write(handle)
+
+
+@pytest.mark.parametrize("integer", [True, False])
+def test_c3d_is_what_the_frame_by_frame_writer_wrote(tmp_path, integer):
+    m = _markers(frames=300)
+    write_c3d(tmp_path / "new.c3d", m, 60.0, NAMES, integer=integer)
+    _c3d_frame_by_frame(tmp_path / "old.c3d", m, 60.0, integer)
+    assert (tmp_path / "new.c3d").read_bytes() == (tmp_path / "old.c3d").read_bytes()
+
+
+@pytest.mark.parametrize("integer", [True, False])
+def test_c3d_with_unseen_points_reads_back_the_same(tmp_path, integer):
+    m = _markers(frames=200, seed=3)
+    m[10:14, 2] = np.nan
+    m[50] = np.nan
+    write_c3d(tmp_path / "new.c3d", m, 60.0, NAMES, integer=integer)
+    _c3d_frame_by_frame(tmp_path / "old.c3d", m, 60.0, integer)
+    new, old = read_c3d(tmp_path / "new.c3d"), read_c3d(tmp_path / "old.c3d")
+    np.testing.assert_array_equal(new.markers, old.markers)
+    assert np.isnan(new.markers[10:14, 2]).all() and np.isnan(new.markers[50]).all()
+    assert new.rate == old.rate == 60.0 and new.names == NAMES
+    np.testing.assert_allclose(new.markers[0], m[0], atol=0.006 if integer else 1e-4)
+
+
+@pytest.mark.parametrize("compress", [False, True])
+def test_npz_compression_is_an_option_and_the_content_the_same(tmp_path, compress):
+    m = _markers()
+    path = tmp_path / "face.npz"
+    write_trajectories(path, m, 60.0, NAMES, {"pcs": m[:, :2, 0]}, compress=compress)
+    with np.load(path) as z:
+        np.testing.assert_array_equal(z["markers"], m)
+        np.testing.assert_array_equal(z["pcs"], m[:, :2, 0])
+        assert z["marker_names"].tolist() == NAMES
+    import zipfile
+
+    with zipfile.ZipFile(path) as zf:
+        kinds = {info.compress_type for info in zf.infolist()}
+    assert kinds == ({zipfile.ZIP_DEFLATED} if compress else {zipfile.ZIP_STORED})
