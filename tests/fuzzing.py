@@ -669,8 +669,9 @@ def marker_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
 
 # --------------------------------------------------------------------------- options
 def _positional_value(ws: Workspace, dest: str, d: Path) -> str:
-    return {"model": str(ws.model), "audio": str(ws.wav), "corpus": str(ws.corpus),
-            "data_dir": str(ws.corpus), "output": str(d / "out")}.get(dest, str(d / dest))
+    return {"model": str(ws.model), "audio": str(ws.wav), "inputs": str(ws.wav),
+            "corpus": str(ws.corpus), "data_dir": str(ws.corpus),
+            "output": str(d / "out")}.get(dest, str(d / dest))
 
 
 def option_targets() -> list[tuple[tuple[str, ...], argparse.ArgumentParser, argparse.Action]]:
@@ -1079,7 +1080,10 @@ def _judge(case: Case, code: int, err: str, status: str | None = None) -> Outcom
     lines = [ln for ln in err.splitlines() if ln.strip()]
     errors = [ln for ln in lines if ln.startswith("facetraj") and ": error: " in ln]
     summary = [ln for ln in lines if ln.startswith("facetraj: ") and " skipped" in ln]
-    if (code == 2 and len(errors) != 1) or (code == EXIT_INCOMPLETE and (errors or not summary)):
+    # synth's batch (issue 28) ends with "facetraj: failed: <file>: <problem>" per input instead
+    failed = [ln for ln in lines if ln.startswith("facetraj: failed: ") and ": " in ln[18:]]
+    if (code == 2 and len(errors) != 1 and not (failed and not errors)) or \
+            (code == EXIT_INCOMPLETE and (errors or not summary)):
         return Outcome(case, "unclear message", code, err[-300:])
     if case.expect_ok and code != 0:
         return Outcome(case, "refused valid input", code, err[-300:])
@@ -1087,7 +1091,8 @@ def _judge(case: Case, code: int, err: str, status: str | None = None) -> Outcom
     if bad is not None:
         return Outcome(case, bad[0], code, bad[1])
     return Outcome(case, {0: "ok", 2: "refused"}.get(code, "skipped bad files"), code,
-                   lines[-1][:200] if lines else "", error_line=(errors or summary or [""])[0])
+                   lines[-1][:200] if lines else "",
+                   error_line=(errors or summary or failed or [""])[0])
 
 
 def _files_problem(case: Case, code: int) -> tuple[str, str] | None:
