@@ -257,12 +257,14 @@ class MainWindow(QMainWindow):
         self.show_error(error_message(exc))
 
     def show_error(self, message: str) -> None:
-        """An error message: in the status bar, and a dialog (or the ``set_error_handler`` one)."""
+        """An error message: in the status bar, and a dialog with the message logged (or only the
+        ``set_error_handler`` one, which reports it itself: ``facetraj --screenshot`` prints it
+        once, as every command does)."""
         self.status_label.setText(message)
-        log.error("%s", message)
         if self._error_handler is not None:
             self._error_handler(message)
         else:
+            log.error("%s", message)
             QMessageBox.critical(self, "facetraj", message)
 
     def set_error_handler(self, handler: Callable[[str], None] | None) -> None:

@@ -260,6 +260,19 @@ def test_screenshot_command_line(trained_cache, tmp_path):
     assert _colour_count(img, style.SYNTH_COLOR) > 150
 
 
+def test_screenshot_error_is_printed_once(trained_cache, tmp_path):
+    """A bad utterance id in screenshot mode: exit 2 and the message once (the window's error
+    report used to log it and the screenshot handler print it again)."""
+    env = {**os.environ, "FACETRAJ_CACHE_DIR": str(trained_cache)}
+    proc = subprocess.run([sys.executable, "-m", "facetraj", "--screenshot", str(tmp_path / "x.png"),
+                           "--utterance", "nosuchid"], cwd=ROOT, env=env, capture_output=True,
+                          text=True, timeout=180)
+    assert proc.returncode == 2
+    lines = [ln for ln in proc.stderr.splitlines() if "nosuchid" in ln]
+    assert lines == [f"facetraj: error: nosuchid: no such utterance in {default_corpus()}"], proc.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
 def test_corrupt_file_shows_error_and_app_keeps_working(window, qtbot, tmp_path, monkeypatch):
     win = window
     bad = tmp_path / "broken.wav"
