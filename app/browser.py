@@ -23,7 +23,8 @@ class UtteranceBrowser(QWidget):
 
     utteranceSelected = pyqtSignal(str)
 
-    COLUMNS = ("utterance", "LL y r", "UL y r")
+    #: the score columns: the correlation r of each lip centre's y, original vs synthesized
+    COLUMNS = ("utterance", "lower lip r", "upper lip r")
 
     def __init__(self, parent: QWidget | None = None):
         super().__init__(parent)
@@ -41,8 +42,8 @@ class UtteranceBrowser(QWidget):
         header.setSectionResizeMode(0, QHeaderView.ResizeMode.Stretch)
         for c in (1, 2):
             header.setSectionResizeMode(c, QHeaderView.ResizeMode.Fixed)
-            self.tree.setColumnWidth(c, 74)
-        self.setMinimumWidth(360)
+            self.tree.setColumnWidth(c, self.tree.fontMetrics().horizontalAdvance(self.COLUMNS[c]) + 16)
+        self.setMinimumWidth(260)
         for c, what in ((1, "lower"), (2, "upper")):
             self.tree.headerItem().setToolTip(
                 c, f"correlation of the {what} lip centre y, original vs synthesized, on speech frames "

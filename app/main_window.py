@@ -58,11 +58,9 @@ from PyQt6.QtCore import QEvent, Qt, QTimer, pyqtSignal
 from PyQt6.QtGui import QKeySequence
 from PyQt6.QtWidgets import (
     QDockWidget,
-    QLabel,
     QMainWindow,
     QMenu,
     QMessageBox,
-    QSizePolicy,
     QSplitter,
     QVBoxLayout,
     QWidget,
@@ -79,6 +77,7 @@ from .cache import load_or_train
 from .controls import (
     SPEEDS,
     LoopRange,
+    TitleBar,
     TransportBar,
     ViewBar,
     add_shortcuts,
@@ -90,6 +89,7 @@ from .marker_panels import MarkerPanels
 from .open_audio import AudioOpener
 from .phases import mark
 from .playback import PlaybackScheduler
+from .provenance import LabelOrigin
 from .settings_panel import SynthSettingsPanel
 from .state import UtteranceView
 from .status import StatusArea
@@ -170,10 +170,7 @@ class MainWindow(QMainWindow):
         self.view_bar = ViewBar(self.face)
         self.camera_buttons = self.view_bar.camera_buttons
         self.transport = self._build_transport()
-        self.title = QLabel("")
-        self.title.setStyleSheet("font-size: 15px; font-weight: 600; padding: 2px 6px;")
-        self.title.setWordWrap(True)          # a long title wraps instead of widening the window
-        self.title.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
+        self.title = TitleBar()
         self.splitter = _split(_column([self.view_bar, self.face, self.transport], 2, stretch=self.face),
                                _column([self.title, self.timeline], 0, stretch=self.timeline))
         self.setCentralWidget(self.splitter)
@@ -182,6 +179,7 @@ class MainWindow(QMainWindow):
         self.browser_dock = self.docks.dock(self.browser, "Utterances", Qt.DockWidgetArea.LeftDockWidgetArea)
         self.settings = SynthSettingsPanel(self.synth_config, self)
         self.settings.configChanged.connect(self.set_synth_config)
+        self.settings.searchChosen.connect(lambda cfg: self.set_synth_config(cfg, explicit=True))
         self.settings_dock = self.docks.dock(self.settings, "Synthesis settings",
                                         Qt.DockWidgetArea.LeftDockWidgetArea)
         self.resizeDocks([self.browser_dock], [400], Qt.Orientation.Horizontal)
@@ -361,15 +359,17 @@ class MainWindow(QMainWindow):
         self.view_bar.set_planar(planar)
 
     # ================================================================== synthesis
-    def set_synth_config(self, cfg: SynthConfig) -> None:
-        """Use new synthesis settings: re-synthesize the current utterance and the correlations."""
-        changed, request = self.state.set_config(cfg)
-        if not changed:
-            return
-        self.settings.set_config(cfg)
+    def set_synth_config(self, cfg: SynthConfig, explicit: bool = False) -> None:
+        """Use new synthesis settings: re-synthesize the current utterance and (when they changed)
+        the correlations. ``explicit``: the user chose the search in ``cfg`` (see
+        ``ViewerModel.set_config``)."""
+        changed, request = self.state.set_config(cfg, explicit)
+        if changed:
+            self.settings.set_config(cfg)
         if request is not None:
             self._synthesize(request)
-        self._start_sweep()
+        if changed:
+            self._start_sweep()
 
     def _synthesize(self, request: SynthRequest) -> None:
         def done(view: UtteranceView) -> None:
@@ -404,6 +404,7 @@ class MainWindow(QMainWindow):
 
     def _show_titles(self, view: UtteranceView) -> None:
         self.title.setText(view_title(view))
+        self.settings.show_used(view.synthesis.config, self.synth_config, view.label_origin)
         self.browser.set_current(view.utterance.name)
         self.scores.score(view, self.model)
         self.status_label.setText(view_summary(view))
@@ -483,9 +484,10 @@ class MainWindow(QMainWindow):
         files beside the audio (``app.open_audio.AudioOpener.open``)."""
         self.audio_opener.open(Path(audio_path), labels_path, **kw)
 
-    def show_external(self, utt: Utterance) -> None:
-        """Show an utterance opened from files (listed under "opened" in the browser)."""
-        name = self.state.add_external(utt)
+    def show_external(self, utt: Utterance, origin: LabelOrigin | None = None) -> None:
+        """Show an utterance opened from files (listed under "opened" in the browser); ``origin``:
+        where its labels came from (the file, the transcript aligned)."""
+        name = self.state.add_external(utt, origin)
         self.browser.add_external(name)
         self.set_utterance(name)
 

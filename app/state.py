@@ -16,6 +16,8 @@ from engine.evaluation.scores import speech_mask
 from engine.method.model import Model
 from engine.method.pipeline import Synthesis, resmooth, synthesize
 
+from .provenance import LabelOrigin
+
 
 def frame_index(t: float, rate: float, n_frames: int, step: int = 0) -> int:
     """The frame at ``t`` seconds (``round(t * rate)``), moved by ``step`` frames, clipped to
@@ -40,6 +42,7 @@ class UtteranceView:
     triangular, spline : ``(T, M, 3)`` the synthesis smoothed each way (paper Figure 4).
     speech : ``(T,)`` bool, speech frames (112 ms median-filtered energy, paper section 3).
     times : ``(T,)`` frame times in seconds.
+    origin : where the phone labels came from (the file, the transcript aligned), if known.
     """
 
     utterance: Utterance
@@ -50,6 +53,15 @@ class UtteranceView:
     spline: np.ndarray
     speech: np.ndarray
     times: np.ndarray
+    origin: LabelOrigin | None = None
+
+    @property
+    def label_origin(self) -> LabelOrigin:
+        """Where the phone labels came from (at least their source)."""
+        source = self.utterance.label_source if self.utterance.phones else "none"
+        if self.origin is None:
+            return LabelOrigin(source)
+        return LabelOrigin(source, self.origin.file, self.origin.transcript)
 
     @property
     def shown(self) -> np.ndarray:
@@ -74,7 +86,8 @@ class UtteranceView:
         return frame_index(t, self.rate, self.n_frames, step)
 
 
-def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig) -> UtteranceView:
+def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig,
+               origin: LabelOrigin | None = None) -> UtteranceView:
     """Synthesize ``utt`` with ``config`` and derive every track the window shows (slow: run in a
     worker). Raises the engine's :class:`~engine.errors.FacetrajError` on bad input."""
     n_frames = utt.n_frames or None
@@ -85,4 +98,5 @@ def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig) ->
     spline = res.markers if config.smoothing == "spline" else resmooth(model, res, "spline")
     speech = speech_mask(utt.audio, utt.sample_rate, res.times)
     return UtteranceView(utterance=utt, split=split, synthesis=res, original=original,
-                         triangular=triangular, spline=spline, speech=speech, times=res.times)
+                         triangular=triangular, spline=spline, speech=speech, times=res.times,
+                         origin=origin)

@@ -5,6 +5,8 @@ result or the error back on the GUI thread. A :class:`TaskRunner` is the one pla
 tracks and stops tasks: the main window has one (``window.tasks``, behind ``window.run_task``); a
 view used on its own, without a window, makes its own. A :class:`Gate` is what a worker waits on
 (e.g. "no sound is playing") without polling: opening it, or cancelling the task, wakes it.
+:func:`one_per_pass` splits GUI-thread work that cannot leave it (widgets, a 3-D scene) into
+steps, one per pass of the event loop, so that the window keeps responding between them.
 """
 
 from __future__ import annotations
@@ -12,12 +14,33 @@ from __future__ import annotations
 import logging
 import threading
 import traceback
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
-from PyQt6.QtCore import QObject, QThread, pyqtSignal
+from PyQt6 import sip
+from PyQt6.QtCore import QObject, QThread, QTimer, pyqtSignal
 
 log = logging.getLogger(__name__)
+
+
+def one_per_pass(owner: QObject, steps: Sequence[Callable[[], None]]) -> None:
+    """Run ``steps`` on the GUI thread, each in its own pass of the event loop (the first in the
+    next pass), in order; the rest are dropped once ``owner`` is deleted. A step that raises is
+    logged and the rest still run."""
+    remaining = list(steps)
+
+    def step() -> None:
+        if not remaining or sip.isdeleted(owner):
+            return
+        fn = remaining.pop(0)
+        try:
+            fn()
+        except Exception:
+            log.exception("a step of %s failed", type(owner).__name__)
+        if remaining:
+            QTimer.singleShot(0, step)
+
+    QTimer.singleShot(0, step)
 
 
 class Cancelled(Exception):

@@ -64,7 +64,8 @@ def test_similarity_view_shows_engine_matrix(qtbot, model, tmp_path):
 
     w = SimilarityView(model)
     qtbot.addWidget(w)
-    w.show()
+    with qtbot.waitSignal(w.ready, timeout=WAIT_MS):      # clustered in the background
+        w.show()
     qtbot.waitExposed(w)
     order = cluster_phones(model).order
     k = len(order)
@@ -131,7 +132,8 @@ def test_pc_slider_moves_points_by_eigenvector_times_value(qtbot, model):
     w = PCModeExplorer(model)
     qtbot.addWidget(w)
     w.resize(1000, 600)
-    w.show()
+    with qtbot.waitSignal(w.ready, timeout=WAIT_MS):      # its scene is built in steps
+        w.show()
     qtbot.waitExposed(w)
     neutral = model.neutral_face()
     assert w.displaced_points() == pytest.approx(neutral)
@@ -222,25 +224,43 @@ def test_inspector_robust_mode_explains_choice(qtbot, model, corpus, tmp_path):
 
 
 def test_settings_panel_explains_modes_and_shows_tuned(qtbot):
+    from app.provenance import LabelOrigin
     from app.settings_panel import MODE_NOTES, SynthSettingsPanel
+
+    def choose(key: str) -> None:                   # as a user does
+        p.mode.setCurrentIndex(p.mode.findData(key))
+        p.mode.activated.emit(p.mode.currentIndex())
 
     p = SynthSettingsPanel(SynthConfig())
     qtbot.addWidget(p)
     p.show()
+    chosen = []
+    p.searchChosen.connect(chosen.append)
     assert p.mode_note.text() == MODE_NOTES["phonetic"]
-    p.mode.setCurrentIndex(p.mode.findData("robust"))
-    assert p.mode_note.text() == MODE_NOTES["robust"]
+    assert not p.tuned_label.isVisible()              # the robust mode's settings: robust only
+    choose("robust")
+    assert p.mode_note.text() == MODE_NOTES["robust"] and p.tuned_label.isVisible()
     assert "without cross-validation" in (p.set_tuned({}) or p.tuned_label.text())
+    assert "`" not in p.tuned_label.text()
     p.set_limits(3, 10.0, {"settings": {"label_weight": 4.0, "triangle_s": 0.133,
                                         "n_context_phones": 6}, "folds": 2})
     assert "κ (label weight) = 4" in p.tuned_label.text() and "2 folds" in p.tuned_label.text()
-    p.mode.setCurrentIndex(p.mode.findData("phonetic"))
-    p.mode.setCurrentIndex(p.mode.findData("robust"))          # picks up the tuned N
+    choose("phonetic")
+    choose("robust")                                  # picks up the tuned N
     cfg = p.config()
     assert cfg.mode == "robust" and cfg.label_weight == 4.0 and cfg.triangle_s == 0.133
     assert cfg.n_context_phones == 6
-    p.mode.setCurrentIndex(p.mode.findData("phonetic"))
+    assert [c.mode for c in chosen] == ["robust", "phonetic", "robust"]
+    choose("phonetic")
     assert p.config().label_weight == SynthConfig().label_weight
+    # the search used is shown, and why it is not the one asked for; the settings still ask
+    # for theirs
+    p.show_used(SynthConfig(mode="robust"), SynthConfig(), LabelOrigin("aligned", transcript="a.txt"))
+    assert p.shown_search() == "robust" and p.mode_note.text() == MODE_NOTES["robust"]
+    assert p.mode_reason.isVisible() and "aligned from a.txt" in p.mode_reason.text()
+    assert p.config().mode == "phonetic"
+    p.show_used(SynthConfig(), SynthConfig(), LabelOrigin("file"))
+    assert p.shown_search() == "phonetic" and not p.mode_reason.isVisible()
 
 
 # ---------------------------------------------------------------------- errors
@@ -322,6 +342,7 @@ def assert_chart_matches_table(w) -> None:
     table = {(w.table.item(r, 0).value, w.table.item(r, 1).text(), w.table.item(r, 2).text()):
              w.table.item(r, 5).value for r in range(w.table.rowCount())}
     finite = {k: v for k, v in table.items() if v == v}
+    w.chart.finish()                                        # built and drawn off the GUI thread
     ax = w.chart.figure.axes[0]
     bars = ax.patches
     assert len(bars) == len(finite) > 0
@@ -404,6 +425,7 @@ def test_kinematics_chart_without_original_and_in_a_narrow_dock(qtbot):
     with qtbot.waitSignal(w.measured):
         w.set_view(view)
     assert w.table.rowCount() == 5
+    w.chart.finish()                                        # built off the GUI thread
     ax = w.chart.figure.axes[0]
     assert len(ax.patches) == 0
     assert any("no original markers" in t.get_text() for t in ax.texts)
@@ -426,15 +448,18 @@ def test_installed_in_main_window(qtbot, corpus, model):
     for t in VIEWS.values():
         assert t in texts
     for key in VIEWS:
-        assert views.open_view(key) is not None
-        assert views.docks[key].widget() is views.widgets[key]
+        if views.open_view(key) is None:                   # its module imported in the background
+            qtbot.waitUntil(lambda k=key: k in views.docks, timeout=WAIT_MS)
+        assert views.docks[key].widget().widget() is views.widgets[key]   # in a scroll area
+    qtbot.waitUntil(lambda: not win.timeline.building, timeout=WAIT_MS)
     # kinematics and errors put their panels into the stack
     titles = [p.title for p in win.timeline.panels]
     assert "lip aperture" in titles and "lip error" in titles
     assert any(t.startswith("tangential velocity") for t in titles)
     views.show_panels(list(PANELS))
     assert all(views.panel_actions[k].isChecked() for k in PANELS)
-    assert len(win.timeline.axes) == len(win.timeline.panels)
+    qtbot.waitUntil(lambda: not win.timeline.building, timeout=WAIT_MS)
+    assert len(win.timeline.axes) == len(win.timeline.panels) == 5 + len(PANELS)
     # the inspector follows the cursor
     ins = views.widgets["inspector"]
     with qtbot.waitSignal(ins.inspected, timeout=5000):
@@ -467,6 +492,9 @@ def test_export_buttons_write_or_report(qtbot, model, corpus, tmp_path, monkeypa
 
     sim = SimilarityView(model)
     qtbot.addWidget(sim)
+    assert not sim.csv_button.isEnabled()                # until the clustering is there
+    qtbot.waitUntil(lambda: sim.clustering is not None, timeout=WAIT_MS)
+    assert sim.csv_button.isEnabled()
     chosen.append(str(tmp_path / "sim.csv"))
     sim._export_csv()
     header = (tmp_path / "sim.csv").read_text().splitlines()[0].split(",")

@@ -187,21 +187,31 @@ def test_changing_n_resynthesizes(window, qtbot):
     assert win.view.utterance.name == other and win.settings.n.value() == 2
 
 
+def choose(combo, key) -> None:
+    """Pick the entry of ``combo`` whose data is ``key``, as a user does (``activated``)."""
+    combo.setCurrentIndex(combo.findData(key))
+    combo.activated.emit(combo.currentIndex())
+
+
 def test_acoustic_search_choice(window, qtbot):
     """The search menu: indexed acoustic-only weights K codewords per frame, the whole-codebook
-    entry (the paper's) weights all 5L, and phonetic comes back with the default K."""
+    entry (the paper's) weights all 5L, and phonetic comes back with the default K; the title
+    names the one used (both used to read "acoustic")."""
     win = window
     n_codewords = len(win.model.codebook.lsf)
     mode = win.settings.mode
-    for key, width in (("acoustic", SynthConfig().acoustic_prefilter), ("acoustic-full", n_codewords)):
+    for key, width, title in (("acoustic", SynthConfig().acoustic_prefilter,
+                               "acoustic only, indexed (K = 128)"),
+                              ("acoustic-full", n_codewords, "acoustic only, whole codebook")):
         with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
-            mode.setCurrentIndex(mode.findData(key))
+            choose(mode, key)
         qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
         synthesis = win.view.synthesis
         assert synthesis.config.mode == "acoustic"
         assert synthesis.frames.candidates.shape == (win.view.n_frames, width)
+        assert title in win.title.text() and win.settings.shown_search() == key
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
-        mode.setCurrentIndex(mode.findData("phonetic"))
+        choose(mode, "phonetic")
     qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
     assert win.synth_config == SynthConfig(n_context_phones=win.synth_config.n_context_phones)
 

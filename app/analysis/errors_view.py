@@ -263,7 +263,7 @@ class LipErrorPanel:
         self.last_segments = []
 
     def draw(self, ax, view) -> None:
-        ax.set_ylabel("|orig - synth|\n(mm)", fontsize=8)
+        ax.set_ylabel("lip error\n(mm)", fontsize=8)
         if view.original is None:
             ax.text(0.5, 0.5, "no original markers", transform=ax.transAxes, ha="center",
                     va="center", color="#888888", fontsize=8)

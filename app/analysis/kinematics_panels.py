@@ -13,9 +13,11 @@ tier.
 from __future__ import annotations
 
 import logging
+from functools import partial
 from pathlib import Path
 
 import numpy as np
+from matplotlib.figure import Figure
 from PyQt6.QtCore import Qt, pyqtSignal
 from PyQt6.QtWidgets import (
     QComboBox,
@@ -182,7 +184,7 @@ class KinematicsControls(QWidget):
         self.changed.emit()
         tl = getattr(self.window_, "timeline", None)
         if tl is not None and self.panel in tl.panels:
-            tl.relayout(tl.xlim())
+            tl.relayout(tl.xlim(), soon=True)
 
     # ------------------------------------------------------------------ measuring
     def set_view(self, view) -> None:
@@ -222,34 +224,10 @@ class KinematicsControls(QWidget):
 
     def _draw_chart(self, m: GestureMeasurement) -> None:
         """The timing error of every landmark row as a horizontal bar (synthesized minus original,
-        ms; late to the right), in the table's order from the top."""
-        fig = self.chart.figure
-        fig.clear()
-        ax = fig.add_subplot(111)
-        rows = [r for r in self.rows if np.isfinite(r.error)]
-        if not rows:
-            why = ("no original markers:\nno timing errors to show" if m.v_original is None else
-                   "no gestures found around\nthe gesture phones")
-            ax.text(0.5, 0.5, why, ha="center", va="center", transform=ax.transAxes,
-                    color="#555555", fontsize=10)
-            ax.set_axis_off()
-        else:
-            ms = np.array([1000 * r.error for r in rows])
-            y = np.arange(len(rows))[::-1]
-            ax.barh(y, ms, color=[LATE_COLOR if e > 0 else EARLY_COLOR for e in ms],
-                    edgecolor="#555555", lw=0.4, height=0.75)
-            ax.set_yticks(y, [f"{r.gesture} {r.label} {r.landmark}" for r in rows],
-                          fontsize=max(5, min(8, 520 // len(rows))))
-            ax.set_ylim(-0.6, len(rows) - 0.4)
-            lim = max(10.0, float(np.abs(ms).max()) * 1.1)
-            ax.set_xlim(-lim, lim)
-            ax.axvline(0.0, color="k", lw=0.6)
-            ax.set_xlabel("synthesized − original (ms)\n← early    late →", fontsize=8)
-            ax.tick_params(axis="x", labelsize=8)
-            ax.set_title("Landmark timing error", fontsize=10)
-            ax.grid(axis="x", alpha=0.3)
-        fig.set_layout_engine("tight")      # laid out again at every draw: resizes keep the labels in
-        self.chart.draw_idle()
+        ms; late to the right), in the table's order from the top (built and drawn off the GUI
+        thread)."""
+        self.chart.rebuild(partial(draw_timing_chart, rows=list(self.rows),
+                                   has_original=m.v_original is not None))
 
     def resizeEvent(self, event) -> None:
         """The chart beside the table when there is room, under it when the dock is narrow."""
@@ -286,6 +264,35 @@ class KinematicsControls(QWidget):
     def _export_textgrid(self) -> None:
         self._export("Export landmarks as TextGrid", "landmarks.TextGrid", "TextGrid (*.TextGrid)",
                      self.export_textgrid)
+
+
+def draw_timing_chart(fig: Figure, rows: list[LandmarkError], has_original: bool) -> None:
+    """The landmark timing errors as horizontal bars, or why there are none."""
+    fig.clear()
+    ax = fig.add_subplot(111)
+    rows = [r for r in rows if np.isfinite(r.error)]
+    if not rows:
+        why = ("no original markers:\nno timing errors to show" if not has_original else
+               "no gestures found around\nthe gesture phones")
+        ax.text(0.5, 0.5, why, ha="center", va="center", transform=ax.transAxes,
+                color="#555555", fontsize=10)
+        ax.set_axis_off()
+        return
+    ms = np.array([1000 * r.error for r in rows])
+    y = np.arange(len(rows))[::-1]
+    ax.barh(y, ms, color=[LATE_COLOR if e > 0 else EARLY_COLOR for e in ms],
+            edgecolor="#555555", lw=0.4, height=0.75)
+    ax.set_yticks(y, [f"{r.gesture} {r.label} {r.landmark}" for r in rows],
+                  fontsize=max(5, min(8, 520 // len(rows))))
+    ax.set_ylim(-0.6, len(rows) - 0.4)
+    lim = max(10.0, float(np.abs(ms).max()) * 1.1)
+    ax.set_xlim(-lim, lim)
+    ax.axvline(0.0, color="k", lw=0.6)
+    ax.set_xlabel("synthesized − original (ms)\n← early    late →", fontsize=8)
+    ax.tick_params(axis="x", labelsize=8)
+    ax.set_title("Landmark timing error", fontsize=10)
+    ax.grid(axis="x", alpha=0.3)
+    fig.set_layout_engine("constrained")   # laid out again at every draw: resizes keep the labels in
 
 
 class VelocityPanel:

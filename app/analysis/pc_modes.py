@@ -4,6 +4,9 @@ Pick a PC and drag its coefficient over +-3 standard deviations: the 3-D view sh
 face (grey), the displaced face (orange) and displacement arrows; beside it the front projection
 as in Figure 2 (circles: neutral, arrows: displacement) and the variance share of every PC.
 "Animate" sweeps the mode back and forth. All shapes come from ``model.mode_shape``.
+
+The view opens at once and builds its 3-D scene and its plots in the passes of the event loop
+that follow (``ready`` when done), so that the window does not freeze while it opens.
 """
 
 from __future__ import annotations
@@ -28,10 +31,11 @@ from PyQt6.QtWidgets import (
 
 from app.plotter_widget import make_plotter
 from app.style import BACKGROUND, SURFACE_COLOR, SYNTH_COLOR
-from app.surface import face_triangles, lip_contours
+from app.surface import lip_contours, stored_face_triangles
 from engine.analysis.pc_modes import describe_mode, mode_displacement, mode_sd, variance_shares
 from engine.method.model import Model
 
+from ..workers import one_per_pass
 from .common import Canvas
 
 log = logging.getLogger(__name__)
@@ -52,6 +56,7 @@ class PCModeExplorer(QWidget):
     """Explore one PC at a time: slider over +-3 SD, 3-D view, Figure 2 projection, variance."""
 
     valueChanged = pyqtSignal(int, float)     # component, coefficient value (mm units of the PC)
+    ready = pyqtSignal()
 
     def __init__(self, model: Model, window=None, parent: QWidget | None = None):
         super().__init__(parent)
@@ -62,9 +67,39 @@ class PCModeExplorer(QWidget):
         self.component = 0
         self.value = 0.0
         self._phase = 0.0
+        rows = self._build_controls()
 
+        self.plotter = None                  # made in the first pass after the view opens
+        self.scene_box = QWidget()
+        self.scene_box.setMinimumHeight(240)
+        QVBoxLayout(self.scene_box).setContentsMargins(0, 0, 0, 0)
+        self.canvas = Canvas(6, 3.4)
+        self.canvas.setMinimumHeight(220)
+        split = QSplitter(Qt.Orientation.Vertical)
+        split.addWidget(self.scene_box)
+        split.addWidget(self.canvas)
+        split.setSizes([520, 340])
+        split.setChildrenCollapsible(False)
+        lay = QVBoxLayout(self)
+        lay.addLayout(rows[0])
+        lay.addLayout(rows[1])
+        lay.addWidget(self.description)
+        lay.addLayout(rows[2])
+        lay.addWidget(split, 1)
+
+        self.timer = QTimer(self)
+        self.timer.setInterval(40)
+        self.timer.timeout.connect(self._tick)
+        self.is_ready = False
+        self.heads = None
+        one_per_pass(self, [self._make_plotter, self._build_scene,
+                            lambda: self.canvas.when_idle(self._build_plots),
+                            lambda: self.set_component(0), self._set_ready])
+
+    def _build_controls(self) -> tuple[QHBoxLayout, QHBoxLayout, QHBoxLayout]:
+        """The rows of controls: component, slider, cameras and 2-D projection."""
         self.combo = QComboBox()
-        for k, share in enumerate(model.pca.explained_ratio):
+        for k, share in enumerate(self.model.pca.explained_ratio):
             self.combo.addItem(f"PC{k + 1}  ({100 * share:.1f} %)")
         self.combo.currentIndexChanged.connect(self.set_component)
         self.slider = QSlider(Qt.Orientation.Horizontal)
@@ -72,8 +107,9 @@ class PCModeExplorer(QWidget):
         self.slider.setTickInterval(SLIDER_STEPS)
         self.slider.setTickPosition(QSlider.TickPosition.TicksBelow)
         self.slider.valueChanged.connect(self._slider_moved)
+        self.slider.setMinimumWidth(220)
         self.value_label = QLabel()
-        self.value_label.setMinimumWidth(170)
+        self.value_label.setMinimumWidth(150)
         self.animate_btn = QPushButton("Animate")
         self.animate_btn.setCheckable(True)
         self.animate_btn.toggled.connect(self.set_animating)
@@ -90,45 +126,41 @@ class PCModeExplorer(QWidget):
         self.arrow_scale.setPrefix("arrows x")
         self.arrow_scale.setToolTip("lengthen the 2-D arrows for legibility (the 3-D view is true to scale)")
         self.arrow_scale.valueChanged.connect(lambda _v: self.set_value(self.value, move_slider=False))
+        # four short rows: the view fits a dock of 520 px (one row of everything pushed the
+        # window past the screen and squeezed the slider to 19 px)
+        component = QHBoxLayout()
+        component.addWidget(QLabel("component:"))
+        component.addWidget(self.combo, 1)
+        component.addWidget(reset)
+        component.addWidget(self.animate_btn)
+        slider_row = QHBoxLayout()
+        slider_row.addWidget(QLabel("-3 SD"))
+        slider_row.addWidget(self.slider, 1)
+        slider_row.addWidget(QLabel("+3 SD"))
+        slider_row.addWidget(self.value_label)
         view_bar = QHBoxLayout()
-        view_bar.addWidget(QLabel("3-D camera:"))
+        view_bar.addWidget(QLabel("3-D:"))
         for name in CAMERAS:
             b = QPushButton(name)
             b.clicked.connect(lambda _c=False, n=name: self.set_camera(n))
             view_bar.addWidget(b)
         view_bar.addStretch(1)
-        view_bar.addWidget(QLabel("2-D projection:"))
+        view_bar.addWidget(QLabel("2-D:"))
         view_bar.addWidget(self.projection)
         view_bar.addWidget(self.arrow_scale)
-        controls = QHBoxLayout()
-        controls.addWidget(QLabel("component:"))
-        controls.addWidget(self.combo)
-        controls.addWidget(QLabel("-3 SD"))
-        controls.addWidget(self.slider, 1)
-        controls.addWidget(QLabel("+3 SD"))
-        controls.addWidget(self.value_label)
-        controls.addWidget(reset)
-        controls.addWidget(self.animate_btn)
 
-        self.plotter = make_plotter(self)    # native on X11: the main window stays raster
+        return component, slider_row, view_bar
+
+    def _make_plotter(self) -> None:
+        """The 3-D view (a native window on X11: the main window stays raster), in a pass of its
+        own: creating its render window takes 60-120 ms."""
+        self.plotter = make_plotter(self.scene_box)
         self.plotter.set_background(BACKGROUND)
-        self.canvas = Canvas(5, 6)
-        split = QSplitter(Qt.Orientation.Horizontal)
-        split.addWidget(self.plotter.interactor)
-        split.addWidget(self.canvas)
-        split.setSizes([600, 450])
-        lay = QVBoxLayout(self)
-        lay.addLayout(controls)
-        lay.addWidget(self.description)
-        lay.addLayout(view_bar)
-        lay.addWidget(split, 1)
+        self.scene_box.layout().addWidget(self.plotter.interactor)
 
-        self.timer = QTimer(self)
-        self.timer.setInterval(40)
-        self.timer.timeout.connect(self._tick)
-        self._build_scene()
-        self._build_plots()
-        self.set_component(0)
+    def _set_ready(self) -> None:
+        self.is_ready = True
+        self.ready.emit()
 
     # ------------------------------------------------------------------ scene
     def _build_scene(self) -> None:
@@ -143,22 +175,27 @@ class PCModeExplorer(QWidget):
         self.arrows.lines = np.column_stack([np.full(n, 2), np.arange(n), np.arange(n) + n]).ravel()
         p = self.plotter
         p.add_mesh(self.neutral_poly, color=NEUTRAL_COLOR, render_points_as_spheres=True,
-                   point_size=11, style="points", name="neutral", pickable=False)
+                   point_size=11, style="points", name="neutral", pickable=False,
+                   reset_camera=False, render=False)
         p.add_mesh(self.displaced, color=SYNTH_COLOR, render_points_as_spheres=True, point_size=11,
-                   style="points", name="displaced", pickable=False)
-        p.add_mesh(self.arrows, color="#222222", line_width=2.5, name="arrows", pickable=False)
+                   style="points", name="displaced", pickable=False,
+                   reset_camera=False, render=False)
+        p.add_mesh(self.arrows, color="#222222", line_width=2.5, name="arrows", pickable=False,
+                   reset_camera=False, render=False)
         try:   # the displaced face as a translucent surface with its lip contours (as the main view)
             contours = lip_contours(self.neutral, self.model.upper_lip, self.model.lower_lip,
                                     list(self.model.lip_corners))
-            tri = face_triangles(self.neutral, contours)
+            tri = stored_face_triangles(self.neutral, contours)   # the main view made it
             surf = pv.PolyData()
             surf.SetPoints(self.displaced.GetPoints())
             surf.faces = np.column_stack([np.full(len(tri), 3), tri]).ravel()
-            p.add_mesh(surf, color=SURFACE_COLOR, opacity=0.35, name="surface", pickable=False)
+            p.add_mesh(surf, color=SURFACE_COLOR, opacity=0.35, name="surface", pickable=False,
+                   reset_camera=False, render=False)
             lips = pv.PolyData()
             lips.SetPoints(self.displaced.GetPoints())
             lips.lines = np.concatenate([[len(c), *c] for c in contours])
-            p.add_mesh(lips, color=SYNTH_COLOR, line_width=3, name="lips", pickable=False)
+            p.add_mesh(lips, color=SYNTH_COLOR, line_width=3, name="lips", pickable=False,
+                   reset_camera=False, render=False)
         except Exception:   # a degenerate marker layout: points and arrows only
             log.debug("no face surface for the PC explorer", exc_info=True)
         self.heads = None
@@ -166,29 +203,33 @@ class PCModeExplorer(QWidget):
 
     def set_camera(self, name: str, render: bool = True) -> None:
         """Look at the face from the ``front``, in ``profile`` or at ``three-quarter``."""
+        if self.plotter is None:
+            return
         direction, up = CAMERAS[name]
         centre = self.neutral.mean(axis=0)
         dist = 3.0 * float(np.ptp(self.neutral, axis=0).max())
         d = np.asarray(direction, dtype=float)
         d /= np.linalg.norm(d)
         self.plotter.camera_position = [tuple(centre + dist * d), tuple(centre), up]
-        self.plotter.reset_camera()
+        self.plotter.renderer.reset_camera(render=False)
         if render:
             self.plotter.render()
 
     def _build_plots(self) -> None:
         fig = self.canvas.figure
         fig.clear()
-        self.ax_face, self.ax_var = fig.subplots(2, 1, gridspec_kw={"height_ratios": [3, 1.2]})
-        fig.subplots_adjust(left=0.12, right=0.97, top=0.95, bottom=0.08, hspace=0.35)
+        # side by side under the 3-D view; constrained layout keeps every label inside at any size
+        self.ax_face, self.ax_var = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.1, 1]})
+        fig.set_layout_engine("constrained")
         share, cumulative = variance_shares(self.model)
         k = np.arange(1, len(share) + 1)
         self.bars = self.ax_var.bar(k, share, color="#9fb7d9")
         self.ax_var.plot(k, cumulative, color="#333333", lw=1, marker=".", ms=3,
                          label="cumulative")
         self.ax_var.set_xlabel("principal component", fontsize=8)
-        self.ax_var.set_ylabel("% variance", fontsize=8)
+        self.ax_var.set_ylabel("variance explained (%)", fontsize=8)
         self.ax_var.set_ylim(0, 105)
+        self.ax_var.set_title("variance of each PC", fontsize=9)
         self.ax_var.tick_params(labelsize=7)
         self.ax_var.legend(fontsize=7, loc="center right")
         self._draw_projection_base()
@@ -213,16 +254,18 @@ class PCModeExplorer(QWidget):
         ax.set_ylim(self.neutral[:, v].min() - pad, self.neutral[:, v].max() + pad)
 
     def _projection_changed(self) -> None:
-        self._draw_projection_base()
-        self.set_value(self.value, move_slider=False)
+        def redraw() -> None:
+            if hasattr(self, "ax_face"):
+                self._draw_projection_base()
+                self._update_plots()
+
+        self.canvas.when_idle(redraw)
 
     # ------------------------------------------------------------------ state
     def set_component(self, k: int) -> None:
         self.component = int(k)
         if self.combo.currentIndex() != k:
             self.combo.setCurrentIndex(k)
-        for i, b in enumerate(self.bars):
-            b.set_color(SYNTH_COLOR if i == k else "#9fb7d9")
         self.description.setText(describe_mode(self.model, k).text())
         self.set_value(self.slider.value() / SLIDER_STEPS * self.sd[k], move_slider=False)
 
@@ -240,6 +283,10 @@ class PCModeExplorer(QWidget):
             self.slider.blockSignals(True)
             self.slider.setValue(int(round(value / self.sd[self.component] * SLIDER_STEPS)))
             self.slider.blockSignals(False)
+        sd = self.sd[self.component]
+        self.value_label.setText(f"{self.value:+.2f} ({self.value / sd:+.2f} SD)")
+        if not hasattr(self, "displaced"):
+            return                          # the scene is still being built (one_per_pass)
         shape = self.model.mode_shape(self.component, self.value)
         disp = mode_displacement(self.model, self.component, self.value)
         self.displaced.points[:] = shape
@@ -248,16 +295,25 @@ class PCModeExplorer(QWidget):
         self.arrows.points[n:] = shape
         self.arrows.GetPoints().Modified()
         self._update_heads(shape, disp)
-        sd = self.sd[self.component]
-        self.value_label.setText(f"{self.value:+.2f} ({self.value / sd:+.2f} SD)")
         self.plotter.render()
+        self.canvas.when_idle(self._update_plots)
+        self.valueChanged.emit(self.component, self.value)
+
+    def _update_plots(self) -> None:
+        """The 2-D projection's arrows and title and the highlighted variance bar for the current
+        component and value (run when the canvas is not being drawn)."""
+        if not hasattr(self, "quiver"):
+            return
+        k, sd = self.component, self.sd[self.component]
+        for i, b in enumerate(self.bars):
+            b.set_color(SYNTH_COLOR if i == k else "#9fb7d9")
+        disp = mode_displacement(self.model, k, self.value)
         h, v = self._axes2d()
         scale = int(self.arrow_scale.value())
         self.quiver.set_UVC(scale * disp[:, h], scale * disp[:, v])
-        self.ax_face.set_title(f"PC{self.component + 1} = {self.value:+.1f} ({self.value / sd:+.1f} SD)"
+        self.ax_face.set_title(f"PC{k + 1} = {self.value:+.1f} ({self.value / sd:+.1f} SD)"
                                + (f", arrows x{scale}" if scale != 1 else ""), fontsize=9)
         self.canvas.draw_idle()
-        self.valueChanged.emit(self.component, self.value)
 
     def _update_heads(self, shape: np.ndarray, disp: np.ndarray) -> None:
         length = np.linalg.norm(disp, axis=1)
@@ -297,6 +353,8 @@ class PCModeExplorer(QWidget):
 
     def close_view(self) -> None:
         self.timer.stop()
+        if self.plotter is None:
+            return
         try:
             self.plotter.close()
         except Exception:
