@@ -114,9 +114,10 @@ def app_figures(out: Path, scratch: Path) -> list[Path]:
 
 def _grab(widget, path: Path) -> Path:
     from .analysis.figures import settle
+    from .plotter_widget import grab_with_3d
 
     settle()
-    widget.grab().save(str(path))
+    grab_with_3d(widget).save(str(path))
     log.info("wrote %s", path)
     return path
 

@@ -40,6 +40,7 @@ from engine.io.export import write_trajectories
 from engine.method.model import Model
 from engine.streaming.synthesizer import LIVE_BATCH_FRAMES, StreamConfig, StreamingSynthesizer
 
+from .plotter_widget import grab_with_3d
 from .view3d import FaceView
 
 log = logging.getLogger(__name__)
@@ -428,7 +429,7 @@ def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = Non
 
     def finish() -> None:
         if screenshot:
-            window.grab().save(str(screenshot))
+            grab_with_3d(window).save(str(screenshot))      # the face as on screen (grab: black)
             print(screenshot)
         app.quit()
 

@@ -89,6 +89,7 @@ from .marker_panels import MarkerPanels
 from .open_audio import AudioOpener
 from .phases import mark
 from .playback import PlaybackScheduler
+from .plotter_widget import grab_with_3d
 from .provenance import LabelOrigin
 from .settings_panel import SynthSettingsPanel
 from .state import UtteranceView
@@ -495,8 +496,7 @@ class MainWindow(QMainWindow):
         """Render the whole window (with the 3-D view) to a PNG."""
         self.face.rerender()
         self.timeline.ensure_drawn()
-        pix = self.grab()
-        self.face.paint_into(pix, self)
+        pix = grab_with_3d(self)        # every 3-D view shown (the PC modes' too), as on screen
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         if not pix.save(str(path), "PNG", PNG_QUALITY):

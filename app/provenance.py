@@ -97,6 +97,14 @@ class LabelOrigin:
             return "recognized from the speech (no text)"
         return f"{src} (label file {self.file})" if self.file else src
 
+    def short(self) -> str:
+        """In a word or two, for the phone tier's row name.
+
+        >>> LabelOrigin("file").short(), LabelOrigin("aligned").short(), LabelOrigin("x-y").short()
+        ('label file', 'aligned', 'x-y')
+        """
+        return {"file": "label file", "none": "none"}.get(self.source or "none", self.source)
+
 
 def mode_reason(requested: SynthConfig, used: SynthConfig, origin: LabelOrigin) -> str:
     """Why the search used differs from the one the settings ask for ("" when it does not):

@@ -136,22 +136,20 @@ class PhoneTierPanel:
     """Word and phone labels with their boundaries."""
 
     title = "phones"
-    height = 0.7
+    height = 0.8
 
     def draw(self, ax, view: UtteranceView) -> None:
         utt = view.utterance
         ax.set_ylim(0, 2 if utt.words else 1)
-        # each row named beside it (a y label "words phones (aligned)" shrank to a few pixels)
-        ax.set_yticks([0.5, 1.5] if utt.words else [0.5], ["phones", "words"][:2 if utt.words else 1],
-                      fontsize=7)
+        # each row named beside it, the phones with where they came from (a y label "words
+        # phones (aligned)" shrank to a few pixels); the title and status line say it in full
+        rows = [f"phones ({view.label_origin.short()})"] if utt.phones else ["phones"]
+        rows += ["words"] if utt.words else []
+        ax.set_yticks([0.5, 1.5][:len(rows)], rows, fontsize=7)
         ax.tick_params(axis="y", length=0)
         if not utt.phones:
             ax.text(0.5, 0.5, "no phone labels: acoustic-only synthesis", transform=ax.transAxes,
                     ha="center", va="center", fontsize=8, color="#777777")
-        else:       # where they came from, in the corner (over the leading silence)
-            ax.text(0.003, 0.96, f"labels: {view.label_origin.text()}", transform=ax.transAxes,
-                    ha="left", va="top", fontsize=7, color="#444444", style="italic", zorder=5,
-                    bbox={"boxstyle": "square,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85})
         # the boundaries: one line collection per tier (an axvline each was 48 artists, a tenth
         # of the timeline's first draw), x in data, y in axes coordinates as axvline's
         across = ax.get_xaxis_transform()
@@ -325,6 +323,9 @@ class Timeline(QWidget):
         self.canvas.hold()
         try:
             fig = self.figure
+            for ax in list(fig.axes):          # one at a time (fig.clear() clears each axes
+                ax.remove()                     # first: 70 ms for eight panels)
+                yield
             fig.clear()
             self.axes, self._spans, self._cursor = [], [], None
             self._bg = None
@@ -368,6 +369,8 @@ class Timeline(QWidget):
             return
         left, bottom = self._margins()
         self._grid.update(left=left, bottom=bottom)
+        for ax in self.axes:            # (GridSpec.update moves only pyplot's figures' axes)
+            ax.set_position(ax.get_subplotspec().get_position(self.figure))
         refit_ylabels(self.axes)
 
     def _draw_panel(self, panel: Panel, ax, last: bool) -> None:

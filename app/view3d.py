@@ -12,7 +12,7 @@ import logging
 import numpy as np
 import pyvista as pv
 from PyQt6.QtCore import QPoint
-from PyQt6.QtGui import QCursor, QImage, QPainter, QPixmap
+from PyQt6.QtGui import QCursor
 from PyQt6.QtWidgets import QToolTip, QVBoxLayout, QWidget
 
 from engine.method.model import Model
@@ -234,24 +234,6 @@ class FaceView(QWidget):
         self.plotter.render()
 
     # ------------------------------------------------------------------ options
-    def paint_into(self, pix: QPixmap, top: QWidget) -> None:
-        """Draw the rendered 3-D scene over its place in ``pix``, a grab of ``top`` (a widget grab
-        does not contain the OpenGL view)."""
-        img = self.plotter.screenshot(return_img=True)
-        if img is None or not img.size:
-            return
-        h, w = img.shape[:2]
-        rgb = np.ascontiguousarray(img[:, :, :3])
-        qimg = QImage(rgb.data, w, h, 3 * w, QImage.Format.Format_RGB888)
-        painter = QPainter(pix)
-        interactor = self.plotter.interactor
-        target = interactor.mapTo(top, QPoint(0, 0))
-        dpr = pix.devicePixelRatio()
-        size = interactor.size()
-        painter.drawImage(target.x(), target.y(), qimg.scaled(int(size.width() * dpr),
-                                                              int(size.height() * dpr)))
-        painter.end()
-
     def set_side_by_side(self, on: bool) -> None:
         self.side_by_side = bool(on)
         self._update_visibility()

@@ -68,8 +68,7 @@ def test_open_audio_with_a_sentence_shows_aligned_phones(window, qtbot, clip, tm
     assert [w.label for w in utt.words] == ["the", "boy", "enjoyed", "the", "noisy", "toy"]
     assert [p.label for p in utt.phones if p.label != "sil"][:4] == ["dh", "ah", "b", "oy"]
     ax = _phone_axis(win)
-    assert [t.get_text() for t in ax.get_yticklabels()] == ["phones", "words"]   # each row named
-    assert "labels: aligned from the sentence typed" in [t.get_text() for t in ax.texts]
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["phones (aligned)", "words"]
     assert "labels: aligned from the sentence typed" in win.title.text()
     assert "boy" in [t.get_text() for t in ax.texts] and "oy" in [t.get_text() for t in ax.texts]
     assert win.audio_opener.box.combo.currentData() == "aligned"
@@ -85,8 +84,7 @@ def test_open_audio_with_a_sentence_shows_aligned_phones(window, qtbot, clip, tm
         box.combo.activated.emit(box.combo.currentIndex())
     assert win.view.utterance.label_source == "recognized" and win.view.utterance.words == []
     ax = _phone_axis(win)
-    assert [t.get_text() for t in ax.get_yticklabels()] == ["phones"]
-    assert "labels: recognized from the speech (no text)" in [t.get_text() for t in ax.texts]
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["phones (recognized)"]
     assert SENTENCE not in win.title.text()     # not what recognized labels say
     assert not np.allclose(win.view.shown, aligned_lips)
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
@@ -98,7 +96,7 @@ def test_open_audio_with_a_sentence_shows_aligned_phones(window, qtbot, clip, tm
         win.set_utterance(win.corpus.info.test[0])
     assert not box.combo.isEnabled()
     label_file = f"{win.view.utterance.name}.TextGrid"
-    assert f"labels: label file {label_file}" in [t.get_text() for t in _phone_axis(win).texts]
+    assert [t.get_text() for t in _phone_axis(win).get_yticklabels()] == ["phones (label file)", "words"]
     assert f"labels: label file {label_file}" in win.title.text()
 
 

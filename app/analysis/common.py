@@ -137,7 +137,8 @@ def fill_table(table: QTableWidget, header: list[str], rows: list[list[QTableWid
     table.setSortingEnabled(sorting)
 
 
-MAX_TABLE_MIN_WIDTH = 720     # px: a table narrower than this shows all its columns
+MAX_TABLE_MIN_WIDTH = 440     # px: a table narrower than this shows all its columns (a wider
+                              # one scrolls inside itself: its dock must fit the window)
 
 
 class _ColumnStretcher(QObject):

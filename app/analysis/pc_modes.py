@@ -25,6 +25,7 @@ from PyQt6.QtWidgets import (
     QSlider,
     QSpinBox,
     QSplitter,
+    QToolButton,
     QVBoxLayout,
     QWidget,
 )
@@ -119,6 +120,7 @@ class PCModeExplorer(QWidget):
         self.description.setWordWrap(True)
         self.projection = QComboBox()
         self.projection.addItems(list(PROJECTIONS))
+        self.projection.setToolTip("the 2-D projection of Figure 2")
         self.projection.currentIndexChanged.connect(self._projection_changed)
         self.arrow_scale = QSpinBox()
         self.arrow_scale.setRange(1, 20)
@@ -141,7 +143,9 @@ class PCModeExplorer(QWidget):
         view_bar = QHBoxLayout()
         view_bar.addWidget(QLabel("3-D:"))
         for name in CAMERAS:
-            b = QPushButton(name)
+            b = QToolButton()
+            b.setText({"three-quarter": "¾ view"}.get(name, name))
+            b.setToolTip(f"3-D camera: {name}")
             b.clicked.connect(lambda _c=False, n=name: self.set_camera(n))
             view_bar.addWidget(b)
         view_bar.addStretch(1)

@@ -1,0 +1,154 @@
+"""The main window with its analysis views, as a phonetician opens them on a 1600 x 1000 window
+(real window under Xvfb): the window stays on the screen while every dock opens and closes and
+the panels' labels stay legible and apart; no view freezes the event loop while it opens; the
+saved screenshot shows each 3-D view as the screen does (issue 29)."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pytestqt")
+pytest.importorskip("pyvistaqt")
+
+if not os.environ.get("DISPLAY"):
+    pytest.skip("the app tests need an X display (run under xvfb-run)", allow_module_level=True)
+
+from PyQt6.QtGui import QImage
+from PyQt6.QtWidgets import QAbstractButton, QSlider
+from screens import Heartbeat, image_array, on_screen, place_in
+
+from app.analysis import PANELS, VIEWS
+from app.figure_canvas import BackgroundCanvas
+from app.main import build_window
+from facetraj.paths import default_corpus
+
+pytestmark = pytest.mark.gui
+
+WAIT_MS = 240_000          # a hang guard (a loaded machine is slow), not a speed limit
+MAX_STALL_MS = 200         # issue 29: no event-loop stall over 200 ms while a view opens
+SIZE = (1600, 1000)
+
+
+@pytest.fixture
+def window(qtbot, trained_cache):
+    win = build_window(default_corpus(), use_audio=False)
+    qtbot.addWidget(win)
+    win.resize(*SIZE)
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        win.show()
+    qtbot.waitExposed(win)
+    qtbot.waitUntil(lambda: not win.busy and not win.timeline.building, timeout=WAIT_MS)
+    yield win
+    win.extension("analysis").close()
+    win.close()
+
+
+def settled(win, key: str) -> bool:
+    """View ``key`` is open, has done its work and drawn it, and so has the window."""
+    views = win.extension("analysis")
+    w = views.widgets.get(key)
+    if w is None or win.busy or win.timeline.building:
+        return False
+    if key == "similarity" and w.clustering is None:
+        return False
+    if key == "pc_modes" and not w.is_ready:
+        return False
+    return not any(c.busy for c in w.findChildren(BackgroundCanvas))
+
+
+def open_all(win, qtbot) -> dict[str, int]:
+    """Open every analysis view from the menu, one after the other, each until it has settled;
+    the longest event-loop stall (ms) of each."""
+    views = win.extension("analysis")
+    beat, longest = Heartbeat(), {}
+    for key in VIEWS:
+        beat.start()
+        views.view_actions[key].trigger()
+        qtbot.waitUntil(lambda k=key: settled(win, k), timeout=WAIT_MS)
+        longest[key] = beat.stop()
+    return longest
+
+
+def test_no_view_freezes_the_window_while_it_opens(window, qtbot):
+    """Every view (its module imported, its work done, its plots drawn, the panels it adds to the
+    timeline) opens without holding up the event loop over 200 ms; before: similarity 2.3-4.4 s,
+    kinematics 3.3 s, PC modes 1.4 s."""
+    longest = open_all(window, qtbot)
+    views = window.extension("analysis")
+    beat = Heartbeat()
+    for key in PANELS:                                  # the panels not opened by a view
+        beat.start()
+        views.panel_actions[key].setChecked(True)
+        qtbot.waitUntil(lambda: not window.timeline.building and not window.busy, timeout=WAIT_MS)
+        longest[f"panel {key}"] = beat.stop()
+    print("longest event-loop stall per view (ms):", longest)
+    assert max(longest.values()) <= MAX_STALL_MS, longest
+
+
+def test_docks_keep_the_window_on_the_screen(window, qtbot):
+    """Opening every view and closing them all leaves the window 1600 px wide and on the screen
+    (it grew to 1635-1864 px and stayed so), every control of every view inside the screen (the
+    PC modes' buttons were past its edge, its slider 19 px wide); with every panel in the
+    timeline the y labels are inside the figure and do not overlap."""
+    win = window
+    screen = win.screen().availableGeometry()
+    views = win.extension("analysis")
+    widths = []
+    for key in VIEWS:
+        views.view_actions[key].trigger()
+        qtbot.waitUntil(lambda k=key: settled(win, k), timeout=WAIT_MS)
+        widths.append(win.frameGeometry().width())
+        assert screen.contains(win.frameGeometry()), (key, win.frameGeometry())
+        for control in views.widgets[key].findChildren((QAbstractButton, QSlider)):
+            if control.isVisible():
+                right = control.mapToGlobal(control.rect().topRight()).x()
+                assert right <= screen.right(), (key, control.text() if hasattr(control, "text") else control)
+    assert widths == [SIZE[0]] * len(VIEWS)
+    slider = views.widgets["pc_modes"].slider
+    views.docks["pc_modes"].raise_()
+    qtbot.waitUntil(lambda: slider.isVisible(), timeout=5000)
+    assert slider.width() >= 200
+    # every panel: the labels legible and apart
+    views.show_panels(list(PANELS))
+    qtbot.waitUntil(lambda: not win.timeline.building, timeout=WAIT_MS)
+    canvas = win.timeline.canvas
+    canvas.finish()
+    renderer = canvas.get_renderer()
+    fig_w, fig_h = canvas.figure.bbox.width, canvas.figure.bbox.height
+    boxes = []
+    for ax in win.timeline.axes:
+        texts = [ax.yaxis.label] if ax.get_ylabel() else list(ax.get_yticklabels())[-1:]
+        for text in texts:
+            e = text.get_window_extent(renderer)
+            assert e.x0 >= 0 and e.y0 >= 0 and e.x1 <= fig_w and e.y1 <= fig_h, text.get_text()
+            assert text.get_fontsize() >= 4.5, text.get_text()
+            boxes.append((text.get_text(), e))
+    for i, (a, ea) in enumerate(boxes):
+        for b, eb in boxes[i + 1:]:
+            assert not ea.overlaps(eb), (a, b)
+    for dock in list(views.docks.values()):
+        dock.close()
+    qtbot.waitUntil(lambda: not win.timeline.building, timeout=WAIT_MS)
+    assert win.frameGeometry().width() == SIZE[0] and screen.contains(win.frameGeometry())
+
+
+def test_saved_screenshot_shows_each_3d_view_as_the_screen_does(window, qtbot, tmp_path):
+    """File > Save screenshot with the PC modes open: the main face and the PC modes' 3-D view in
+    the PNG are what the screen shows there, not noise or black (the PC modes' pane was)."""
+    win = window
+    views = win.extension("analysis")
+    views.view_actions["pc_modes"].trigger()
+    qtbot.waitUntil(lambda: settled(win, "pc_modes"), timeout=WAIT_MS)
+    win.activateWindow()
+    win.raise_()
+    qtbot.wait(300)                                    # the 3-D views painted on the screen
+    shot = image_array(QImage(str(win.save_screenshot(tmp_path / "shot.png"))))
+    for name, view in (("face", win.plotter.interactor),
+                       ("PC modes", views.widgets["pc_modes"].plotter.interactor)):
+        saved, screen = place_in(shot, view, win).astype(float), on_screen(view).astype(float)
+        assert saved.shape == screen.shape, name
+        assert saved.std() > 20, f"{name}: flat (black) in the screenshot"
+        assert np.abs(saved - screen).mean() < 6, f"{name}: the screenshot differs from the screen"
