@@ -15,6 +15,7 @@ Attributes
     ``model``, ``corpus``, ``view`` (``UtteranceView``, ``app/state.py``), ``synth_config`` (read
     from ``state``), ``plotter`` (a plotter widget, ``app/plotter_widget.py``), ``face`` (``FaceView``),
     ``timeline`` (``app/timeline.py``), ``analysis_menu``, ``marker_panels`` (``MarkerPanels``),
+    ``closed_lips`` (``engine.analysis.lips.ClosedLips`` of the model: the lips at closure),
     ``action_screenshot`` (File-menu entries of extensions go before it).
 
 Signals
@@ -66,6 +67,7 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
+from engine.analysis.lips import ClosedLips, closed_lips
 from engine.config import SynthConfig
 from engine.data import Utterance
 from engine.errors import FacetrajError
@@ -134,6 +136,7 @@ class MainWindow(QMainWindow):
         self.playback.prepareDue.connect(self._prepare_time)
         self.clock.playingChanged.connect(self._on_playing_changed)
         self._error_handler: Callable[[str], None] | None = None
+        self.closed_lips: ClosedLips | None = None      # the talker's lips at closure (per model)
         self._extensions: dict[str, object] = {}
         self.menus = WindowMenus(self, self.report_error)
         self.docks = WindowDocks(self)
@@ -331,7 +334,8 @@ class MainWindow(QMainWindow):
         mark("model ready")
         self.stop()
         first = self.state.set_model(corpus, model, texts)
-        self.face.set_model(model)
+        self.closed_lips = closed_lips(model)     # the 3-D mouth shuts there; the lip panels' line
+        self.face.set_model(model, self.closed_lips)
         self.settings.set_limits(model.config.context, model.config.nu, model.tuned)
         info = corpus.info
         self.browser.populate({"test": list(info.test), "train": list(info.train)}, texts)

@@ -11,6 +11,8 @@ SPEECH_DOT_COLOR = "#222222"    # speech/silence dots
 CURSOR_COLOR = "#d6336c"        # the play cursor
 LOOP_COLOR = "#2b8a3e"          # the loop range
 SURFACE_COLOR = "#ecc9ae"       # the face surface
+CAVITY_COLOR = "#3b1f1a"        # the mouth opening (dark: the oral cavity behind the lips)
+CLOSED_COLOR = "#5f6b3a"        # the lips at closure (the lip panels' reference line)
 BACKGROUND = "#ffffff"
 
 

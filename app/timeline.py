@@ -28,6 +28,7 @@ from PyQt6.QtWidgets import QSizePolicy, QVBoxLayout, QWidget
 from .figure_canvas import BackgroundCanvas
 from .state import UtteranceView
 from .style import (
+    CLOSED_COLOR,
     CURSOR_COLOR,
     LABEL_MARGIN_PX,
     LOOP_COLOR,
@@ -175,7 +176,9 @@ class PhoneTierPanel:
 
 class LipPanel:
     """Upper- or lower-lip centre y: original (dotted), spline (dark) and triangular (light)
-    synthesis, and the speech/silence dots on a line through the middle (paper Figure 4)."""
+    synthesis, and the speech/silence dots on a line through the middle (paper Figure 4); a
+    dashed line marks where the talker's lip is when the lips are closed (the window's
+    ``closed_lips``)."""
 
     height = 1.2
 
@@ -200,7 +203,10 @@ class LipPanel:
             orig = view.original[:, k, 1]
             ax.plot(t, orig, color=ORIGINAL_COLOR, lw=1.5, ls=(0, (2, 1.5)), label="original")
             ys.append(orig)
-        allv = np.concatenate([y[np.isfinite(y)] for y in ys])
+        closed = getattr(self.window, "closed_lips", None)
+        closed_y = float(closed.markers[k, 1]) if closed is not None else None
+        extra = [np.array([closed_y])] if closed_y is not None else []
+        allv = np.concatenate([y[np.isfinite(y)] for y in ys] + extra)
         lo, hi = float(allv.min()), float(allv.max())
         pad = 0.12 * max(hi - lo, 0.5)
         top = 0.45 * max(hi - lo, 0.5) if self.which == "upper" else pad   # room for the legend
@@ -209,6 +215,10 @@ class LipPanel:
         sp = view.speech
         ax.plot(t[sp], np.full(int(sp.sum()), mid), ls="none", marker=".", ms=2.2,
                 color=SPEECH_DOT_COLOR, label="speech frames")
+        if closed_y is not None:     # the talker's lip at closure (the middles of /p b m/)
+            ax.axhline(closed_y, color=CLOSED_COLOR, lw=0.9, ls=(0, (6, 3)), zorder=0.5)
+            ax.text(1.0, closed_y, "closed ", transform=ax.get_yaxis_transform(), ha="right",
+                    va="bottom", fontsize=6.5, color=CLOSED_COLOR)
         fit_ylabel(ax, f"{self.which} lip\ny (mm)")
         if self.which == "upper":
             ax.legend(loc="upper right", fontsize=7, ncol=4, frameon=True, framealpha=0.85,

@@ -152,3 +152,45 @@ def test_saved_screenshot_shows_each_3d_view_as_the_screen_does(window, qtbot, t
         assert saved.shape == screen.shape, name
         assert saved.std() > 20, f"{name}: flat (black) in the screenshot"
         assert np.abs(saved - screen).mean() < 6, f"{name}: the screenshot differs from the screen"
+
+
+def test_the_face_shows_the_mouth_closed_at_a_b_and_the_lip_panels_where_closed_is(window, qtbot,
+                                                                                   tmp_path):
+    """The original markers of s002 ("The boy ...") with the face surface on them, from the
+    front: between the lip centre markers the picture is skin at the /b/ (the surface had a hole
+    there) and the dark mouth at the /oy/ after it; the lip panels draw the talker's closed lip
+    positions as a reference line."""
+    from app import style
+
+    win = window
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        win.set_utterance("s002")
+    qtbot.waitUntil(lambda: not win.busy and not win.timeline.building, timeout=WAIT_MS)
+    win.view_bar.show_synth.setChecked(False)             # the surface follows the original set
+    win.view_bar.set_camera("front")
+    model, face = win.model, win.face
+    phones = {p.label: p for p in win.view.utterance.phones}
+    cavity = np.array([int(style.CAVITY_COLOR[i:i + 2], 16) for i in (1, 3, 5)], float)
+    counts = {}
+    for label in ("b", "oy"):
+        seg = phones[label]
+        win.seek((seg.start + seg.end) / 2)
+        shot = image_array(QImage(str(win.save_screenshot(tmp_path / f"{label}.png")))).astype(float)
+        view = win.plotter.interactor
+        pts = face.original.current
+        xy = face._project(pts[[model.upper_lip, model.lower_lip]])
+        origin = view.mapTo(win, view.rect().topLeft())
+        x = origin.x() + int(round(xy[:, 0].mean()))
+        y_top = origin.y() + view.height() - int(round(xy[0, 1])) + 8     # under the markers'
+        y_bottom = origin.y() + view.height() - int(round(xy[1, 1])) - 8  # dots and lines
+        box = shot[y_top:y_bottom, x - 15:x + 15]
+        assert box.size, label
+        counts[label] = (int((np.linalg.norm(box - cavity, axis=2) < 40).sum()),
+                         int((box.min(axis=2) > 245).sum()))           # dark mouth, white hole
+    assert counts["b"] == (0, 0), counts
+    assert counts["oy"][0] > 30, counts
+    closed = win.closed_lips
+    for panel, marker in (("upper lip y", model.upper_lip), ("lower lip y", model.lower_lip)):
+        ax = win.timeline.axes_of(next(p for p in win.timeline.panels if p.title == panel))
+        ys = [line.get_ydata() for line in ax.lines if len(set(line.get_ydata())) == 1]
+        assert any(np.allclose(y, closed.markers[marker, 1]) for y in ys), panel
