@@ -116,12 +116,20 @@ class UtteranceBrowser(QWidget):
             return
         for col, v in ((1, lower), (2, upper)):
             item.setText(col, "–" if v is None or not math.isfinite(v) else f"{v:.3f}")
+            item.setForeground(col, self.palette().text())
+            item.setToolTip(col, "")
 
-    def clear_scores(self) -> None:
-        for item in self.items.values():
-            if item.text(1) != "–":
-                item.setText(1, "…")
-                item.setText(2, "…")
+    def show_scores(self, scores: dict[str, tuple[float, float]]) -> None:
+        """The scores known for the present settings; the others keep what they show, greyed
+        (computed with other settings), or "…" (not yet computed)."""
+        stale = self.palette().placeholderText()
+        for utt_id, item in self.items.items():
+            if utt_id in scores:
+                self.set_scores(utt_id, *scores[utt_id])
+            elif item.text(1) not in ("–", "…"):
+                for col in (1, 2):
+                    item.setForeground(col, stale)
+                    item.setToolTip(col, "computed with other settings; the present ones' follows")
 
     def apply_filter(self, text: str) -> None:
         words = normalise_text(text).split()

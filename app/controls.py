@@ -88,6 +88,7 @@ class ViewBar(QWidget):
         for cb in (self.show_original, self.show_synth):
             cb.toggled.connect(lambda _c: face.set_sets_visible(self.show_original.isChecked(),
                                                                 self.show_synth.isChecked()))
+        self._original_wanted = True
         self.surface = QCheckBox("surface")
         self.surface.setChecked(True)
         self.surface.toggled.connect(face.set_surface)
@@ -95,6 +96,24 @@ class ViewBar(QWidget):
             w.setFocusPolicy(Qt.FocusPolicy.NoFocus)
             lay.addWidget(w)
         lay.addStretch(1)
+
+    def set_has_original(self, has: bool) -> None:
+        """An utterance without original markers (a recording opened for synthesis): the
+        "original" box off and unticked, saying why; with them again, as the user left it."""
+        box = self.show_original
+        if has == box.isEnabled():
+            return
+        box.blockSignals(True)
+        if has:
+            box.setChecked(self._original_wanted)
+            box.setToolTip("show the recorded markers (this colour in the 3-D view; lines: lip "
+                           "contours)")
+        else:
+            self._original_wanted = box.isChecked()
+            box.setChecked(False)
+            box.setToolTip("this recording has no original markers")
+        box.setEnabled(has)
+        box.blockSignals(False)
 
     def set_planar(self, planar: bool) -> None:
         """Midsagittal (2-D) markers: the profile camera, and no face surface to offer."""

@@ -394,6 +394,7 @@ class MainWindow(QMainWindow):
             self.timeline.loop = None
             t = self.state.take_pending_time(t)
         self.playback.set_frames(view.n_frames, view.rate)
+        self.view_bar.set_has_original(view.original is not None)
         self.face.set_view(view)
         self.timeline.set_view(view, keep_zoom=not new_utterance)
         mark("timeline drawn")

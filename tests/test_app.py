@@ -324,3 +324,53 @@ def test_corrupt_file_shows_error_and_app_keeps_working(window, qtbot, tmp_path,
     assert win.view.split == "external" and win.view.original is None
     assert win.view.synthesis.config.mode == "acoustic"
     assert win.browser.tree.currentItem() is win.browser.items[win.view.utterance.name]
+    # no original markers: the "original" box is off and unticked (it stayed ticked), and comes
+    # back as it was with a corpus utterance
+    box = win.view_bar.show_original
+    assert not box.isEnabled() and not box.isChecked() and "no original" in box.toolTip()
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        win.set_utterance(win.corpus.info.test[0])
+    assert box.isEnabled() and box.isChecked()
+
+
+def test_browser_scores_are_kept_per_settings(qtbot, toy_corpus, toy_model, monkeypatch):
+    """The lip-correlation sweep computes each utterance once per settings: after a change only
+    the new settings' scores are computed (the old ones stay shown, greyed), and going back to
+    earlier settings shows theirs at once with nothing computed (the sweep used to restart from
+    nothing after every change); the browser's columns say what they hold."""
+    from app import correlations
+    from app.browser import UtteranceBrowser
+    from app.viewer_model import ViewerModel
+    from app.workers import Gate, TaskRunner
+
+    browser = UtteranceBrowser()
+    qtbot.addWidget(browser)
+    assert browser.COLUMNS[1:] == ("lower lip r", "upper lip r")
+    state = ViewerModel()
+    state.set_model(toy_corpus, toy_model, {})
+    info = toy_corpus.info
+    browser.populate({"test": list(info.test), "train": list(info.train)}, {})
+    scores = correlations.BrowserScores(browser, TaskRunner(browser), Gate())
+    computed: list[str] = []
+    sweep = correlations.correlation_sweep
+    monkeypatch.setattr(correlations, "correlation_sweep",
+                        lambda m, c, ids, cfg, before: (computed.extend(u for _s, u in ids),
+                                                        sweep(m, c, ids, cfg, before))[1])
+    finished: list = []
+    n = len(state.correlation_ids())
+    texts = lambda: {u: browser.items[u].text(1) for u in info.ids}  # noqa: E731
+    scores.start(state, finished.append)
+    qtbot.waitUntil(lambda: len(finished) == 1, timeout=WAIT_MS)
+    first = texts()
+    assert len(computed) == n and "…" not in first.values()
+    state.set_config(state.synth_config.with_(n_context_phones=5))
+    scores.start(state, finished.append)
+    stale = browser.palette().placeholderText().color()
+    assert all(browser.items[u].foreground(1).color() == stale for u in info.ids)   # old: greyed
+    qtbot.waitUntil(lambda: len(finished) == 2, timeout=WAIT_MS)
+    assert len(computed) == 2 * n
+    state.set_config(state.synth_config.with_(n_context_phones=3))
+    scores.start(state, finished.append)
+    assert len(finished) == 3 and len(computed) == 2 * n          # known: shown, nothing computed
+    assert texts() == first
+    assert all(browser.items[u].foreground(1).color() != stale for u in info.ids)
