@@ -39,6 +39,7 @@ from .style import (
     fit_ylabel,
     refit_ylabels,
 )
+from .workers import STEP_MS
 
 log = logging.getLogger(__name__)
 
@@ -313,7 +314,7 @@ class Timeline(QWidget):
             except StopIteration:
                 self._building = None
                 return
-            QTimer.singleShot(0, step)
+            QTimer.singleShot(STEP_MS, step)
 
         self.canvas.when_idle(step)
 

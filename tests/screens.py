@@ -4,6 +4,8 @@ stalls."""
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 from PyQt6.QtCore import QElapsedTimer, QObject, QPoint, QTimer
 from PyQt6.QtGui import QGuiApplication, QImage
@@ -34,7 +36,8 @@ def place_in(shot: np.ndarray, widget: QWidget, top: QWidget) -> np.ndarray:
 
 class Heartbeat(QObject):
     """A 10 ms timer that records the longest gap between its ticks: how long the event loop
-    was held up (a stall) while it ran."""
+    was held up (a stall) while it ran; and, for the same gaps, how much of it the GUI thread
+    spent working (its CPU time: the part that is the program's, not the machine's load)."""
 
     def __init__(self, interval_ms: int = 10):
         super().__init__()
@@ -43,20 +46,24 @@ class Heartbeat(QObject):
         self.timer.timeout.connect(self._beat)
         self.clock = QElapsedTimer()
         self.last = 0
-        self.longest = 0
+        self.last_cpu = 0.0
+        self.longest = 0            # ms, wall time
+        self.longest_cpu = 0        # ms, the GUI thread's CPU time within one gap
 
     def start(self) -> None:
         self.clock.start()
-        self.last, self.longest = 0, 0
+        self.last, self.longest, self.longest_cpu = 0, 0, 0
+        self.last_cpu = time.thread_time()
         self.timer.start()
 
     def _beat(self) -> None:
-        now = self.clock.elapsed()
+        now, cpu = self.clock.elapsed(), time.thread_time()
         self.longest = max(self.longest, now - self.last)
-        self.last = now
+        self.longest_cpu = max(self.longest_cpu, int(round(1000 * (cpu - self.last_cpu))))
+        self.last, self.last_cpu = now, cpu
 
     def stop(self) -> int:
-        """Stop; the longest gap in ms."""
+        """Stop; the longest gap in ms (wall time)."""
         self._beat()
         self.timer.stop()
         return self.longest

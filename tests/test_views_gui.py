@@ -59,23 +59,28 @@ def settled(win, key: str) -> bool:
     return not any(c.busy for c in w.findChildren(BackgroundCanvas))
 
 
-def open_all(win, qtbot) -> dict[str, int]:
+def open_all(win, qtbot) -> dict[str, tuple[int, int]]:
     """Open every analysis view from the menu, one after the other, each until it has settled;
-    the longest event-loop stall (ms) of each."""
+    the longest event-loop stall of each: (wall ms, the GUI thread's CPU ms in that stall)."""
     views = win.extension("analysis")
     beat, longest = Heartbeat(), {}
     for key in VIEWS:
         beat.start()
         views.view_actions[key].trigger()
         qtbot.waitUntil(lambda k=key: settled(win, k), timeout=WAIT_MS)
-        longest[key] = beat.stop()
+        longest[key] = (beat.stop(), beat.longest_cpu)
     return longest
 
 
 def test_no_view_freezes_the_window_while_it_opens(window, qtbot):
     """Every view (its module imported, its work done, its plots drawn, the panels it adds to the
     timeline) opens without holding up the event loop over 200 ms; before: similarity 2.3-4.4 s,
-    kinematics 3.3 s, PC modes 1.4 s."""
+    kinematics 3.3 s, PC modes 1.4 s.
+
+    Two measures of the same heartbeat: the gap (wall time), and the GUI thread's own work in
+    it (CPU time). The first is what the user sees; on a machine whose cores other processes
+    share it also holds their time, so the test checks the second against 200 ms and the first
+    against 200 ms times the machine's load average per core (at least 1)."""
     longest = open_all(window, qtbot)
     views = window.extension("analysis")
     beat = Heartbeat()
@@ -83,9 +88,11 @@ def test_no_view_freezes_the_window_while_it_opens(window, qtbot):
         beat.start()
         views.panel_actions[key].setChecked(True)
         qtbot.waitUntil(lambda: not window.timeline.building and not window.busy, timeout=WAIT_MS)
-        longest[f"panel {key}"] = beat.stop()
-    print("longest event-loop stall per view (ms):", longest)
-    assert max(longest.values()) <= MAX_STALL_MS, longest
+        longest[f"panel {key}"] = (beat.stop(), beat.longest_cpu)
+    print("longest event-loop stall per view (wall ms, GUI-thread CPU ms):", longest)
+    assert max(cpu for _wall, cpu in longest.values()) <= MAX_STALL_MS, longest
+    load = max(1.0, os.getloadavg()[0] / max(os.cpu_count() or 1, 1))
+    assert max(wall for wall, _cpu in longest.values()) <= MAX_STALL_MS * load, (load, longest)
 
 
 def test_docks_keep_the_window_on_the_screen(window, qtbot):

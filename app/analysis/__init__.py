@@ -20,6 +20,8 @@ from PyQt6.QtCore import QEvent, QObject, Qt, pyqtSignal
 from PyQt6.QtGui import QAction
 from PyQt6.QtWidgets import QDockWidget, QWidget
 
+from ..workers import keep_long_lived
+
 log = logging.getLogger(__name__)
 
 __all__ = ["AnalysisViews", "install"]
@@ -121,6 +123,7 @@ class AnalysisViews(QObject):
             self.show_panels(["aperture", "velocity"])
         if key == "errors":
             self.show_panels(["lip_error"])
+        keep_long_lived()       # full garbage passes over every view's objects froze the window
         self.viewOpened.emit(key)
 
     def _kinematics_controls(self):

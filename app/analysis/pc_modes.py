@@ -13,9 +13,11 @@ from __future__ import annotations
 
 import logging
 import math
+from functools import partial
 
 import numpy as np
 import pyvista as pv
+from matplotlib.figure import Figure
 from PyQt6.QtCore import Qt, QTimer, pyqtSignal
 from PyQt6.QtWidgets import (
     QComboBox,
@@ -31,8 +33,9 @@ from PyQt6.QtWidgets import (
 )
 
 from app.plotter_widget import make_plotter
-from app.style import BACKGROUND, SURFACE_COLOR, SYNTH_COLOR
+from app.style import BACKGROUND, SYNTH_COLOR
 from app.surface import lip_contours, stored_face_triangles
+from app.view3d import MarkerSet
 from engine.analysis.pc_modes import describe_mode, mode_displacement, mode_sd, variance_shares
 from engine.method.model import Model
 
@@ -93,8 +96,9 @@ class PCModeExplorer(QWidget):
         self.timer.timeout.connect(self._tick)
         self.is_ready = False
         self.heads = None
-        one_per_pass(self, [self._make_plotter, self._build_scene,
-                            lambda: self.canvas.when_idle(self._build_plots),
+        one_per_pass(self, [self._make_plotter, self._build_scene, self._build_guides,
+                            lambda: self.canvas.rebuild(partial(self._build_plots,
+                                                                axes2d=self._axes2d())),
                             lambda: self.set_component(0), self._set_ready])
 
     def _build_controls(self) -> tuple[QHBoxLayout, QHBoxLayout, QHBoxLayout]:
@@ -168,41 +172,30 @@ class PCModeExplorer(QWidget):
 
     # ------------------------------------------------------------------ scene
     def _build_scene(self) -> None:
-        n = len(self.neutral)
-        verts = np.column_stack([np.ones(n, int), np.arange(n)]).ravel()
-        self.neutral_poly = pv.PolyData(self.neutral.copy())
-        self.neutral_poly.verts = verts
-        self.displaced = pv.PolyData(self.neutral.copy())
-        self.displaced.verts = verts
-        both = np.vstack([self.neutral, self.neutral])
-        self.arrows = pv.PolyData(both)
-        self.arrows.lines = np.column_stack([np.full(n, 2), np.arange(n), np.arange(n) + n]).ravel()
-        p = self.plotter
-        p.add_mesh(self.neutral_poly, color=NEUTRAL_COLOR, render_points_as_spheres=True,
-                   point_size=11, style="points", name="neutral", pickable=False,
-                   reset_camera=False, render=False)
-        p.add_mesh(self.displaced, color=SYNTH_COLOR, render_points_as_spheres=True, point_size=11,
-                   style="points", name="displaced", pickable=False,
-                   reset_camera=False, render=False)
-        p.add_mesh(self.arrows, color="#222222", line_width=2.5, name="arrows", pickable=False,
-                   reset_camera=False, render=False)
-        try:   # the displaced face as a translucent surface with its lip contours (as the main view)
-            contours = lip_contours(self.neutral, self.model.upper_lip, self.model.lower_lip,
-                                    list(self.model.lip_corners))
+        """The displaced face: its points, lip contours and surface as the main view draws them
+        (``MarkerSet``: opaque, under the points; a translucent one cost a transparency pass)."""
+        contours = lip_contours(self.neutral, self.model.upper_lip, self.model.lower_lip,
+                                list(self.model.lip_corners))
+        try:
             tri = stored_face_triangles(self.neutral, contours)   # the main view made it
-            surf = pv.PolyData()
-            surf.SetPoints(self.displaced.GetPoints())
-            surf.faces = np.column_stack([np.full(len(tri), 3), tri]).ravel()
-            p.add_mesh(surf, color=SURFACE_COLOR, opacity=0.35, name="surface", pickable=False,
-                   reset_camera=False, render=False)
-            lips = pv.PolyData()
-            lips.SetPoints(self.displaced.GetPoints())
-            lips.lines = np.concatenate([[len(c), *c] for c in contours])
-            p.add_mesh(lips, color=SYNTH_COLOR, line_width=3, name="lips", pickable=False,
-                   reset_camera=False, render=False)
         except Exception:   # a degenerate marker layout: points and arrows only
             log.debug("no face surface for the PC explorer", exc_info=True)
-        self.heads = None
+            tri = None
+        self.face_set = MarkerSet(self.plotter, "displaced", SYNTH_COLOR, self.neutral, contours, tri)
+        self.displaced = self.face_set.points
+
+    def _build_guides(self) -> None:
+        """The neutral face's points (grey) and the displacement arrows; the camera."""
+        n = len(self.neutral)
+        self.neutral_poly = pv.PolyData(self.neutral.copy())
+        self.neutral_poly.verts = np.column_stack([np.ones(n, int), np.arange(n)]).ravel()
+        self.arrows = pv.PolyData(np.vstack([self.neutral, self.neutral]))
+        self.arrows.lines = np.column_stack([np.full(n, 2), np.arange(n), np.arange(n) + n]).ravel()
+        self.plotter.add_mesh(self.neutral_poly, color=NEUTRAL_COLOR, render_points_as_spheres=True,
+                              point_size=11, style="points", name="neutral", pickable=False,
+                              reset_camera=False, render=False)
+        self.plotter.add_mesh(self.arrows, color="#222222", line_width=2.5, name="arrows",
+                              pickable=False, reset_camera=False, render=False)
         self.set_camera("three-quarter", render=False)
 
     def set_camera(self, name: str, render: bool = True) -> None:
@@ -219,8 +212,9 @@ class PCModeExplorer(QWidget):
         if render:
             self.plotter.render()
 
-    def _build_plots(self) -> None:
-        fig = self.canvas.figure
+    def _build_plots(self, fig: Figure, axes2d: tuple[int, int]) -> None:
+        """The 2-D projection and the variance of each PC (built in the drawing thread:
+        ``BackgroundCanvas.rebuild``; ``axes2d`` read from the projection box beforehand)."""
         fig.clear()
         # side by side under the 3-D view; constrained layout keeps every label inside at any size
         self.ax_face, self.ax_var = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.1, 1]})
@@ -236,15 +230,15 @@ class PCModeExplorer(QWidget):
         self.ax_var.set_title("variance of each PC", fontsize=9)
         self.ax_var.tick_params(labelsize=7)
         self.ax_var.legend(fontsize=7, loc="center right")
-        self._draw_projection_base()
+        self._draw_projection_base(None, axes2d)
 
     def _axes2d(self) -> tuple[int, int]:
         return PROJECTIONS[self.projection.currentText()]
 
-    def _draw_projection_base(self) -> None:
+    def _draw_projection_base(self, _fig: Figure | None, axes2d: tuple[int, int]) -> None:
         ax = self.ax_face
         ax.clear()
-        h, v = self._axes2d()
+        h, v = axes2d
         ax.plot(self.neutral[:, h], self.neutral[:, v], "o", mfc="none", mec="#333333", ms=6)
         self.quiver = ax.quiver(self.neutral[:, h], self.neutral[:, v], np.zeros(len(self.neutral)),
                                 np.zeros(len(self.neutral)), angles="xy", scale_units="xy", scale=1,
@@ -258,12 +252,9 @@ class PCModeExplorer(QWidget):
         ax.set_ylim(self.neutral[:, v].min() - pad, self.neutral[:, v].max() + pad)
 
     def _projection_changed(self) -> None:
-        def redraw() -> None:
-            if hasattr(self, "ax_face"):
-                self._draw_projection_base()
-                self._update_plots()
-
-        self.canvas.when_idle(redraw)
+        if hasattr(self, "ax_face") or self.canvas.busy:
+            self.canvas.rebuild(partial(self._draw_projection_base, axes2d=self._axes2d()))
+            self.canvas.when_idle(self._update_plots)
 
     # ------------------------------------------------------------------ state
     def set_component(self, k: int) -> None:
@@ -289,12 +280,11 @@ class PCModeExplorer(QWidget):
             self.slider.blockSignals(False)
         sd = self.sd[self.component]
         self.value_label.setText(f"{self.value:+.2f} ({self.value / sd:+.2f} SD)")
-        if not hasattr(self, "displaced"):
+        if not hasattr(self, "arrows"):
             return                          # the scene is still being built (one_per_pass)
         shape = self.model.mode_shape(self.component, self.value)
         disp = mode_displacement(self.model, self.component, self.value)
-        self.displaced.points[:] = shape
-        self.displaced.GetPoints().Modified()
+        self.face_set.set_points(shape)
         n = len(shape)
         self.arrows.points[n:] = shape
         self.arrows.GetPoints().Modified()
