@@ -243,6 +243,22 @@ class TransportBar(QWidget):
                 self.time_label.setFixedWidth(width + 8)
 
 
+def playback_shortcuts(window) -> list[QShortcut]:
+    """The main window's keys (space, arrows, shift+arrows, Home/End, Esc; see ``KEYS_HELP``)."""
+    K, M = Qt.Key, Qt.KeyboardModifier
+    bindings = [
+        (QKeySequence(K.Key_Space), window.toggle_play),
+        (QKeySequence(K.Key_Left), lambda: window.step_frames(-1)),
+        (QKeySequence(K.Key_Right), lambda: window.step_frames(1)),
+        (QKeySequence(M.ShiftModifier | K.Key_Left), lambda: window.step_phone(-1)),
+        (QKeySequence(M.ShiftModifier | K.Key_Right), lambda: window.step_phone(1)),
+        (QKeySequence(K.Key_Home), lambda: window.seek(0.0)),
+        (QKeySequence(K.Key_End), lambda: window.seek(window.clock.duration)),
+        (QKeySequence(K.Key_Escape), window.loop.clear),
+    ]
+    return add_shortcuts(window, bindings)
+
+
 def add_shortcuts(widget: QWidget,
                   bindings: list[tuple[QKeySequence, Callable[[], object]]]) -> list[QShortcut]:
     """Window-wide keyboard shortcuts on ``widget``."""

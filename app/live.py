@@ -169,6 +169,21 @@ class LiveWindow(QMainWindow):
         self.level.setValue(-60)
         self.level.setFormat("input %v dB")
         right.addWidget(self.level)
+        self._build_panels()
+        self.canvas.mpl_connect("draw_event", self._on_full_draw)
+        right.addWidget(self.canvas, 1)
+        lay.addLayout(right, 2)
+        self.setCentralWidget(central)
+        self.message = QLabel()
+        self.statusBar().addWidget(self.message, 1)
+        if from_file is None and not self.devices:
+            self.message.setText(NO_INPUT_DEVICE)
+            self.start_action.setEnabled(False)
+        else:
+            self.message.setText("press Start")
+
+    def _build_panels(self) -> None:
+        """The scrolling upper and lower lip panels, in the main window's colours, with a legend."""
         self.figure = Figure(figsize=(5, 4), tight_layout=True)
         self.canvas = FigureCanvasQTAgg(self.figure)
         self.axes = [self.figure.add_subplot(2, 1, k + 1) for k in range(2)]
@@ -194,17 +209,6 @@ class LiveWindow(QMainWindow):
                             loc="upper left", fontsize=7, ncol=2, frameon=True, framealpha=0.85)
         self.axes[1].set_xlabel("time (s, 0 = now)", fontsize=8)
         self._background = None
-        self.canvas.mpl_connect("draw_event", self._on_full_draw)
-        right.addWidget(self.canvas, 1)
-        lay.addLayout(right, 2)
-        self.setCentralWidget(central)
-        self.message = QLabel()
-        self.statusBar().addWidget(self.message, 1)
-        if from_file is None and not self.devices:
-            self.message.setText(NO_INPUT_DEVICE)
-            self.start_action.setEnabled(False)
-        else:
-            self.message.setText("press Start")
 
     # ------------------------------------------------------------------ a take
     def start(self) -> None:

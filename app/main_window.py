@@ -82,9 +82,9 @@ from .controls import (
     TitleBar,
     TransportBar,
     ViewBar,
-    add_shortcuts,
     ask_corpus_folder,
     ask_screenshot_path,
+    playback_shortcuts,
 )
 from .correlations import BrowserScores
 from .marker_panels import MarkerPanels
@@ -144,7 +144,7 @@ class MainWindow(QMainWindow):
         self.audio_opener = AudioOpener(self)       # "Open audio…" and its label sources
         self.settings.add_widget(self.audio_opener.box)
         self._build_menus()
-        self._build_shortcuts()
+        self._shortcuts = playback_shortcuts(self)
         if corpus_path is not None:
             self._open_first_corpus(Path(corpus_path), model_path)
 
@@ -222,20 +222,6 @@ class MainWindow(QMainWindow):
         self.menus.action("View", "Remove the marker trajectory panels", self.marker_panels.clear)
         self.analysis_menu = self.menu("Analysis")
         self.menus.action("Help", "Keys", lambda: QMessageBox.information(self, "Keys", KEYS_HELP))
-
-    def _build_shortcuts(self) -> None:
-        K, M = Qt.Key, Qt.KeyboardModifier
-        bindings = [
-            (QKeySequence(K.Key_Space), self.toggle_play),
-            (QKeySequence(K.Key_Left), lambda: self.step_frames(-1)),
-            (QKeySequence(K.Key_Right), lambda: self.step_frames(1)),
-            (QKeySequence(M.ShiftModifier | K.Key_Left), lambda: self.step_phone(-1)),
-            (QKeySequence(M.ShiftModifier | K.Key_Right), lambda: self.step_phone(1)),
-            (QKeySequence(K.Key_Home), lambda: self.seek(0.0)),
-            (QKeySequence(K.Key_End), lambda: self.seek(self.clock.duration)),
-            (QKeySequence(K.Key_Escape), self.loop.clear),
-        ]
-        self._shortcuts = add_shortcuts(self, bindings)
 
     # ================================================================== public contract
     def menu(self, name: str) -> QMenu:

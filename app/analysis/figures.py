@@ -68,6 +68,37 @@ def shoot(widget: QWidget, path: Path) -> Path:
     return path
 
 
+def _window_figures(win, views, out: Path, has_test: bool, only: set[str] | None) -> list[Path]:
+    """The window with every panel (``analysis_window.png``) and as a phonetician sees it with
+    the PC modes docked (``analysis_docked.png``)."""
+    written = []
+    if only is None or "window" in only:
+        for key in ("aperture", "width", "protrusion", "velocity", "lip_error"):
+            views.panel_actions[key].setChecked(True)
+        win.resize(1600, 1400)
+        win.splitter.setSizes([300, 1100])
+        if has_test:
+            win.seek(0.0)
+        _finish(lambda: not win.timeline.building, "the panels")
+        written.append(shoot(win, out / "analysis_window.png"))
+    if only is None or "docked" in only:        # as a phonetician sees it: PC modes docked
+        for key in ("aperture", "width", "protrusion", "velocity", "lip_error"):
+            views.panel_actions[key].setChecked(False)
+        win.resize(1600, 1000)
+        win.splitter.setSizes([480, 520])
+        dock = views.docks.get("pc_modes")
+        if dock is not None:
+            dock.setFloating(False)
+            dock.show()
+            dock.raise_()
+        _finish(lambda: not win.timeline.building and not win.busy, "the window")
+        win.seek(min(2.38, win.view.duration / 2))
+        settle(500)
+        win.timeline.ensure_drawn()
+        written.append(win.save_screenshot(out / "analysis_docked.png"))
+    return written
+
+
 def make_figures(corpus_dir: Path, out: Path, per_split: int = 6,
                  only: set[str] | None = None) -> list[Path]:
     """Open the main window on ``corpus_dir`` with the analysis views and save their screenshots
@@ -130,30 +161,7 @@ def make_figures(corpus_dir: Path, out: Path, per_split: int = 6,
             w.tabs.setCurrentIndex(1)
             written.append(shoot(dock, out / "analysis_errors_utterances.png"))
         dock.hide()
-    if only is None or "window" in only:
-        for key in ("aperture", "width", "protrusion", "velocity", "lip_error"):
-            views.panel_actions[key].setChecked(True)
-        win.resize(1600, 1400)
-        win.splitter.setSizes([300, 1100])
-        if info.test:
-            win.seek(0.0)
-        _finish(lambda: not win.timeline.building, "the panels")
-        written.append(shoot(win, out / "analysis_window.png"))
-    if only is None or "docked" in only:        # as a phonetician sees it: PC modes docked
-        for key in ("aperture", "width", "protrusion", "velocity", "lip_error"):
-            views.panel_actions[key].setChecked(False)
-        win.resize(1600, 1000)
-        win.splitter.setSizes([480, 520])
-        dock = views.docks.get("pc_modes")
-        if dock is not None:
-            dock.setFloating(False)
-            dock.show()
-            dock.raise_()
-        _finish(lambda: not win.timeline.building and not win.busy, "the window")
-        win.seek(min(2.38, win.view.duration / 2))
-        settle(500)
-        win.timeline.ensure_drawn()
-        written.append(win.save_screenshot(out / "analysis_docked.png"))
+    written += _window_figures(win, views, out, bool(info.test), only)
     views.close()
     win.close()
     return written
