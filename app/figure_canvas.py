@@ -141,10 +141,12 @@ class BackgroundCanvas(FigureCanvasQTAgg):
         """Bring the pixels up to date now, on this thread (a screenshot, an export): the running
         draw is waited for, a due one is made here."""
         self.wait()
-        if self._timer_due or self._again or self._builds or self._drawn_key != self._size_key():
-            self._timer_due = self._again = False       # the scheduled start finds nothing due
+        if self._builds:                # the builds due, then the changes waiting for them
             builds, self._builds = self._builds, []
             _run_builds(builds, self.figure)
+            self._run_after()
+        if self._timer_due or self._again or self._drawn_key != self._size_key():
+            self._timer_due = self._again = False       # the scheduled start finds nothing due
             self.draw()
 
     # ------------------------------------------------------------------ drawing
@@ -189,6 +191,8 @@ class BackgroundCanvas(FigureCanvasQTAgg):
         self._drawing = None
         if error is not None:
             log.debug("background draw failed (%s): drawing on the GUI thread", error)
+            builds, self._builds = self._builds, []
+            _run_builds(builds, self.figure)
             self._run_after()
             self._again = False
             try:
@@ -200,8 +204,9 @@ class BackgroundCanvas(FigureCanvasQTAgg):
             target = self.get_renderer()
             target.restore_region(renderer.copy_from_bbox(self.figure.bbox))
             self._finished_draw(key)
-        self._run_after()
-        if self._again and not self._held:
+        if not self._builds:            # changes wait for the builds asked for before them
+            self._run_after()
+        if (self._again or self._builds) and not self._held:
             self._again = False
             self.draw_idle()
 

@@ -68,10 +68,11 @@ class SynthSettingsPanel(QWidget):
         self.nu.setDecimals(2)
         self.nu.setToolTip("ν: eq 3 constant of the visual phoneme similarity")
         self.mode = QComboBox()
-        self.mode.addItem("robust (labels weighted by confidence)", "robust")
-        self.mode.addItem("phonetic (labels restrict the search)", "phonetic")
-        self.mode.addItem("acoustic only, indexed (fast)", "acoustic")
-        self.mode.addItem("acoustic only, whole codebook (paper, slow)", "acoustic-full")
+        # short: the line under the box explains the search (the box fits a narrow dock)
+        self.mode.addItem("robust (labels weighted)", "robust")
+        self.mode.addItem("phonetic (the paper)", "phonetic")
+        self.mode.addItem("acoustic only, indexed", "acoustic")
+        self.mode.addItem("acoustic only, whole codebook", "acoustic-full")
         self.mode.setToolTip(
             "phonetic: eq 4 picks N context-phones from the labels, eqs 5-8 weight their codewords.\n"
             "acoustic only, indexed: no labels; eqs 6-8 weight the codewords nearest to each frame by\n"

@@ -156,6 +156,11 @@ def test_pc_slider_moves_points_by_eigenvector_times_value(qtbot, model):
         want = neutral + value * model.pca.components[k].reshape(-1, 3)
         assert w.displaced_points() == pytest.approx(want, abs=1e-9)
     assert w.slider.maximum() == 3 * SLIDER_STEPS and w.slider.minimum() == -3 * SLIDER_STEPS
+    # the 2-D projection's arrows follow (its plots are built off the GUI thread first)
+    w.canvas.finish()
+    disp = want - neutral
+    assert w.quiver.U == pytest.approx(w.arrow_scale.value() * disp[:, 0])
+    assert w.ax_face.get_title().startswith("PC2 = ")
     # variance share of every PC, from the model
     heights = [b.get_height() for b in w.bars]
     assert heights == pytest.approx(100 * model.pca.explained_ratio)

@@ -138,7 +138,7 @@ class AnalysisViews(QObject):
         model = self.window.model
         if key in ("aperture", "width", "protrusion"):
             from .kinematics_panels import LipMeasurePanel
-            return LipMeasurePanel(model, key)
+            return LipMeasurePanel(model, key, getattr(self.window, "closed_lips", None))
         if key == "velocity":
             return self._kinematics_controls().panel
         if key == "lip_error":

@@ -33,7 +33,8 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from app.style import ORIGINAL_COLOR, SYNTH_COLOR
+from app.style import CLOSED_COLOR, ORIGINAL_COLOR, SYNTH_COLOR
+from engine.analysis.lips import ClosedLips
 from engine.evaluation.kinematics import (
     LABIAL_PHONES,
     LANDMARKS,
@@ -69,12 +70,16 @@ class LipMeasurePanel:
 
     height = 0.9
 
-    def __init__(self, model: Model, measure: str):
+    def __init__(self, model: Model, measure: str, closed: ClosedLips | None = None):
         if measure not in MEASURES:
             raise ValueError(f"unknown lip measure {measure!r}")
         self.model = model
         self.measure = measure
         self.title = MEASURES[measure][0]
+        # the aperture at the talker's closures (``closed``: the distance the 3-D view's mouth
+        # shuts at), drawn as a reference
+        self.closed = (getattr(model_lip_measures(model, closed.markers[None]), measure)[0]
+                       if measure == "aperture" and closed is not None else None)
 
     def draw(self, ax, view) -> None:
         syn = getattr(model_lip_measures(self.model, view.synthesis.markers), self.measure)
@@ -84,6 +89,10 @@ class LipMeasurePanel:
             orig = getattr(model_lip_measures(self.model, view.original), self.measure)
             ax.plot(view.times[: len(orig)], orig, color=ORIGINAL_COLOR, lw=1.3, ls=(0, (2, 1.5)),
                     label="original")
+        if self.closed is not None:
+            ax.axhline(self.closed, color=CLOSED_COLOR, lw=0.9, ls=(0, (6, 3)), zorder=0.5)
+            ax.text(1.0, self.closed, "closed ", transform=ax.get_yaxis_transform(), ha="right",
+                    va="bottom", fontsize=6.5, color=CLOSED_COLOR)
         ax.set_ylabel(MEASURES[self.measure][1], fontsize=8)
 
 

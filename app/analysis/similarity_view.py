@@ -171,7 +171,7 @@ class SimilarityView(QWidget):
         self.table.verticalHeader().setVisible(False)
 
     def _fill_table1(self) -> None:
-        heads = ["Phoneme", "Closest", "S", "2nd", "S", "3rd", "S", "paper's top 3 (nu = 10)"]
+        heads = ["Phoneme", "Closest", "S", "2nd", "S", "3rd", "S", "paper's top 3 (ν = 10)"]
         paper = paper_table1()
         rows = []
         for r in self.table1:
