@@ -27,7 +27,7 @@ log = logging.getLogger(__name__)
 
 SURFACE_INSET_MM = 4.0
 #: how far behind the lips the dark backing of the mouth opening lies
-CAVITY_DEPTH_MM = 6.0
+CAVITY_DEPTH_MM = 4.0
 
 CAMERA_PRESETS: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] = {
     # direction from the face to the camera (x to the talker's left, y up, z forward), view up
@@ -134,11 +134,12 @@ class MarkerSet:
 
     def _cavity_points(self, surface: np.ndarray) -> np.ndarray:
         """The backing's outline and centre for the surface's vertices ``surface``: the opening
-        moved back (z is forward) and widened by a quarter about its centre."""
+        moved back (z is forward), a tenth wider and twice as tall about its centre (behind
+        the lips: the opaque surface hides what is not behind the opening)."""
         loop = surface[self._cavity_loop]
         centre = loop.mean(axis=0)
-        out = centre + 1.25 * (loop - centre)
-        out[:, 2] = loop[:, 2] - CAVITY_DEPTH_MM
+        out = centre + (loop - centre) * [1.1, 2.0, 1.0]    # taller: it fills the opening seen
+        out[:, 2] = loop[:, 2] - CAVITY_DEPTH_MM             # from above or below too
         return np.vstack([out, centre - [0.0, 0.0, CAVITY_DEPTH_MM]])
 
     def set_points(self, pts: np.ndarray) -> None:

@@ -201,3 +201,77 @@ def test_the_face_shows_the_mouth_closed_at_a_b_and_the_lip_panels_where_closed_
         ax = win.timeline.axes_of(next(p for p in win.timeline.panels if p.title == panel))
         ys = [line.get_ydata() for line in ax.lines if len(set(line.get_ydata())) == 1]
         assert any(np.allclose(y, closed.markers[marker, 1]) for y in ys), panel
+
+
+def _texts(fig) -> list:
+    """Every visible text of a figure: titles, axis labels, tick labels, legends' texts."""
+    out = list(fig.texts)
+    for ax in fig.axes:
+        out += [ax.title, ax.xaxis.label, ax.yaxis.label]
+        for axis in (ax.xaxis, ax.yaxis):       # the tick labels drawn: those in the view
+            lo, hi = sorted(axis.get_view_interval())
+            out += [label for tick, label in zip(axis.get_ticklocs(), axis.get_ticklabels(),
+                                                 strict=True) if lo <= tick <= hi]
+        legend = ax.get_legend()
+        if legend is not None:
+            out += [*legend.get_texts(), legend.get_title()]
+    return [t for t in out if t.get_visible() and t.get_text().strip()]
+
+
+def assert_plots_legible(canvas, what: str) -> None:
+    """Every text of ``canvas``'s figure inside it and none over another (titles, labels, tick
+    labels, legends); no legend over a bar."""
+    canvas.finish()
+    fig, renderer = canvas.figure, canvas.get_renderer()
+    box = fig.bbox
+    texts = [(t.get_text(), t.get_window_extent(renderer)) for t in _texts(fig)]
+    for text, e in texts:
+        assert e.x0 >= box.x0 - 1 and e.y0 >= box.y0 - 1 and e.x1 <= box.x1 + 1 \
+            and e.y1 <= box.y1 + 1, (what, text, e)
+    for i, (a, ea) in enumerate(texts):
+        for b, eb in texts[i + 1:]:
+            assert not ea.overlaps(eb), (what, a, b)
+    for ax in fig.axes:
+        legend = ax.get_legend()
+        if legend is None:
+            continue
+        lb = legend.get_window_extent(renderer)
+        for bar in ax.patches:
+            assert not lb.overlaps(bar.get_window_extent(renderer)), (what, "legend over a bar")
+
+
+def test_the_views_plots_are_legible_in_their_docks(window, qtbot):
+    """Metrics (Table 2 and the N sweep, computed on one utterance per split), errors and PC
+    modes docked at 1600 x 1000: no title, label, tick label or legend cut or over another, no
+    legend over the bars (the Metrics titles overlapped, its bar labels ran together as "train
+    triangspline", its y label was cut, its legend covered bars; the Errors chart's title and x
+    label were cut; the PC modes had no y labels); the Table 2 rows need no scrolling, the
+    paper's values in rows under ours."""
+    win = window
+    views = win.extension("analysis")
+    for key in ("metrics", "errors", "pc_modes"):
+        views.view_actions[key].trigger()
+        qtbot.waitUntil(lambda k=key: settled(win, k), timeout=WAIT_MS)
+    metrics = views.widgets["metrics"]
+    views.docks["metrics"].raise_()
+    metrics.per_split.setValue(1)
+    metrics.max_n.setValue(2)
+    with qtbot.waitSignal(metrics.table2Done, timeout=WAIT_MS):
+        metrics.run_table2.click()
+    with qtbot.waitSignal(metrics.sweepDone, timeout=WAIT_MS):
+        metrics.run_sweep.click()
+    assert_plots_legible(metrics.canvas, "metrics")
+    table = metrics.table
+    assert table.verticalScrollBar().maximum() == 0 and table.horizontalScrollBar().maximum() == 0
+    assert table.columnCount() == 6
+    errors = views.widgets["errors"]
+    views.docks["errors"].raise_()
+    errors.per_split.setValue(1)
+    with qtbot.waitSignal(errors.reportReady, timeout=WAIT_MS):
+        errors.run_btn.click()
+    assert_plots_legible(errors.phone_chart, "errors")
+    pc = views.widgets["pc_modes"]
+    views.docks["pc_modes"].raise_()
+    qtbot.waitUntil(lambda: pc.canvas.isVisible(), timeout=5000)
+    assert_plots_legible(pc.canvas, "PC modes")
+    assert pc.ax_face.get_ylabel() and pc.ax_var.get_ylabel()
