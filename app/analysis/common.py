@@ -18,6 +18,7 @@ from PyQt6.QtWidgets import (
     QFileDialog,
     QMessageBox,
     QSizePolicy,
+    QSplitter,
     QTableWidget,
     QTableWidgetItem,
     QWidget,
@@ -52,6 +53,16 @@ def _cmap(name: str):
 
 
 NAN_COLOR = "#eeeeee"
+
+
+def vertical_split(top: QWidget, bottom: QWidget, sizes: tuple[int, int]) -> QSplitter:
+    """``top`` over ``bottom`` in a splitter (neither collapsible), shared as ``sizes``."""
+    split = QSplitter(Qt.Orientation.Vertical)
+    split.addWidget(top)
+    split.addWidget(bottom)
+    split.setSizes(list(sizes))
+    split.setChildrenCollapsible(False)
+    return split
 
 
 def heat_colors(values: np.ndarray, lo: float = 0.0, hi: float = 1.0,

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
-from PyQt6.QtCore import Qt, pyqtSignal
+from PyQt6.QtCore import pyqtSignal
 from PyQt6.QtGui import QColor
 from PyQt6.QtWidgets import (
     QCheckBox,
@@ -22,7 +22,6 @@ from PyQt6.QtWidgets import (
     QProgressBar,
     QPushButton,
     QSpinBox,
-    QSplitter,
     QTableWidget,
     QVBoxLayout,
     QWidget,
@@ -52,6 +51,7 @@ from .common import (
     stop_own_tasks,
     task_runner,
     text_item,
+    vertical_split,
 )
 
 log = logging.getLogger(__name__)
@@ -153,14 +153,9 @@ class MetricsView(QWidget):
         self.table.verticalHeader().setDefaultSectionSize(self.table.fontMetrics().height() + 6)
         self.canvas = Canvas(6, 5.2)
         self.canvas.setMinimumHeight(320)
-        split = QSplitter(Qt.Orientation.Vertical)
-        split.addWidget(self.table)
-        split.addWidget(self.canvas)
-        split.setSizes([300, 520])
-        split.setChildrenCollapsible(False)
         lay = QVBoxLayout(self)
         lay.addWidget(self._options(exp))
-        lay.addWidget(split, 1)
+        lay.addWidget(vertical_split(self.table, self.canvas, (300, 520)), 1)
         self._draw()
 
     def _options(self, exports: list) -> QGroupBox:

@@ -26,7 +26,6 @@ from PyQt6.QtWidgets import (
     QPushButton,
     QSlider,
     QSpinBox,
-    QSplitter,
     QToolButton,
     QVBoxLayout,
     QWidget,
@@ -40,7 +39,7 @@ from engine.analysis.pc_modes import describe_mode, mode_displacement, mode_sd, 
 from engine.method.model import Model
 
 from ..workers import one_per_pass
-from .common import Canvas
+from .common import Canvas, vertical_split
 
 log = logging.getLogger(__name__)
 
@@ -79,11 +78,7 @@ class PCModeExplorer(QWidget):
         QVBoxLayout(self.scene_box).setContentsMargins(0, 0, 0, 0)
         self.canvas = Canvas(6, 3.4)
         self.canvas.setMinimumHeight(220)
-        split = QSplitter(Qt.Orientation.Vertical)
-        split.addWidget(self.scene_box)
-        split.addWidget(self.canvas)
-        split.setSizes([520, 340])
-        split.setChildrenCollapsible(False)
+        split = vertical_split(self.scene_box, self.canvas, (520, 340))
         lay = QVBoxLayout(self)
         lay.addLayout(rows[0])
         lay.addLayout(rows[1])
