@@ -74,14 +74,16 @@ OWN_LOGGERS = ("facetraj", "engine", "app", "benchmarks")
 def configure_logging(verbose: int = 0, quiet: bool = False) -> None:
     """Log to stderr: facetraj's own messages from INFO (DEBUG with ``verbose``, ERROR only with
     ``quiet``); the libraries' messages from WARNING, and all of them with ``verbose >= 2``.
+    Nothing changes when the root logger has handlers already (as ``logging.basicConfig``).
 
     ``-v`` used to turn every logger to DEBUG: of 323 lines of a ``facetraj -v --screenshot``, 292
     were matplotlib's font matching.
     """
+    if logging.getLogger().handlers:
+        return          # configured already (an embedding program, a test run): as basicConfig
     own = logging.DEBUG if verbose else logging.ERROR if quiet else logging.INFO
     libraries = logging.DEBUG if verbose >= 2 else max(own, logging.WARNING)
     logging.basicConfig(level=libraries, format="%(levelname)s: %(message)s")
-    logging.getLogger().setLevel(libraries)     # also when the root had a handler already
     for name in OWN_LOGGERS:
         logging.getLogger(name).setLevel(own)
 
