@@ -238,7 +238,6 @@ def test_inspector_robust_mode_explains_choice(qtbot, model, corpus, tmp_path):
 
 
 def test_settings_panel_explains_modes_and_shows_tuned(qtbot):
-    from app.provenance import LabelOrigin
     from app.settings_panel import MODE_NOTES, SynthSettingsPanel
 
     def choose(key: str) -> None:                   # as a user does
@@ -269,11 +268,12 @@ def test_settings_panel_explains_modes_and_shows_tuned(qtbot):
     assert p.config().label_weight == SynthConfig().label_weight
     # the search used is shown, and why it is not the one asked for; the settings still ask
     # for theirs
-    p.show_used(SynthConfig(mode="robust"), SynthConfig(), LabelOrigin("aligned", transcript="a.txt"))
+    p.show_used(SynthConfig(mode="robust"), SynthConfig(),
+                "robust mode: aligned labels are not hand-checked")
     assert p.shown_search() == "robust" and p.mode_note.text() == MODE_NOTES["robust"]
-    assert p.mode_reason.isVisible() and "aligned from a.txt" in p.mode_reason.text()
+    assert p.mode_reason.isVisible() and "aligned labels are not hand-checked" in p.mode_reason.text()
     assert p.config().mode == "phonetic"
-    p.show_used(SynthConfig(), SynthConfig(), LabelOrigin("file"))
+    p.show_used(SynthConfig(), SynthConfig(), "phonetic mode: hand-checked labels (the paper)")
     assert p.shown_search() == "phonetic" and not p.mode_reason.isVisible()
 
 

@@ -126,14 +126,16 @@ def test_choosing_the_search_shown_is_explicit_and_the_title_names_the_search_us
     from app.viewer_model import view_summary, view_title
 
     utt = toy_corpus.utterance(toy_corpus.info.test[0])
-    name = state.add_external(replace(utt, markers=None, label_source="aligned", text="a b c"),
+    name = state.add_external(replace(utt, markers=None, label_source="aligned", text="a b c",
+                                      provenance=Provenance("aligned")),
                               LabelOrigin("aligned", transcript="x.txt"))
     req = state.request_utterance(name)
     view = req.run()
     assert state.accept(req, view) and view.synthesis.config.mode == "robust"
     assert "robust, N=3" in view_title(view) and "labels: aligned from x.txt" in view_title(view)
     assert "“a b c”" in view_title(view)
-    assert view_summary(view).endswith("labels: aligned from x.txt")
+    assert "labels: aligned from x.txt; robust mode: aligned labels are not hand-checked" in \
+        view_summary(view)
     changed, again = state.set_config(state.synth_config, explicit=True)       # phonetic: obeyed
     assert not changed and again is not None and again.mode_chosen
     view = again.run()
