@@ -23,7 +23,8 @@ class UtteranceBrowser(QWidget):
 
     utteranceSelected = pyqtSignal(str)
 
-    COLUMNS = ("utterance", "LL y r", "UL y r")
+    #: the score columns: the correlation r of each lip centre's y, original vs synthesized
+    COLUMNS = ("utterance", "lower lip r", "upper lip r")
 
     def __init__(self, parent: QWidget | None = None):
         super().__init__(parent)
@@ -41,8 +42,8 @@ class UtteranceBrowser(QWidget):
         header.setSectionResizeMode(0, QHeaderView.ResizeMode.Stretch)
         for c in (1, 2):
             header.setSectionResizeMode(c, QHeaderView.ResizeMode.Fixed)
-            self.tree.setColumnWidth(c, 74)
-        self.setMinimumWidth(360)
+            self.tree.setColumnWidth(c, self.tree.fontMetrics().horizontalAdvance(self.COLUMNS[c]) + 16)
+        self.setMinimumWidth(260)
         for c, what in ((1, "lower"), (2, "upper")):
             self.tree.headerItem().setToolTip(
                 c, f"correlation of the {what} lip centre y, original vs synthesized, on speech frames "
@@ -115,12 +116,20 @@ class UtteranceBrowser(QWidget):
             return
         for col, v in ((1, lower), (2, upper)):
             item.setText(col, "–" if v is None or not math.isfinite(v) else f"{v:.3f}")
+            item.setForeground(col, self.palette().text())
+            item.setToolTip(col, "")
 
-    def clear_scores(self) -> None:
-        for item in self.items.values():
-            if item.text(1) != "–":
-                item.setText(1, "…")
-                item.setText(2, "…")
+    def show_scores(self, scores: dict[str, tuple[float, float]]) -> None:
+        """The scores known for the present settings; the others keep what they show, greyed
+        (computed with other settings), or "…" (not yet computed)."""
+        stale = self.palette().placeholderText()
+        for utt_id, item in self.items.items():
+            if utt_id in scores:
+                self.set_scores(utt_id, *scores[utt_id])
+            elif item.text(1) not in ("–", "…"):
+                for col in (1, 2):
+                    item.setForeground(col, stale)
+                    item.setToolTip(col, "computed with other settings; the present ones' follows")
 
     def apply_filter(self, text: str) -> None:
         words = normalise_text(text).split()

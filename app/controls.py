@@ -18,10 +18,11 @@ from PyQt6.QtWidgets import (
     QFileDialog,
     QHBoxLayout,
     QLabel,
-    QPushButton,
+    QSizePolicy,
     QSlider,
     QStyle,
     QToolButton,
+    QVBoxLayout,
     QWidget,
 )
 
@@ -31,8 +32,13 @@ from .transport import PlaybackClock
 from .view3d import CAMERA_PRESETS, FaceView
 
 SPEEDS = (1.0, 0.5, 0.25)
-#: the longest read-out the time label is sized for (``MainWindow._show_time`` writes it)
-TIME_TEMPLATE = "000.000 / 000.000 s  frame 00000  /xxxxx/"
+#: between the title's first line and the details (``app.viewer_model.view_title``)
+TITLE_SEPARATOR = "    ·    "
+#: the camera buttons' texts (short: the bar fits a narrow 3-D view)
+CAMERA_LABELS = {"three-quarter": "¾ view"}
+#: the read-out the time label is sized for (``MainWindow._show_time`` writes it); a longer one
+#: (a file over 100 s) widens it once
+TIME_TEMPLATE = "00.000 / 00.000 s  frame 0000  /xxx/"
 
 
 def colour_dot(colour: str, size: int = 14) -> QIcon:
@@ -57,18 +63,18 @@ class ViewBar(QWidget):
         self.face = face
         lay = QHBoxLayout(self)
         lay.setContentsMargins(4, 0, 4, 0)
-        lay.addWidget(QLabel("camera:"))
         self.camera_buttons: dict[str, QToolButton] = {}
         for name in CAMERA_PRESETS:
             b = QToolButton()
-            b.setText(name)
+            b.setText(CAMERA_LABELS.get(name, name))
+            b.setToolTip(f"camera: {name}")
             b.setCheckable(True)
             b.setAutoExclusive(True)
             b.clicked.connect(lambda _c=False, n=name: face.set_camera(n))
             lay.addWidget(b)
             self.camera_buttons[name] = b
         self.camera_buttons[face.preset].setChecked(True)
-        lay.addSpacing(12)
+        lay.addSpacing(8)
         self.side_by_side = QCheckBox("side by side")
         self.side_by_side.toggled.connect(face.set_side_by_side)
         # the check boxes of the two point sets carry their colours: they are the legend too
@@ -82,13 +88,32 @@ class ViewBar(QWidget):
         for cb in (self.show_original, self.show_synth):
             cb.toggled.connect(lambda _c: face.set_sets_visible(self.show_original.isChecked(),
                                                                 self.show_synth.isChecked()))
-        self.surface = QCheckBox("face surface")
+        self._original_wanted = True
+        self.surface = QCheckBox("surface")
         self.surface.setChecked(True)
         self.surface.toggled.connect(face.set_surface)
         for w in (self.show_original, self.show_synth, self.side_by_side, self.surface):
             w.setFocusPolicy(Qt.FocusPolicy.NoFocus)
             lay.addWidget(w)
         lay.addStretch(1)
+
+    def set_has_original(self, has: bool) -> None:
+        """An utterance without original markers (a recording opened for synthesis): the
+        "original" box off and unticked, saying why; with them again, as the user left it."""
+        box = self.show_original
+        if has == box.isEnabled():
+            return
+        box.blockSignals(True)
+        if has:
+            box.setChecked(self._original_wanted)
+            box.setToolTip("show the recorded markers (this colour in the 3-D view; lines: lip "
+                           "contours)")
+        else:
+            self._original_wanted = box.isChecked()
+            box.setChecked(False)
+            box.setToolTip("this recording has no original markers")
+        box.setEnabled(has)
+        box.blockSignals(False)
 
     def set_planar(self, planar: bool) -> None:
         """Midsagittal (2-D) markers: the profile camera, and no face surface to offer."""
@@ -103,6 +128,46 @@ class ViewBar(QWidget):
         self.face.set_camera(name)
         if name in self.camera_buttons:
             self.camera_buttons[name].setChecked(True)
+
+
+class TitleBar(QWidget):
+    """The title over the panels: two lines of fixed height (what is shown; how it was made), each
+    elided to the width, so that no title widens the window or changes the panels' height (a
+    title wrapping onto a second line resized the timeline, which then drew anew)."""
+
+    def __init__(self, parent: QWidget | None = None):
+        super().__init__(parent)
+        self.heading = QLabel("")
+        self.heading.setStyleSheet("font-size: 15px; font-weight: 600;")
+        self.details = QLabel("")
+        self.details.setStyleSheet("color: #333333;")
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(6, 2, 6, 2)
+        lay.setSpacing(0)
+        for label in (self.heading, self.details):
+            label.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Fixed)
+            lay.addWidget(label)
+        self._texts = ("", "")
+
+    def setText(self, text: str) -> None:
+        """The title: its first line, then the rest (split at the first "    ·    ")."""
+        head, _, rest = text.partition(TITLE_SEPARATOR)
+        self._texts = (head, rest)
+        self.setToolTip(text.replace(TITLE_SEPARATOR, "\n"))
+        self._elide()
+
+    def text(self) -> str:
+        """The whole title (as given to :meth:`setText`)."""
+        return TITLE_SEPARATOR.join(t for t in self._texts if t)
+
+    def resizeEvent(self, event) -> None:
+        super().resizeEvent(event)
+        self._elide()
+
+    def _elide(self) -> None:
+        for label, text in zip((self.heading, self.details), self._texts, strict=True):
+            width = max(20, self.width() - 12)
+            label.setText(label.fontMetrics().elidedText(text, Qt.TextElideMode.ElideRight, width))
 
 
 class TransportBar(QWidget):
@@ -131,7 +196,7 @@ class TransportBar(QWidget):
         # bars and the splitter around it again (a label whose size hint may change does)
         self.time_label.ensurePolished()
         width = self.time_label.fontMetrics().horizontalAdvance(TIME_TEMPLATE)
-        self.time_label.setFixedSize(max(300, width), self.time_label.sizeHint().height())
+        self.time_label.setFixedSize(width, self.time_label.sizeHint().height())
         lay.addWidget(self.time_label)
         self.speed = QComboBox()
         for s in SPEEDS:
@@ -145,8 +210,10 @@ class TransportBar(QWidget):
         self.loop_box.setToolTip("loop the selected range (drag on the panels to select; Esc clears)")
         lay.addWidget(self.loop_box)
 
-    def _button(self, lay: QHBoxLayout, icon: QStyle.StandardPixmap, tip: str, slot) -> QPushButton:
-        b = QPushButton(self.style().standardIcon(icon), "")
+    def _button(self, lay: QHBoxLayout, icon: QStyle.StandardPixmap, tip: str, slot) -> QToolButton:
+        b = QToolButton()
+        b.setIcon(self.style().standardIcon(icon))
+        b.setAutoRaise(False)
         b.setToolTip(tip)
         b.setFocusPolicy(Qt.FocusPolicy.NoFocus)
         b.clicked.connect(lambda _c=False: slot())
@@ -171,6 +238,25 @@ class TransportBar(QWidget):
             self.slider.blockSignals(False)
         if self.time_label.text() != text:
             self.time_label.setText(text)
+            width = self.time_label.fontMetrics().horizontalAdvance(text)
+            if width > self.time_label.width():
+                self.time_label.setFixedWidth(width + 8)
+
+
+def playback_shortcuts(window) -> list[QShortcut]:
+    """The main window's keys (space, arrows, shift+arrows, Home/End, Esc; see ``KEYS_HELP``)."""
+    K, M = Qt.Key, Qt.KeyboardModifier
+    bindings = [
+        (QKeySequence(K.Key_Space), window.toggle_play),
+        (QKeySequence(K.Key_Left), lambda: window.step_frames(-1)),
+        (QKeySequence(K.Key_Right), lambda: window.step_frames(1)),
+        (QKeySequence(M.ShiftModifier | K.Key_Left), lambda: window.step_phone(-1)),
+        (QKeySequence(M.ShiftModifier | K.Key_Right), lambda: window.step_phone(1)),
+        (QKeySequence(K.Key_Home), lambda: window.seek(0.0)),
+        (QKeySequence(K.Key_End), lambda: window.seek(window.clock.duration)),
+        (QKeySequence(K.Key_Escape), window.loop.clear),
+    ]
+    return add_shortcuts(window, bindings)
 
 
 def add_shortcuts(widget: QWidget,

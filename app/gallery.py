@@ -7,7 +7,8 @@ MOCHA-TIMIT utterance (``../shared/data/mocha_fsew0_001``, read in place), an ut
 original markers (File > Open audio of a WAV) and a long file (a few corpus utterances joined
 into one WAV); the dialogs of *Open audio* (the sentence, words missing from the dictionary, the
 error of a corrupt WAV) and the synthesis settings with each search mode's note, each shown
-non-modally and grabbed; frames of ``facetraj video``; and the analysis views
+non-modally and grabbed; frames of ``facetraj video``; the mouth at a /b/ before and after the
+lips' strips; the Live window; and the analysis views
 (:func:`app.analysis.figures.make_figures`). Scratch files go to a temporary folder, never into
 the repository. The results figures come from ``make report``, the corpus figure from
 ``docs/figures/make_corpus_figures.py`` (``make figures`` runs that too).
@@ -114,9 +115,10 @@ def app_figures(out: Path, scratch: Path) -> list[Path]:
 
 def _grab(widget, path: Path) -> Path:
     from .analysis.figures import settle
+    from .plotter_widget import grab_with_3d
 
     settle()
-    widget.grab().save(str(path))
+    grab_with_3d(widget).save(str(path))
     log.info("wrote %s", path)
     return path
 
@@ -196,6 +198,95 @@ def dialog_figures(out: Path, scratch: Path) -> list[Path]:
     return written
 
 
+def mouth_figure(out: Path) -> list[Path]:
+    """The original markers of s002 ("The boy enjoyed the noisy toy.") at its /b/ and at the
+    /oy/ after it, with the face surface on them, from the front: as the surface was (a hole
+    between the lip outlines even with the lips pressed together) and as it is (the lips'
+    strips, shut at closure). One picture, ``closed_mouth.png``: before on top, after below."""
+    from PyQt6.QtGui import QColor, QPainter, QPixmap
+    from PyQt6.QtWidgets import QGridLayout, QLabel, QWidget
+
+    from engine.config import SynthConfig
+    from engine.io.corpus import load_corpus
+
+    from .analysis.figures import settle
+    from .cache import load_or_train
+    from .plotter_widget import grab_with_3d
+    from .state import build_view
+    from .view3d import FaceView
+
+    corpus = load_corpus(DEFAULT_CORPUS)
+    model = load_or_train(corpus)
+    utt = corpus.utterance("s002")
+    view = build_view(model, utt, "train", SynthConfig())
+    phones = {p.label: p for p in utt.phones}
+    sheet = QWidget()
+    grid = QGridLayout(sheet)
+    faces = []
+    for row, (closed, what) in enumerate(((False, "before: the surface kept a hole"),
+                                          (True, "after: the lips close where they meet"))):
+        for col, label in enumerate(("b", "oy")):
+            face = FaceView(sheet, closed_mouth=closed)
+            face.setFixedSize(360, 300)
+            face.set_model(model)
+            face.set_view(view)
+            face.set_sets_visible(True, False)      # the original markers carry the surface
+            face.set_camera("front", render=False)
+            cam = face.plotter.camera               # on the mouth, closer
+            lips = face.neutral[sorted(set(face.contours[0]) | set(face.contours[1]))].mean(axis=0)
+            shift = lips - np.asarray(cam.focal_point)
+            cam.focal_point = tuple(np.asarray(cam.focal_point) + shift)
+            cam.position = tuple(np.asarray(cam.position) + shift)
+            cam.zoom(2.4)
+            seg = phones[label]
+            face.show_frame(view.frame_at((seg.start + seg.end) / 2))
+            faces.append(face)
+            grid.addWidget(face, 2 * row + 1, col)
+            caption = QLabel(f"{what}  ·  /{label}/ of “boy”" if label == "b"
+                             else f"/{label}/ of “boy”")
+            grid.addWidget(caption, 2 * row, col)
+    sheet.show()
+    settle(800)
+    pix = grab_with_3d(sheet)
+    framed = QPixmap(pix.size())
+    framed.fill(QColor("white"))
+    painter = QPainter(framed)
+    painter.drawPixmap(0, 0, pix)
+    painter.end()
+    path = out / "closed_mouth.png"
+    framed.save(str(path))
+    for face in faces:
+        face.close_view()
+    sheet.close()
+    log.info("wrote %s", path)
+    return [path]
+
+
+def live_figure(out: Path) -> list[Path]:
+    """The Live window after a file played through it (``live_window.png``)."""
+    from engine.io.audio import read_audio
+    from engine.io.corpus import audio_path, load_corpus
+
+    from .analysis.figures import wait_until
+    from .cache import load_or_train
+    from .live import LiveWindow
+
+    corpus = load_corpus(DEFAULT_CORPUS)
+    model = load_or_train(corpus)
+    audio = read_audio(audio_path(corpus.root, "s002"))
+    window = LiveWindow(model, None, audio, block_s=0.05, fast=True)
+    window.resize(1400, 800)
+    window.show()
+    done = []
+    window.takeFinished.connect(lambda: done.append(1))
+    window.start()
+    wait_until(lambda: bool(done), 120)
+    path = _grab(window, out / "live_window.png")
+    window.face.close_view()
+    window.close()
+    return [path]
+
+
 def video_figures(out: Path) -> list[Path]:
     """Frames of ``facetraj video`` at its default size and a small one, and acoustic-only."""
     import imageio.v3 as iio
@@ -238,6 +329,8 @@ def make_gallery(out: Path, analysis: bool = True) -> list[Path]:
     out.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="facetraj-gallery-") as tmp:
         written = video_figures(out)
+        written += mouth_figure(out)
+        written += live_figure(out)
         written += app_figures(out, Path(tmp))
         written += dialog_figures(out, Path(tmp))
     if analysis:

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.backends.backend_qtagg import FigureCanvasQTAgg
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 from matplotlib.transforms import Bbox
 from PyQt6.QtCore import QTimer, pyqtSignal
 from PyQt6.QtWidgets import (
@@ -40,6 +41,8 @@ from engine.io.export import write_trajectories
 from engine.method.model import Model
 from engine.streaming.synthesizer import LIVE_BATCH_FRAMES, StreamConfig, StreamingSynthesizer
 
+from .plotter_widget import grab_with_3d
+from .style import SPEECH_DOT_COLOR, SYNTH_COLOR, TRIANGULAR_COLOR
 from .view3d import FaceView
 
 log = logging.getLogger(__name__)
@@ -166,20 +169,7 @@ class LiveWindow(QMainWindow):
         self.level.setValue(-60)
         self.level.setFormat("input %v dB")
         right.addWidget(self.level)
-        self.figure = Figure(figsize=(5, 4), tight_layout=True)
-        self.canvas = FigureCanvasQTAgg(self.figure)
-        self.axes = [self.figure.add_subplot(2, 1, k + 1) for k in range(2)]
-        self.lines, self.dots = [], []
-        for ax, which in zip(self.axes, ("upper", "lower"), strict=True):
-            ax.set_ylabel(f"{which} lip y (mm)", fontsize=8)
-            ax.set_xlim(-SHOWN_S, 0.0)
-            # animated: left out of full draws, blitted over the cached background (_plot)
-            (line,) = ax.plot([], [], color="#d62728", lw=1.5, animated=True)
-            (dots,) = ax.plot([], [], ls="none", marker=".", ms=3, color="#2ca02c", animated=True)
-            self.lines.append(line)
-            self.dots.append(dots)
-        self.axes[1].set_xlabel("time (s, 0 = now)", fontsize=8)
-        self._background = None
+        self._build_panels()
         self.canvas.mpl_connect("draw_event", self._on_full_draw)
         right.addWidget(self.canvas, 1)
         lay.addLayout(right, 2)
@@ -191,6 +181,34 @@ class LiveWindow(QMainWindow):
             self.start_action.setEnabled(False)
         else:
             self.message.setText("press Start")
+
+    def _build_panels(self) -> None:
+        """The scrolling upper and lower lip panels, in the main window's colours, with a legend."""
+        self.figure = Figure(figsize=(5, 4), tight_layout=True)
+        self.canvas = FigureCanvasQTAgg(self.figure)
+        self.axes = [self.figure.add_subplot(2, 1, k + 1) for k in range(2)]
+        self.lines, self.dots = [], []
+        smoothing = self.config.smoothing
+        line_label = f"synthesized, {smoothing}" if smoothing != "none" else "synthesized"
+        line_color = TRIANGULAR_COLOR if smoothing == "triangular" else SYNTH_COLOR
+        for ax, which in zip(self.axes, ("upper", "lower"), strict=True):
+            ax.set_ylabel(f"{which} lip y (mm)", fontsize=8)
+            ax.set_xlim(-SHOWN_S, 0.0)
+            # the main window's colours (app/style.py); animated: left out of full draws,
+            # blitted over the cached background (_plot)
+            (line,) = ax.plot([], [], color=line_color, lw=1.6, animated=True, label=line_label)
+            (dots,) = ax.plot([], [], ls="none", marker=".", ms=3, color=SPEECH_DOT_COLOR,
+                              animated=True, label="speech frames (live energy)")
+            self.lines.append(line)
+            self.dots.append(dots)
+        # the legend (part of the background: drawn with the axes, not per frame)
+        self.axes[0].legend(handles=[Line2D([], [], color=line_color, lw=1.6, label=line_label),
+                                     Line2D([], [], ls="none", marker=".", ms=5,
+                                            color=SPEECH_DOT_COLOR,
+                                            label="speech frames (live energy)")],
+                            loc="upper left", fontsize=7, ncol=2, frameon=True, framealpha=0.85)
+        self.axes[1].set_xlabel("time (s, 0 = now)", fontsize=8)
+        self._background = None
 
     # ------------------------------------------------------------------ a take
     def start(self) -> None:
@@ -378,8 +396,9 @@ class LiveWindow(QMainWindow):
             pad = 0.15 * max(hi - lo, 0.5)
             y0, y1 = ax.get_ylim()
             # outside the axes, or using less than half of them: new limits (and a full draw)
-            if lo < y0 or hi > y1 or (hi - lo + 2 * pad) < 0.5 * (y1 - y0):
-                ax.set_ylim(lo - pad, hi + pad)
+            top = 3 * pad if ax is self.axes[0] else pad       # room for the legend
+            if lo < y0 or hi > y1 or (hi - lo + pad + top) < 0.5 * (y1 - y0):
+                ax.set_ylim(lo - pad, hi + top)
                 rescale = True
         if rescale or self._background is None:
             self.canvas.draw_idle()             # _on_full_draw blits the lines
@@ -428,7 +447,7 @@ def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = Non
 
     def finish() -> None:
         if screenshot:
-            window.grab().save(str(screenshot))
+            grab_with_3d(window).save(str(screenshot))      # the face as on screen (grab: black)
             print(screenshot)
         app.quit()
 

@@ -15,6 +15,7 @@ Attributes
     ``model``, ``corpus``, ``view`` (``UtteranceView``, ``app/state.py``), ``synth_config`` (read
     from ``state``), ``plotter`` (a plotter widget, ``app/plotter_widget.py``), ``face`` (``FaceView``),
     ``timeline`` (``app/timeline.py``), ``analysis_menu``, ``marker_panels`` (``MarkerPanels``),
+    ``closed_lips`` (``engine.analysis.lips.ClosedLips`` of the model: the lips at closure),
     ``action_screenshot`` (File-menu entries of extensions go before it).
 
 Signals
@@ -58,16 +59,15 @@ from PyQt6.QtCore import QEvent, Qt, QTimer, pyqtSignal
 from PyQt6.QtGui import QKeySequence
 from PyQt6.QtWidgets import (
     QDockWidget,
-    QLabel,
     QMainWindow,
     QMenu,
     QMessageBox,
-    QSizePolicy,
     QSplitter,
     QVBoxLayout,
     QWidget,
 )
 
+from engine.analysis.lips import ClosedLips, closed_lips
 from engine.config import SynthConfig
 from engine.data import Utterance
 from engine.errors import FacetrajError
@@ -79,17 +79,20 @@ from .cache import load_or_train
 from .controls import (
     SPEEDS,
     LoopRange,
+    TitleBar,
     TransportBar,
     ViewBar,
-    add_shortcuts,
     ask_corpus_folder,
     ask_screenshot_path,
+    playback_shortcuts,
 )
 from .correlations import BrowserScores
 from .marker_panels import MarkerPanels
 from .open_audio import AudioOpener
 from .phases import mark
 from .playback import PlaybackScheduler
+from .plotter_widget import grab_with_3d
+from .provenance import LabelOrigin
 from .settings_panel import SynthSettingsPanel
 from .state import UtteranceView
 from .status import StatusArea
@@ -133,6 +136,7 @@ class MainWindow(QMainWindow):
         self.playback.prepareDue.connect(self._prepare_time)
         self.clock.playingChanged.connect(self._on_playing_changed)
         self._error_handler: Callable[[str], None] | None = None
+        self.closed_lips: ClosedLips | None = None      # the talker's lips at closure (per model)
         self._extensions: dict[str, object] = {}
         self.menus = WindowMenus(self, self.report_error)
         self.docks = WindowDocks(self)
@@ -140,7 +144,7 @@ class MainWindow(QMainWindow):
         self.audio_opener = AudioOpener(self)       # "Open audio…" and its label sources
         self.settings.add_widget(self.audio_opener.box)
         self._build_menus()
-        self._build_shortcuts()
+        self._shortcuts = playback_shortcuts(self)
         if corpus_path is not None:
             self._open_first_corpus(Path(corpus_path), model_path)
 
@@ -170,10 +174,7 @@ class MainWindow(QMainWindow):
         self.view_bar = ViewBar(self.face)
         self.camera_buttons = self.view_bar.camera_buttons
         self.transport = self._build_transport()
-        self.title = QLabel("")
-        self.title.setStyleSheet("font-size: 15px; font-weight: 600; padding: 2px 6px;")
-        self.title.setWordWrap(True)          # a long title wraps instead of widening the window
-        self.title.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
+        self.title = TitleBar()
         self.splitter = _split(_column([self.view_bar, self.face, self.transport], 2, stretch=self.face),
                                _column([self.title, self.timeline], 0, stretch=self.timeline))
         self.setCentralWidget(self.splitter)
@@ -182,6 +183,7 @@ class MainWindow(QMainWindow):
         self.browser_dock = self.docks.dock(self.browser, "Utterances", Qt.DockWidgetArea.LeftDockWidgetArea)
         self.settings = SynthSettingsPanel(self.synth_config, self)
         self.settings.configChanged.connect(self.set_synth_config)
+        self.settings.searchChosen.connect(lambda cfg: self.set_synth_config(cfg, explicit=True))
         self.settings_dock = self.docks.dock(self.settings, "Synthesis settings",
                                         Qt.DockWidgetArea.LeftDockWidgetArea)
         self.resizeDocks([self.browser_dock], [400], Qt.Orientation.Horizontal)
@@ -221,20 +223,6 @@ class MainWindow(QMainWindow):
         self.analysis_menu = self.menu("Analysis")
         self.menus.action("Help", "Keys", lambda: QMessageBox.information(self, "Keys", KEYS_HELP))
 
-    def _build_shortcuts(self) -> None:
-        K, M = Qt.Key, Qt.KeyboardModifier
-        bindings = [
-            (QKeySequence(K.Key_Space), self.toggle_play),
-            (QKeySequence(K.Key_Left), lambda: self.step_frames(-1)),
-            (QKeySequence(K.Key_Right), lambda: self.step_frames(1)),
-            (QKeySequence(M.ShiftModifier | K.Key_Left), lambda: self.step_phone(-1)),
-            (QKeySequence(M.ShiftModifier | K.Key_Right), lambda: self.step_phone(1)),
-            (QKeySequence(K.Key_Home), lambda: self.seek(0.0)),
-            (QKeySequence(K.Key_End), lambda: self.seek(self.clock.duration)),
-            (QKeySequence(K.Key_Escape), self.loop.clear),
-        ]
-        self._shortcuts = add_shortcuts(self, bindings)
-
     # ================================================================== public contract
     def menu(self, name: str) -> QMenu:
         """The menu ``name`` ("File", "View", "Analysis", "Help"; another name: a new menu)."""
@@ -257,12 +245,14 @@ class MainWindow(QMainWindow):
         self.show_error(error_message(exc))
 
     def show_error(self, message: str) -> None:
-        """An error message: in the status bar, and a dialog (or the ``set_error_handler`` one)."""
+        """An error message: in the status bar, and a dialog with the message logged (or only the
+        ``set_error_handler`` one, which reports it itself: ``facetraj --screenshot`` prints it
+        once, as every command does)."""
         self.status_label.setText(message)
-        log.error("%s", message)
         if self._error_handler is not None:
             self._error_handler(message)
         else:
+            log.error("%s", message)
             QMessageBox.critical(self, "facetraj", message)
 
     def set_error_handler(self, handler: Callable[[str], None] | None) -> None:
@@ -330,7 +320,8 @@ class MainWindow(QMainWindow):
         mark("model ready")
         self.stop()
         first = self.state.set_model(corpus, model, texts)
-        self.face.set_model(model)
+        self.closed_lips = closed_lips(model)     # the 3-D mouth shuts there; the lip panels' line
+        self.face.set_model(model, self.closed_lips)
         self.settings.set_limits(model.config.context, model.config.nu, model.tuned)
         info = corpus.info
         self.browser.populate({"test": list(info.test), "train": list(info.train)}, texts)
@@ -359,15 +350,17 @@ class MainWindow(QMainWindow):
         self.view_bar.set_planar(planar)
 
     # ================================================================== synthesis
-    def set_synth_config(self, cfg: SynthConfig) -> None:
-        """Use new synthesis settings: re-synthesize the current utterance and the correlations."""
-        changed, request = self.state.set_config(cfg)
-        if not changed:
-            return
-        self.settings.set_config(cfg)
+    def set_synth_config(self, cfg: SynthConfig, explicit: bool = False) -> None:
+        """Use new synthesis settings: re-synthesize the current utterance and (when they changed)
+        the correlations. ``explicit``: the user chose the search in ``cfg`` (see
+        ``ViewerModel.set_config``)."""
+        changed, request = self.state.set_config(cfg, explicit)
+        if changed:
+            self.settings.set_config(cfg)
         if request is not None:
             self._synthesize(request)
-        self._start_sweep()
+        if changed:
+            self._start_sweep()
 
     def _synthesize(self, request: SynthRequest) -> None:
         def done(view: UtteranceView) -> None:
@@ -387,6 +380,7 @@ class MainWindow(QMainWindow):
             self.timeline.loop = None
             t = self.state.take_pending_time(t)
         self.playback.set_frames(view.n_frames, view.rate)
+        self.view_bar.set_has_original(view.original is not None)
         self.face.set_view(view)
         self.timeline.set_view(view, keep_zoom=not new_utterance)
         mark("timeline drawn")
@@ -402,6 +396,7 @@ class MainWindow(QMainWindow):
 
     def _show_titles(self, view: UtteranceView) -> None:
         self.title.setText(view_title(view))
+        self.settings.show_used(view.synthesis.config, self.synth_config, view.mode_reason)
         self.browser.set_current(view.utterance.name)
         self.scores.score(view, self.model)
         self.status_label.setText(view_summary(view))
@@ -481,9 +476,10 @@ class MainWindow(QMainWindow):
         files beside the audio (``app.open_audio.AudioOpener.open``)."""
         return self.audio_opener.open(Path(audio_path), labels_path, **kw)
 
-    def show_external(self, utt: Utterance) -> None:
-        """Show an utterance opened from files (listed under "opened" in the browser)."""
-        name = self.state.add_external(utt)
+    def show_external(self, utt: Utterance, origin: LabelOrigin | None = None) -> None:
+        """Show an utterance opened from files (listed under "opened" in the browser); ``origin``:
+        where its labels came from (the file, the transcript aligned)."""
+        name = self.state.add_external(utt, origin)
         self.browser.add_external(name)
         self.set_utterance(name)
 
@@ -491,8 +487,7 @@ class MainWindow(QMainWindow):
         """Render the whole window (with the 3-D view) to a PNG."""
         self.face.rerender()
         self.timeline.ensure_drawn()
-        pix = self.grab()
-        self.face.paint_into(pix, self)
+        pix = grab_with_3d(self)        # every 3-D view shown (the PC modes' too), as on screen
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         if not pix.save(str(path), "PNG", PNG_QUALITY):

@@ -36,6 +36,8 @@ from engine.errors import FacetrajError, InputError
 from engine.io.audio import read_audio
 from engine.labels.phoneset import ARPABET
 
+from .provenance import LabelOrigin
+
 if TYPE_CHECKING:   # the labelling engine is imported when audio is opened (issue #15: cold start)
     import numpy as np
 
@@ -146,6 +148,7 @@ class OpenedAudio:
     audio: object
     rate: int
     text: str = ""
+    text_from: str = ""                 # where the sentence came from: "s001.txt", "the sentence typed"
     label_file: Path | None = None
     extra_dict: dict[str, list[str]] = field(default_factory=dict)
     labels: dict[str, Labels | None] = field(default_factory=dict)
@@ -172,6 +175,16 @@ class OpenedAudio:
                 self.labels[source] = label_audio(self.audio, self.rate, "recognized",
                                                   source=self.path)
         return self.labels[source]
+
+    def origin(self, source: str) -> LabelOrigin:
+        """Where the labels of ``source`` (a :data:`SOURCE_CHOICES` key) came from."""
+        labels = self.labels.get(source)
+        found = labels.source if labels is not None else "none"
+        if source == "file" and self.label_file is not None:
+            return LabelOrigin(found, file=self.label_file.name)
+        if source == "aligned":
+            return LabelOrigin(found, transcript=self.text_from or "the sentence typed")
+        return LabelOrigin(found)
 
     def utterance(self, source: str, marker_rate: float, marker_names: list[str]) -> Utterance:
         labels = self.labels_for(source)
@@ -226,7 +239,7 @@ class AudioHost(Protocol):
 
     def show_error(self, message: str) -> None: ...
     def run_task(self, fn: Callable, on_done: Callable | None, label: str, **options) -> object: ...
-    def show_external(self, utt: Utterance) -> None: ...
+    def show_external(self, utt: Utterance, origin: LabelOrigin | None = None) -> None: ...
 
 
 class AudioOpener(QObject):
@@ -306,23 +319,24 @@ class AudioOpener(QObject):
         while name in (win.corpus.info.ids if win.corpus else []):
             name += "'"
         label_file, txt = beside(audio_path)
-        sentence = text if text is not None else None
         opened = OpenedAudio(name, audio_path, audio, rate, label_file=labels_path or label_file,
                              extra_dict=dict(extra_dict or {}))
-        if sentence is None and labels_path is None and not recognize and label_file is None \
-                and txt is not None:
+        # the sentence to align: the one typed, else the .txt beside the audio (also when a label
+        # file is used first: "aligned" is then one choice of the labels box)
+        if text:
+            opened.text, opened.text_from = text, "the sentence typed"
+        elif txt is not None:
             try:
-                sentence = read_transcript(txt)
-            except FacetrajError as exc:       # not UTF-8 (found by make fuzz: it crashed the app)
+                opened.text, opened.text_from = read_transcript(txt), txt.name
+            except FacetrajError as exc:
                 win.show_error(str(exc))
                 return
-        opened.text = sentence or ""
 
         def work(progress) -> tuple[OpenedAudio, str]:
             if acoustic_only:
                 return opened, "none"
             progress(0.1, f"labelling {audio_path.name}")
-            labels = labels_for_audio(audio_path, audio, rate, labels=labels_path, text=sentence,
+            labels = labels_for_audio(audio_path, audio, rate, labels=labels_path, text=text,
                                       recognize=recognize, extra_dict=opened.extra_dict,
                                       fallback=True)
             source = labels.source if labels else "none"
@@ -333,7 +347,7 @@ class AudioOpener(QObject):
             if isinstance(exc, MissingWordsError):
                 dialog = MissingWordsDialog(exc.words, win)
                 if dialog.exec() == QDialog.DialogCode.Accepted:
-                    self.open(audio_path, labels_path, sentence, recognize, acoustic_only,
+                    self.open(audio_path, labels_path, text, recognize, acoustic_only,
                               {**opened.extra_dict, **dialog.pronunciations()})
                 return
             win.show_error(str(exc) if isinstance(exc, FacetrajError)
@@ -346,7 +360,7 @@ class AudioOpener(QObject):
         win = self.window
         self.opened[opened.name] = opened
         utt = opened.utterance(source, win.model.marker_rate, win.model.marker_names)
-        win.show_external(utt)
+        win.show_external(utt, opened.origin(source))
 
     # -- switching
     def switch(self, source: str) -> None:
@@ -357,15 +371,16 @@ class AudioOpener(QObject):
             return
         win = self.window
 
-        def work(progress) -> Utterance:
+        def work(progress) -> tuple[Utterance, LabelOrigin]:
             progress(0.1, f"labels: {source}")
-            return opened.utterance(source, win.model.marker_rate, win.model.marker_names)
+            return (opened.utterance(source, win.model.marker_rate, win.model.marker_names),
+                    opened.origin(source))
 
         def failed(exc: BaseException) -> None:
             self.box.show_for(opened, view.utterance.label_source)
             win.show_error(str(exc))
 
-        win.run_task(work, win.show_external, f"labels: {source}", on_error=failed)
+        win.run_task(work, lambda r: win.show_external(*r), f"labels: {source}", on_error=failed)
 
     def _on_utterance(self, name: str) -> None:
         view = self.window.view

@@ -314,6 +314,7 @@ def export_figure(window, path: Path) -> Path:
     suffix = path.suffix.lower().lstrip(".")
     if suffix not in ("png", "svg", "pdf"):
         raise FacetrajError(f"{path}: unknown figure format (use .png, .svg or .pdf)")
+    window.timeline.ensure_drawn()      # panels being built finished, a background draw waited for
     with atomic_write(path) as tmp:
         window.timeline.figure.savefig(tmp, format=suffix, dpi=150, facecolor="white")
     return path

@@ -18,8 +18,10 @@ import logging
 import os
 from collections.abc import Iterator
 
+import numpy as np
 import pyvista
-from PyQt6.QtGui import QGuiApplication
+from PyQt6.QtCore import QPoint, QRect
+from PyQt6.QtGui import QGuiApplication, QImage, QPainter, QPixmap
 from PyQt6.QtWidgets import QWidget
 from pyvista.plotting.plotter import BasePlotter
 from pyvista.plotting.render_window_interactor import RenderWindowInteractor
@@ -54,6 +56,44 @@ def make_plotter(parent: QWidget | None = None, multi_samples: int = 0, native: 
 def is_native(plotter) -> bool:
     """Whether ``plotter`` renders into its own native window (:class:`NativePlotter`)."""
     return isinstance(plotter, NativePlotter)
+
+
+def grab_with_3d(top: QWidget) -> QPixmap:
+    """``top.grab()`` with every visible 3-D view inside it drawn in, as on the screen.
+
+    A widget grab holds noise or black where a view renders through OpenGL (a native window or
+    a ``QOpenGLWidget``): each such view shown (not in a hidden tab or dock) is rendered and its
+    own picture painted over its place, clipped to the part of it on screen (a dock's scroll
+    area may hide some). The main window's 3-D view, the PC-modes view and the Live window's face
+    are all saved this way.
+    """
+    pix = top.grab()
+    dpr = pix.devicePixelRatio()
+    painter = QPainter(pix)
+    try:
+        for view in top.findChildren(QWidget):
+            if not isinstance(view, BasePlotter) or not view.isVisible():
+                continue
+            visible = view.visibleRegion().boundingRect()
+            if visible.isEmpty():
+                continue
+            BasePlotter.render(view)
+            img = view.screenshot(return_img=True)
+            if img is None or not img.size:
+                continue
+            rgb = np.ascontiguousarray(img[:, :, :3])
+            h, w = rgb.shape[:2]
+            qimg = QImage(rgb.data, w, h, 3 * w, QImage.Format.Format_RGB888)
+            qimg = qimg.scaled(int(view.width() * dpr), int(view.height() * dpr))
+            qimg.setDevicePixelRatio(dpr)
+            origin = view.mapTo(top, QPoint(0, 0))
+            painter.save()
+            painter.setClipRect(QRect(origin + visible.topLeft(), visible.size()))
+            painter.drawImage(origin, qimg)
+            painter.restore()
+    finally:
+        painter.end()
+    return pix
 
 
 @contextlib.contextmanager

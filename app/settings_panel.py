@@ -1,6 +1,11 @@
 """The synthesis settings side panel (paper section 2.3): N, C, xi, nu, the search mode (robust,
 phonetic or acoustic-only, each explained in one line), smoothing, and the robust mode's settings
-cross-validated at training. A change is announced once the user pauses (debounced)."""
+cross-validated at training. A change is announced once the user pauses (debounced).
+
+The search selector shows the search the synthesis on screen *used* (``show_used``: the labels
+may have made the engine choose another than the settings ask for; the line under it says why);
+choosing one in it is the user's explicit choice (``searchChosen``), which the labels' rule then
+leaves alone."""
 
 from __future__ import annotations
 
@@ -20,23 +25,15 @@ from PyQt6.QtWidgets import (
 
 from engine.config import SynthConfig
 
-#: One line per search mode, shown under the selector.
-MODE_NOTES = {
-    "robust": "robust: eq 4's and the acoustically nearest codewords together; each label counts "
-              "as much as the aligner/recognizer trusts it (default for automatic labels).",
-    "phonetic": "phonetic (the paper): the labels alone pick the N context-phones searched "
-                "(eq 4); best with hand-checked labels.",
-    "acoustic": "acoustic only: no labels; the codewords nearest to each frame by eq 5, found "
-                "in the model's LSF index (fast).",
-    "acoustic-full": "acoustic only, whole codebook: eqs 5-8 over every codeword, as the paper "
-                     "(slow).",
-}
+from .provenance import MODE_NOTES, mode_reason, search_key
 
+__all__ = ["MODE_NOTES", "SynthSettingsPanel"]
 
 class SynthSettingsPanel(QWidget):
     """Edits a :class:`SynthConfig`; emits ``configChanged`` after a short pause in editing."""
 
     configChanged = pyqtSignal(object)
+    searchChosen = pyqtSignal(object)      # the settings with the search the user picked
 
     def __init__(self, config: SynthConfig | None = None, parent: QWidget | None = None,
                  debounce_ms: int = 300):
@@ -46,6 +43,7 @@ class SynthSettingsPanel(QWidget):
         self._timer.setInterval(debounce_ms)
         self._timer.timeout.connect(lambda: self.configChanged.emit(self.config()))
         self._base = config or SynthConfig()
+        self._requested = search_key(self._base)     # the search the settings ask for
         self._tuned: dict = {}
         self._build_inputs()
         self._build_layout()
@@ -70,10 +68,11 @@ class SynthSettingsPanel(QWidget):
         self.nu.setDecimals(2)
         self.nu.setToolTip("ν: eq 3 constant of the visual phoneme similarity")
         self.mode = QComboBox()
-        self.mode.addItem("robust (labels weighted by confidence)", "robust")
-        self.mode.addItem("phonetic (labels restrict the search)", "phonetic")
-        self.mode.addItem("acoustic only, indexed (fast)", "acoustic")
-        self.mode.addItem("acoustic only, whole codebook (paper, slow)", "acoustic-full")
+        # short: the line under the box explains the search (the box fits a narrow dock)
+        self.mode.addItem("robust (labels weighted)", "robust")
+        self.mode.addItem("phonetic (the paper)", "phonetic")
+        self.mode.addItem("acoustic only, indexed", "acoustic")
+        self.mode.addItem("acoustic only, whole codebook", "acoustic-full")
         self.mode.setToolTip(
             "phonetic: eq 4 picks N context-phones from the labels, eqs 5-8 weight their codewords.\n"
             "acoustic only, indexed: no labels; eqs 6-8 weight the codewords nearest to each frame by\n"
@@ -83,6 +82,10 @@ class SynthSettingsPanel(QWidget):
             "context plus a penalty for codewords eq 4 did not choose, times the label's confidence.")
         self.mode_note = QLabel("")
         self.mode_note.setWordWrap(True)
+        self.mode_reason = QLabel("")
+        self.mode_reason.setWordWrap(True)
+        self.mode_reason.setStyleSheet("color: #a34700;")
+        self.mode_reason.hide()
         self.tuned_label = QLabel("")
         self.tuned_label.setWordWrap(True)
         self.smoothing = QComboBox()
@@ -90,6 +93,9 @@ class SynthSettingsPanel(QWidget):
                              ("none", "none")):
             self.smoothing.addItem(label, value)
         self.smoothing.setToolTip("smoothing of the synthesized markers shown in 3-D")
+        for combo in (self.mode, self.smoothing):      # the panel fits a narrow left dock
+            combo.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon)
+            combo.setMinimumContentsLength(16)
         self.reset = QPushButton("Paper defaults")
         self.status = QLabel("")
         self.status.setWordWrap(True)
@@ -105,6 +111,7 @@ class SynthSettingsPanel(QWidget):
         form.addRow("ν (eq 3)", nu_row)
         form.addRow("search", self.mode)
         form.addRow(self.mode_note)
+        form.addRow(self.mode_reason)
         form.addRow("smoothing", self.smoothing)
         lay = QVBoxLayout(self)
         self._layout = lay
@@ -120,7 +127,7 @@ class SynthSettingsPanel(QWidget):
         self.xi.valueChanged.connect(self._changed)
         self.nu.valueChanged.connect(self._changed)
         self.nu_default.toggled.connect(self._on_nu_default)
-        self.mode.currentIndexChanged.connect(self._changed)
+        self.mode.activated.connect(self._search_chosen)      # the user's choice, not set_config's
         self.mode.currentIndexChanged.connect(self._show_mode_note)
         self._show_mode_note()
         self.smoothing.currentIndexChanged.connect(self._changed)
@@ -131,10 +138,39 @@ class SynthSettingsPanel(QWidget):
         self._layout.insertWidget(self._layout.count() - 2, widget)
 
     def _show_mode_note(self, *_args) -> None:
-        self.mode_note.setText(MODE_NOTES.get(self.mode.currentData(), ""))
+        """The line under the selector explains the search shown; the robust mode's settings
+        show with the robust search only."""
+        key = self.mode.currentData()
+        self.mode_note.setText(MODE_NOTES.get(key, ""))
+        self.tuned_label.setVisible(key == "robust")
+
+    def _search_chosen(self, index: int) -> None:
+        """The user picked a search (also the one shown): that is what the settings ask for now,
+        and the labels' rule leaves it alone (``searchChosen``)."""
+        self._timer.stop()
+        self._requested = self.mode.itemData(index)
         n = self._tuned.get("settings", {}).get("n_context_phones")
-        if self.mode.currentData() == "robust" and n is not None:
+        if self._requested == "robust" and n is not None:
+            self.n.blockSignals(True)
             self.n.setValue(int(n))                  # the cross-validated N, still editable
+            self.n.blockSignals(False)
+        self.mode_reason.hide()
+        self.searchChosen.emit(self.config())
+
+    def show_used(self, used: SynthConfig, requested: SynthConfig, reason: str) -> None:
+        """Show the search the synthesis on screen used (its ``Synthesis.config``) and, when it
+        is not the one ``requested``, why (the engine's ``reason``, ``mode_reason``)."""
+        self.mode.blockSignals(True)
+        self.mode.setCurrentIndex(max(0, self.mode.findData(search_key(used))))
+        self.mode.blockSignals(False)
+        self._show_mode_note()
+        reason = mode_reason(requested, used, reason)
+        self.mode_reason.setText(reason)
+        self.mode_reason.setVisible(bool(reason))
+
+    def shown_search(self) -> str:
+        """The search the selector shows (``robust``, ``phonetic``, ``acoustic``, ``acoustic-full``)."""
+        return self.mode.currentData()
 
     def set_limits(self, max_context: int, default_nu: float, tuned: dict | None = None) -> None:
         """Fit the controls to a model: C up to its trained context, ν's default, and the robust
@@ -153,7 +189,7 @@ class SynthSettingsPanel(QWidget):
         self._tuned = tuned or {}
         if not settings:
             self.tuned_label.setText("robust mode: default settings (the model was trained "
-                                     "without cross-validation; `facetraj train --tune` "
+                                     "without cross-validation; “facetraj train --tune” "
                                      "tunes them)")
             return
         names = {"n_context_phones": "N", "xi": "ξ", "label_weight": "κ (label weight)",
@@ -177,14 +213,17 @@ class SynthSettingsPanel(QWidget):
         self.nu.setEnabled(cfg.nu is not None)
         if cfg.nu is not None:
             self.nu.setValue(cfg.nu)
-        key = "acoustic-full" if cfg.mode == "acoustic" and cfg.acoustic_prefilter is None else cfg.mode
-        self.mode.setCurrentIndex(max(0, self.mode.findData(key)))
+        self._requested = search_key(cfg)
+        self.mode.setCurrentIndex(max(0, self.mode.findData(self._requested)))
         self.smoothing.setCurrentIndex(max(0, self.smoothing.findData(cfg.smoothing)))
         for w in widgets:
             w.blockSignals(False)
+        self._show_mode_note()
 
     def config(self) -> SynthConfig:
-        key = self.mode.currentData()
+        """The settings as edited, with the search they ask for (not necessarily the one shown:
+        see ``show_used``)."""
+        key = self._requested
         search = {}
         if key == "acoustic-full":
             search = {"acoustic_prefilter": None}

@@ -16,6 +16,8 @@ from engine.evaluation.scores import speech_mask
 from engine.method.model import Model
 from engine.method.pipeline import Synthesis, resmooth, synthesize
 
+from .provenance import LabelOrigin
+
 
 def frame_index(t: float, rate: float, n_frames: int, step: int = 0) -> int:
     """The frame at ``t`` seconds (``round(t * rate)``), moved by ``step`` frames, clipped to
@@ -43,6 +45,7 @@ class UtteranceView:
     mode_reason : why the synthesis runs in its mode (:func:`engine.method.modes.choose_mode`).
     voice_match : how well the recording's voice matches the training voice, in [0, 1]
         (:mod:`engine.method.voice_match`; NaN for a model file without the figure).
+    origin : where the phone labels came from (the file, the transcript aligned), if known.
     """
 
     utterance: Utterance
@@ -55,6 +58,15 @@ class UtteranceView:
     times: np.ndarray
     mode_reason: str = ""
     voice_match: float = float("nan")
+    origin: LabelOrigin | None = None
+
+    @property
+    def label_origin(self) -> LabelOrigin:
+        """Where the phone labels came from (at least their source)."""
+        source = self.utterance.label_source if self.utterance.phones else "none"
+        if self.origin is None:
+            return LabelOrigin(source)
+        return LabelOrigin(source, self.origin.file, self.origin.transcript)
 
     @property
     def shown(self) -> np.ndarray:
@@ -80,7 +92,7 @@ class UtteranceView:
 
 
 def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig,
-               mode_reason: str = "") -> UtteranceView:
+               mode_reason: str = "", origin: LabelOrigin | None = None) -> UtteranceView:
     """Synthesize ``utt`` with ``config`` (its labels weighed by their confidence) and derive
     every track the window shows (slow: run in a worker). Raises the engine's
     :class:`~engine.errors.FacetrajError` on bad input."""
@@ -94,4 +106,4 @@ def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig,
     speech = speech_mask(utt.audio, utt.sample_rate, res.times)
     return UtteranceView(utterance=utt, split=split, synthesis=res, original=original,
                          triangular=triangular, spline=spline, speech=speech, times=res.times,
-                         mode_reason=mode_reason, voice_match=res.voice_match)
+                         mode_reason=mode_reason, voice_match=res.voice_match, origin=origin)

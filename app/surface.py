@@ -1,6 +1,7 @@
-"""The geometry of the 3-D view's face: the lip contour polylines and the face surface's triangles
+"""The geometry of the 3-D view's face: the lip contour polylines, the face surface's triangles
 over the markers, computed once per model and kept in the cache folder (``stored_face_triangles``)
-so that a start with a cached model needs no triangulation (and no ``scipy.spatial``).
+so that a start with a cached model needs no triangulation (and no ``scipy.spatial``), and the
+lips between their markers and the mouth opening (:class:`Mouth`), which close when the lips meet.
 """
 
 from __future__ import annotations
@@ -8,6 +9,7 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -129,3 +131,95 @@ def stored_face_triangles(neutral: np.ndarray, contours: list[list[int]],
     except (OSError, InputError) as exc:
         log.info("face surface not stored (%s)", exc)
     return tri
+
+
+@dataclass(frozen=True)
+class Mouth:
+    """The lips' surface from their markers to the mouth opening, which closes when they meet.
+
+    The lip markers sit on the outside of the lips: with the lips together, an upper and a lower
+    marker are still a lip's thickness apart (about 11 mm at the centre). Each lip marker gets an
+    *inner edge* point on the way to its partner on the other lip (the nearest in x), as far
+    from it as half their distance at closure (``engine.analysis.lips.closed_lips``), so that the
+    two inner edges meet, and the mouth is shut, when the pair is no farther apart than at the
+    talker's closures, and open by the rest when they part. The strips between each lip's
+    markers and its inner edge are triangles over the markers and these extra points
+    (:meth:`points`, after the markers; :meth:`triangles`).
+
+    ``upper``, ``lower``: the lip contour markers between the corners; ``partner_of_upper`` /
+    ``partner_of_lower``: each one's partner on the other lip; ``half_closed_upper`` /
+    ``half_closed_lower``: half the pair's distance at closure (mm); ``corners``: left, right.
+    """
+
+    upper: np.ndarray
+    lower: np.ndarray
+    partner_of_upper: np.ndarray
+    partner_of_lower: np.ndarray
+    half_closed_upper: np.ndarray
+    half_closed_lower: np.ndarray
+    corners: tuple[int, int]
+
+    @classmethod
+    def between(cls, neutral: np.ndarray, contours: list[list[int]],
+                closed: np.ndarray) -> Mouth | None:
+        """The mouth of a face whose lip contours (corner .. corner, upper then lower) are
+        ``contours``; ``closed``: ``(M, 3)`` the markers at closure. None without two contours
+        with markers between their corners."""
+        if len(contours) != 2 or len(contours[0]) < 3 or len(contours[1]) < 3:
+            return None
+        up, lo = np.array(contours[0][1:-1]), np.array(contours[1][1:-1])
+        pu = lo[np.argmin(np.abs(neutral[up, None, 0] - neutral[None, lo, 0]), axis=1)]
+        pl = up[np.argmin(np.abs(neutral[lo, None, 0] - neutral[None, up, 0]), axis=1)]
+        return cls(up, lo, pu, pl,
+                   0.5 * np.linalg.norm(closed[up] - closed[pu], axis=1),
+                   0.5 * np.linalg.norm(closed[lo] - closed[pl], axis=1),
+                   (int(contours[0][0]), int(contours[0][-1])))
+
+    @property
+    def n_points(self) -> int:
+        return len(self.upper) + len(self.lower)
+
+    def points(self, markers: np.ndarray) -> np.ndarray:
+        """The inner edge points ``(n_points, 3)`` of ``markers`` ``(M, 3)``: the upper lip's,
+        then the lower lip's."""
+        return np.concatenate([_inner(markers, self.upper, self.partner_of_upper, self.half_closed_upper),
+                               _inner(markers, self.lower, self.partner_of_lower, self.half_closed_lower)])
+
+    def opening_loop(self, n_markers: int) -> np.ndarray:
+        """The mouth opening's outline as vertex ids of the surface (inner points numbered from
+        ``n_markers``): left corner, the upper inner edge, right corner, the lower one back."""
+        left, right = self.corners
+        nu = len(self.upper)
+        upper = list(range(n_markers, n_markers + nu))
+        lower = list(range(n_markers + nu, n_markers + self.n_points))
+        return np.array([left, *upper, right, *lower[::-1]], dtype=np.int64)
+
+    def owners(self) -> np.ndarray:
+        """The marker each inner edge point belongs to, ``(n_points,)``."""
+        return np.concatenate([self.upper, self.lower])
+
+    def triangles(self, n_markers: int) -> np.ndarray:
+        """The lips' strips ``(n, 3)``, inner points numbered from ``n_markers`` on."""
+        left, right = self.corners
+        tri = []
+        first = n_markers
+        for lip in (self.upper, self.lower):
+            outer = [left, *lip.tolist(), right]
+            inner = [left, *range(first, first + len(lip)), right]
+            first += len(lip)
+            for k in range(len(outer) - 1):
+                a, b, c, d = outer[k], outer[k + 1], inner[k + 1], inner[k]
+                if a != d:
+                    tri.append((a, c, d))
+                if b != c:
+                    tri.append((a, b, c))
+        return np.array(tri, dtype=np.int64)
+
+
+def _inner(markers: np.ndarray, own: np.ndarray, partner: np.ndarray, half: np.ndarray) -> np.ndarray:
+    """Each ``own`` marker moved towards its partner by ``half`` its closed distance, at most to
+    the middle of the pair (the lips meet there)."""
+    d = markers[partner] - markers[own]
+    gap = np.linalg.norm(d, axis=1)
+    t = np.minimum(0.5, half / np.maximum(gap, 1e-9))
+    return markers[own] + t[:, None] * d

@@ -5,6 +5,10 @@ A panel is any object with ``title: str``, ``height: float`` (relative) and
 and draws the moving cursor by blitting (a full redraw happens only on layout, zoom or pan): the
 cursor of every panel is one line artist in pixels, restored and drawn over a strip in one pass.
 
+Full draws run in the background (``app/figure_canvas.py``); while one runs the figure is not
+changed (a relayout waits for it), and panels added by a view are built one per pass of the event
+loop (``relayout(soon=True)``), so that opening a view never freezes the window.
+
 Mouse: click to seek, drag to select a loop range, wheel to zoom the time axis around the pointer,
 right or middle drag to pan, double-click to show the whole utterance.
 """
@@ -15,31 +19,40 @@ import logging
 from typing import Protocol
 
 import numpy as np
-from matplotlib.backends.backend_qtagg import FigureCanvasQTAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.transforms import Bbox, IdentityTransform
-from PyQt6.QtCore import pyqtSignal
+from PyQt6.QtCore import QTimer, pyqtSignal
 from PyQt6.QtWidgets import QSizePolicy, QVBoxLayout, QWidget
 
+from .figure_canvas import BackgroundCanvas
 from .state import UtteranceView
 from .style import (
+    CLOSED_COLOR,
     CURSOR_COLOR,
+    LABEL_MARGIN_PX,
     LOOP_COLOR,
     ORIGINAL_COLOR,
     SPEECH_DOT_COLOR,
     SPLINE_COLOR,
     TRIANGULAR_COLOR,
     fit_ylabel,
+    refit_ylabels,
 )
+from .workers import STEP_MS
 
 log = logging.getLogger(__name__)
 
+#: the timeline's bottom margin: the time tick labels and "time (s)"
+BOTTOM_MARGIN_PX = 40.0
 
-class _Canvas(FigureCanvasQTAgg):
-    """A canvas whose ``blit`` schedules the repaint instead of forcing it: the window then puts
-    the cursor, the 3-D frame and the widgets on screen in one flush per frame (each flush composes
-    the whole window through OpenGL once a GL widget is in it)."""
+
+class _Canvas(BackgroundCanvas):
+    """A canvas whose full draws run off the GUI thread (``app/figure_canvas.py``: a resize, a
+    zoom or new panels do not freeze the window) and whose ``blit`` schedules the repaint instead
+    of forcing it: the window then puts the cursor, the 3-D frame and the widgets on screen in one
+    flush per frame (each flush composes the whole window through OpenGL once a GL widget is in
+    it)."""
 
     def blit(self, bbox=None) -> None:
         if bbox is None:
@@ -125,16 +138,17 @@ class PhoneTierPanel:
     """Word and phone labels with their boundaries."""
 
     title = "phones"
-    height = 0.55
+    height = 0.8
 
     def draw(self, ax, view: UtteranceView) -> None:
         utt = view.utterance
         ax.set_ylim(0, 2 if utt.words else 1)
-        ax.set_yticks([])
-        tier = "words\nphones" if utt.words else "phones"
-        short = {"recognized": "recog."}.get(utt.label_source, utt.label_source)
-        source = f"\n({short})" if utt.phones else ""
-        fit_ylabel(ax, tier + source)
+        # each row named beside it, the phones with where they came from (a y label "words
+        # phones (aligned)" shrank to a few pixels); the title and status line say it in full
+        rows = [f"phones ({view.label_origin.short()})"] if utt.phones else ["phones"]
+        rows += ["words"] if utt.words else []
+        ax.set_yticks([0.5, 1.5][:len(rows)], rows, fontsize=7)
+        ax.tick_params(axis="y", length=0)
         if not utt.phones:
             ax.text(0.5, 0.5, "no phone labels: acoustic-only synthesis", transform=ax.transAxes,
                     ha="center", va="center", fontsize=8, color="#777777")
@@ -163,7 +177,9 @@ class PhoneTierPanel:
 
 class LipPanel:
     """Upper- or lower-lip centre y: original (dotted), spline (dark) and triangular (light)
-    synthesis, and the speech/silence dots on a line through the middle (paper Figure 4)."""
+    synthesis, and the speech/silence dots on a line through the middle (paper Figure 4); a
+    dashed line marks where the talker's lip is when the lips are closed (the window's
+    ``closed_lips``)."""
 
     height = 1.2
 
@@ -188,7 +204,10 @@ class LipPanel:
             orig = view.original[:, k, 1]
             ax.plot(t, orig, color=ORIGINAL_COLOR, lw=1.5, ls=(0, (2, 1.5)), label="original")
             ys.append(orig)
-        allv = np.concatenate([y[np.isfinite(y)] for y in ys])
+        closed = getattr(self.window, "closed_lips", None)
+        closed_y = float(closed.markers[k, 1]) if closed is not None else None
+        extra = [np.array([closed_y])] if closed_y is not None else []
+        allv = np.concatenate([y[np.isfinite(y)] for y in ys] + extra)
         lo, hi = float(allv.min()), float(allv.max())
         pad = 0.12 * max(hi - lo, 0.5)
         top = 0.45 * max(hi - lo, 0.5) if self.which == "upper" else pad   # room for the legend
@@ -197,6 +216,10 @@ class LipPanel:
         sp = view.speech
         ax.plot(t[sp], np.full(int(sp.sum()), mid), ls="none", marker=".", ms=2.2,
                 color=SPEECH_DOT_COLOR, label="speech frames")
+        if closed_y is not None:     # the talker's lip at closure (the middles of /p b m/)
+            ax.axhline(closed_y, color=CLOSED_COLOR, lw=0.9, ls=(0, (6, 3)), zorder=0.5)
+            ax.text(1.0, closed_y, "closed ", transform=ax.get_yaxis_transform(), ha="right",
+                    va="bottom", fontsize=6.5, color=CLOSED_COLOR)
         fit_ylabel(ax, f"{self.which} lip\ny (mm)")
         if self.which == "upper":
             ax.legend(loc="upper right", fontsize=7, ncol=4, frameon=True, framealpha=0.85,
@@ -234,7 +257,9 @@ class Timeline(QWidget):
         self._bg_bounds: tuple[float, ...] = ()
         self._press: tuple[float, float, int] | None = None   # (xdata, xpixel, button)
         self._drag_span: tuple[float, float] | None = None
-        self.canvas.mpl_connect("draw_event", self._on_draw)
+        self._building = None                   # the relayout being built over several passes
+        self._grid = None                       # the panels' grid (its margins follow resizes)
+        self.canvas.drawn.connect(self._on_draw)
         self.canvas.mpl_connect("resize_event", self._on_resize)
         self.canvas.mpl_connect("button_press_event", self._on_press)
         self.canvas.mpl_connect("motion_notify_event", self._on_motion)
@@ -242,14 +267,14 @@ class Timeline(QWidget):
         self.canvas.mpl_connect("scroll_event", self._on_scroll)
 
     # ------------------------------------------------------------------ panels
-    def add_panel(self, panel: Panel) -> None:
+    def add_panel(self, panel: Panel, soon: bool = False) -> None:
         self.panels.append(panel)
-        self.relayout()
+        self.relayout(self.xlim() if self.axes else None, soon=soon)
 
-    def remove_panel(self, panel: Panel) -> None:
+    def remove_panel(self, panel: Panel, soon: bool = False) -> None:
         if panel in self.panels:
             self.panels.remove(panel)
-            self.relayout()
+            self.relayout(self.xlim() if self.axes else None, soon=soon)
 
     def set_view(self, view: UtteranceView | None, keep_zoom: bool = False) -> None:
         xlim = self.axes[0].get_xlim() if (keep_zoom and self.axes) else None
@@ -263,44 +288,114 @@ class Timeline(QWidget):
         except (ValueError, IndexError):
             return None
 
-    def relayout(self, xlim: tuple[float, float] | None = None) -> None:
-        """Rebuild the figure: one axes per panel, shared time axis, then a full draw."""
-        fig = self.figure
-        fig.clear()
-        self.axes, self._spans, self._cursor = [], [], None
-        if not self.panels or self.view is None:
-            self._request_draw()
+    @property
+    def building(self) -> bool:
+        """Whether a relayout is being built (``relayout(soon=True)``) or drawn."""
+        return self._building is not None or self.canvas.busy
+
+    def relayout(self, xlim: tuple[float, float] | None = None, soon: bool = False) -> None:
+        """Rebuild the figure (one axes per panel, shared time axis) and draw it in the
+        background. Now (the axes are there on return), or with ``soon`` one panel per pass of
+        the event loop, after a draw that is running (a view adding panels)."""
+        self._stop_building()
+        steps = self._build_steps(xlim)
+        if not soon:
+            self.canvas.wait()
+            for _ in steps:
+                pass
             return
-        # the bottom margin in pixels: room for the tick labels and "time (s)" at any height
-        bottom = min(0.3, 40.0 / max(fig.get_figheight() * fig.dpi, 1.0))
-        # the left margin too: two-line y labels beside tick labels such as "-22.5"
-        left = min(0.3, 84.0 / max(fig.get_figwidth() * fig.dpi, 1.0))
-        grid = fig.add_gridspec(len(self.panels), 1, height_ratios=[p.height for p in self.panels],
-                                left=left, right=0.99, top=0.985, bottom=bottom, hspace=0.09)
-        first = None
-        for i, panel in enumerate(self.panels):
-            ax = fig.add_subplot(grid[i, 0], sharex=first)
-            first = first or ax
+        self._building = steps
+
+        def step() -> None:
+            if self._building is not steps:
+                return                  # replaced by a newer relayout
             try:
-                panel.draw(ax, self.view)
-            except Exception:  # a broken panel must not take the window down
-                log.exception("panel %r failed to draw", getattr(panel, "title", panel))
-                ax.text(0.5, 0.5, f"{getattr(panel, 'title', 'panel')}: drawing failed",
-                        transform=ax.transAxes, ha="center", va="center", color="red")
-            ax.tick_params(labelsize=7, length=2)
-            if i < len(self.panels) - 1:
-                ax.tick_params(labelbottom=False)
-            ax.grid(axis="x", color="#dddddd", lw=0.5)
-            self.axes.append(ax)
-        self.axes[-1].set_xlabel("time (s)", fontsize=8)
-        # animated: left out of full draws, drawn over the saved background (_on_draw, set_cursor)
-        self._cursor = Line2D([], [], color=CURSOR_COLOR, lw=1.2, animated=True,
-                              transform=IdentityTransform())
-        fig.add_artist(self._cursor)
-        self._draw_loop_spans()
-        first.set_xlim(*(xlim or (0.0, self.view.duration)))
-        fig.align_ylabels(self.axes)
-        self.canvas.draw()
+                next(steps)
+            except StopIteration:
+                self._building = None
+                return
+            QTimer.singleShot(STEP_MS, step)
+
+        self.canvas.when_idle(step)
+
+    def _stop_building(self) -> None:
+        steps, self._building = self._building, None
+        if steps is not None:
+            steps.close()
+
+    def _finish_building(self) -> None:
+        steps, self._building = self._building, None
+        if steps is not None:
+            for _ in steps:
+                pass
+
+    def _build_steps(self, xlim: tuple[float, float] | None):
+        """The relayout, a step per panel (a generator); no draw starts until it ends."""
+        self.canvas.hold()
+        try:
+            fig = self.figure
+            for ax in list(fig.axes):          # one at a time (fig.clear() clears each axes
+                ax.remove()                     # first: 70 ms for eight panels)
+                yield
+            fig.clear()
+            self.axes, self._spans, self._cursor = [], [], None
+            self._bg = None
+            panels = list(self.panels)
+            if not panels or self.view is None:
+                return
+            yield
+            left, bottom = self._margins()
+            grid = fig.add_gridspec(len(panels), 1, height_ratios=[p.height for p in panels],
+                                    left=left, right=0.99, top=0.985, bottom=bottom, hspace=0.09)
+            self._grid = grid
+            first = None
+            for i, panel in enumerate(panels):
+                ax = fig.add_subplot(grid[i, 0], sharex=first)
+                first = first or ax
+                self._draw_panel(panel, ax, last=i == len(panels) - 1)
+                self.axes.append(ax)
+                yield
+            self.axes[-1].set_xlabel("time (s)", fontsize=8)
+            # animated: left out of full draws, drawn over the saved background (_on_draw, set_cursor)
+            self._cursor = Line2D([], [], color=CURSOR_COLOR, lw=1.2, animated=True,
+                                  transform=IdentityTransform())
+            fig.add_artist(self._cursor)
+            self._draw_loop_spans()
+            first.set_xlim(*(xlim or (0.0, self.view.duration)))
+        finally:
+            self.canvas.release()
+
+    def _margins(self) -> tuple[float, float]:
+        """The left and bottom margins as fractions of the figure: fixed in pixels (the y labels
+        and tick labels; the time axis), whatever the size."""
+        fig = self.figure
+        return (min(0.3, LABEL_MARGIN_PX / max(fig.get_figwidth() * fig.dpi, 1.0)),
+                min(0.3, BOTTOM_MARGIN_PX / max(fig.get_figheight() * fig.dpi, 1.0)))
+
+    def _fit_to_size(self) -> None:
+        """After a resize: the margins in pixels and every y label fitted again (they were
+        fractions of the size the figure was built at: a narrower timeline cut "upper lip" off
+        its label)."""
+        if self._grid is None or not self.axes:
+            return
+        left, bottom = self._margins()
+        self._grid.update(left=left, bottom=bottom)
+        for ax in self.axes:            # (GridSpec.update moves only pyplot's figures' axes)
+            ax.set_position(ax.get_subplotspec().get_position(self.figure))
+        refit_ylabels(self.axes)
+
+    def _draw_panel(self, panel: Panel, ax, last: bool) -> None:
+        try:
+            panel.draw(ax, self.view)
+        except Exception:  # a broken panel must not take the window down
+            log.exception("panel %r failed to draw", getattr(panel, "title", panel))
+            ax.text(0.5, 0.5, f"{getattr(panel, 'title', 'panel')}: drawing failed",
+                    transform=ax.transAxes, ha="center", va="center", color="red")
+        refit_ylabels([ax])                     # every panel's label placed the same way
+        ax.tick_params(labelsize=7, length=2)
+        if not last:
+            ax.tick_params(labelbottom=False)
+        ax.grid(axis="x", color="#dddddd", lw=0.5)
 
     def _draw_loop_spans(self) -> None:
         for s in self._spans:
@@ -320,11 +415,16 @@ class Timeline(QWidget):
         return self._bg is not None
 
     def ensure_drawn(self) -> None:
-        """Bring the canvas up to date for a picture of it (a screenshot): a full draw only when
-        the last one is stale (never drawn, resized, zoomed, loop range changed). Otherwise the
+        """Bring the canvas up to date for a picture of it (a screenshot): a relayout being built
+        is finished and a full draw made only when the last one is stale (never drawn, resized,
+        zoomed, loop range changed; a background draw running is waited for). Otherwise the
         canvas already holds that draw with the cursor blitted at ``cursor_time``, pixel for
         pixel what a new full draw gives (``test_a_moved_cursor_leaves_no_trace``)."""
+        self._finish_building()
+        self.canvas.wait()
         if not self.cursor_ready or tuple(self.figure.bbox.bounds) != self._bg_bounds:
+            self.canvas.finish()
+        if not self.cursor_ready:
             self.canvas.draw()
 
     def _request_draw(self) -> None:
@@ -333,7 +433,9 @@ class Timeline(QWidget):
         self._bg = None
         self.canvas.draw_idle()
 
-    def _on_draw(self, event) -> None:
+    def _on_draw(self) -> None:
+        if self._building is not None:
+            return                      # a relayout is on its way: its draw follows
         self._bg = self.canvas.copy_from_bbox(self.figure.bbox)
         self._bg_bounds = tuple(self.figure.bbox.bounds)
         self._cursor_rows = [(ax.bbox.y0, ax.bbox.y1) for ax in self.axes]
@@ -356,6 +458,8 @@ class Timeline(QWidget):
 
     def _on_resize(self, event) -> None:
         self._bg = None
+        if self._building is None:
+            self.canvas.when_idle(self._fit_to_size)
 
     def set_cursor(self, t: float, follow: bool = False) -> None:
         """Move the cursor to ``t`` seconds by blitting; with ``follow`` the visible range pages
@@ -369,7 +473,7 @@ class Timeline(QWidget):
                 width = hi - lo
                 lo = min(max(0.0, t - 0.1 * width), max(0.0, self.view.duration - width))
                 self.axes[0].set_xlim(lo, lo + width)
-                self.canvas.draw()
+                self._request_draw()
                 return
         if self._bg is None or tuple(self.figure.bbox.bounds) != self._bg_bounds:
             self._request_draw()     # a full draw is due anyway (layout, resize, zoom)

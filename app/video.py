@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from engine.analysis.lips import closed_lips
 from engine.data import PhoneSegment, Utterance
 from engine.io.audio import write_audio
 from engine.io.files import atomic_write
@@ -24,7 +25,7 @@ from engine.method.model import Model
 from engine.method.pipeline import Synthesis
 
 from .style import BACKGROUND, CURSOR_COLOR, ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
-from .surface import face_triangles, lip_contours
+from .surface import Mouth, face_triangles, lip_contours
 from .view3d import CAMERA_PRESETS, MarkerSet
 
 log = logging.getLogger(__name__)
@@ -248,8 +249,9 @@ class VideoFrames:
         self.plotter.add_light(pv.Light(light_type="headlight", intensity=0.75))
         self.plotter.add_light(pv.Light(position=(0.4, 1.0, 0.6), light_type="camera light",
                                         intensity=0.35))
+        mouth = Mouth.between(neutral, contours, closed_lips(model).markers)   # it shuts at /p b m/
         self.synth_set = MarkerSet(self.plotter, "synthesized", SYNTH_COLOR, neutral, contours,
-                                   triangles)
+                                   triangles, mouth)
         self.orig_set = None
         if original is not None:
             self.orig_set = MarkerSet(self.plotter, "original", ORIGINAL_COLOR, neutral, contours, None)

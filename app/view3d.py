@@ -12,19 +12,22 @@ import logging
 import numpy as np
 import pyvista as pv
 from PyQt6.QtCore import QPoint
-from PyQt6.QtGui import QCursor, QImage, QPainter, QPixmap
+from PyQt6.QtGui import QCursor
 from PyQt6.QtWidgets import QToolTip, QVBoxLayout, QWidget
 
+from engine.analysis.lips import ClosedLips, closed_lips
 from engine.method.model import Model
 
 from .plotter_widget import is_native, make_plotter
 from .state import UtteranceView
-from .style import BACKGROUND, ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
-from .surface import lip_contours, stored_face_triangles
+from .style import BACKGROUND, CAVITY_COLOR, ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
+from .surface import Mouth, lip_contours, stored_face_triangles
 
 log = logging.getLogger(__name__)
 
 SURFACE_INSET_MM = 4.0
+#: how far behind the lips the dark backing of the mouth opening lies
+CAVITY_DEPTH_MM = 4.0
 
 CAMERA_PRESETS: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] = {
     # direction from the face to the camera (x to the talker's left, y up, z forward), view up
@@ -55,11 +58,14 @@ def _fill_nan(markers: np.ndarray, fallback: np.ndarray) -> np.ndarray:
 
 class MarkerSet:
     """One marker set in the scene: points, lip lines, optionally a surface, all sharing points.
-    Adding them renders nothing (the owner renders the finished scene once)."""
+    The surface has the lips' inner edges too (``mouth``, :class:`app.surface.Mouth`): the mouth
+    closes where the lips meet. Adding them renders nothing (the owner renders the finished scene
+    once)."""
 
     def __init__(self, plotter: pv.BasePlotter, name: str, color: str, neutral: np.ndarray,
-                 contours: list[list[int]], triangles: np.ndarray | None):
+                 contours: list[list[int]], triangles: np.ndarray | None, mouth: Mouth | None = None):
         self.name = name
+        self.mouth = mouth if triangles is not None and len(triangles) else None
         self.points = pv.PolyData(neutral.copy())
         self.points.verts = np.column_stack([np.ones(len(neutral), int), np.arange(len(neutral))]).ravel()
         self.actor = plotter.add_mesh(self.points, color=color, render_points_as_spheres=True,
@@ -73,30 +79,68 @@ class MarkerSet:
                                            reset_camera=False, pickable=False, render=False)
         self.surface_actor = None
         self._inset: np.ndarray | None = None
+        self.n_markers = len(neutral)
         if triangles is not None and len(triangles):
-            faces = np.column_stack([np.full(len(triangles), 3), triangles]).ravel()
-            # normals of the neutral face, kept (the face moves little): smooth, cheap shading
-            shape = pv.PolyData(neutral, faces=faces).compute_normals(
-                cell_normals=False, auto_orient_normals=True, consistent_normals=True)
-            normals = np.asarray(shape.point_data["Normals"])
-            if normals[:, 2].mean() < 0:       # z is forward: normals face the viewer
-                normals = -normals
-            # the surface lies SURFACE_INSET_MM under the markers, so that it hides neither its
-            # own markers nor original markers a little behind them; opaque, because a
-            # translucent surface costs an order-independent transparency pass (several times
-            # the whole frame on a software renderer)
-            self._inset = SURFACE_INSET_MM * normals
-            self.surface = pv.PolyData(neutral - self._inset, faces=faces)
-            self.surface.point_data.active_normals = normals
-            self.surface_actor = plotter.add_mesh(self.surface, color=SURFACE_COLOR, opacity=1.0,
-                                                  smooth_shading=False, name=f"{name}-surface",
-                                                  reset_camera=False, pickable=False,
-                                                  specular=0.1, ambient=0.3, diffuse=0.75, render=False)
-            self.surface_actor.GetProperty().SetInterpolationToGouraud()
+            self._add_surface(plotter, name, neutral, triangles)
         self.current = neutral.copy()
         # numpy views of the VTK point arrays: a frame update writes into them in place
         self.xyz = self.points.points
         self.surface_xyz = self.surface.points if self._inset is not None else None
+
+    def _add_surface(self, plotter: pv.BasePlotter, name: str, neutral: np.ndarray,
+                     triangles: np.ndarray) -> None:
+        vertices, tri = neutral, triangles
+        if self.mouth is not None:
+            vertices = np.vstack([neutral, self.mouth.points(neutral)])
+            tri = np.vstack([triangles, self.mouth.triangles(len(neutral))])
+        faces = np.column_stack([np.full(len(tri), 3), tri]).ravel()
+        # normals of the neutral face, kept (the face moves little): smooth, cheap shading
+        shape = pv.PolyData(vertices, faces=faces).compute_normals(
+            cell_normals=False, auto_orient_normals=True, consistent_normals=True)
+        normals = np.asarray(shape.point_data["Normals"])
+        faces = shape.faces                # wound consistently (the lips' strips too): no face
+        #                                    of the surface is lit as a back face
+        if normals[:, 2].mean() < 0:       # z is forward: normals face the viewer
+            normals = -normals
+        if self.mouth is not None:         # an inner edge point lies as deep as its marker
+            normals[self.n_markers:] = normals[self.mouth.owners()]
+        # the surface lies SURFACE_INSET_MM under the markers, so that it hides neither its
+        # own markers nor original markers a little behind them; opaque, because a
+        # translucent surface costs an order-independent transparency pass (several times
+        # the whole frame on a software renderer)
+        self._inset = SURFACE_INSET_MM * normals
+        self.surface = pv.PolyData(vertices - self._inset, faces=faces)
+        self.surface.point_data.active_normals = normals
+        self.surface_actor = plotter.add_mesh(self.surface, color=SURFACE_COLOR, opacity=1.0,
+                                              smooth_shading=False, name=f"{name}-surface",
+                                              reset_camera=False, pickable=False,
+                                              specular=0.1, ambient=0.3, diffuse=0.75, render=False)
+        self.surface_actor.GetProperty().SetInterpolationToGouraud()
+        if self.mouth is not None:
+            self._add_cavity(plotter, name, vertices)
+
+    def _add_cavity(self, plotter: pv.BasePlotter, name: str, vertices: np.ndarray) -> None:
+        """A dark backing behind the mouth opening (a fan over its outline, moved CAVITY_DEPTH_MM
+        straight back and a little wider than it): an open mouth shows dark, a closed one skin,
+        instead of the background through a hole."""
+        self._cavity_loop = self.mouth.opening_loop(self.n_markers)
+        n = len(self._cavity_loop)
+        faces = np.column_stack([np.full(n, 3), np.full(n, n), np.arange(n),
+                                 (np.arange(n) + 1) % n]).ravel()
+        self.cavity = pv.PolyData(self._cavity_points(vertices - self._inset), faces=faces)
+        self.cavity_actor = plotter.add_mesh(self.cavity, color=CAVITY_COLOR, name=f"{name}-mouth",
+                                             reset_camera=False, pickable=False, lighting=False,
+                                             render=False)
+
+    def _cavity_points(self, surface: np.ndarray) -> np.ndarray:
+        """The backing's outline and centre for the surface's vertices ``surface``: the opening
+        moved back (z is forward), a tenth wider and twice as tall about its centre (behind
+        the lips: the opaque surface hides what is not behind the opening)."""
+        loop = surface[self._cavity_loop]
+        centre = loop.mean(axis=0)
+        out = centre + (loop - centre) * [1.1, 2.0, 1.0]    # taller: it fills the opening seen
+        out[:, 2] = loop[:, 2] - CAVITY_DEPTH_MM             # from above or below too
+        return np.vstack([out, centre - [0.0, 0.0, CAVITY_DEPTH_MM]])
 
     def set_points(self, pts: np.ndarray) -> None:
         """Move the markers (and their lip lines and surface) to ``pts``, in place: the same
@@ -105,7 +149,12 @@ class MarkerSet:
         np.copyto(self.xyz, pts)
         self.points.GetPoints().Modified()
         if self.surface_xyz is not None:
-            np.subtract(pts, self._inset, out=self.surface_xyz)
+            m = self.n_markers
+            np.subtract(pts, self._inset[:m], out=self.surface_xyz[:m])
+            if self.mouth is not None:
+                np.subtract(self.mouth.points(pts), self._inset[m:], out=self.surface_xyz[m:])
+                self.cavity.points[:] = self._cavity_points(self.surface_xyz)
+                self.cavity.GetPoints().Modified()
             self.surface.GetPoints().Modified()
 
     def set_visible(self, visible: bool, surface: bool) -> None:
@@ -113,6 +162,8 @@ class MarkerSet:
         self.line_actor.SetVisibility(visible)
         if self.surface_actor is not None:
             self.surface_actor.SetVisibility(visible and surface)
+        if self.mouth is not None:
+            self.cavity_actor.SetVisibility(visible and surface)
 
 
 class FaceView(QWidget):
@@ -120,8 +171,9 @@ class FaceView(QWidget):
     ``show_frame(k)`` displays frame ``k`` of the view."""
 
     def __init__(self, parent: QWidget | None = None, multi_samples: int = 0,
-                 native: bool | None = None):
+                 native: bool | None = None, closed_mouth: bool = True):
         super().__init__(parent)
+        self.closed_mouth = closed_mouth       # False: the lips' strips left out (the old surface)
         self.plotter = make_plotter(self, multi_samples, native)
         self.plotter.set_background(BACKGROUND)
         lay = QVBoxLayout(self)
@@ -144,8 +196,9 @@ class FaceView(QWidget):
         self.plotter.iren.add_observer("MouseMoveEvent", self._on_mouse_move)
 
     # ------------------------------------------------------------------ scene
-    def set_model(self, model: Model) -> None:
-        """Build the scene for ``model``'s marker set."""
+    def set_model(self, model: Model, closed: ClosedLips | None = None) -> None:
+        """Build the scene for ``model``'s marker set; ``closed``: the talker's lips at closure
+        (``engine.analysis.lips.closed_lips``, made here if not given), where the mouth shuts."""
         self.model = model
         self.ahead = -1
         self.plotter.clear()
@@ -159,8 +212,13 @@ class FaceView(QWidget):
         self.neutral = neutral
         self.contours = lip_contours(neutral, model.upper_lip, model.lower_lip, list(model.lip_corners))
         tri = stored_face_triangles(neutral, self.contours)
-        self.synth = MarkerSet(self.plotter, "synthesized", SYNTH_COLOR, neutral, self.contours, tri)
-        self.original = MarkerSet(self.plotter, "original", ORIGINAL_COLOR, neutral, self.contours, None)
+        closed = closed if closed is not None else closed_lips(model)
+        mouth = Mouth.between(neutral, self.contours, closed.markers) if self.closed_mouth else None
+        self.synth = MarkerSet(self.plotter, "synthesized", SYNTH_COLOR, neutral, self.contours, tri,
+                               mouth)
+        # the original markers have a surface too: shown when the synthesized ones are hidden
+        self.original = MarkerSet(self.plotter, "original", ORIGINAL_COLOR, neutral, self.contours,
+                                  tri, mouth)
         width = float(np.ptp(neutral[:, 0]))
         self._half_gap = np.array([0.55 * width + 10.0, 0.0, 0.0])
         # no VTK text (legend, caption): re-rasterizing text costs more than the whole scene on a
@@ -181,7 +239,9 @@ class FaceView(QWidget):
         if self.synth is None:
             return
         has_orig = self._orig is not None or self.view is None
-        self.original.set_visible(self.show_original and has_orig, False)
+        # one surface: the synthesized face's, or the original's when only it is shown
+        self.original.set_visible(self.show_original and has_orig,
+                                  self.show_surface and not self.show_synth)
         self.synth.set_visible(self.show_synth, self.show_surface)
         self._offset = self._half_gap if (self.side_by_side and has_orig) else np.zeros(3)
 
@@ -234,24 +294,6 @@ class FaceView(QWidget):
         self.plotter.render()
 
     # ------------------------------------------------------------------ options
-    def paint_into(self, pix: QPixmap, top: QWidget) -> None:
-        """Draw the rendered 3-D scene over its place in ``pix``, a grab of ``top`` (a widget grab
-        does not contain the OpenGL view)."""
-        img = self.plotter.screenshot(return_img=True)
-        if img is None or not img.size:
-            return
-        h, w = img.shape[:2]
-        rgb = np.ascontiguousarray(img[:, :, :3])
-        qimg = QImage(rgb.data, w, h, 3 * w, QImage.Format.Format_RGB888)
-        painter = QPainter(pix)
-        interactor = self.plotter.interactor
-        target = interactor.mapTo(top, QPoint(0, 0))
-        dpr = pix.devicePixelRatio()
-        size = interactor.size()
-        painter.drawImage(target.x(), target.y(), qimg.scaled(int(size.width() * dpr),
-                                                              int(size.height() * dpr)))
-        painter.end()
-
     def set_side_by_side(self, on: bool) -> None:
         self.side_by_side = bool(on)
         self._update_visibility()

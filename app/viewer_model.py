@@ -25,12 +25,13 @@ from engine.data import Utterance
 from engine.errors import FacetrajError
 from engine.evaluation.paper import FIGURE4_TEXT
 from engine.evaluation.scores import evaluate_utterance
-from engine.io.corpus import Corpus
+from engine.io.corpus import Corpus, label_path
 from engine.method.model import Model
 from engine.method.modes import choose_mode
 from engine.progress import Progress
 
 from .phases import mark
+from .provenance import LabelOrigin, search_key, search_title
 from .state import UtteranceView, build_view
 
 log = logging.getLogger(__name__)
@@ -63,6 +64,7 @@ class SynthRequest:
     config: SynthConfig
     generation: int
     mode_chosen: bool = False
+    origin: LabelOrigin | None = None      # the label file or transcript, when known
 
     def run(self, progress: Progress | None = None) -> UtteranceView:
         """Load and synthesize (slow: run in a worker). Without phone labels the synthesis is
@@ -74,7 +76,8 @@ class SynthRequest:
             progress(0.3, f"synthesizing {utt.name}")
         choice = choose_mode(self.config, utt.phones, utt.provenance, explicit=self.mode_chosen,
                              tuned=self.model.tuned)
-        return build_view(self.model, utt, self.split, choice.config, choice.describe())
+        return build_view(self.model, utt, self.split, choice.config, choice.describe(),
+                          self.origin)
 
 
 @dataclass
@@ -86,6 +89,7 @@ class ViewerModel:
     model: Model | None = None
     texts: dict[str, str] = field(default_factory=dict)
     external: dict[str, Utterance] = field(default_factory=dict)
+    external_origin: dict[str, LabelOrigin] = field(default_factory=dict)
     view: UtteranceView | None = None
     pending_utterance: str | None = None     # asked for before the model was ready
     pending_time: float | None = None        # where the first utterance starts
@@ -100,6 +104,7 @@ class ViewerModel:
         opened from files. Returns the utterance to show first (the one asked for, or the default)."""
         self.corpus, self.model, self.texts = corpus, model, texts
         self.external.clear()
+        self.external_origin.clear()
         self.view = None
         self.request = None
         first = self.pending_utterance or (self.default_utterance() if self.show_default else None)
@@ -118,12 +123,14 @@ class ViewerModel:
                 return utt_id
         return (info.test or info.train or [None])[0]
 
-    def add_external(self, utt: Utterance) -> str:
-        """Keep an utterance opened from files under a name no corpus utterance has; return it."""
+    def add_external(self, utt: Utterance, origin: LabelOrigin | None = None) -> str:
+        """Keep an utterance opened from files (and where its labels came from) under a name no
+        corpus utterance has; return it."""
         name = utt.name
         while name in (self.corpus.info.ids if self.corpus else []):
             name += "'"
         self.external[name] = replace(utt, name=name)
+        self.external_origin[name] = origin or LabelOrigin(utt.label_source)
         return name
 
     # ------------------------------------------------------------------ requests
@@ -136,32 +143,52 @@ class ViewerModel:
             return None
         if utt_id in self.external:
             utt = self.external[utt_id]
-            return self._new_request(lambda: utt, "external", True)
+            return self._new_request(lambda: utt, "external", True, self.external_origin.get(utt_id))
         if self.corpus is None:
             return None
         corpus, info = self.corpus, self.corpus.info
         if utt_id not in info.ids:
             raise FacetrajError(f"{utt_id}: no such utterance in {corpus.root}")
         split = "test" if utt_id in info.test else "train"
-        return self._new_request(lambda: corpus.utterance(utt_id), split, True)
+        try:
+            origin = LabelOrigin("file", file=label_path(corpus.data_root, utt_id).name)
+        except FacetrajError:           # reading the utterance reports it
+            origin = None
+        return self._new_request(lambda: corpus.utterance(utt_id), split, True, origin)
 
-    def set_config(self, config: SynthConfig) -> tuple[bool, SynthRequest | None]:
-        """Use new settings: (whether they changed, the re-synthesis of the latest request)."""
-        if config == self.synth_config:
+    def set_config(self, config: SynthConfig, explicit: bool = False) -> tuple[bool, SynthRequest | None]:
+        """Use new settings: (whether they changed, the re-synthesis of the latest request).
+        ``explicit``: the user chose the search (``config.mode``): the labels' rule must not switch
+        it (``choose_mode(explicit=True)``), and the utterance is synthesized again when the search
+        shown differs, even with unchanged settings (choosing "phonetic" while the robust search
+        chosen for aligned labels was shown did nothing)."""
+        changed = config != self.synth_config
+        shown = self.view.synthesis.config if self.view is not None else None
+        if explicit:
+            self.mode_chosen = True
+            if shown is not None and search_key(shown) == search_key(config) and (
+                    shown.with_(mode=config.mode) == config.with_(mode=shown.mode)):
+                self.synth_config = config      # the view shows it already: nothing to redo
+                return changed, None
+            if not changed and shown is None:
+                return False, None
+        elif not changed:
             return False, None
-        self.mode_chosen |= config.mode != self.synth_config.mode
+        else:
+            self.mode_chosen |= config.mode != self.synth_config.mode
         self.synth_config = config
         req = self.request
         if req is None:
-            return True, None
+            return changed, None
         # the utterance asked for last (it may still be on its way)
-        return True, self._new_request(req.load, req.split, req.new_utterance)
+        return changed, self._new_request(req.load, req.split, req.new_utterance, req.origin)
 
-    def _new_request(self, load: Callable[[], Utterance], split: str, new_utterance: bool) -> SynthRequest:
+    def _new_request(self, load: Callable[[], Utterance], split: str, new_utterance: bool,
+                     origin: LabelOrigin | None = None) -> SynthRequest:
         assert self.model is not None
         self.generation += 1
         self.request = SynthRequest(load, split, new_utterance, self.model, self.synth_config,
-                                    self.generation, self.mode_chosen)
+                                    self.generation, self.mode_chosen, origin)
         return self.request
 
     def is_current(self, request: SynthRequest) -> bool:
@@ -175,8 +202,7 @@ class ViewerModel:
             return False
         self.view = view
         utt = view.utterance
-        self.request = SynthRequest(lambda: utt, view.split, False, request.model, request.config,
-                                    request.generation)
+        self.request = replace(request, load=lambda: utt, split=view.split, new_utterance=False)
         return True
 
     def take_pending_time(self, default: float) -> float:
@@ -225,17 +251,22 @@ SMOOTHING_NAMES = {"triangular": "triangular", "spline": "spline", "none": "unsm
 
 
 def view_title(view: UtteranceView) -> str:
-    """The title over the panels: utterance, split, text and how the 3-D synthesis was made."""
+    """The title over the panels: utterance, split, text, how the 3-D synthesis was made (the
+    search the synthesis used, ``Synthesis.config``) and where the labels came from. The text of
+    recognized labels is not shown: it is not what they say."""
     utt, cfg = view.utterance, view.synthesis.config
-    text = f" — “{utt.text}”" if utt.text else ""
+    origin = view.label_origin
+    text = f" — “{utt.text}”" if utt.text and origin.source != "recognized" else ""
+    n = f", N={cfg.n_context_phones}" if cfg.mode in ("phonetic", "robust") else ""
     return (f"{utt.name} ({view.split}){text}    ·    3-D: {SMOOTHING_NAMES[cfg.smoothing]} synthesis, "
-            f"{cfg.mode}, N={cfg.n_context_phones}")
+            f"{search_title(cfg)}{n};  labels: {origin.text()}")
 
 
 def view_summary(view: UtteranceView) -> str:
-    """The status line of a new view: frames, rate, speech frames, and the mode and why."""
+    """The status line of a new view: frames, rate, speech frames, the labels' origin, the mode
+    and why, and the voice match."""
     text = (f"{view.utterance.name}: {view.n_frames} frames at {view.rate:g} Hz, "
-            f"{int(view.speech.sum())} speech frames")
+            f"{int(view.speech.sum())} speech frames; labels: {view.label_origin.text()}")
     text = f"{text}; {view.mode_reason}" if view.mode_reason else text
     return f"{text}; voice match {view.voice_match:.2f}" if math.isfinite(view.voice_match) else text
 

@@ -1,5 +1,6 @@
 """The main window's menus and docks: menus by name (new ones before Help), menu entries whose
-engine errors are reported rather than raised, and docks tabbed together by area."""
+engine errors are reported rather than raised, and docks tabbed together by area, each view in a
+scroll area so that no dock can push the window wider than the screen."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ from typing import Any
 
 from PyQt6.QtCore import Qt
 from PyQt6.QtGui import QAction
-from PyQt6.QtWidgets import QDockWidget, QMainWindow, QMenu, QWidget
+from PyQt6.QtWidgets import QDockWidget, QFrame, QMainWindow, QMenu, QScrollArea, QWidget
 
 from engine.errors import FacetrajError
 
@@ -65,10 +66,36 @@ class WindowDocks:
         return dock
 
     def add(self, widget: QWidget, title: str, area: Qt.DockWidgetArea) -> QDockWidget:
-        """A dock tabbed with the one added to the same area before it."""
-        dock = self.dock(widget, title, area)
+        """A dock tabbed with the one added to the same area before it; ``widget`` sits in a
+        scroll area (``dock.widget().widget()``): a view wider than its dock scrolls instead of
+        widening the window (a main window grows to fit the minimum widths of its docks: four
+        analysis views took it from 1600 to 1864 px and it stayed so after they closed). The
+        first dock of an area gets :func:`dock_width` of the window."""
+        scroll = QScrollArea()
+        scroll.setWidget(widget)
+        scroll.setWidgetResizable(True)
+        scroll.setFrameShape(QFrame.Shape.NoFrame)
+        # across only: the views fill the dock's height (their tables, plots and splitters
+        # stretch or shrink), so no dock can make the window taller either
+        scroll.setVerticalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        dock = self.dock(scroll, title, area)
         previous = self.last.get(area)
         if previous is not None:
             self.window.tabifyDockWidget(previous, dock)
+        else:
+            orientation = (Qt.Orientation.Horizontal
+                           if area in (Qt.DockWidgetArea.LeftDockWidgetArea,
+                                       Qt.DockWidgetArea.RightDockWidgetArea)
+                           else Qt.Orientation.Vertical)
+            self.window.resizeDocks([dock], [dock_width(self.window.width())], orientation)
         self.last[area] = dock
         return dock
+
+
+def dock_width(window_width: int) -> int:
+    """The width an analysis dock opens with: a third of the window, 420-620 px.
+
+    >>> dock_width(1600), dock_width(1280), dock_width(2400)
+    (560, 448, 620)
+    """
+    return int(min(620, max(420, 0.35 * window_width)))

@@ -77,7 +77,7 @@ class SynthConfig:
     mode : ``phonetic`` (labels restrict the search, eq 4), ``acoustic`` (no labels) or
         ``robust`` (eq 4's and the acoustically nearest codewords together, the labels counting
         as much as their confidence, with acoustic context: ``engine.method.selection``; the default for
-        labels that are not hand-checked, :func:`engine.method.pipeline.mode_for`).
+        labels that are not hand-checked, :func:`engine.method.modes.choose_mode`).
     gamma_min, gamma_max, gamma_steps : the grid searched for gamma (eqs 6-7).
     smoothing : ``triangular`` (100 ms zero-phase window), ``spline`` or ``none``.
     triangle_s : the triangular window's total duration.

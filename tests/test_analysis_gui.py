@@ -64,7 +64,8 @@ def test_similarity_view_shows_engine_matrix(qtbot, model, tmp_path):
 
     w = SimilarityView(model)
     qtbot.addWidget(w)
-    w.show()
+    with qtbot.waitSignal(w.ready, timeout=WAIT_MS):      # clustered in the background
+        w.show()
     qtbot.waitExposed(w)
     order = cluster_phones(model).order
     k = len(order)
@@ -108,11 +109,20 @@ def test_metrics_view_table2_and_sweep_match_engine(qtbot, model, corpus, tmp_pa
     assert w.progress.value() == 1000
     sub = subset_corpus(corpus, 2)
     want = table2_rows(table2(model, sub, acoustic=False))
-    assert [w.table.item(r, 0).text() for r in range(w.table.rowCount())] == [r.name for r in want]
+    names = [w.table.item(r, 0).text() for r in range(w.table.rowCount())]
+    ours = [r for r, name in enumerate(names) if not name.strip().startswith("the paper")]
+    assert [names[r] for r in ours] == [r.name for r in want]
     assert [r.name for r in want][:4] == ["Train (Triang.)", "Train (Spline)", "Test (Triang.)",
                                           "Test (Spline)"]
     for col, metric in ((1, "whole_face"), (2, "lower_lip"), (3, "upper_lip")):
-        assert cell_values(w.table, col) == pytest.approx([getattr(r, metric) for r in want])
+        assert [w.table.item(r, col).value for r in ours] == pytest.approx(
+            [getattr(r, metric) for r in want])
+    # each phonetic N = 3 row is followed by the paper's (Table 2 of the paper)
+    from engine.evaluation.paper import table2_value
+    assert names[ours[0] + 1].strip() == "the paper, same condition"
+    assert [w.table.item(ours[0] + 1, c).value for c in (1, 2, 3)] == pytest.approx(
+        table2_value("train", "triangular"))
+    assert w.table.columnCount() == 6
     with qtbot.waitSignal(w.sweepDone, timeout=WAIT_MS):
         w.run_sweep.click()
     curves = {c.split: c for c in sweep_curves(sweep_n(model, sub, (1, 2)))}
@@ -131,7 +141,8 @@ def test_pc_slider_moves_points_by_eigenvector_times_value(qtbot, model):
     w = PCModeExplorer(model)
     qtbot.addWidget(w)
     w.resize(1000, 600)
-    w.show()
+    with qtbot.waitSignal(w.ready, timeout=WAIT_MS):      # its scene is built in steps
+        w.show()
     qtbot.waitExposed(w)
     neutral = model.neutral_face()
     assert w.displaced_points() == pytest.approx(neutral)
@@ -145,6 +156,11 @@ def test_pc_slider_moves_points_by_eigenvector_times_value(qtbot, model):
         want = neutral + value * model.pca.components[k].reshape(-1, 3)
         assert w.displaced_points() == pytest.approx(want, abs=1e-9)
     assert w.slider.maximum() == 3 * SLIDER_STEPS and w.slider.minimum() == -3 * SLIDER_STEPS
+    # the 2-D projection's arrows follow (its plots are built off the GUI thread first)
+    w.canvas.finish()
+    disp = want - neutral
+    assert w.quiver.U == pytest.approx(w.arrow_scale.value() * disp[:, 0])
+    assert w.ax_face.get_title().startswith("PC2 = ")
     # variance share of every PC, from the model
     heights = [b.get_height() for b in w.bars]
     assert heights == pytest.approx(100 * model.pca.explained_ratio)
@@ -224,23 +240,41 @@ def test_inspector_robust_mode_explains_choice(qtbot, model, corpus, tmp_path):
 def test_settings_panel_explains_modes_and_shows_tuned(qtbot):
     from app.settings_panel import MODE_NOTES, SynthSettingsPanel
 
+    def choose(key: str) -> None:                   # as a user does
+        p.mode.setCurrentIndex(p.mode.findData(key))
+        p.mode.activated.emit(p.mode.currentIndex())
+
     p = SynthSettingsPanel(SynthConfig())
     qtbot.addWidget(p)
     p.show()
+    chosen = []
+    p.searchChosen.connect(chosen.append)
     assert p.mode_note.text() == MODE_NOTES["phonetic"]
-    p.mode.setCurrentIndex(p.mode.findData("robust"))
-    assert p.mode_note.text() == MODE_NOTES["robust"]
+    assert not p.tuned_label.isVisible()              # the robust mode's settings: robust only
+    choose("robust")
+    assert p.mode_note.text() == MODE_NOTES["robust"] and p.tuned_label.isVisible()
     assert "without cross-validation" in (p.set_tuned({}) or p.tuned_label.text())
+    assert "`" not in p.tuned_label.text()
     p.set_limits(3, 10.0, {"settings": {"label_weight": 4.0, "triangle_s": 0.133,
                                         "n_context_phones": 6}, "folds": 2})
     assert "κ (label weight) = 4" in p.tuned_label.text() and "2 folds" in p.tuned_label.text()
-    p.mode.setCurrentIndex(p.mode.findData("phonetic"))
-    p.mode.setCurrentIndex(p.mode.findData("robust"))          # picks up the tuned N
+    choose("phonetic")
+    choose("robust")                                  # picks up the tuned N
     cfg = p.config()
     assert cfg.mode == "robust" and cfg.label_weight == 4.0 and cfg.triangle_s == 0.133
     assert cfg.n_context_phones == 6
-    p.mode.setCurrentIndex(p.mode.findData("phonetic"))
+    assert [c.mode for c in chosen] == ["robust", "phonetic", "robust"]
+    choose("phonetic")
     assert p.config().label_weight == SynthConfig().label_weight
+    # the search used is shown, and why it is not the one asked for; the settings still ask
+    # for theirs
+    p.show_used(SynthConfig(mode="robust"), SynthConfig(),
+                "robust mode: aligned labels are not hand-checked")
+    assert p.shown_search() == "robust" and p.mode_note.text() == MODE_NOTES["robust"]
+    assert p.mode_reason.isVisible() and "aligned labels are not hand-checked" in p.mode_reason.text()
+    assert p.config().mode == "phonetic"
+    p.show_used(SynthConfig(), SynthConfig(), "phonetic mode: hand-checked labels (the paper)")
+    assert p.shown_search() == "phonetic" and not p.mode_reason.isVisible()
 
 
 # ---------------------------------------------------------------------- errors
@@ -259,7 +293,8 @@ def test_error_view_matches_engine_and_jumps(qtbot, model, corpus, view):
     assert cell_values(w.phone_table, 1) == pytest.approx([p.correlation for p in rep.phones], nan_ok=True)
     assert cell_values(w.phone_table, 2) == pytest.approx([p.rms for p in rep.phones])
     assert cell_values(w.utt_table, 5) == pytest.approx([u.rms for u in rep.utterances])
-    # beside the table: the per-phone correlations as bars, sorted, one per phone with a value
+    # under the table: the per-phone correlations as bars, sorted, one per phone with a value
+    w.phone_chart.finish()                              # built and drawn off the GUI thread
     ax = w.phone_chart.figure.axes[0]
     finite = sorted(p.correlation for p in rep.phones if p.correlation == p.correlation)
     assert [b.get_width() for b in ax.patches] == pytest.approx(finite)
@@ -322,6 +357,7 @@ def assert_chart_matches_table(w) -> None:
     table = {(w.table.item(r, 0).value, w.table.item(r, 1).text(), w.table.item(r, 2).text()):
              w.table.item(r, 5).value for r in range(w.table.rowCount())}
     finite = {k: v for k, v in table.items() if v == v}
+    w.chart.finish()                                        # built and drawn off the GUI thread
     ax = w.chart.figure.axes[0]
     bars = ax.patches
     assert len(bars) == len(finite) > 0
@@ -404,6 +440,7 @@ def test_kinematics_chart_without_original_and_in_a_narrow_dock(qtbot):
     with qtbot.waitSignal(w.measured):
         w.set_view(view)
     assert w.table.rowCount() == 5
+    w.chart.finish()                                        # built off the GUI thread
     ax = w.chart.figure.axes[0]
     assert len(ax.patches) == 0
     assert any("no original markers" in t.get_text() for t in ax.texts)
@@ -426,15 +463,18 @@ def test_installed_in_main_window(qtbot, corpus, model):
     for t in VIEWS.values():
         assert t in texts
     for key in VIEWS:
-        assert views.open_view(key) is not None
-        assert views.docks[key].widget() is views.widgets[key]
+        if views.open_view(key) is None:                   # its module imported in the background
+            qtbot.waitUntil(lambda k=key: k in views.docks, timeout=WAIT_MS)
+        assert views.docks[key].widget().widget() is views.widgets[key]   # in a scroll area
+    qtbot.waitUntil(lambda: not win.timeline.building, timeout=WAIT_MS)
     # kinematics and errors put their panels into the stack
     titles = [p.title for p in win.timeline.panels]
     assert "lip aperture" in titles and "lip error" in titles
     assert any(t.startswith("tangential velocity") for t in titles)
     views.show_panels(list(PANELS))
     assert all(views.panel_actions[k].isChecked() for k in PANELS)
-    assert len(win.timeline.axes) == len(win.timeline.panels)
+    qtbot.waitUntil(lambda: not win.timeline.building, timeout=WAIT_MS)
+    assert len(win.timeline.axes) == len(win.timeline.panels) == 5 + len(PANELS)
     # the inspector follows the cursor
     ins = views.widgets["inspector"]
     with qtbot.waitSignal(ins.inspected, timeout=5000):
@@ -467,6 +507,9 @@ def test_export_buttons_write_or_report(qtbot, model, corpus, tmp_path, monkeypa
 
     sim = SimilarityView(model)
     qtbot.addWidget(sim)
+    assert not sim.csv_button.isEnabled()                # until the clustering is there
+    qtbot.waitUntil(lambda: sim.clustering is not None, timeout=WAIT_MS)
+    assert sim.csv_button.isEnabled()
     chosen.append(str(tmp_path / "sim.csv"))
     sim._export_csv()
     header = (tmp_path / "sim.csv").read_text().splitlines()[0].split(",")

@@ -187,21 +187,31 @@ def test_changing_n_resynthesizes(window, qtbot):
     assert win.view.utterance.name == other and win.settings.n.value() == 2
 
 
+def choose(combo, key) -> None:
+    """Pick the entry of ``combo`` whose data is ``key``, as a user does (``activated``)."""
+    combo.setCurrentIndex(combo.findData(key))
+    combo.activated.emit(combo.currentIndex())
+
+
 def test_acoustic_search_choice(window, qtbot):
     """The search menu: indexed acoustic-only weights K codewords per frame, the whole-codebook
-    entry (the paper's) weights all 5L, and phonetic comes back with the default K."""
+    entry (the paper's) weights all 5L, and phonetic comes back with the default K; the title
+    names the one used (both used to read "acoustic")."""
     win = window
     n_codewords = len(win.model.codebook.lsf)
     mode = win.settings.mode
-    for key, width in (("acoustic", SynthConfig().acoustic_prefilter), ("acoustic-full", n_codewords)):
+    for key, width, title in (("acoustic", SynthConfig().acoustic_prefilter,
+                               "acoustic only, indexed (K = 128)"),
+                              ("acoustic-full", n_codewords, "acoustic only, whole codebook")):
         with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
-            mode.setCurrentIndex(mode.findData(key))
+            choose(mode, key)
         qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
         synthesis = win.view.synthesis
         assert synthesis.config.mode == "acoustic"
         assert synthesis.frames.candidates.shape == (win.view.n_frames, width)
+        assert title in win.title.text() and win.settings.shown_search() == key
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
-        mode.setCurrentIndex(mode.findData("phonetic"))
+        choose(mode, "phonetic")
     qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
     assert win.synth_config == SynthConfig(n_context_phones=win.synth_config.n_context_phones)
 
@@ -260,6 +270,19 @@ def test_screenshot_command_line(trained_cache, tmp_path):
     assert _colour_count(img, style.SYNTH_COLOR) > 150
 
 
+def test_screenshot_error_is_printed_once(trained_cache, tmp_path):
+    """A bad utterance id in screenshot mode: exit 2 and the message once (the window's error
+    report used to log it and the screenshot handler print it again)."""
+    env = {**os.environ, "FACETRAJ_CACHE_DIR": str(trained_cache)}
+    proc = subprocess.run([sys.executable, "-m", "facetraj", "--screenshot", str(tmp_path / "x.png"),
+                           "--utterance", "nosuchid"], cwd=ROOT, env=env, capture_output=True,
+                          text=True, timeout=180)
+    assert proc.returncode == 2
+    lines = [ln for ln in proc.stderr.splitlines() if "nosuchid" in ln]
+    assert lines == [f"facetraj: error: nosuchid: no such utterance in {default_corpus()}"], proc.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
 def test_corrupt_file_shows_error_and_app_keeps_working(window, qtbot, tmp_path, monkeypatch):
     win = window
     bad = tmp_path / "broken.wav"
@@ -301,3 +324,53 @@ def test_corrupt_file_shows_error_and_app_keeps_working(window, qtbot, tmp_path,
     assert win.view.split == "external" and win.view.original is None
     assert win.view.synthesis.config.mode == "acoustic"
     assert win.browser.tree.currentItem() is win.browser.items[win.view.utterance.name]
+    # no original markers: the "original" box is off and unticked (it stayed ticked), and comes
+    # back as it was with a corpus utterance
+    box = win.view_bar.show_original
+    assert not box.isEnabled() and not box.isChecked() and "no original" in box.toolTip()
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        win.set_utterance(win.corpus.info.test[0])
+    assert box.isEnabled() and box.isChecked()
+
+
+def test_browser_scores_are_kept_per_settings(qtbot, toy_corpus, toy_model, monkeypatch):
+    """The lip-correlation sweep computes each utterance once per settings: after a change only
+    the new settings' scores are computed (the old ones stay shown, greyed), and going back to
+    earlier settings shows theirs at once with nothing computed (the sweep used to restart from
+    nothing after every change); the browser's columns say what they hold."""
+    from app import correlations
+    from app.browser import UtteranceBrowser
+    from app.viewer_model import ViewerModel
+    from app.workers import Gate, TaskRunner
+
+    browser = UtteranceBrowser()
+    qtbot.addWidget(browser)
+    assert browser.COLUMNS[1:] == ("lower lip r", "upper lip r")
+    state = ViewerModel()
+    state.set_model(toy_corpus, toy_model, {})
+    info = toy_corpus.info
+    browser.populate({"test": list(info.test), "train": list(info.train)}, {})
+    scores = correlations.BrowserScores(browser, TaskRunner(browser), Gate())
+    computed: list[str] = []
+    sweep = correlations.correlation_sweep
+    monkeypatch.setattr(correlations, "correlation_sweep",
+                        lambda m, c, ids, cfg, before: (computed.extend(u for _s, u in ids),
+                                                        sweep(m, c, ids, cfg, before))[1])
+    finished: list = []
+    n = len(state.correlation_ids())
+    texts = lambda: {u: browser.items[u].text(1) for u in info.ids}  # noqa: E731
+    scores.start(state, finished.append)
+    qtbot.waitUntil(lambda: len(finished) == 1, timeout=WAIT_MS)
+    first = texts()
+    assert len(computed) == n and "…" not in first.values()
+    state.set_config(state.synth_config.with_(n_context_phones=5))
+    scores.start(state, finished.append)
+    stale = browser.palette().placeholderText().color()
+    assert all(browser.items[u].foreground(1).color() == stale for u in info.ids)   # old: greyed
+    qtbot.waitUntil(lambda: len(finished) == 2, timeout=WAIT_MS)
+    assert len(computed) == 2 * n
+    state.set_config(state.synth_config.with_(n_context_phones=3))
+    scores.start(state, finished.append)
+    assert len(finished) == 3 and len(computed) == 2 * n          # known: shown, nothing computed
+    assert texts() == first
+    assert all(browser.items[u].foreground(1).color() != stale for u in info.ids)

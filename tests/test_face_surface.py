@@ -3,6 +3,8 @@ default face, open at the mouth, no triangle folded across the outline, none for
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numpy as np
 import pytest
 
@@ -129,3 +131,56 @@ def test_the_triangulation_is_stored_and_read_back(tmp_path, monkeypatch, defaul
     (tmp_path / "blocked").write_text("a file where the cache folder should be")
     monkeypatch.setenv("FACETRAJ_CACHE_DIR", str(tmp_path / "blocked"))
     np.testing.assert_array_equal(surface.stored_face_triangles(neutral, contours), made)
+
+
+# ---------------------------------------------------------------------- the mouth (issue 29)
+@pytest.fixture(scope="module")
+def boy(default_model, default_corpus):
+    """The original markers of s002 ("The boy enjoyed the noisy toy.") and its /b/ and /oy/."""
+    utt = default_corpus.utterance("s002")
+    markers = default_model.normalise_markers(utt.markers)
+    b = next(p for p in utt.phones if p.label == "b")
+    oy = next(p for p in utt.phones if p.label == "oy")
+    frame = lambda seg: int(round((seg.start + seg.end) / 2 * default_model.marker_rate))  # noqa: E731
+    return markers, frame(b), frame(oy)
+
+
+def test_the_mouth_closes_when_the_lips_meet(face, boy):
+    """At the /b/ of "boy" the lips' inner edges meet (the surface had a hole there: the markers
+    sit on the outside of the lips, 11 mm apart at closure); at /oy/ they are apart by the
+    aperture beyond the closed distance."""
+    from app.surface import Mouth
+    from engine.analysis.lips import closed_lips
+
+    m, neutral, contours, tri = face
+    closed = closed_lips(m)
+    assert closed.how == "bilabials" and closed.tokens > 50
+    assert 8.0 < float(closed.gap(m.upper_lip, m.lower_lip)) < 14.0        # about a lip's thickness
+    mouth = Mouth.between(neutral, contours, closed.markers)
+    markers, b, oy = boy
+    nu = len(mouth.upper)
+
+    def opening(k: int) -> np.ndarray:
+        """Each upper inner point's distance to its partner's inner point."""
+        inner = mouth.points(markers[k])
+        lower_of = {int(o): i for i, o in enumerate(mouth.lower)}
+        return np.array([np.linalg.norm(inner[i] - inner[nu + lower_of[int(p)]])
+                         for i, p in enumerate(mouth.partner_of_upper)])
+
+    assert opening(b).max() < 1e-6                                         # shut
+    centre = list(mouth.upper).index(m.upper_lip)
+    gap = np.linalg.norm(markers[oy, m.upper_lip] - markers[oy, m.lower_lip])
+    assert opening(oy)[centre] == pytest.approx(gap - float(closed.gap(m.upper_lip, m.lower_lip)),
+                                                abs=1e-6)
+    assert opening(oy)[centre] > 2.0                                       # open
+    # the lips' strips close the surface's mouth: with them no edge is left open between the
+    # contours (every contour edge of the lips is shared by two triangles)
+    strips = mouth.triangles(len(neutral))
+    full = np.vstack([tri, strips])
+    edges: dict[tuple[int, int], int] = {}
+    for t in full.tolist():
+        for a, c in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
+            edges[(min(a, c), max(a, c))] = edges.get((min(a, c), max(a, c)), 0) + 1
+    for lip in contours:
+        for a, c in pairwise(lip):
+            assert edges.get((min(a, c), max(a, c))) == 2, (a, c)

@@ -9,8 +9,11 @@ import pytest
 pytest.importorskip("pytestqt")
 pytest.importorskip("pyvistaqt")
 
-from app import live
+from screens import image_array, on_screen, place_in
+
+from app import live, style
 from app.main import build_window
+from app.plotter_widget import grab_with_3d
 from engine.config import SynthConfig
 from engine.errors import FacetrajError
 from engine.io.audio import read_audio
@@ -52,6 +55,17 @@ def test_live_window_plays_a_file_and_its_take_reopens(qtbot, default_model, utt
     window.face.rerender()
     assert np.asarray(window.face.plotter.screenshot()).std() > 10
     assert _image_std(window.grab().toImage()) > 10
+    # the picture saved (facetraj live --screenshot's) shows the face as the screen does (it was
+    # black), and the lip panels the main window's colours with a legend of the speech dots
+    qtbot.wait(200)
+    view = window.face.plotter.interactor
+    saved = place_in(image_array(grab_with_3d(window).toImage()), view, window).astype(float)
+    assert saved.std() > 20
+    assert np.abs(saved - on_screen(view).astype(float)).mean() < 6
+    assert window.lines[0].get_color() == style.TRIANGULAR_COLOR
+    assert window.dots[0].get_color() == style.SPEECH_DOT_COLOR
+    legend = [t.get_text() for t in window.axes[0].get_legend().get_texts()]
+    assert legend == ["synthesized, triangular", "speech frames (live energy)"]
     # the take: WAV + C3D, reopened like any utterance's files
     path, wav = window.save_take(tmp_path / "take.c3d")
     back, back_rate = read_audio(wav)
@@ -90,3 +104,26 @@ def test_live_toggle_in_the_main_window(qtbot, default_corpus, trained_cache, mo
     assert opened and opened[-1].isVisible()
     window.extension("live").action.setChecked(False)
     assert not opened[-1].isVisible()
+
+
+def test_live_screenshot_command_saves_the_face(default_model, tmp_path, default_corpus):
+    """``facetraj live --from-file ... --screenshot``: the face in the PNG, not black."""
+    import subprocess
+    import sys
+
+    from engine.io.corpus import audio_path
+
+    model = default_model.save(tmp_path / "m.npz")
+    out = tmp_path / "live.png"
+    proc = subprocess.run([sys.executable, "-m", "facetraj", "-q", "live", "--model", str(model),
+                           "--from-file", str(audio_path(default_corpus.root, "s002")),
+                           "--as-fast-as-possible", "--screenshot", str(out)],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    from PyQt6.QtGui import QImage
+
+    img = image_array(QImage(str(out))).astype(float)
+    left = img[:, : img.shape[1] // 2]
+    skin = np.array([int(style.SURFACE_COLOR[i:i + 2], 16) for i in (1, 3, 5)], float)
+    near = np.linalg.norm(left - skin, axis=2) < 60
+    assert near.mean() > 0.1, "the face surface is missing from the saved picture"

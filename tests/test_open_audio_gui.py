@@ -68,7 +68,8 @@ def test_open_audio_with_a_sentence_shows_aligned_phones(window, qtbot, clip, tm
     assert [w.label for w in utt.words] == ["the", "boy", "enjoyed", "the", "noisy", "toy"]
     assert [p.label for p in utt.phones if p.label != "sil"][:4] == ["dh", "ah", "b", "oy"]
     ax = _phone_axis(win)
-    assert ax.get_ylabel() == "words\nphones\n(aligned)"
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["phones (aligned)", "words"]
+    assert "labels: aligned from the sentence typed" in win.title.text()
     assert "boy" in [t.get_text() for t in ax.texts] and "oy" in [t.get_text() for t in ax.texts]
     assert win.audio_opener.box.combo.currentData() == "aligned"
     assert win.audio_opener.box.combo.isEnabled()
@@ -82,7 +83,9 @@ def test_open_audio_with_a_sentence_shows_aligned_phones(window, qtbot, clip, tm
         box.combo.setCurrentIndex(box.combo.findData("recognized"))
         box.combo.activated.emit(box.combo.currentIndex())
     assert win.view.utterance.label_source == "recognized" and win.view.utterance.words == []
-    assert _phone_axis(win).get_ylabel() == "phones\n(recog.)"     # short: fits a small tier
+    ax = _phone_axis(win)
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["phones (recognized)"]
+    assert SENTENCE not in win.title.text()     # not what recognized labels say
     assert not np.allclose(win.view.shown, aligned_lips)
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
         box.combo.setCurrentIndex(box.combo.findData("none"))
@@ -92,7 +95,9 @@ def test_open_audio_with_a_sentence_shows_aligned_phones(window, qtbot, clip, tm
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
         win.set_utterance(win.corpus.info.test[0])
     assert not box.combo.isEnabled()
-    assert _phone_axis(win).get_ylabel().endswith("(file)")
+    label_file = f"{win.view.utterance.name}.TextGrid"
+    assert [t.get_text() for t in _phone_axis(win).get_yticklabels()] == ["phones (label file)", "words"]
+    assert f"labels: label file {label_file}" in win.title.text()
 
 
 def test_menu_asks_the_sentence_and_a_missing_word(window, qtbot, clip, monkeypatch):
@@ -177,3 +182,55 @@ def test_recordings_from_the_command_line_open_one_after_another(qtbot, trained_
     assert view.utterance.provenance.kind == "recognized"
     assert view.synthesis.config.mode == "robust" and "voice match" in win.status_label.text()
     win.close()
+
+
+def test_the_search_shown_is_the_search_used_for_each_label_choice(window, qtbot, tmp_path):
+    """A recording with a label file and a transcript beside it, switched through its label
+    choices: the settings panel shows the search the synthesis used (``Synthesis.config``) and
+    the title names it and where the labels came from; choosing the search shown does nothing,
+    choosing another is obeyed (the panel read "phonetic" for aligned labels while the synthesis
+    was robust, and "robust" for no labels while it was acoustic-only)."""
+    from app.provenance import search_key, search_title
+
+    win = window
+    stem = tmp_path / "boy"
+    for suffix in (".flac", ".TextGrid", ".txt"):
+        shutil.copy(CLIP.with_suffix(suffix), stem.with_suffix(suffix))
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        win.open_audio(stem.with_suffix(".flac"))
+    box, mode = win.audio_opener.box, win.settings.mode
+    origins = {"file": "label file boy.TextGrid", "aligned": "aligned from boy.txt",
+               "recognized": "recognized from the speech (no text)",
+               "none": "none: acoustic-only synthesis"}
+    used = {}
+    for source in ("file", "aligned", "recognized", "none"):
+        if source != "file":
+            with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+                box.combo.setCurrentIndex(box.combo.findData(source))
+                box.combo.activated.emit(box.combo.currentIndex())
+        qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+        config = win.view.synthesis.config
+        used[source] = search_key(config)
+        assert win.settings.shown_search() == used[source], source
+        assert f"3-D: triangular synthesis, {search_title(config)}" in win.title.text(), source
+        assert f"labels: {origins[source]}" in win.title.text(), source
+        assert win.settings.mode_reason.isVisible() == (used[source] != "phonetic"), source
+    assert used == {"file": "phonetic", "aligned": "robust", "recognized": "robust",
+                    "none": "acoustic"}
+    # aligned labels (robust shown): choosing robust, the search shown, synthesizes nothing;
+    # choosing phonetic is obeyed
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        box.combo.setCurrentIndex(box.combo.findData("aligned"))
+        box.combo.activated.emit(box.combo.currentIndex())
+    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    assert win.settings.shown_search() == "robust"
+    generation = win.state.generation
+    mode.activated.emit(mode.findData("robust"))
+    assert win.state.generation == generation
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        mode.setCurrentIndex(mode.findData("phonetic"))
+        mode.activated.emit(mode.currentIndex())
+    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    assert win.view.synthesis.config.mode == "phonetic" and win.settings.shown_search() == "phonetic"
+    assert "phonetic (the paper), N=3" in win.title.text()
+    assert not win.settings.mode_reason.isVisible()

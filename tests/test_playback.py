@@ -285,7 +285,7 @@ def test_a_screenshot_uses_the_panels_as_drawn(window, tmp_path, monkeypatch):
 @gui
 @pytest.mark.gui
 def test_a_new_scene_renders_once(window):
-    """Building the scene for a model adds five meshes and renders the finished scene once (a
+    """Building the scene for a model adds its meshes and renders the finished scene once (a
     render per mesh was four renders too many on the first frame's path)."""
     face = window.face
     renders = []

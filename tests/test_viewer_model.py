@@ -117,6 +117,52 @@ def test_aligned_labels_are_synthesized_robust_unless_the_user_chose_a_mode(stat
     assert fresh.request_utterance(utt.name).run().synthesis.config.mode == "phonetic"
 
 
+def test_choosing_the_search_shown_is_explicit_and_the_title_names_the_search_used(state, toy_corpus):
+    """Choosing the search the view shows (the one the labels made the engine use) is the user's
+    choice from then on, with no synthesis to redo; choosing phonetic where robust is shown is
+    obeyed although the settings already asked for phonetic. The title and status line say the
+    search the synthesis used and where the labels came from."""
+    from app.provenance import LabelOrigin
+    from app.viewer_model import view_summary, view_title
+
+    utt = toy_corpus.utterance(toy_corpus.info.test[0])
+    name = state.add_external(replace(utt, markers=None, label_source="aligned", text="a b c",
+                                      provenance=Provenance("aligned")),
+                              LabelOrigin("aligned", transcript="x.txt"))
+    req = state.request_utterance(name)
+    view = req.run()
+    assert state.accept(req, view) and view.synthesis.config.mode == "robust"
+    assert "robust, N=3" in view_title(view) and "labels: aligned from x.txt" in view_title(view)
+    assert "“a b c”" in view_title(view)
+    assert "labels: aligned from x.txt; robust mode: aligned labels are not hand-checked" in \
+        view_summary(view)
+    changed, again = state.set_config(state.synth_config, explicit=True)       # phonetic: obeyed
+    assert not changed and again is not None and again.mode_chosen
+    view = again.run()
+    assert state.accept(again, view) and view.synthesis.config.mode == "phonetic"
+    assert "phonetic (the paper), N=3" in view_title(view)
+    generation = state.generation
+    changed, again = state.set_config(state.synth_config, explicit=True)       # shown: nothing
+    assert (changed, again, state.generation) == (False, None, generation)
+    # recognized labels: not the transcript in the title; acoustic: no N, the index's K named
+    state.add_external(replace(utt, markers=None, label_source="recognized", text="a b c",
+                               name="r"))
+    req = state.request_utterance("r")
+    view = req.run()
+    assert "“" not in view_title(view) and "recognized from the speech" in view_title(view)
+    state.set_config(state.synth_config.with_(mode="acoustic", acoustic_prefilter=None), explicit=True)
+    view = state.request.run()
+    assert "acoustic only, whole codebook (the paper);  labels:" in view_title(view)
+
+
+def test_provenance_doctests():
+    import doctest
+
+    import app.provenance
+
+    assert doctest.testmod(app.provenance).failed == 0
+
+
 def test_frame_and_phone_arithmetic(state, toy_corpus):
     req = state.request_utterance(toy_corpus.info.test[0])
     state.accept(req, req.run())

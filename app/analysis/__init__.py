@@ -11,23 +11,32 @@ Each view is also a standalone widget taking ``(model[, corpus], window=None)``.
 
 from __future__ import annotations
 
+import importlib
 import logging
+import sys
 from collections.abc import Callable
 
-from PyQt6.QtCore import QEvent, QObject, Qt
+from PyQt6.QtCore import QEvent, QObject, Qt, pyqtSignal
 from PyQt6.QtGui import QAction
 from PyQt6.QtWidgets import QDockWidget, QWidget
+
+from ..workers import keep_long_lived
 
 log = logging.getLogger(__name__)
 
 __all__ = ["AnalysisViews", "install"]
 
 
-class AnalysisViews:
-    """The analysis menu, docks and timeline panels of one main window."""
+class AnalysisViews(QObject):
+    """The analysis menu, docks and timeline panels of one main window. ``viewOpened(key)``
+    after a view is shown."""
+
+    viewOpened = pyqtSignal(str)
 
     def __init__(self, window):
+        super().__init__(window)
         self.window = window
+        self._importing: dict[str, list[Callable[[], None]]] = {}
         self.docks: dict[str, QDockWidget] = {}
         self.widgets: dict[str, QWidget] = {}
         self.panels: dict[str, object] = {}
@@ -52,31 +61,58 @@ class AnalysisViews:
         window.installEventFilter(_CloseWatcher(self, window))
 
     # ------------------------------------------------------------------ views
-    def _factories(self) -> dict[str, Callable[[], QWidget]]:
-        from .errors_view import ErrorView
-        from .inspector import CodebookInspector
-        from .metrics_view import MetricsView
-        from .pc_modes import PCModeExplorer
-        from .similarity_view import SimilarityView
+    def _after_import(self, module: str, fn: Callable[[], None], label: str) -> bool:
+        """Run ``fn`` now when the view module ``module`` is imported, else import it in the
+        background first (a view's module brings scipy's clustering or ``ndimage``: 0.1-1.7 s
+        that must not freeze the window) and run ``fn`` then. Whether ``fn`` ran now."""
+        name = f"{__name__}.{module}"
+        if name in sys.modules:
+            fn()
+            return True
+        waiting = self._importing.setdefault(name, [])
+        waiting.append(fn)
+        if len(waiting) == 1:
+            def done(_module) -> None:
+                for then in self._importing.pop(name, []):
+                    then()
 
+            def failed(exc: BaseException) -> None:
+                self._importing.pop(name, None)
+                self.window.report_error(exc)
+
+            self.window.run_task(lambda _p: importlib.import_module(name), done, label,
+                                 on_error=failed)
+        return False
+
+    def _create(self, key: str) -> QWidget:
+        """View ``key``'s widget (its module imported). Each view does its slow work in the
+        background (``app/analysis/common.py: task_runner``) or in steps (``one_per_pass``)."""
         w = self.window
-        return {
-            "similarity": lambda: SimilarityView(w.model, w),
-            "metrics": lambda: MetricsView(w.model, w.corpus, w),
-            "pc_modes": lambda: PCModeExplorer(w.model, w),
-            "inspector": lambda: CodebookInspector(w.model, w),
-            "errors": lambda: ErrorView(w.model, w.corpus, w),
-            "kinematics": lambda: self._kinematics_controls(),
-        }
+        if key == "kinematics":
+            return self._kinematics_controls()
+        module = sys.modules[f"{__name__}.{VIEW_MODULES[key]}"]
+        cls = getattr(module, VIEW_CLASSES[key])
+        if key in ("metrics", "errors"):
+            return cls(w.model, w.corpus, w)
+        return cls(w.model, w)
 
     def open_view(self, key: str) -> QWidget | None:
-        """Show view ``key`` (created on first use); None while no model is loaded."""
+        """Show view ``key`` (created on first use) and return it; None while no model is loaded
+        or while its module is imported in the background (``viewOpened`` follows)."""
         w = self.window
         if w.model is None:
             w.show_status("the model is not ready yet", 4000)
             return None
+        if self._after_import(VIEW_MODULES[key], lambda: self._open(key), f"opening {TITLES[key]}"):
+            return self.widgets[key]
+        return None
+
+    def _open(self, key: str) -> None:
+        w = self.window
+        if w.model is None:
+            return
         if key not in self.docks:
-            widget = self._factories()[key]()
+            widget = self._create(key)
             dock = w.add_dock(widget, TITLES[key], Qt.DockWidgetArea.RightDockWidgetArea)
             self.docks[key] = dock
             self.widgets[key] = widget
@@ -87,7 +123,8 @@ class AnalysisViews:
             self.show_panels(["aperture", "velocity"])
         if key == "errors":
             self.show_panels(["lip_error"])
-        return self.widgets[key]
+        keep_long_lived()       # full garbage passes over every view's objects froze the window
+        self.viewOpened.emit(key)
 
     def _kinematics_controls(self):
         from .kinematics_panels import KinematicsControls
@@ -98,15 +135,14 @@ class AnalysisViews:
 
     # ------------------------------------------------------------------ panels
     def _make_panel(self, key: str):
-        from .errors_view import LipErrorPanel
-        from .kinematics_panels import LipMeasurePanel
-
         model = self.window.model
         if key in ("aperture", "width", "protrusion"):
-            return LipMeasurePanel(model, key)
+            from .kinematics_panels import LipMeasurePanel
+            return LipMeasurePanel(model, key, getattr(self.window, "closed_lips", None))
         if key == "velocity":
             return self._kinematics_controls().panel
         if key == "lip_error":
+            from .errors_view import LipErrorPanel
             return LipErrorPanel(model)
         raise KeyError(key)
 
@@ -120,7 +156,7 @@ class AnalysisViews:
         finally:
             self._batch = False
         if self.window.model is not None:
-            tl.relayout(tl.xlim() if tl.axes else None)
+            tl.relayout(tl.xlim() if tl.axes else None, soon=True)
 
     def set_panel(self, key: str, on: bool) -> None:
         """Add or remove timeline panel ``key`` (kept checked and added once a model exists)."""
@@ -128,16 +164,25 @@ class AnalysisViews:
         if not on:
             panel = self.panels.pop(key, None)
             if panel is not None:
-                tl.remove_panel(panel)
+                tl.remove_panel(panel, soon=True)
             return
         if key in self.panels or self.window.model is None:
             return
+        self._after_import(PANEL_MODULES[key], lambda: self._add_panel(key),
+                           f"adding the {PANELS[key]} panel")
+
+    def _add_panel(self, key: str) -> None:
+        """Add panel ``key`` (its module imported) if it is still wanted."""
+        if (key in self.panels or self.window.model is None
+                or not self.panel_actions[key].isChecked()):
+            return
+        tl = self.window.timeline
         panel = self._make_panel(key)
         self.panels[key] = panel
         if self._batch:
             tl.panels.append(panel)
         else:
-            tl.add_panel(panel)
+            tl.add_panel(panel, soon=True)
 
     # ------------------------------------------------------------------ model changes
     def _model_changed(self) -> None:
@@ -197,6 +242,12 @@ TITLES = {
     "errors": "Errors",
     "kinematics": "Kinematics",
 }
+#: the module (in this package) and class of each view
+VIEW_MODULES = {"similarity": "similarity_view", "metrics": "metrics_view", "pc_modes": "pc_modes",
+                "inspector": "inspector", "errors": "errors_view", "kinematics": "kinematics_panels"}
+VIEW_CLASSES = {"similarity": "SimilarityView", "metrics": "MetricsView",
+                "pc_modes": "PCModeExplorer", "inspector": "CodebookInspector",
+                "errors": "ErrorView", "kinematics": "KinematicsControls"}
 PANELS = {
     "aperture": "lip aperture",
     "width": "lip width",
@@ -204,6 +255,11 @@ PANELS = {
     "velocity": "tangential velocity and landmarks",
     "lip_error": "lip error |original - synthesized|",
 }
+
+
+PANEL_MODULES = {"aperture": "kinematics_panels", "width": "kinematics_panels",
+                 "protrusion": "kinematics_panels", "velocity": "kinematics_panels",
+                 "lip_error": "errors_view"}
 
 
 def install(window) -> AnalysisViews:

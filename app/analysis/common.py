@@ -11,7 +11,6 @@ from typing import Any
 
 import numpy as np
 from matplotlib import colormaps
-from matplotlib.backends.backend_qtagg import FigureCanvasQTAgg
 from matplotlib.figure import Figure
 from PyQt6.QtCore import QEvent, QObject, Qt, QTimer
 from PyQt6.QtGui import QColor
@@ -19,18 +18,21 @@ from PyQt6.QtWidgets import (
     QFileDialog,
     QMessageBox,
     QSizePolicy,
+    QSplitter,
     QTableWidget,
     QTableWidgetItem,
     QWidget,
 )
 
+from app.figure_canvas import BackgroundCanvas
 from app.workers import TaskRunner
 
 log = logging.getLogger(__name__)
 
 
-class Canvas(FigureCanvasQTAgg):
-    """A matplotlib figure in a widget."""
+class Canvas(BackgroundCanvas):
+    """A matplotlib figure in a widget, drawn off the GUI thread (``app/figure_canvas.py``: change
+    the figure in ``when_idle``)."""
 
     def __init__(self, width: float = 6, height: float = 4, dpi: int = 100):
         self.figure = Figure(figsize=(width, height), dpi=dpi)
@@ -39,6 +41,7 @@ class Canvas(FigureCanvasQTAgg):
         self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
 
     def save_png(self, path: str | Path, dpi: int = 150) -> Path:
+        self.finish()                   # a build on its way is part of the picture
         path = Path(path)
         self.figure.savefig(path, dpi=dpi, bbox_inches="tight")
         return path
@@ -49,18 +52,36 @@ def _cmap(name: str):
     return colormaps[name]          # a copy per lookup: cache it (initialising one is slow)
 
 
+NAN_COLOR = "#eeeeee"
+
+
+def vertical_split(top: QWidget, bottom: QWidget, sizes: tuple[int, int]) -> QSplitter:
+    """``top`` over ``bottom`` in a splitter (neither collapsible), shared as ``sizes``."""
+    split = QSplitter(Qt.Orientation.Vertical)
+    split.addWidget(top)
+    split.addWidget(bottom)
+    split.setSizes(list(sizes))
+    split.setChildrenCollapsible(False)
+    return split
+
+
+def heat_colors(values: np.ndarray, lo: float = 0.0, hi: float = 1.0,
+                cmap: str = "YlOrRd") -> tuple[np.ndarray, np.ndarray]:
+    """Background colours ``(..., 3)`` in [0, 1] of ``values`` on ``[lo, hi]`` (NaN: light grey)
+    and whether each needs dark text: all mapped in one call."""
+    values = np.asarray(values, dtype=np.float64)
+    finite = np.isfinite(values)
+    x = np.clip((values - lo) / (hi - lo), 0.0, 1.0) if hi > lo else np.zeros_like(values)
+    rgb = _cmap(cmap)(np.where(finite, x, 0.0))[..., :3]
+    rgb[~finite] = QColor(NAN_COLOR).getRgbF()[:3]
+    dark_text = rgb @ np.array([0.299, 0.587, 0.114]) > 0.55
+    return rgb, dark_text
+
+
 def heat_color(value: float, lo: float = 0.0, hi: float = 1.0, cmap: str = "YlOrRd") -> QColor:
     """A background colour for ``value`` on ``[lo, hi]`` (NaN: light grey)."""
-    if not np.isfinite(value):
-        return QColor("#eeeeee")
-    x = 0.0 if hi <= lo else float(np.clip((value - lo) / (hi - lo), 0, 1))
-    r, g, b, _ = _cmap(cmap)(x)
-    return QColor.fromRgbF(r, g, b)
-
-
-def text_color_for(bg: QColor) -> QColor:
-    lum = 0.299 * bg.redF() + 0.587 * bg.greenF() + 0.114 * bg.blueF()
-    return QColor("black") if lum > 0.55 else QColor("white")
+    rgb, _dark = heat_colors(np.array(value), lo, hi, cmap)
+    return QColor.fromRgbF(*rgb)
 
 
 class NumberItem(QTableWidgetItem):
@@ -89,11 +110,26 @@ def text_item(text: str) -> QTableWidgetItem:
 
 
 def heat_item(value: float, lo: float, hi: float, fmt: str = "{:.2f}", cmap: str = "YlOrRd") -> NumberItem:
-    item = NumberItem(value, fmt)
-    bg = heat_color(value, lo, hi, cmap)
-    item.setBackground(bg)
-    item.setForeground(text_color_for(bg))
-    return item
+    return heat_items(np.array([[value]]), lo, hi, fmt, cmap)[0][0]
+
+
+def heat_items(values: np.ndarray, lo: float, hi: float, fmt: str = "{:.2f}",
+               cmap: str = "YlOrRd") -> list[list[NumberItem]]:
+    """Heat-coloured cells of a 2-D array of values (a 40 x 40 similarity matrix coloured one
+    cell at a time took 120 ms)."""
+    values = np.asarray(values, dtype=np.float64)
+    rgb, dark_text = heat_colors(values, lo, hi, cmap)
+    black, white = QColor("black"), QColor("white")
+    rows = []
+    for r in range(values.shape[0]):
+        row = []
+        for c in range(values.shape[1]):
+            item = NumberItem(values[r, c], fmt)
+            item.setBackground(QColor.fromRgbF(*rgb[r, c]))
+            item.setForeground(black if dark_text[r, c] else white)
+            row.append(item)
+        rows.append(row)
+    return rows
 
 
 def fill_table(table: QTableWidget, header: list[str], rows: list[list[QTableWidgetItem]]) -> None:
@@ -112,7 +148,8 @@ def fill_table(table: QTableWidget, header: list[str], rows: list[list[QTableWid
     table.setSortingEnabled(sorting)
 
 
-MAX_TABLE_MIN_WIDTH = 720     # px: a table narrower than this shows all its columns
+MAX_TABLE_MIN_WIDTH = 440     # px: a table narrower than this shows all its columns (a wider
+                              # one scrolls inside itself: its dock must fit the window)
 
 
 class _ColumnStretcher(QObject):

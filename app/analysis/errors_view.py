@@ -10,11 +10,13 @@ the current utterance highlighted.
 from __future__ import annotations
 
 import logging
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 from matplotlib import colormaps
-from PyQt6.QtCore import pyqtSignal
+from matplotlib.figure import Figure
+from PyQt6.QtCore import Qt, pyqtSignal
 from PyQt6.QtWidgets import (
     QComboBox,
     QHBoxLayout,
@@ -59,6 +61,31 @@ log = logging.getLogger(__name__)
 SPLITS = {"test": ("test",), "train": ("train",), "train + test": ("train", "test")}
 
 
+def draw_phone_chart(fig: Figure, phones: list) -> None:
+    """Per-phone correlation as horizontal bars, sorted (best at the top), coloured like the
+    table's cells; constrained layout keeps the title and the x label inside."""
+    fig.clear()
+    fig.set_layout_engine("constrained")
+    ax = fig.add_subplot(111)
+    phones = sorted((p for p in phones if p.correlation == p.correlation), key=lambda p: p.correlation)
+    if not phones:
+        ax.text(0.5, 0.5, "no phone has enough frames for a correlation", ha="center",
+                va="center", transform=ax.transAxes, color="#555555")
+        ax.set_axis_off()
+        return
+    r = np.array([p.correlation for p in phones])
+    y = np.arange(len(phones))
+    ax.barh(y, r, color=colormaps["RdYlGn"](np.clip(r, 0.0, 1.0)), edgecolor="#555555", lw=0.4)
+    ax.set_yticks(y, [p.phone for p in phones], fontsize=max(5, min(8, 600 // len(phones))))
+    ax.set_ylim(-0.6, len(phones) - 0.4)
+    ax.set_xlim(min(0.0, float(r.min()) - 0.05), 1.0)
+    ax.axvline(0.0, color="k", lw=0.6)
+    ax.set_xlabel("correlation r, original vs synthesized lip y", fontsize=8)
+    ax.set_title("Per phone, sorted (best at the top)", fontsize=9)
+    ax.tick_params(axis="x", labelsize=7)
+    ax.grid(axis="x", alpha=0.3)
+
+
 class ErrorView(QWidget):
     """Per-phone, per-utterance and worst-segment errors over a corpus."""
 
@@ -85,13 +112,13 @@ class ErrorView(QWidget):
         self.progress.setRange(0, 1000)
         csv_btn = QPushButton("Export CSV…")
         csv_btn.clicked.connect(self._export_csv)
-        top = QHBoxLayout()
+        top = QHBoxLayout()                 # two short rows: they fit a dock of 420 px
         top.addWidget(QLabel("split:"))
         top.addWidget(self.splits)
         top.addWidget(QLabel("utterances:"))
         top.addWidget(self.per_split)
         top.addWidget(self.run_btn)
-        top.addWidget(self.progress, 1)
+        top.addStretch(1)
         top.addWidget(csv_btn)
 
         self.phone_table = QTableWidget()
@@ -105,11 +132,12 @@ class ErrorView(QWidget):
         self.worst_table.cellClicked.connect(self._worst_clicked)
         self.tabs = QTabWidget()
         self.phone_chart = Canvas(5, 5)
-        per_phone = QSplitter()
+        per_phone = QSplitter(Qt.Orientation.Vertical)     # the chart under the table
         per_phone.addWidget(self.phone_table)
         per_phone.addWidget(self.phone_chart)
-        per_phone.setStretchFactor(0, 3)
-        per_phone.setStretchFactor(1, 2)
+        per_phone.setStretchFactor(0, 2)
+        per_phone.setStretchFactor(1, 3)
+        per_phone.setChildrenCollapsible(False)
         self.tabs.addTab(per_phone, "Per phone")
         self.tabs.addTab(self.utt_table, "Per utterance")
         self.tabs.addTab(self.worst_table, "Worst segments")
@@ -118,6 +146,7 @@ class ErrorView(QWidget):
         self.status.setWordWrap(True)
         lay = QVBoxLayout(self)
         lay.addLayout(top)
+        lay.addWidget(self.progress)
         lay.addWidget(self.status)
         lay.addWidget(self.tabs, 1)
         self.jumpRequested.connect(self._jump)
@@ -178,31 +207,8 @@ class ErrorView(QWidget):
                             "Click an utterance or a segment to go there.")
 
     def _draw_phone_chart(self, report: ErrorReport) -> None:
-        """Per-phone correlation as horizontal bars, sorted (best at the top), coloured like the
-        table's cells."""
-        fig = self.phone_chart.figure
-        fig.clear()
-        ax = fig.add_subplot(111)
-        phones = sorted((p for p in report.phones if p.correlation == p.correlation),
-                        key=lambda p: p.correlation)
-        if not phones:
-            ax.text(0.5, 0.5, "no phone has enough frames for a correlation", ha="center",
-                    va="center", transform=ax.transAxes, color="#555555")
-            ax.set_axis_off()
-        else:
-            r = np.array([p.correlation for p in phones])
-            y = np.arange(len(phones))
-            ax.barh(y, r, color=colormaps["RdYlGn"](np.clip(r, 0.0, 1.0)), edgecolor="#555555",
-                    lw=0.4)
-            ax.set_yticks(y, [p.phone for p in phones], fontsize=max(5, min(9, 600 // len(phones))))
-            ax.set_ylim(-0.6, len(phones) - 0.4)
-            ax.set_xlim(min(0.0, float(r.min()) - 0.05), 1.0)
-            ax.axvline(0.0, color="k", lw=0.6)
-            ax.set_xlabel("correlation, original vs synthesized lip y")
-            ax.set_title("Per phone, sorted (best at the top)", fontsize=10)
-            ax.grid(axis="x", alpha=0.3)
-        fig.tight_layout()
-        self.phone_chart.draw_idle()
+        """Per-phone correlation as horizontal bars (built and drawn off the GUI thread)."""
+        self.phone_chart.rebuild(partial(draw_phone_chart, phones=list(report.phones)))
 
     def _utt_clicked(self, row: int, _col: int) -> None:
         utt = self.utt_table.item(row, 0).text()
@@ -263,7 +269,7 @@ class LipErrorPanel:
         self.last_segments = []
 
     def draw(self, ax, view) -> None:
-        ax.set_ylabel("|orig - synth|\n(mm)", fontsize=8)
+        ax.set_ylabel("lip error\n(mm)", fontsize=8)
         if view.original is None:
             ax.text(0.5, 0.5, "no original markers", transform=ax.transAxes, ha="center",
                     va="center", color="#888888", fontsize=8)

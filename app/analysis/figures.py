@@ -17,6 +17,9 @@ from pathlib import Path
 from PyQt6.QtCore import QEventLoop, QTimer
 from PyQt6.QtWidgets import QApplication, QWidget
 
+from app.figure_canvas import BackgroundCanvas
+from app.plotter_widget import grab_with_3d
+
 log = logging.getLogger(__name__)
 
 
@@ -53,10 +56,47 @@ def _finish(cond: Callable[[], bool], what: str, timeout_s: float = 1800.0) -> N
 
 
 def shoot(widget: QWidget, path: Path) -> Path:
+    """Save a picture of ``widget`` once its plots are drawn (they draw off the GUI thread) and
+    its 3-D views rendered (as on the screen)."""
     settle()
-    widget.grab().save(str(path))
+    for canvas in widget.findChildren(BackgroundCanvas):
+        if canvas.isVisible():
+            canvas.finish()
+    settle(100)
+    grab_with_3d(widget).save(str(path))
     log.info("wrote %s", path)
     return path
+
+
+def _window_figures(win, views, out: Path, has_test: bool, only: set[str] | None) -> list[Path]:
+    """The window with every panel (``analysis_window.png``) and as a phonetician sees it with
+    the PC modes docked (``analysis_docked.png``)."""
+    written = []
+    if only is None or "window" in only:
+        for key in ("aperture", "width", "protrusion", "velocity", "lip_error"):
+            views.panel_actions[key].setChecked(True)
+        win.resize(1600, 1400)
+        win.splitter.setSizes([300, 1100])
+        if has_test:
+            win.seek(0.0)
+        _finish(lambda: not win.timeline.building, "the panels")
+        written.append(shoot(win, out / "analysis_window.png"))
+    if only is None or "docked" in only:        # as a phonetician sees it: PC modes docked
+        for key in ("aperture", "width", "protrusion", "velocity", "lip_error"):
+            views.panel_actions[key].setChecked(False)
+        win.resize(1600, 1000)
+        win.splitter.setSizes([480, 520])
+        dock = views.docks.get("pc_modes")
+        if dock is not None:
+            dock.setFloating(False)
+            dock.show()
+            dock.raise_()
+        _finish(lambda: not win.timeline.building and not win.busy, "the window")
+        win.seek(min(2.38, win.view.duration / 2))
+        settle(500)
+        win.timeline.ensure_drawn()
+        written.append(win.save_screenshot(out / "analysis_docked.png"))
+    return written
 
 
 def make_figures(corpus_dir: Path, out: Path, per_split: int = 6,
@@ -77,12 +117,19 @@ def make_figures(corpus_dir: Path, out: Path, per_split: int = 6,
         raise RuntimeError("the window did not load the corpus")
     written = []
     info = load_corpus(corpus_dir).info
-    standalone = {"similarity": (1000, 900), "metrics": (1100, 850), "pc_modes": (1300, 750),
-                  "inspector": (900, 950), "errors": (1000, 750), "kinematics": (1100, 700)}
+    # each view at about the size it has docked in a 1600 x 1000 window (a third of its width)
+    standalone = {"similarity": (600, 900), "metrics": (600, 950), "pc_modes": (600, 950),
+                  "inspector": (600, 950), "errors": (600, 900), "kinematics": (600, 900)}
     for key, size in standalone.items():
         if only is not None and key not in only:
             continue
-        w = views.open_view(key)
+        views.open_view(key)
+        _finish(lambda k=key: k in views.docks and not win.busy, f"opening {key}")
+        w = views.widgets[key]
+        if key == "similarity":
+            _finish(lambda w=w: w.clustering is not None, "the clustering")
+        if key == "pc_modes":
+            _finish(lambda w=w: w.is_ready, "the PC modes' scene")
         dock = views.docks[key]
         dock.setFloating(True)
         dock.resize(*size)
@@ -114,14 +161,7 @@ def make_figures(corpus_dir: Path, out: Path, per_split: int = 6,
             w.tabs.setCurrentIndex(1)
             written.append(shoot(dock, out / "analysis_errors_utterances.png"))
         dock.hide()
-    if only is None or "window" in only:
-        for key in ("aperture", "width", "protrusion", "velocity", "lip_error"):
-            views.panel_actions[key].setChecked(True)
-        win.resize(1600, 1400)
-        win.splitter.setSizes([300, 1100])
-        if info.test:
-            win.seek(0.0)
-        written.append(shoot(win, out / "analysis_window.png"))
+    written += _window_figures(win, views, out, bool(info.test), only)
     views.close()
     win.close()
     return written

@@ -12,8 +12,10 @@ from :func:`engine.analysis.inspector.inspect_frame`.
 from __future__ import annotations
 
 import logging
+from functools import partial
 
 import numpy as np
+from matplotlib.figure import Figure
 from PyQt6.QtCore import Qt, QTimer, pyqtSignal
 from PyQt6.QtWidgets import (
     QFormLayout,
@@ -177,23 +179,28 @@ class CodebookInspector(QWidget):
         self.inspected.emit(ins)
 
     def _draw(self, ins: FrameInspection) -> None:
-        fig = self.canvas.figure
-        fig.clear()
-        ax, axw = fig.subplots(1, 2, gridspec_kw={"width_ratios": [3, 2]})
-        fig.subplots_adjust(left=0.14, right=0.98, bottom=0.2, top=0.86, wspace=0.3)
-        # LSFs as a barcode on a frequency axis: closely spaced pairs mark the formants
-        ax.vlines(ins.lsf_hz, 0.52, 0.98, color=ORIGINAL_COLOR, lw=1.6)
-        ax.vlines(ins.lsf_hat_hz, 0.02, 0.48, color=SYNTH_COLOR, lw=1.6)
-        ax.set_yticks([0.25, 0.75], ["w-hat (eq 7)", "w (input)"], fontsize=7)
-        ax.set_ylim(0, 1)
-        ax.set_xlim(0, self.model.config.audio_rate / 2)
-        ax.set_xlabel("LSF frequency (Hz)", fontsize=8)
-        ax.set_title(f"LSF vector at {ins.time:.3f} s", fontsize=9)
-        ax.tick_params(labelsize=7)
-        w = [c.weight for c in ins.codewords]
-        axw.bar(np.arange(1, len(w) + 1), w, color=SYNTH_COLOR)
-        axw.set_xlabel("codeword (heaviest first)", fontsize=8)
-        axw.set_ylabel("v_i", fontsize=8)
-        axw.set_title(f"weights, gamma = {ins.gamma:.2f}", fontsize=9)
-        axw.tick_params(labelsize=7)
-        self.canvas.draw_idle()
+        """The LSF barcodes and the weights (built and drawn off the GUI thread)."""
+        self.canvas.rebuild(partial(draw_inspection, ins=ins,
+                                    nyquist=self.model.config.audio_rate / 2))
+
+
+def draw_inspection(fig: Figure, ins: FrameInspection, nyquist: float) -> None:
+    """The input LSF vector w against its approximation w-hat as barcodes on a frequency axis
+    (closely spaced pairs mark the formants), and the candidates' weights as bars."""
+    fig.clear()
+    ax, axw = fig.subplots(1, 2, gridspec_kw={"width_ratios": [3, 2]})
+    fig.set_layout_engine("constrained")
+    ax.vlines(ins.lsf_hz, 0.52, 0.98, color=ORIGINAL_COLOR, lw=1.6)
+    ax.vlines(ins.lsf_hat_hz, 0.02, 0.48, color=SYNTH_COLOR, lw=1.6)
+    ax.set_yticks([0.25, 0.75], ["w-hat (eq 7)", "w (input)"], fontsize=7)
+    ax.set_ylim(0, 1)
+    ax.set_xlim(0, nyquist)
+    ax.set_xlabel("LSF frequency (Hz)", fontsize=8)
+    ax.set_title(f"LSF vector at {ins.time:.3f} s", fontsize=9)
+    ax.tick_params(labelsize=7)
+    w = [c.weight for c in ins.codewords]
+    axw.bar(np.arange(1, len(w) + 1), w, color=SYNTH_COLOR)
+    axw.set_xlabel("codeword (heaviest first)", fontsize=8)
+    axw.set_ylabel("v_i", fontsize=8)
+    axw.set_title(f"weights, gamma = {ins.gamma:.2f}", fontsize=9)
+    axw.tick_params(labelsize=7)

@@ -13,9 +13,11 @@ tier.
 from __future__ import annotations
 
 import logging
+from functools import partial
 from pathlib import Path
 
 import numpy as np
+from matplotlib.figure import Figure
 from PyQt6.QtCore import Qt, pyqtSignal
 from PyQt6.QtWidgets import (
     QComboBox,
@@ -31,7 +33,8 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from app.style import ORIGINAL_COLOR, SYNTH_COLOR
+from app.style import CLOSED_COLOR, ORIGINAL_COLOR, SYNTH_COLOR
+from engine.analysis.lips import ClosedLips
 from engine.evaluation.kinematics import (
     LABIAL_PHONES,
     LANDMARKS,
@@ -67,12 +70,16 @@ class LipMeasurePanel:
 
     height = 0.9
 
-    def __init__(self, model: Model, measure: str):
+    def __init__(self, model: Model, measure: str, closed: ClosedLips | None = None):
         if measure not in MEASURES:
             raise ValueError(f"unknown lip measure {measure!r}")
         self.model = model
         self.measure = measure
         self.title = MEASURES[measure][0]
+        # the aperture at the talker's closures (``closed``: the distance the 3-D view's mouth
+        # shuts at), drawn as a reference
+        self.closed = (getattr(model_lip_measures(model, closed.markers[None]), measure)[0]
+                       if measure == "aperture" and closed is not None else None)
 
     def draw(self, ax, view) -> None:
         syn = getattr(model_lip_measures(self.model, view.synthesis.markers), self.measure)
@@ -82,6 +89,10 @@ class LipMeasurePanel:
             orig = getattr(model_lip_measures(self.model, view.original), self.measure)
             ax.plot(view.times[: len(orig)], orig, color=ORIGINAL_COLOR, lw=1.3, ls=(0, (2, 1.5)),
                     label="original")
+        if self.closed is not None:
+            ax.axhline(self.closed, color=CLOSED_COLOR, lw=0.9, ls=(0, (6, 3)), zorder=0.5)
+            ax.text(1.0, self.closed, "closed ", transform=ax.get_yaxis_transform(), ha="right",
+                    va="bottom", fontsize=6.5, color=CLOSED_COLOR)
         ax.set_ylabel(MEASURES[self.measure][1], fontsize=8)
 
 
@@ -182,7 +193,7 @@ class KinematicsControls(QWidget):
         self.changed.emit()
         tl = getattr(self.window_, "timeline", None)
         if tl is not None and self.panel in tl.panels:
-            tl.relayout(tl.xlim())
+            tl.relayout(tl.xlim(), soon=True)
 
     # ------------------------------------------------------------------ measuring
     def set_view(self, view) -> None:
@@ -222,34 +233,10 @@ class KinematicsControls(QWidget):
 
     def _draw_chart(self, m: GestureMeasurement) -> None:
         """The timing error of every landmark row as a horizontal bar (synthesized minus original,
-        ms; late to the right), in the table's order from the top."""
-        fig = self.chart.figure
-        fig.clear()
-        ax = fig.add_subplot(111)
-        rows = [r for r in self.rows if np.isfinite(r.error)]
-        if not rows:
-            why = ("no original markers:\nno timing errors to show" if m.v_original is None else
-                   "no gestures found around\nthe gesture phones")
-            ax.text(0.5, 0.5, why, ha="center", va="center", transform=ax.transAxes,
-                    color="#555555", fontsize=10)
-            ax.set_axis_off()
-        else:
-            ms = np.array([1000 * r.error for r in rows])
-            y = np.arange(len(rows))[::-1]
-            ax.barh(y, ms, color=[LATE_COLOR if e > 0 else EARLY_COLOR for e in ms],
-                    edgecolor="#555555", lw=0.4, height=0.75)
-            ax.set_yticks(y, [f"{r.gesture} {r.label} {r.landmark}" for r in rows],
-                          fontsize=max(5, min(8, 520 // len(rows))))
-            ax.set_ylim(-0.6, len(rows) - 0.4)
-            lim = max(10.0, float(np.abs(ms).max()) * 1.1)
-            ax.set_xlim(-lim, lim)
-            ax.axvline(0.0, color="k", lw=0.6)
-            ax.set_xlabel("synthesized − original (ms)\n← early    late →", fontsize=8)
-            ax.tick_params(axis="x", labelsize=8)
-            ax.set_title("Landmark timing error", fontsize=10)
-            ax.grid(axis="x", alpha=0.3)
-        fig.set_layout_engine("tight")      # laid out again at every draw: resizes keep the labels in
-        self.chart.draw_idle()
+        ms; late to the right), in the table's order from the top (built and drawn off the GUI
+        thread)."""
+        self.chart.rebuild(partial(draw_timing_chart, rows=list(self.rows),
+                                   has_original=m.v_original is not None))
 
     def resizeEvent(self, event) -> None:
         """The chart beside the table when there is room, under it when the dock is narrow."""
@@ -286,6 +273,35 @@ class KinematicsControls(QWidget):
     def _export_textgrid(self) -> None:
         self._export("Export landmarks as TextGrid", "landmarks.TextGrid", "TextGrid (*.TextGrid)",
                      self.export_textgrid)
+
+
+def draw_timing_chart(fig: Figure, rows: list[LandmarkError], has_original: bool) -> None:
+    """The landmark timing errors as horizontal bars, or why there are none."""
+    fig.clear()
+    ax = fig.add_subplot(111)
+    rows = [r for r in rows if np.isfinite(r.error)]
+    if not rows:
+        why = ("no original markers:\nno timing errors to show" if not has_original else
+               "no gestures found around\nthe gesture phones")
+        ax.text(0.5, 0.5, why, ha="center", va="center", transform=ax.transAxes,
+                color="#555555", fontsize=10)
+        ax.set_axis_off()
+        return
+    ms = np.array([1000 * r.error for r in rows])
+    y = np.arange(len(rows))[::-1]
+    ax.barh(y, ms, color=[LATE_COLOR if e > 0 else EARLY_COLOR for e in ms],
+            edgecolor="#555555", lw=0.4, height=0.75)
+    ax.set_yticks(y, [f"{r.gesture} {r.label} {r.landmark}" for r in rows],
+                  fontsize=max(5, min(8, 520 // len(rows))))
+    ax.set_ylim(-0.6, len(rows) - 0.4)
+    lim = max(10.0, float(np.abs(ms).max()) * 1.1)
+    ax.set_xlim(-lim, lim)
+    ax.axvline(0.0, color="k", lw=0.6)
+    ax.set_xlabel("synthesized − original (ms)\n← early    late →", fontsize=8)
+    ax.tick_params(axis="x", labelsize=8)
+    ax.set_title("Landmark timing error", fontsize=10)
+    ax.grid(axis="x", alpha=0.3)
+    fig.set_layout_engine("constrained")   # laid out again at every draw: resizes keep the labels in
 
 
 class VelocityPanel:

@@ -6,10 +6,13 @@ background worker with progress. Export CSV (Table 2, sweep) and PNG (the two pl
 from __future__ import annotations
 
 import logging
+from functools import partial
 from pathlib import Path
 
 import numpy as np
-from PyQt6.QtCore import Qt, pyqtSignal
+from matplotlib.figure import Figure
+from PyQt6.QtCore import pyqtSignal
+from PyQt6.QtGui import QColor
 from PyQt6.QtWidgets import (
     QCheckBox,
     QGridLayout,
@@ -19,7 +22,6 @@ from PyQt6.QtWidgets import (
     QProgressBar,
     QPushButton,
     QSpinBox,
-    QSplitter,
     QTableWidget,
     QVBoxLayout,
     QWidget,
@@ -49,6 +51,7 @@ from .common import (
     stop_own_tasks,
     task_runner,
     text_item,
+    vertical_split,
 )
 
 log = logging.getLogger(__name__)
@@ -64,9 +67,47 @@ def _paper(row: Table2Row) -> tuple[float, float, float]:
 
 
 def _short(row: Table2Row) -> str:
-    """A compact bar label: split, smoothing, acoustic-only."""
+    """A compact bar label in lines: split, smoothing, acoustic-only."""
     smooth = {"triangular": "triang.", "spline": "spline"}.get(row.smoothing, row.smoothing)
     return f"{row.split}\n{smooth}" + ("\nacoustic" if row.mode != "phonetic" else "")
+
+
+def draw_metrics(fig: Figure, rows: list[Table2Row], curves: list[SweepCurve]) -> None:
+    """Table 2 as grouped bars (one group per condition, a bar per measure, the legend above the
+    plot) over the N sweep (Figure 5), one under the other so that each has the dock's width;
+    constrained layout keeps every label inside."""
+    fig.clear()
+    fig.set_layout_engine("constrained")
+    ax1, ax2 = fig.subplots(2, 1, height_ratios=[3, 2])
+    if rows:
+        x = np.arange(len(rows))
+        width = 0.27
+        for k, m in enumerate(METRICS):
+            ax1.bar(x + (k - 1) * width, [getattr(r, m) for r in rows], width, label=METRIC_NAMES[m])
+        ax1.set_xticks(x, [_short(r) for r in rows], fontsize=7)
+        ax1.set_ylim(0, 1.0)
+        ax1.legend(fontsize=7, ncol=3, loc="lower center", bbox_to_anchor=(0.5, 1.0),
+                   frameon=False, title="Table 2: mean correlation on speech frames",
+                   title_fontsize=8)
+    else:
+        ax1.text(0.5, 0.5, "Compute Table 2", ha="center", va="center", transform=ax1.transAxes,
+                 color="#888888")
+        ax1.set_title("Table 2: mean correlation on speech frames", fontsize=8)
+    ax1.set_ylabel("correlation r", fontsize=8)
+    ax1.tick_params(labelsize=7)
+    if curves:
+        for c in curves:
+            style = "-o" if c.split == "test" else "--s"
+            ax2.plot(c.ns, c.whole_face, style, ms=4, label=f"{c.split} (whole face)")
+        ax2.legend(fontsize=7)
+        ax2.set_xticks(curves[0].ns)
+    else:
+        ax2.text(0.5, 0.5, "Run N sweep", ha="center", va="center", transform=ax2.transAxes,
+                 color="#888888")
+    ax2.set_xlabel("N (context-phones searched)", fontsize=8)
+    ax2.set_ylabel("correlation r", fontsize=8)
+    ax2.set_title("Figure 5: correlation against N (triangular)", fontsize=8)
+    ax2.tick_params(labelsize=7)
 
 
 class MetricsView(QWidget):
@@ -97,45 +138,47 @@ class MetricsView(QWidget):
         self.max_n.setValue(10)
         self.run_table2 = QPushButton("Compute Table 2")
         self.run_table2.clicked.connect(self.start_table2)
-        self.run_sweep = QPushButton("Run N sweep")
+        self.run_sweep = QPushButton("Run N sweep, N = 1 to")
         self.run_sweep.clicked.connect(self.start_sweep)
         self.progress = QProgressBar()
         self.progress.setRange(0, 1000)
         self.status = QLabel("")
+        self.status.setWordWrap(True)
         exp = [("Table 2 CSV…", self._export_table2), ("N sweep CSV…", self._export_sweep),
                ("PNG…", self._export_png)]
 
+        self.table = QTableWidget()
+        self.table.setSortingEnabled(False)             # ours, each followed by the paper's
+        self.table.verticalHeader().setVisible(False)
+        self.table.verticalHeader().setDefaultSectionSize(self.table.fontMetrics().height() + 6)
+        self.canvas = Canvas(6, 5.2)
+        self.canvas.setMinimumHeight(320)
+        lay = QVBoxLayout(self)
+        lay.addWidget(self._options(exp))
+        lay.addWidget(vertical_split(self.table, self.canvas, (300, 520)), 1)
+        self._draw()
+
+    def _options(self, exports: list) -> QGroupBox:
+        """The run options in short rows (they fit a dock of 420 px), the progress and export."""
         opts = QGroupBox("Run")
         g = QGridLayout(opts)
         g.addWidget(QLabel("utterances per split:"), 0, 0)
         g.addWidget(self.per_split, 0, 1)
-        g.addWidget(self.acoustic, 0, 2)
-        g.addWidget(self.run_table2, 0, 3)
-        g.addWidget(QLabel("N from 1 to:"), 1, 0)
-        g.addWidget(self.max_n, 1, 1)
-        g.addWidget(self.run_sweep, 1, 3)
-        g.addWidget(self.progress, 2, 0, 1, 3)
-        g.addWidget(self.status, 2, 3)
+        g.addWidget(self.acoustic, 0, 2, 1, 2)
+        g.addWidget(self.run_table2, 1, 0)
+        g.addWidget(self.run_sweep, 1, 1, 1, 2)
+        g.addWidget(self.max_n, 1, 3)
+        g.addWidget(self.progress, 2, 0, 1, 4)
+        g.addWidget(self.status, 3, 0, 1, 4)
         buttons = QHBoxLayout()
-        buttons.addWidget(QLabel("Export:"))
-        for text, slot in exp:
+        buttons.addWidget(QLabel("export:"))
+        for text, slot in exports:
             b = QPushButton(text)
             b.clicked.connect(slot)
             buttons.addWidget(b)
         buttons.addStretch(1)
-
-        self.table = QTableWidget()
-        self.table.setSortingEnabled(True)
-        self.table.verticalHeader().setVisible(False)
-        self.canvas = Canvas(9, 3.6)
-        split = QSplitter(Qt.Orientation.Vertical)
-        split.addWidget(self.table)
-        split.addWidget(self.canvas)
-        lay = QVBoxLayout(self)
-        lay.addWidget(opts)
-        lay.addLayout(buttons)
-        lay.addWidget(split, 1)
-        self._draw()
+        g.addLayout(buttons, 4, 0, 1, 4)
+        return opts
 
     # ------------------------------------------------------------------ work
     def _subset(self) -> Corpus:
@@ -179,17 +222,30 @@ class MetricsView(QWidget):
 
     # ------------------------------------------------------------------ display
     def set_table2(self, result: EvalResult) -> None:
+        """Our Table 2 rows, each phonetic N = 3 row followed by the paper's (grey): six columns
+        that fit the dock (the paper's values had three columns of their own, past its edge)."""
         self.table2_result = result
         self.rows = table2_rows(result)
-        head = ["Test condition", "Whole Face", "Lower Lip", "Upper Lip", "N", "utterances",
-                "paper: Whole Face", "Lower Lip", "Upper Lip"]
-        rows = [[text_item(r.name), *(heat_item(getattr(r, m), 0.4, 1.0, "{:.4f}", "RdYlGn")
-                                      for m in METRICS),
-                 NumberItem(r.n_context_phones, "{:.0f}"), NumberItem(r.utterances, "{:.0f}"),
-                 *(NumberItem(v, "{:.4f}") for v in _paper(r))]
-                for r in self.rows]
+        head = ["condition", "whole face r", "lower lip r", "upper lip r", "N", "utterances"]
+        rows = []
+        for r in self.rows:
+            rows.append([text_item(r.name), *(heat_item(getattr(r, m), 0.4, 1.0, "{:.4f}", "RdYlGn")
+                                              for m in METRICS),
+                         NumberItem(r.n_context_phones, "{:.0f}"), NumberItem(r.utterances, "{:.0f}")])
+            paper = _paper(r)
+            if np.isfinite(paper).all():
+                rows.append([text_item("   the paper, same condition"),
+                             *(NumberItem(v, "{:.2f}") for v in paper),
+                             NumberItem(TABLE2_N, "{:.0f}"), text_item("")])
+                for item in rows[-1]:
+                    item.setForeground(QColor("#666666"))
         fill_table(self.table, head, rows)
-        self.status.setText(f"Table 2: {len(self.rows)} conditions")
+        self.table.resizeRowsToContents()
+        rows_height = sum(self.table.rowHeight(r) for r in range(self.table.rowCount()))
+        # every row in view (the rows needed scrolling), up to half the dock
+        self.table.setMinimumHeight(min(440, rows_height + self.table.horizontalHeader().height()
+                                        + 2 * self.table.frameWidth() + 2))
+        self.status.setText(f"Table 2: {len(self.rows)} conditions (grey: the paper's)")
         self._draw()
 
     def set_sweep(self, result: EvalResult) -> None:
@@ -199,39 +255,8 @@ class MetricsView(QWidget):
         self._draw()
 
     def _draw(self) -> None:
-        fig = self.canvas.figure
-        fig.clear()
-        ax1, ax2 = fig.subplots(1, 2, gridspec_kw={"width_ratios": [3, 2]})
-        fig.subplots_adjust(left=0.07, right=0.98, bottom=0.3, top=0.9, wspace=0.25)
-        if self.rows:
-            x = np.arange(len(self.rows))
-            width = 0.27
-            for k, m in enumerate(METRICS):
-                ax1.bar(x + (k - 1) * width, [getattr(r, m) for r in self.rows], width,
-                        label=METRIC_NAMES[m])
-            ax1.set_xticks(x, [_short(r) for r in self.rows], fontsize=6.5)
-            ax1.set_ylim(0, 1.18)
-            ax1.set_yticks(np.linspace(0, 1, 6))
-            ax1.legend(fontsize=7, ncol=3, loc="upper center", frameon=False)
-        else:
-            ax1.text(0.5, 0.5, "Compute Table 2", ha="center", va="center", transform=ax1.transAxes,
-                     color="#888888")
-        ax1.set_title("Table 2: mean correlation, speech frames", fontsize=9)
-        ax1.set_ylabel("correlation", fontsize=8)
-        ax1.tick_params(labelsize=7)
-        if self.curves:
-            for c in self.curves:
-                style = "-o" if c.split == "test" else "--s"
-                ax2.plot(c.ns, c.whole_face, style, ms=4, label=f"{c.split} (whole face)")
-            ax2.set_xlabel("N (context-phones searched)", fontsize=8)
-            ax2.legend(fontsize=7)
-            ax2.set_xticks(self.curves[0].ns)
-        else:
-            ax2.text(0.5, 0.5, "Run N sweep", ha="center", va="center", transform=ax2.transAxes,
-                     color="#888888")
-        ax2.set_title("Figure 5: correlation against N (triangular)", fontsize=9)
-        ax2.tick_params(labelsize=7)
-        self.canvas.draw_idle()
+        """Both plots, built and drawn off the GUI thread."""
+        self.canvas.rebuild(partial(draw_metrics, rows=list(self.rows), curves=list(self.curves)))
 
     def closeEvent(self, event) -> None:
         stop_own_tasks(self, self.tasks)

@@ -4,15 +4,20 @@ Pick a PC and drag its coefficient over +-3 standard deviations: the 3-D view sh
 face (grey), the displaced face (orange) and displacement arrows; beside it the front projection
 as in Figure 2 (circles: neutral, arrows: displacement) and the variance share of every PC.
 "Animate" sweeps the mode back and forth. All shapes come from ``model.mode_shape``.
+
+The view opens at once and builds its 3-D scene and its plots in the passes of the event loop
+that follow (``ready`` when done), so that the window does not freeze while it opens.
 """
 
 from __future__ import annotations
 
 import logging
 import math
+from functools import partial
 
 import numpy as np
 import pyvista as pv
+from matplotlib.figure import Figure
 from PyQt6.QtCore import Qt, QTimer, pyqtSignal
 from PyQt6.QtWidgets import (
     QComboBox,
@@ -21,18 +26,20 @@ from PyQt6.QtWidgets import (
     QPushButton,
     QSlider,
     QSpinBox,
-    QSplitter,
+    QToolButton,
     QVBoxLayout,
     QWidget,
 )
 
 from app.plotter_widget import make_plotter
-from app.style import BACKGROUND, SURFACE_COLOR, SYNTH_COLOR
-from app.surface import face_triangles, lip_contours
+from app.style import BACKGROUND, SYNTH_COLOR
+from app.surface import lip_contours, stored_face_triangles
+from app.view3d import MarkerSet
 from engine.analysis.pc_modes import describe_mode, mode_displacement, mode_sd, variance_shares
 from engine.method.model import Model
 
-from .common import Canvas
+from ..workers import one_per_pass
+from .common import Canvas, vertical_split
 
 log = logging.getLogger(__name__)
 
@@ -52,6 +59,7 @@ class PCModeExplorer(QWidget):
     """Explore one PC at a time: slider over +-3 SD, 3-D view, Figure 2 projection, variance."""
 
     valueChanged = pyqtSignal(int, float)     # component, coefficient value (mm units of the PC)
+    ready = pyqtSignal()
 
     def __init__(self, model: Model, window=None, parent: QWidget | None = None):
         super().__init__(parent)
@@ -62,9 +70,36 @@ class PCModeExplorer(QWidget):
         self.component = 0
         self.value = 0.0
         self._phase = 0.0
+        rows = self._build_controls()
 
+        self.plotter = None                  # made in the first pass after the view opens
+        self.scene_box = QWidget()
+        self.scene_box.setMinimumHeight(240)
+        QVBoxLayout(self.scene_box).setContentsMargins(0, 0, 0, 0)
+        self.canvas = Canvas(6, 3.4)
+        self.canvas.setMinimumHeight(220)
+        split = vertical_split(self.scene_box, self.canvas, (520, 340))
+        lay = QVBoxLayout(self)
+        lay.addLayout(rows[0])
+        lay.addLayout(rows[1])
+        lay.addWidget(self.description)
+        lay.addLayout(rows[2])
+        lay.addWidget(split, 1)
+
+        self.timer = QTimer(self)
+        self.timer.setInterval(40)
+        self.timer.timeout.connect(self._tick)
+        self.is_ready = False
+        self.heads = None
+        one_per_pass(self, [self._make_plotter, self._build_scene, self._build_guides,
+                            lambda: self.canvas.rebuild(partial(self._build_plots,
+                                                                axes2d=self._axes2d())),
+                            lambda: self.set_component(0), self._set_ready])
+
+    def _build_controls(self) -> tuple[QHBoxLayout, QHBoxLayout, QHBoxLayout]:
+        """The rows of controls: component, slider, cameras and 2-D projection."""
         self.combo = QComboBox()
-        for k, share in enumerate(model.pca.explained_ratio):
+        for k, share in enumerate(self.model.pca.explained_ratio):
             self.combo.addItem(f"PC{k + 1}  ({100 * share:.1f} %)")
         self.combo.currentIndexChanged.connect(self.set_component)
         self.slider = QSlider(Qt.Orientation.Horizontal)
@@ -72,8 +107,9 @@ class PCModeExplorer(QWidget):
         self.slider.setTickInterval(SLIDER_STEPS)
         self.slider.setTickPosition(QSlider.TickPosition.TicksBelow)
         self.slider.valueChanged.connect(self._slider_moved)
+        self.slider.setMinimumWidth(220)
         self.value_label = QLabel()
-        self.value_label.setMinimumWidth(170)
+        self.value_label.setMinimumWidth(150)
         self.animate_btn = QPushButton("Animate")
         self.animate_btn.setCheckable(True)
         self.animate_btn.toggled.connect(self.set_animating)
@@ -83,6 +119,7 @@ class PCModeExplorer(QWidget):
         self.description.setWordWrap(True)
         self.projection = QComboBox()
         self.projection.addItems(list(PROJECTIONS))
+        self.projection.setToolTip("the 2-D projection of Figure 2")
         self.projection.currentIndexChanged.connect(self._projection_changed)
         self.arrow_scale = QSpinBox()
         self.arrow_scale.setRange(1, 20)
@@ -90,116 +127,113 @@ class PCModeExplorer(QWidget):
         self.arrow_scale.setPrefix("arrows x")
         self.arrow_scale.setToolTip("lengthen the 2-D arrows for legibility (the 3-D view is true to scale)")
         self.arrow_scale.valueChanged.connect(lambda _v: self.set_value(self.value, move_slider=False))
+        # four short rows: the view fits a dock of 520 px (one row of everything pushed the
+        # window past the screen and squeezed the slider to 19 px)
+        component = QHBoxLayout()
+        component.addWidget(QLabel("component:"))
+        component.addWidget(self.combo, 1)
+        component.addWidget(reset)
+        component.addWidget(self.animate_btn)
+        slider_row = QHBoxLayout()
+        slider_row.addWidget(QLabel("-3 SD"))
+        slider_row.addWidget(self.slider, 1)
+        slider_row.addWidget(QLabel("+3 SD"))
+        slider_row.addWidget(self.value_label)
         view_bar = QHBoxLayout()
-        view_bar.addWidget(QLabel("3-D camera:"))
+        view_bar.addWidget(QLabel("3-D:"))
         for name in CAMERAS:
-            b = QPushButton(name)
+            b = QToolButton()
+            b.setText({"three-quarter": "¾ view"}.get(name, name))
+            b.setToolTip(f"3-D camera: {name}")
             b.clicked.connect(lambda _c=False, n=name: self.set_camera(n))
             view_bar.addWidget(b)
         view_bar.addStretch(1)
-        view_bar.addWidget(QLabel("2-D projection:"))
+        view_bar.addWidget(QLabel("2-D:"))
         view_bar.addWidget(self.projection)
         view_bar.addWidget(self.arrow_scale)
-        controls = QHBoxLayout()
-        controls.addWidget(QLabel("component:"))
-        controls.addWidget(self.combo)
-        controls.addWidget(QLabel("-3 SD"))
-        controls.addWidget(self.slider, 1)
-        controls.addWidget(QLabel("+3 SD"))
-        controls.addWidget(self.value_label)
-        controls.addWidget(reset)
-        controls.addWidget(self.animate_btn)
 
-        self.plotter = make_plotter(self)    # native on X11: the main window stays raster
+        return component, slider_row, view_bar
+
+    def _make_plotter(self) -> None:
+        """The 3-D view (a native window on X11: the main window stays raster), in a pass of its
+        own: creating its render window takes 60-120 ms."""
+        self.plotter = make_plotter(self.scene_box)
         self.plotter.set_background(BACKGROUND)
-        self.canvas = Canvas(5, 6)
-        split = QSplitter(Qt.Orientation.Horizontal)
-        split.addWidget(self.plotter.interactor)
-        split.addWidget(self.canvas)
-        split.setSizes([600, 450])
-        lay = QVBoxLayout(self)
-        lay.addLayout(controls)
-        lay.addWidget(self.description)
-        lay.addLayout(view_bar)
-        lay.addWidget(split, 1)
+        self.scene_box.layout().addWidget(self.plotter.interactor)
 
-        self.timer = QTimer(self)
-        self.timer.setInterval(40)
-        self.timer.timeout.connect(self._tick)
-        self._build_scene()
-        self._build_plots()
-        self.set_component(0)
+    def _set_ready(self) -> None:
+        self.is_ready = True
+        self.ready.emit()
 
     # ------------------------------------------------------------------ scene
     def _build_scene(self) -> None:
-        n = len(self.neutral)
-        verts = np.column_stack([np.ones(n, int), np.arange(n)]).ravel()
-        self.neutral_poly = pv.PolyData(self.neutral.copy())
-        self.neutral_poly.verts = verts
-        self.displaced = pv.PolyData(self.neutral.copy())
-        self.displaced.verts = verts
-        both = np.vstack([self.neutral, self.neutral])
-        self.arrows = pv.PolyData(both)
-        self.arrows.lines = np.column_stack([np.full(n, 2), np.arange(n), np.arange(n) + n]).ravel()
-        p = self.plotter
-        p.add_mesh(self.neutral_poly, color=NEUTRAL_COLOR, render_points_as_spheres=True,
-                   point_size=11, style="points", name="neutral", pickable=False)
-        p.add_mesh(self.displaced, color=SYNTH_COLOR, render_points_as_spheres=True, point_size=11,
-                   style="points", name="displaced", pickable=False)
-        p.add_mesh(self.arrows, color="#222222", line_width=2.5, name="arrows", pickable=False)
-        try:   # the displaced face as a translucent surface with its lip contours (as the main view)
-            contours = lip_contours(self.neutral, self.model.upper_lip, self.model.lower_lip,
-                                    list(self.model.lip_corners))
-            tri = face_triangles(self.neutral, contours)
-            surf = pv.PolyData()
-            surf.SetPoints(self.displaced.GetPoints())
-            surf.faces = np.column_stack([np.full(len(tri), 3), tri]).ravel()
-            p.add_mesh(surf, color=SURFACE_COLOR, opacity=0.35, name="surface", pickable=False)
-            lips = pv.PolyData()
-            lips.SetPoints(self.displaced.GetPoints())
-            lips.lines = np.concatenate([[len(c), *c] for c in contours])
-            p.add_mesh(lips, color=SYNTH_COLOR, line_width=3, name="lips", pickable=False)
+        """The displaced face: its points, lip contours and surface as the main view draws them
+        (``MarkerSet``: opaque, under the points; a translucent one cost a transparency pass)."""
+        contours = lip_contours(self.neutral, self.model.upper_lip, self.model.lower_lip,
+                                list(self.model.lip_corners))
+        try:
+            tri = stored_face_triangles(self.neutral, contours)   # the main view made it
         except Exception:   # a degenerate marker layout: points and arrows only
             log.debug("no face surface for the PC explorer", exc_info=True)
-        self.heads = None
+            tri = None
+        self.face_set = MarkerSet(self.plotter, "displaced", SYNTH_COLOR, self.neutral, contours, tri)
+        self.displaced = self.face_set.points
+
+    def _build_guides(self) -> None:
+        """The neutral face's points (grey) and the displacement arrows; the camera."""
+        n = len(self.neutral)
+        self.neutral_poly = pv.PolyData(self.neutral.copy())
+        self.neutral_poly.verts = np.column_stack([np.ones(n, int), np.arange(n)]).ravel()
+        self.arrows = pv.PolyData(np.vstack([self.neutral, self.neutral]))
+        self.arrows.lines = np.column_stack([np.full(n, 2), np.arange(n), np.arange(n) + n]).ravel()
+        self.plotter.add_mesh(self.neutral_poly, color=NEUTRAL_COLOR, render_points_as_spheres=True,
+                              point_size=11, style="points", name="neutral", pickable=False,
+                              reset_camera=False, render=False)
+        self.plotter.add_mesh(self.arrows, color="#222222", line_width=2.5, name="arrows",
+                              pickable=False, reset_camera=False, render=False)
         self.set_camera("three-quarter", render=False)
 
     def set_camera(self, name: str, render: bool = True) -> None:
         """Look at the face from the ``front``, in ``profile`` or at ``three-quarter``."""
+        if self.plotter is None:
+            return
         direction, up = CAMERAS[name]
         centre = self.neutral.mean(axis=0)
         dist = 3.0 * float(np.ptp(self.neutral, axis=0).max())
         d = np.asarray(direction, dtype=float)
         d /= np.linalg.norm(d)
         self.plotter.camera_position = [tuple(centre + dist * d), tuple(centre), up]
-        self.plotter.reset_camera()
+        self.plotter.renderer.reset_camera(render=False)
         if render:
             self.plotter.render()
 
-    def _build_plots(self) -> None:
-        fig = self.canvas.figure
+    def _build_plots(self, fig: Figure, axes2d: tuple[int, int]) -> None:
+        """The 2-D projection and the variance of each PC (built in the drawing thread:
+        ``BackgroundCanvas.rebuild``; ``axes2d`` read from the projection box beforehand)."""
         fig.clear()
-        self.ax_face, self.ax_var = fig.subplots(2, 1, gridspec_kw={"height_ratios": [3, 1.2]})
-        fig.subplots_adjust(left=0.12, right=0.97, top=0.95, bottom=0.08, hspace=0.35)
+        # side by side under the 3-D view; constrained layout keeps every label inside at any size
+        self.ax_face, self.ax_var = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.1, 1]})
+        fig.set_layout_engine("constrained")
         share, cumulative = variance_shares(self.model)
         k = np.arange(1, len(share) + 1)
         self.bars = self.ax_var.bar(k, share, color="#9fb7d9")
         self.ax_var.plot(k, cumulative, color="#333333", lw=1, marker=".", ms=3,
                          label="cumulative")
         self.ax_var.set_xlabel("principal component", fontsize=8)
-        self.ax_var.set_ylabel("% variance", fontsize=8)
+        self.ax_var.set_ylabel("variance explained (%)", fontsize=8)
         self.ax_var.set_ylim(0, 105)
+        self.ax_var.set_title("variance of each PC", fontsize=9)
         self.ax_var.tick_params(labelsize=7)
         self.ax_var.legend(fontsize=7, loc="center right")
-        self._draw_projection_base()
+        self._draw_projection_base(None, axes2d)
 
     def _axes2d(self) -> tuple[int, int]:
         return PROJECTIONS[self.projection.currentText()]
 
-    def _draw_projection_base(self) -> None:
+    def _draw_projection_base(self, _fig: Figure | None, axes2d: tuple[int, int]) -> None:
         ax = self.ax_face
         ax.clear()
-        h, v = self._axes2d()
+        h, v = axes2d
         ax.plot(self.neutral[:, h], self.neutral[:, v], "o", mfc="none", mec="#333333", ms=6)
         self.quiver = ax.quiver(self.neutral[:, h], self.neutral[:, v], np.zeros(len(self.neutral)),
                                 np.zeros(len(self.neutral)), angles="xy", scale_units="xy", scale=1,
@@ -213,16 +247,15 @@ class PCModeExplorer(QWidget):
         ax.set_ylim(self.neutral[:, v].min() - pad, self.neutral[:, v].max() + pad)
 
     def _projection_changed(self) -> None:
-        self._draw_projection_base()
-        self.set_value(self.value, move_slider=False)
+        if hasattr(self, "ax_face") or self.canvas.busy:
+            self.canvas.rebuild(partial(self._draw_projection_base, axes2d=self._axes2d()))
+            self.canvas.when_idle(self._update_plots)
 
     # ------------------------------------------------------------------ state
     def set_component(self, k: int) -> None:
         self.component = int(k)
         if self.combo.currentIndex() != k:
             self.combo.setCurrentIndex(k)
-        for i, b in enumerate(self.bars):
-            b.set_color(SYNTH_COLOR if i == k else "#9fb7d9")
         self.description.setText(describe_mode(self.model, k).text())
         self.set_value(self.slider.value() / SLIDER_STEPS * self.sd[k], move_slider=False)
 
@@ -240,24 +273,36 @@ class PCModeExplorer(QWidget):
             self.slider.blockSignals(True)
             self.slider.setValue(int(round(value / self.sd[self.component] * SLIDER_STEPS)))
             self.slider.blockSignals(False)
+        sd = self.sd[self.component]
+        self.value_label.setText(f"{self.value:+.2f} ({self.value / sd:+.2f} SD)")
+        if not hasattr(self, "arrows"):
+            return                          # the scene is still being built (one_per_pass)
         shape = self.model.mode_shape(self.component, self.value)
         disp = mode_displacement(self.model, self.component, self.value)
-        self.displaced.points[:] = shape
-        self.displaced.GetPoints().Modified()
+        self.face_set.set_points(shape)
         n = len(shape)
         self.arrows.points[n:] = shape
         self.arrows.GetPoints().Modified()
         self._update_heads(shape, disp)
-        sd = self.sd[self.component]
-        self.value_label.setText(f"{self.value:+.2f} ({self.value / sd:+.2f} SD)")
         self.plotter.render()
+        self.canvas.when_idle(self._update_plots)
+        self.valueChanged.emit(self.component, self.value)
+
+    def _update_plots(self) -> None:
+        """The 2-D projection's arrows and title and the highlighted variance bar for the current
+        component and value (run when the canvas is not being drawn)."""
+        if not hasattr(self, "quiver"):
+            return
+        k, sd = self.component, self.sd[self.component]
+        for i, b in enumerate(self.bars):
+            b.set_color(SYNTH_COLOR if i == k else "#9fb7d9")
+        disp = mode_displacement(self.model, k, self.value)
         h, v = self._axes2d()
         scale = int(self.arrow_scale.value())
         self.quiver.set_UVC(scale * disp[:, h], scale * disp[:, v])
-        self.ax_face.set_title(f"PC{self.component + 1} = {self.value:+.1f} ({self.value / sd:+.1f} SD)"
+        self.ax_face.set_title(f"PC{k + 1} = {self.value:+.1f} ({self.value / sd:+.1f} SD)"
                                + (f", arrows x{scale}" if scale != 1 else ""), fontsize=9)
         self.canvas.draw_idle()
-        self.valueChanged.emit(self.component, self.value)
 
     def _update_heads(self, shape: np.ndarray, disp: np.ndarray) -> None:
         length = np.linalg.norm(disp, axis=1)
@@ -297,6 +342,8 @@ class PCModeExplorer(QWidget):
 
     def close_view(self) -> None:
         self.timer.stop()
+        if self.plotter is None:
+            return
         try:
             self.plotter.close()
         except Exception:

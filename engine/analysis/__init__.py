@@ -10,6 +10,8 @@ module per view (mirroring ``app/analysis/``):
 * :mod:`.inspector` (``inspector``): the codebook inspector, everything eqs 4-8 did at one frame;
 * :mod:`.pc_modes` (``pc_modes``): principal component modes (Figure 2): displacement, standard
   deviations, which markers move;
+* :mod:`.lips` (the 3-D view and the lip panels): the talker's lips at closure, where the face's
+  mouth shuts and the panels draw their "closed" line;
 * :mod:`.common`: the CSV writer and the quick-look corpus subset they share.
 
 The kinematics panels' numbers are in :mod:`engine.evaluation.kinematics`. Pure numpy/scipy; every number

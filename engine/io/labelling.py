@@ -3,7 +3,7 @@
 - :func:`labels_for_audio` is THE rule for where the labels of an audio file come from, used by
   the command line and the app: a label file given, else a sentence given (aligned), else
   recognition asked for, else a label file beside the audio (same stem), else a ``.txt``
-  transcript beside it (aligned), else none -- and then :func:`engine.method.pipeline.mode_for` switches
+  transcript beside it (aligned), else none -- and then :func:`engine.method.modes.choose_mode` switches
   to acoustic-only synthesis.
 - :func:`label_audio` labels one recording by ``"aligned"`` (from its text) or ``"recognized"``,
   through a cache outside the repository (``engine.io.cachedir``), keyed by the audio's content, the
