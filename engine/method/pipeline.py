@@ -30,7 +30,7 @@ from .smoothing import smooth
 from .speaker import choose_warp, warp_lsf
 from .speech import pauses, speech_mask
 from .synthesis import FrameWeights, gamma_grid, nearest_codewords, weight_frames
-from .voice_match import voice_distance, voice_match
+from .voice_match import label_weight_scale, voice_distance, voice_match
 
 log = logging.getLogger(__name__)
 
@@ -128,8 +128,8 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         if config.mode == "robust":
             conf = frame_confidence(list(phones), confidence, times)
             conf[unlabelled[frame_seg]] = 0.0
-            scale = max(1.0, ratio) if config.label_weight_by_voice and np.isfinite(ratio) else 1.0
-            fw = _robust(model, w, candidates, conf, config, scale)
+            scale = label_weight_scale(ratio, config.label_weight_by_voice)
+            fw = robust_weights(model, w, candidates, conf, config, scale)
         else:
             fw = _weighted(model, w, lambda a, b: candidates[a:b], config)
     elif config.mode == "acoustic":
@@ -195,16 +195,23 @@ def _eq4(model: Model, segs: list[PhoneSegment], times: np.ndarray, config: Synt
     return segments, frame_seg, cb.codewords_of(top)[frame_seg]
 
 
-def _robust(model: Model, w: np.ndarray, candidates: np.ndarray, conf: np.ndarray,
-            config: SynthConfig, scale: float = 1.0) -> FrameWeights:
+def robust_weights(model: Model, w: np.ndarray, candidates: np.ndarray, conf: np.ndarray,
+                   config: SynthConfig, scale: float = 1.0, w_ctx: np.ndarray | None = None
+                   ) -> FrameWeights:
     """The robust mode's eqs 5-8 (``engine.method.selection``), its label weight times
-    ``scale`` (the voice's distance ratio: eq 5's distances grow with it)."""
-    cb, mc = model.codebook, model.config
+    ``scale`` (the voice's distance ratio: eq 5's distances grow with it); ``w_ctx``: the input
+    frames at :func:`context_offsets` when ``w`` is part of a longer input (a stream)."""
+    cb = model.codebook
     near = model.lsf_index().nearest(w, cb.lsf, config.robust_candidates, config.acoustic_probe or 8)
     return robust_frames(w, candidates, near, conf, cb.lsf, cb.pcs, _gammas(config),
-                         config.label_weight * scale, cb.lsf_context,
-                         np.array([-mc.lsf_context_frames, mc.lsf_context_frames]),
-                         config.context_weight)
+                         config.label_weight * scale, cb.lsf_context, context_offsets(model),
+                         config.context_weight, w_ctx=w_ctx)
+
+
+def context_offsets(model: Model) -> np.ndarray:
+    """The frame offsets of the robust mode's acoustic context (the codewords' stored LSFs)."""
+    k = model.config.lsf_context_frames
+    return np.array([-k, k])
 
 
 def _weighted(model: Model, w: np.ndarray, candidates: Callable[[int, int], np.ndarray],
