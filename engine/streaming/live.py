@@ -301,11 +301,12 @@ class FileTake:
 
 def stream_file(model: Model, audio: np.ndarray, rate: int, block_s: float,
                 synth: SynthConfig | None = None, config: LiveConfig | None = None,
-                real_time: bool = False,
-                sleep: Callable[[float], None] = time.sleep) -> FileTake:
+                real_time: bool = False, sleep: Callable[[float], None] = time.sleep,
+                cmn: RunningCmn | None = None) -> FileTake:
     """``audio`` through a :class:`LiveStream` in blocks of ``block_s`` seconds (the recognizer in
-    this thread), paced to the audio clock when ``real_time``: ``facetraj live --from-file``."""
-    stream = LiveStream(model, rate, synth, config)
+    this thread), paced to the audio clock when ``real_time``: ``facetraj live --from-file``
+    (``cmn``: the running cepstral mean of earlier takes, as the Live window keeps it)."""
+    stream = LiveStream(model, rate, synth, config, cmn=cmn)
     block = max(1, int(round(block_s * rate)))
     parts, times = [], []
     t0 = time.perf_counter()

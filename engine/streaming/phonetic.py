@@ -42,7 +42,7 @@ from ..method.voice_match import indexed_distances
 from .closure import ClosureStream, pause_runs
 from .front import LsfFront
 from .phones import PhoneSnapshot
-from .speech import SPEECH, SpeechStream
+from .speech import SILENT, SPEECH, UNRANGED, SpeechStream
 from .synthesizer import StreamFrames
 from .voice import RunningVoice
 
@@ -279,7 +279,26 @@ class PhoneticSynthesizer:
         strengths = closure_strengths(len(bil), "recognized", self.voice.match)
         first = max(0, self._emitted - int(PAUSE_LOOKBACK_S * self.rate))
         dec = np.asarray(self.speech.decisions[first:])
-        pauses = pause_runs(dec, np.arange(first, first + len(dec)) / self.rate,
-                            self.synth.rest_pause_s) if len(dec) else np.zeros((0, 2))
+        times = np.arange(first, first + len(dec)) / self.rate
+        dec = np.where((dec == UNRANGED) & recognized_silence(snap, times), SILENT, dec)
+        pauses = pause_runs(dec, times, self.synth.rest_pause_s) if len(dec) else np.zeros((0, 2))
         return ClosurePlan(intervals, strengths, pauses)
 
+
+
+def recognized_silence(snap: PhoneSnapshot, times: np.ndarray) -> np.ndarray:
+    """Whether the settled phone at each of ``times`` is silence (times not settled: no). Before
+    a stream's energy has spanned its range (:mod:`engine.streaming.speech`: the silence before
+    the first words), the recognizer says where the pauses are.
+
+    >>> from engine.data import PhoneSegment
+    >>> snap = PhoneSnapshot([PhoneSegment(0, .3, "sil"), PhoneSegment(.3, .4, "b")],
+    ...                      np.ones(2), 0.4)
+    >>> recognized_silence(snap, np.array([0.1, 0.35, 0.5])).tolist()
+    [True, False, False]
+    """
+    out = np.zeros(len(times), dtype=bool)
+    for seg in snap.segments:
+        if seg.label == SILENCE:
+            out |= (times >= seg.start) & (times < min(seg.end, snap.settled_s))
+    return out
