@@ -114,3 +114,60 @@ def test_any_device_format_becomes_mono_floats():
     x = np.array([0.5, -2.0, np.nan], "<f4").tobytes()                  # out of range, NaN
     assert decode_pcm(x, "Float", 1).tolist() == [0.5, -1.0, 0.0]
     assert decode_pcm(np.array([2 ** 30], "<i4").tobytes() + b"\x01", "Int32", 1).tolist() == [0.5]
+
+
+class _Device:
+    """A device that records only in its own format: 48 kHz stereo float."""
+
+    def isFormatSupported(self, fmt):
+        return False
+
+    def preferredFormat(self):
+        from PyQt6.QtMultimedia import QAudioFormat
+
+        fmt = QAudioFormat()
+        fmt.setSampleRate(48000)
+        fmt.setChannelCount(2)
+        fmt.setSampleFormat(QAudioFormat.SampleFormat.Float)
+        return fmt
+
+    def description(self):
+        return "USB headset"
+
+    def id(self):
+        return b"usb"
+
+
+def test_a_device_with_another_rate_records_in_its_own_format():
+    from app.live_input import capture_format
+
+    fmt = capture_format(_Device())
+    assert (fmt.sampleRate(), fmt.channelCount(), fmt.sampleFormat().name) == (48000, 2, "Float")
+
+
+def test_a_source_that_stops_with_an_error_is_a_lost_input():
+    from PyQt6.QtMultimedia import QtAudio
+
+    from app.live_input import MicFeeder
+
+    class Source:
+        def __init__(self):
+            self.err, self.st = QtAudio.Error.NoError, QtAudio.State.ActiveState
+
+        def error(self):
+            return self.err
+
+        def state(self):
+            return self.st
+
+    class Io:
+        def readAll(self):
+            return np.array([0.5, -0.5, 0.25, 0.25], "<f4").tobytes()
+
+    feeder = object.__new__(MicFeeder)          # as MicFeeder(device) makes it, without a device
+    feeder.device, feeder.source, feeder.io = _Device(), Source(), Io()
+    feeder.rate, feeder.channels, feeder.sample_format, feeder._quiet_polls = 48000, 2, "Float", 0
+    assert feeder.poll().tolist() == [0.0, 0.25]
+    feeder.source.err = QtAudio.Error.IOError
+    with pytest.raises(InputLost, match="USB headset stopped delivering audio"):
+        feeder.poll()

@@ -303,3 +303,19 @@ def test_a_minute_of_silence_or_clipping_streams_with_bounded_state(default_mode
     rec = stream.recognizer
     assert rec.restarts >= 4                                  # utterances of at most 10 s
     assert len(rec.track.phones) < 2000
+
+
+def test_a_device_at_44_1_khz_streams_with_phones(default_model, utterance):
+    from engine.method.lsf import resample_audio
+
+    audio, rate, _ = utterance
+    a44 = resample_audio(audio, rate, 44100)
+    take = stream_file(default_model, a44, 44100, 0.01)
+    here = stream_file(default_model, audio, rate, 0.01)
+    assert len(take.frames) == len(here.frames)
+    # 44.1 kHz is resampled to 16 kHz for the recognizer: nearly the same phones, frame by frame
+    from engine.evaluation.live_eval import frame_labels
+
+    n = int(len(audio) / rate * 100)
+    alike = np.mean(frame_labels(take.labels.phones, n) == frame_labels(here.labels.phones, n))
+    assert alike > 0.8
