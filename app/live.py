@@ -41,17 +41,19 @@ from engine.errors import FacetrajError
 from engine.io.audio import read_audio, write_audio
 from engine.io.export import write_trajectories
 from engine.method.model import Model
-from engine.streaming.live import LiveConfig, LiveStream
 
-from .live_input import MIC_RATE, FileFeeder, InputLost, MicFeeder, input_devices
+from .live_input import MIC_RATE, FileFeeder, InputHealth, InputLost, MicFeeder, input_devices
 from .live_phones import PhonePanel
 from .view3d import FaceView
 
 log = logging.getLogger(__name__)
 
-#: shown when there is no microphone
+#: shown in the window when there is no microphone, and said by ``facetraj live`` (exit 2)
 NO_INPUT_DEVICE = ("no audio input device found (is a microphone connected and a sound server "
                    "running?): Open recording... plays a file through live mode")
+NO_INPUT_DEVICE_COMMAND = ("no audio input device found (is a microphone connected and a sound "
+                           "server running?); use --from-file FILE to play a file through live "
+                           "mode (or Open recording... in the app's Live window)")
 SHOWN_S = 4.0
 TICK_MS = 15
 PLOT_EVERY_S = 0.2
@@ -74,7 +76,7 @@ class LiveWindow(QMainWindow):
         self.model = model
         self.config = config or SynthConfig()
         self.from_file, self.block_s, self.fast = from_file, block_s, fast
-        self.stream: LiveStream | None = None
+        self.stream = None                  # the take's engine.streaming.live.LiveStream
         self.feeder: FileFeeder | MicFeeder | None = None
         self.rate = MIC_RATE
         self._new_take()
@@ -172,6 +174,8 @@ class LiveWindow(QMainWindow):
     # ------------------------------------------------------------------ a take
     def start(self) -> None:
         """Begin a take (the previous one is dropped)."""
+        from engine.streaming.live import LiveConfig, LiveStream  # the recognizer: with a take
+
         index = self.device_box.currentIndex() - (self.device_box.count() - len(self.devices))
         try:
             if self.from_file is not None and index < 0:
@@ -192,6 +196,7 @@ class LiveWindow(QMainWindow):
             return
         self.phones.new_stream(self.stream)
         self.phones.take_started()
+        self.health = InputHealth(self.rate)
         self._new_take()
         self.start_action.setEnabled(False)
         self.stop_action.setEnabled(True)
@@ -292,6 +297,7 @@ class LiveWindow(QMainWindow):
                 self.audio.append(block.astype(np.float32))
                 self._samples += len(block)
                 self.phones.latency.arrived(self.take_seconds)
+                self.health.add(block)
                 rms = float(np.sqrt(np.mean(block**2)) + 1e-12)
                 self._level = max(self._level, int(np.clip(20 * np.log10(rms), -60, 0)))
                 self._consume(self.stream.feed(block))
@@ -334,6 +340,8 @@ class LiveWindow(QMainWindow):
             self._level = -60
             self._plot()
             self.phones.refresh(self.stream, (self.n_frames - 1) / self.model.marker_rate)
+            if self.stream is not None:
+                self.message.setText(self.health.message or f"live: {self.stream.choice.describe()}")
 
     def _frame(self, k: int) -> np.ndarray:
         """Marker frame ``k`` of the take (the last chunks are searched from the end)."""
@@ -411,9 +419,10 @@ def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = Non
              device: str | None = None, screenshot: str | None = None,
              quit_after: float | None = None, phones: bool = True) -> int:
     """Open the Live window (``facetraj live``) and start a take. No input device and no file:
-    the window says so (:data:`NO_INPUT_DEVICE`) and offers to open a recording. With
-    ``screenshot``, the window is saved to that PNG when the file has been played (or after
-    ``quit_after`` seconds) and closes."""
+    :class:`FacetrajError` with :data:`NO_INPUT_DEVICE_COMMAND` (a command must not wait for a
+    window nobody asked for; the window itself offers to open a recording). With ``screenshot``,
+    the window is saved to that PNG when the file has been played (or after ``quit_after``
+    seconds) and closes."""
     from engine.threads import one_blas_thread
 
     from .display import ensure_display, require_display
@@ -426,6 +435,8 @@ def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = Non
     require_display("the Live window (facetraj live without -o)")
     one_blas_thread()       # the stream is synthesized beside the rendering (engine.threads)
     app = QApplication.instance() or QApplication(sys.argv[:1])
+    if audio is None and not input_devices():
+        raise FacetrajError(NO_INPUT_DEVICE_COMMAND)
     window = LiveWindow(model, config, audio, block_s, fast, device, phones)
     window.resize(1400, 800)
     window.show()
@@ -438,9 +449,8 @@ def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = Non
 
     if screenshot or quit_after:
         window.takeFinished.connect(finish)
-        if quit_after:                  # a take to stop (its end finishes), or none: finish
-            QTimer.singleShot(int(quit_after * 1000),
-                              lambda: window.stop() if window.stream is not None else finish())
+        if quit_after:
+            QTimer.singleShot(int(quit_after * 1000), window.stop)
     QTimer.singleShot(0, window.start)
     app.exec()
     return 0

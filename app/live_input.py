@@ -136,3 +136,43 @@ class MicFeeder:
 
     def stop(self) -> None:
         self.source.stop()
+
+
+class InputHealth:
+    """What is wrong with the input, if anything, over the last ``window_s``: clipping (more than
+    ``clip_share`` of the samples at full scale) or silence (nothing above ``silent_level`` for
+    ``silent_s``): the window says so and the take goes on.
+
+    >>> h = InputHealth(16000)
+    >>> h.add(np.ones(1600)); h.message
+    'the input is clipping (100 % of samples at full scale): lower its level'
+    >>> h = InputHealth(16000, silent_s=0.5)
+    >>> for _ in range(6): h.add(np.zeros(1600))
+    >>> h.message
+    'no sound for 0.6 s: is the microphone muted?'
+    """
+
+    def __init__(self, rate: int, window_s: float = 2.0, clip_share: float = 0.01,
+                 silent_s: float = 5.0, silent_level: float = 1e-4):
+        self.rate, self.window_s = rate, window_s
+        self.clip_share, self.silent_s, self.silent_level = clip_share, silent_s, silent_level
+        self._recent: list[tuple[int, int]] = []            # (samples, clipped) per block
+        self._silent = 0                                     # samples since the last sound
+
+    def add(self, block: np.ndarray) -> None:
+        x = np.abs(np.asarray(block, dtype=np.float64))
+        self._recent.append((len(x), int((x >= 0.999).sum())))
+        while sum(n for n, _ in self._recent) > self.window_s * self.rate and len(self._recent) > 1:
+            self._recent.pop(0)
+        self._silent = 0 if (len(x) and x.max() > self.silent_level) else self._silent + len(x)
+
+    @property
+    def message(self) -> str:
+        n = sum(k for k, _ in self._recent)
+        clipped = sum(c for _, c in self._recent)
+        if n and clipped > self.clip_share * n:
+            return (f"the input is clipping ({100 * clipped / n:.0f} % of samples at full scale): "
+                    "lower its level")
+        if self._silent >= self.silent_s * self.rate:
+            return f"no sound for {self._silent / self.rate:.1f} s: is the microphone muted?"
+        return ""

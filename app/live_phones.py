@@ -14,6 +14,7 @@ import time
 from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from PyQt6.QtCore import QRectF, Qt
@@ -21,12 +22,13 @@ from PyQt6.QtGui import QColor, QPainter
 from PyQt6.QtWidgets import QComboBox, QLabel, QSizePolicy, QWidget
 
 from engine.data import PhoneSegment
-from engine.io.labelling import write_labels
 from engine.labels.phoneset import SILENCE
-from engine.labels.provenance import Labels
 from engine.method.closure import BILABIALS
-from engine.streaming.live import LiveStream
-from engine.streaming.recognizer import RunningCmn
+
+if TYPE_CHECKING:       # the recognizer is imported with the first take, not with the app
+    from engine.labels.provenance import Labels
+    from engine.streaming.live import LiveStream
+    from engine.streaming.recognizer import RunningCmn
 
 #: the switch's choices
 PHONES, ACOUSTIC = "phones + acoustics", "acoustic-only"
@@ -208,6 +210,8 @@ class PhonePanel:
         """The take's phones as a TextGrid at ``path`` (none acoustic-only)."""
         if self.labels is None:
             return None
+        from engine.io.labelling import write_labels
+
         write_labels(path, self.labels, duration, overwrite)
         self.saved = path
         return path
@@ -217,6 +221,8 @@ def voice_text(stream: LiveStream) -> str:
     """The voice match and what live mode adapts, for the status bar."""
     if stream.recognizer is None:
         return " acoustic-only "
+    if stream.recognition_error is not None:
+        return f" recognition stopped ({stream.recognition_error}): acoustic-only from there "
     ratio, heard = stream.voice_ratio, stream.heard_s
     if not np.isfinite(ratio):
         return f" voice match: measuring ({heard:.1f} s of speech) "

@@ -3,9 +3,6 @@ reopened; no input device gives the documented message, not a crash."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
@@ -15,9 +12,11 @@ pytest.importorskip("pyvistaqt")
 from app import live
 from app.main import build_window
 from engine.config import SynthConfig
+from engine.errors import FacetrajError
 from engine.io.audio import read_audio
 from engine.io.markerfiles import read_c3d
 from engine.method.pipeline import synthesize
+from facetraj.cli import main
 
 
 @pytest.fixture
@@ -65,7 +64,7 @@ def test_live_window_plays_a_file_and_its_take_reopens(qtbot, default_model, utt
     qtbot.wait(50)                                      # the panels' last draw
 
 
-def test_no_input_device_gives_the_message(qtbot, default_model, monkeypatch, tmp_path):
+def test_no_input_device_gives_the_message(qtbot, default_model, monkeypatch, capsys, tmp_path):
     monkeypatch.setattr(live, "input_devices", lambda: [])
     window = live.LiveWindow(default_model)
     qtbot.addWidget(window)
@@ -77,12 +76,11 @@ def test_no_input_device_gives_the_message(qtbot, default_model, monkeypatch, tm
     assert window.phones.open_action.isEnabled()        # a recording can be played instead
     window.start()                                      # nothing to start: still the message
     assert window.message.text() == live.NO_INPUT_DEVICE and window.stream is None
-    # facetraj live without a microphone opens the window (it offers a recording), no error
-    # (its own process: its event loop quits the application when it ends)
+    with pytest.raises(FacetrajError, match="no audio input device"):
+        live.run_live(lambda: default_model)
     model_file = default_model.save(tmp_path / "m.npz")
-    done = subprocess.run([sys.executable, "-m", "facetraj", "-q", "live", "--model", str(model_file),
-                           "--quit-after", "0.5"], capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0 and "Traceback" not in done.stderr
+    assert main(["-q", "live", "--model", str(model_file)]) == 2
+    assert live.NO_INPUT_DEVICE_COMMAND in capsys.readouterr().err
 
 
 def test_live_toggle_in_the_main_window(qtbot, default_corpus, trained_cache, monkeypatch):

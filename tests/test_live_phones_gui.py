@@ -171,3 +171,17 @@ def test_a_source_that_stops_with_an_error_is_a_lost_input():
     feeder.source.err = QtAudio.Error.IOError
     with pytest.raises(InputLost, match="USB headset stopped delivering audio"):
         feeder.poll()
+
+
+def test_clipped_input_is_said_and_the_take_goes_on(qtbot, default_model, monkeypatch, tmp_path):
+    window = _window(qtbot, default_model, monkeypatch)
+    rate = 16000
+    t = np.arange(4 * rate) / rate
+    path = tmp_path / "clipped.wav"
+    write_audio(path, np.clip(3 * np.sin(2 * np.pi * 200 * t), -1, 1), rate)
+    window.open_recording(path)
+    qtbot.waitUntil(lambda: "clipping" in window.message.text(), timeout=60_000)
+    with qtbot.waitSignal(window.takeFinished, timeout=120_000):
+        pass
+    assert window.n_frames == 4 * 60 + 1
+    qtbot.wait(50)
