@@ -70,8 +70,9 @@ class PhoneTrack:
     >>> track.freeze(4)
     >>> [(p.start, p.end, p.label, p.confidence) for p in track.phones]
     [(0, 2, 'sil', 1.0), (2, 4, 'm', 0.5)]
-    >>> track.segments()[1], track.settled_s
-    (PhoneSegment(start=0.02, end=0.04, label='m'), 0.04)
+    >>> snap = track.snapshot()
+    >>> snap.segments[1], snap.confidence.tolist(), snap.settled_s
+    (PhoneSegment(start=0.02, end=0.04, label='m'), [1.0, 0.5], 0.04)
     """
 
     def __init__(self, frame_s: float = 0.01):
@@ -125,13 +126,6 @@ class PhoneTrack:
         """The first frame no hypothesis has covered yet."""
         return self.frozen + len(self._latest)
 
-    def segments(self, since_s: float = 0.0) -> list[PhoneSegment]:
-        """The settled phones ending after ``since_s`` as segments in seconds (the last one may
-        still grow: it ends where the settled audio ends)."""
-        first = first_phone_after(self.phones, since_s / self.frame_s)
-        f = self.frame_s
-        return [PhoneSegment(p.start * f, p.end * f, p.label) for p in self.phones[first:]]
-
     def snapshot(self, since_s: float = 0.0, before: int = 0) -> PhoneSnapshot:
         """The settled phones from the one holding ``since_s`` on, and ``before`` more before it
         (eq 4's left context)."""
@@ -141,11 +135,6 @@ class PhoneTrack:
         return PhoneSnapshot([PhoneSegment(p.start * f, p.end * f, p.label) for p in phones],
                              np.array([p.confidence for p in phones], dtype=np.float64),
                              self.settled_s)
-
-    def confidence(self, since_s: float = 0.0) -> np.ndarray:
-        """The stability of each phone of :meth:`segments` (the same ``since_s``)."""
-        first = first_phone_after(self.phones, since_s / self.frame_s)
-        return np.array([p.confidence for p in self.phones[first:]], dtype=np.float64)
 
 
 def first_phone_after(phones: Sequence[FrozenPhone], frame: float) -> int:

@@ -164,8 +164,7 @@ def _cmn_vector(text: str) -> np.ndarray:
 # --------------------------------------------------------------------------- the recognizer
 class StreamingRecognizer:
     """Audio blocks (any rate, mono floats in [-1, 1]) in with :meth:`feed`, :meth:`flush` at the
-    end; the settled phones in :attr:`track` (``track.segments()``, ``track.confidence()``,
-    ``track.settled_s``)."""
+    end; the settled phones in :attr:`track` (``track.snapshot()``, ``track.settled_s``)."""
 
     def __init__(self, sample_rate: int, config: RecognizerConfig | None = None,
                  cmn: RunningCmn | None = None):
