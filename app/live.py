@@ -1,10 +1,13 @@
 """Live mode: the synthesized face follows a microphone (QtMultimedia ``QAudioSource``) or a file
-played in real time, through the streaming synthesizer (``engine.streaming``).
+played in real time, through live mode's stream (``engine.streaming.live``: phones recognized as
+they are spoken, or acoustic-only).
 
 The window shows the 3-D face (synthesized points only), an input level meter, and the upper and
 lower lip y of the last few seconds scrolling, with speech/silence dots computed live (the
-energy of the 20 ms before each frame against the take's running floor and peak). Stop keeps the
-take: its audio and trajectories can be saved (WAV + C3D/TSV) and opened like any utterance.
+energy of the 20 ms before each frame against the take's running floor and peak), and under them
+the phones (``app.live_phones``). Stop keeps the take: its audio, trajectories and phones can be
+saved (WAV + C3D/TSV + TextGrid) and opened like any utterance. A device that disappears ends the
+take with a message; what was recorded is kept.
 """
 
 from __future__ import annotations
@@ -36,98 +39,47 @@ from PyQt6.QtWidgets import (
 
 from engine.config import SynthConfig
 from engine.errors import FacetrajError
-from engine.io.audio import write_audio
+from engine.io.audio import read_audio, write_audio
 from engine.io.export import write_trajectories
 from engine.method.model import Model
-from engine.streaming.synthesizer import LIVE_BATCH_FRAMES, StreamConfig, StreamingSynthesizer
 
+from .live_input import MIC_RATE, FileFeeder, InputHealth, InputLost, MicFeeder, input_devices
+from .live_phones import PhonePanel
 from .plotter_widget import grab_with_3d
 from .style import SPEECH_DOT_COLOR, SYNTH_COLOR, TRIANGULAR_COLOR
 from .view3d import FaceView
 
 log = logging.getLogger(__name__)
 
-#: shown (and raised by ``facetraj live``) when there is no microphone
+#: shown in the window when there is no microphone, and said by ``facetraj live`` (exit 2)
 NO_INPUT_DEVICE = ("no audio input device found (is a microphone connected and a sound server "
-                   "running?); use --from-file FILE to play a file through live mode")
-MIC_RATE = 16000
+                   "running?): Open recording... plays a file through live mode")
+NO_INPUT_DEVICE_COMMAND = ("no audio input device found (is a microphone connected and a sound "
+                           "server running?); use --from-file FILE to play a file through live "
+                           "mode (or Open recording... in the app's Live window)")
 SHOWN_S = 4.0
 TICK_MS = 15
 PLOT_EVERY_S = 0.2
-
-
-def input_devices() -> list:
-    """The audio input devices QtMultimedia sees (``QAudioDevice``), default first."""
-    from PyQt6.QtMultimedia import QMediaDevices
-
-    devices = list(QMediaDevices.audioInputs())
-    default = QMediaDevices.defaultAudioInput()
-    devices.sort(key=lambda d: d.id() != default.id())
-    return devices
-
-
-class FileFeeder:
-    """Blocks of a file as the audio clock reaches them (``fast``: the next block every poll)."""
-
-    def __init__(self, audio: np.ndarray, rate: int, block_s: float, fast: bool = False):
-        self.audio, self.rate, self.fast = audio, rate, fast
-        self.block = max(1, int(round(block_s * rate)))
-        self.pos = 0
-        self.t0 = time.perf_counter()
-
-    def poll(self) -> np.ndarray | None:
-        """The samples due now (possibly none); ``None`` once the file has been played."""
-        if self.pos >= len(self.audio):
-            return None
-        due = self.pos + self.block if self.fast else \
-            int((time.perf_counter() - self.t0) * self.rate) // self.block * self.block
-        due = min(max(due, self.pos), len(self.audio))
-        out, self.pos = self.audio[self.pos:due], due
-        return out
-
-    def stop(self) -> None:
-        self.pos = len(self.audio)
-
-
-class MicFeeder:
-    """16 kHz mono 16-bit blocks from a ``QAudioSource`` (pull mode: read what has arrived)."""
-
-    def __init__(self, device):
-        from PyQt6.QtMultimedia import QAudioFormat, QAudioSource
-
-        fmt = QAudioFormat()
-        fmt.setSampleRate(MIC_RATE)
-        fmt.setChannelCount(1)
-        fmt.setSampleFormat(QAudioFormat.SampleFormat.Int16)
-        self.rate = MIC_RATE
-        self.source = QAudioSource(device, fmt)
-        self.io = self.source.start()
-
-    def poll(self) -> np.ndarray | None:
-        data = bytes(self.io.readAll()) if self.io is not None else b""
-        data = data[: len(data) // 2 * 2]
-        return np.frombuffer(data, dtype="<i2").astype(np.float64) / 32768.0
-
-    def stop(self) -> None:
-        self.source.stop()
+__all__ = ["MIC_RATE", "FileFeeder", "LiveWindow", "MicFeeder", "input_devices", "run_live"]
 
 
 class LiveWindow(QMainWindow):
     """The Live window. ``start()`` begins a take from the chosen device (or ``from_file``),
-    ``stop()`` ends it; ``save_take(path)`` writes ``path`` (.c3d/.tsv/...) and the WAV beside it.
+    ``stop()`` ends it; ``save_take(path)`` writes ``path`` (.c3d/.tsv/...), the WAV and (with
+    phones) the TextGrid beside it. ``phones``: the mode switch's first setting.
     """
 
     takeFinished = pyqtSignal()
 
     def __init__(self, model: Model, config: SynthConfig | None = None,
                  from_file: tuple[np.ndarray, int] | None = None, block_s: float = 0.01,
-                 fast: bool = False, device: str | None = None):
+                 fast: bool = False, device: str | None = None, phones: bool = True):
         super().__init__()
         self.setWindowTitle("facetraj - live")
         self.model = model
-        self.config = (config or SynthConfig()).with_(mode="acoustic")
+        self.config = config or SynthConfig()
         self.from_file, self.block_s, self.fast = from_file, block_s, fast
-        self.stream: StreamingSynthesizer | None = None
+        self.stream = None                  # the take's engine.streaming.live.LiveStream
         self.feeder: FileFeeder | MicFeeder | None = None
         self.rate = MIC_RATE
         self._new_take()
@@ -140,8 +92,6 @@ class LiveWindow(QMainWindow):
         self.addToolBar(bar)
         self.device_box = QComboBox()
         self.devices = [] if from_file is not None else input_devices()
-        if from_file is not None:
-            self.device_box.addItem("file")
         for d in self.devices:
             self.device_box.addItem(d.description())
         if device:
@@ -149,6 +99,9 @@ class LiveWindow(QMainWindow):
             match = [i for i, n in enumerate(names) if device.lower() in n.lower()]
             if match:
                 self.device_box.setCurrentIndex(match[0])
+        if from_file is not None:
+            self.device_box.insertItem(0, "file")
+            self.device_box.setCurrentIndex(0)
         bar.addWidget(QLabel(" input: "))
         bar.addWidget(self.device_box)
         self.start_action = bar.addAction("Start", self.start)
@@ -172,6 +125,7 @@ class LiveWindow(QMainWindow):
         self._build_panels()
         self.canvas.mpl_connect("draw_event", self._on_full_draw)
         right.addWidget(self.canvas, 1)
+        self.phones = PhonePanel(self, bar, right, phones, SHOWN_S)
         lay.addLayout(right, 2)
         self.setCentralWidget(central)
         self.message = QLabel()
@@ -209,26 +163,62 @@ class LiveWindow(QMainWindow):
                             loc="upper left", fontsize=7, ncol=2, frameon=True, framealpha=0.85)
         self.axes[1].set_xlabel("time (s, 0 = now)", fontsize=8)
         self._background = None
+    # ------------------------------------------------------------------ a file
+    def open_recording(self, path: str | Path) -> bool:
+        """Play the recording at ``path`` through live mode (a new take); a file that cannot be
+        read is said in the status bar."""
+        try:
+            audio, rate = read_audio(path)
+        except (OSError, FacetrajError) as exc:
+            self.message.setText(f"could not open the recording: {exc}")
+            return False
+        self.stop()
+        self.from_file = (audio, rate)
+        if self.device_box.count() == len(self.devices):
+            self.device_box.insertItem(0, "file")
+        self.device_box.setItemText(0, f"file: {Path(path).name}")
+        self.device_box.setCurrentIndex(0)
+        self.start_action.setEnabled(True)
+        self.start()
+        return True
+
+    def open_dialog(self) -> None:
+        name, _ = QFileDialog.getOpenFileName(self, "Play a recording through live mode", "",
+                                              "Audio (*.wav *.flac)")
+        if name:
+            self.open_recording(name)
 
     # ------------------------------------------------------------------ a take
     def start(self) -> None:
         """Begin a take (the previous one is dropped)."""
-        if self.from_file is not None:
-            audio, rate = self.from_file
-            self.feeder = FileFeeder(audio, rate, self.block_s, self.fast)
-        elif self.devices:
-            self.feeder = MicFeeder(self.devices[self.device_box.currentIndex()])
-        else:
-            self.message.setText(NO_INPUT_DEVICE)
+        from engine.streaming.live import LiveConfig, LiveStream  # the recognizer: with a take
+
+        index = self.device_box.currentIndex() - (self.device_box.count() - len(self.devices))
+        try:
+            if self.from_file is not None and index < 0:
+                audio, rate = self.from_file
+                self.feeder = FileFeeder(audio, rate, self.block_s, self.fast)
+            elif self.devices:
+                self.feeder = MicFeeder(self.devices[max(index, 0)])
+            else:
+                self.message.setText(NO_INPUT_DEVICE)
+                return
+            self.rate = self.feeder.rate
+            self.stream = LiveStream(self.model, self.rate, self.config,
+                                     LiveConfig(phones=self.phones.phones_on), threaded=True,
+                                     cmn=self.phones.cmn)
+        except (InputLost, ValueError, RuntimeError, OSError) as exc:
+            self.message.setText(f"could not start: {exc}")
+            self.stream = None
             return
-        self.rate = self.feeder.rate
-        self.stream = StreamingSynthesizer(self.model, StreamConfig(self.rate, self.config,
-                                                                     LIVE_BATCH_FRAMES))
+        self.phones.new_stream(self.stream)
+        self.phones.take_started()
+        self.health = InputHealth(self.rate)
         self._new_take()
         self.start_action.setEnabled(False)
         self.stop_action.setEnabled(True)
         self.save_action.setEnabled(False)
-        self.message.setText("live")
+        self.message.setText(f"live: {self.stream.choice.describe()}")
         self._timer.start()
 
     def _new_take(self) -> None:
@@ -243,21 +233,28 @@ class LiveWindow(QMainWindow):
         self._level = -60               # the loudest block (dB) since the meter was last set
         self._t_start = time.perf_counter()
 
-    def stop(self) -> None:
-        """End the take: the last frames come out (the smoothing's lookahead) and it is kept."""
+    def stop(self, reason: str = "") -> None:
+        """End the take: the last frames come out (the smoothing's lookahead) and it is kept
+        (``reason``: why it ended, when not by the user)."""
         if self.stream is None:
             return
         self._timer.stop()
         self.feeder.stop()
-        self._consume(self.stream.flush())
-        self.stream = None
+        stream, self.stream = self.stream, None
+        self._consume(stream.flush())
+        self.phones.take_finished(stream, self.take_seconds)
         self._show_due()
         self.start_action.setEnabled(True)
         self.stop_action.setEnabled(False)
         self.save_action.setEnabled(self.n_frames > 0)
-        self.message.setText(f"take: {self.take_seconds:.1f} s, {self.n_frames} frames, "
+        self.message.setText((f"{reason}; " if reason else "") +
+                             f"take: {self.take_seconds:.1f} s, {self.n_frames} frames, "
                              f"{self.fps:.0f} face updates/s")
         self.takeFinished.emit()
+
+    def closeEvent(self, event) -> None:
+        self.stop()                 # the recognizer's thread ends with the take
+        super().closeEvent(event)
 
     @property
     def n_frames(self) -> int:
@@ -280,15 +277,17 @@ class LiveWindow(QMainWindow):
         return audio, self.rate, markers
 
     def save_take(self, path: str | Path, overwrite: bool = False) -> tuple[Path, Path]:
-        """Write the take's trajectories to ``path`` (.c3d, .tsv, .csv or .npz) and its audio to
-        the WAV of the same name; both paths."""
+        """Write the take's trajectories to ``path`` (.c3d, .tsv, .csv or .npz), its audio to
+        the WAV of the same name and its recognized phones to the TextGrid (with their
+        provenance, ``app.live_phones``); the first two paths."""
         audio, rate, markers = self.take()
         path = Path(path)
         wav = path.with_suffix(".wav")
         write_audio(wav, audio, rate, overwrite)
         out = write_trajectories(path, markers, self.model.marker_rate, self.model.marker_names,
                                  overwrite=overwrite)
-        self.message.setText(f"take saved: {out} and {wav.name}")
+        grid = self.phones.save(path.with_suffix(".TextGrid"), len(audio) / rate, overwrite)
+        self.message.setText(f"take saved: {out}, {wav.name}" + (f" and {grid.name}" if grid else ""))
         return out, wav
 
     def _save_dialog(self) -> None:
@@ -302,17 +301,27 @@ class LiveWindow(QMainWindow):
 
     # ------------------------------------------------------------------ the clock
     def _tick(self) -> None:
-        block = self.feeder.poll()
+        try:
+            block = self.feeder.poll()
+        except InputLost as exc:
+            self.stop(f"{exc}: the take so far is kept")
+            return
         if block is None:
             self.stop()
             return
-        if len(block):
-            self.audio.append(block)
-            self._samples += len(block)
-            rms = float(np.sqrt(np.mean(block**2)) + 1e-12)
-            self._level = max(self._level, int(np.clip(20 * np.log10(rms), -60, 0)))
-            self._consume(self.stream.feed(block))
-        self._show_due()
+        try:
+            if len(block):
+                self.audio.append(block.astype(np.float32))
+                self._samples += len(block)
+                self.phones.latency.arrived(self.take_seconds)
+                self.health.add(block)
+                rms = float(np.sqrt(np.mean(block**2)) + 1e-12)
+                self._level = max(self._level, int(np.clip(20 * np.log10(rms), -60, 0)))
+                self._consume(self.stream.feed(block))
+            self._show_due()
+        except Exception as exc:        # a slot must not raise (PyQt aborts): end the take
+            log.exception("live take stopped")
+            self.stop(f"live mode stopped ({exc}): the take so far is kept")
 
     def _consume(self, frames) -> None:
         """Keep the frames of the take; they are shown when due (:meth:`_show_due`)."""
@@ -335,6 +344,7 @@ class LiveWindow(QMainWindow):
         if due <= self._shown:
             return
         self._shown = due
+        self.phones.latency.shown(due / self.model.marker_rate)
         self.face.synth.set_points(self._frame(due))
         self.face.request_render()
         self.updates += 1
@@ -346,6 +356,9 @@ class LiveWindow(QMainWindow):
             self.level.setValue(self._level)
             self._level = -60
             self._plot()
+            self.phones.refresh(self.stream, (self.n_frames - 1) / self.model.marker_rate)
+            if self.stream is not None:
+                self.message.setText(self.health.message or f"live: {self.stream.choice.describe()}")
 
     def _frame(self, k: int) -> np.ndarray:
         """Marker frame ``k`` of the take (the last chunks are searched from the end)."""
@@ -422,11 +435,12 @@ class LiveWindow(QMainWindow):
 def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = None,
              from_file: Path | None = None, block_s: float = 0.01, fast: bool = False,
              device: str | None = None, screenshot: str | None = None,
-             quit_after: float | None = None) -> int:
+             quit_after: float | None = None, phones: bool = True) -> int:
     """Open the Live window (``facetraj live``) and start a take. No input device and no file:
-    :class:`FacetrajError` with :data:`NO_INPUT_DEVICE`. With ``screenshot``, the window is saved
-    to that PNG when the file has been played (or after ``quit_after`` seconds) and closes."""
-    from engine.io.audio import read_audio
+    :class:`FacetrajError` with :data:`NO_INPUT_DEVICE_COMMAND` (a command must not wait for a
+    window nobody asked for; the window itself offers to open a recording). With ``screenshot``,
+    the window is saved to that PNG when the file has been played (or after ``quit_after``
+    seconds) and closes."""
     from engine.threads import one_blas_thread
 
     from .display import ensure_display, require_display
@@ -440,8 +454,8 @@ def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = Non
     one_blas_thread()       # the stream is synthesized beside the rendering (engine.threads)
     app = QApplication.instance() or QApplication(sys.argv[:1])
     if audio is None and not input_devices():
-        raise FacetrajError(NO_INPUT_DEVICE)
-    window = LiveWindow(model, config, audio, block_s, fast, device)
+        raise FacetrajError(NO_INPUT_DEVICE_COMMAND)
+    window = LiveWindow(model, config, audio, block_s, fast, device, phones)
     window.resize(1400, 800)
     window.show()
 

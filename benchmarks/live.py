@@ -1,13 +1,17 @@
-"""Live mode (issue 13): latency from an audio sample entering to its face frame, speed of the
-streaming path, and face updates per second of the Live window under Xvfb.
+"""Live mode (issues 13 and 27): latency from an audio sample entering to its face frame, speed of
+the streaming path, acoustic-only and with phones recognized as they are spoken; the lip closure
+of ``facetraj live --from-file`` on the CMU ARCTIC samples; face updates per second of the Live
+window under Xvfb.
 
 Latency is simulated on the audio clock, without sleeping: blocks of ``BLOCK_S`` arrive at their
 last sample's time and queue up when the previous one is still being processed; a block's
 processing starts at ``max(its arrival, the previous block's end)`` and lasts its ``feed()`` call's
-measured wall time; a frame's latency is the end of the processing of the block that completes it
-minus the frame's time (the algorithm's lookahead, the block wait, the queue and the compute; a
-stream slower than real time shows as growing latency; the render of the frame is the live fps
-row's business).
+measured wall time (with phones: the recognizer's and the synthesizer's, one after the other, as
+``facetraj live --from-file`` runs them; in the window the recognizer has a thread of its own, but
+PocketSphinx holds Python's lock while it decodes); a frame's latency is the end of the processing
+of the block that completes it minus the frame's time (the algorithm's lookahead, the block wait,
+the queue and the compute; a stream slower than real time shows as growing latency; the render of
+the frame is the live fps row's business).
 
 ``python -m benchmarks.live [--section docs/benchmarks.md]`` runs only these and writes them as
 a section of that file (``python -m benchmarks`` puts them in the main table).
@@ -24,25 +28,25 @@ from pathlib import Path
 
 import numpy as np
 
-from engine.config import SynthConfig
-from engine.streaming.synthesizer import LIVE_BATCH_FRAMES, StreamConfig, StreamingSynthesizer
+from engine.streaming.live import LiveConfig, LiveStream
 from engine.threads import one_blas_thread
 
 from .common import BenchContext, BenchRow, concatenate_input, load_context, markdown_table
 
 BLOCK_S = 0.01                 # a typical audio callback (10 ms)
 SPEED_BLOCKS_S = (0.01, 0.1, 1.0)
-AIMS = {"latency": 150.0, "speed": 20.0, "fps": 30.0}
+AIMS = {"latency": 150.0, "latency phones": 250.0, "speed": 20.0, "speed phones": 5.0,
+        "fps": 30.0, "closure": 0.7, "vowel max": 17.0}
 SECTION = ("<!-- live benchmarks: written by python -m benchmarks.live -->",
            "<!-- end of live benchmarks -->")
+MODES = {"acoustic-only": LiveConfig(phones=False), "phones + acoustics": LiveConfig()}
 
 
-def _stream(model, audio: np.ndarray, rate: int, block_s: float, batch: int = LIVE_BATCH_FRAMES
-            ) -> tuple[list[float], float, float]:
-    """Per-frame latencies (s), and the total wall and CPU time of streaming ``audio`` in blocks
-    (frames analysed in batches of ``batch``; live mode's by default)."""
-    cfg = SynthConfig(mode="acoustic")
-    stream = StreamingSynthesizer(model, StreamConfig(rate, cfg, batch))
+def _stream(model, audio: np.ndarray, rate: int, block_s: float, config: LiveConfig
+            ) -> tuple[list[float], float, float, LiveStream]:
+    """Per-frame latencies (s), the total wall and CPU time of streaming ``audio`` in blocks, and
+    the stream."""
+    stream = LiveStream(model, rate, config=config)
     block = max(1, int(round(block_s * rate)))
     latencies: list[float] = []
     total = 0.0
@@ -58,7 +62,7 @@ def _stream(model, audio: np.ndarray, rate: int, block_s: float, batch: int = LI
         latencies += [busy_until - t for t in frames.times]
     t0 = time.perf_counter()
     stream.flush()
-    return latencies, total + time.perf_counter() - t0, time.process_time() - cpu0
+    return latencies, total + time.perf_counter() - t0, time.process_time() - cpu0, stream
 
 
 def run(ctx: BenchContext) -> list[BenchRow]:
@@ -69,35 +73,105 @@ def run(ctx: BenchContext) -> list[BenchRow]:
 
 
 def _run(ctx: BenchContext) -> list[BenchRow]:
-    model = ctx.model
     seconds = 5.0 if ctx.smoke else 30.0
     audio, rate, _ = concatenate_input(ctx.test_utts or ctx.train_utts, seconds)
-    _stream(model, audio[: rate], rate, BLOCK_S)                       # warm-up
-    lat, _, _ = _stream(model, audio, rate, BLOCK_S)
-    lat_ms = 1000 * np.asarray(lat)
-    look = 1000 * StreamingSynthesizer(model, StreamConfig(batch_frames=LIVE_BATCH_FRAMES)).lookahead_s
     rows = []
-    for name, value in (("median", np.median(lat_ms)), ("95th percentile", np.percentile(lat_ms, 95))):
-        rows.append(BenchRow("live", f"latency sample -> face frame, {name}", float(value), "ms",
-                             f"<= {AIMS['latency']:.0f} ms", bool(value <= AIMS["latency"]),
-                             note=f"{BLOCK_S * 1000:.0f} ms blocks, {seconds:g} s of test speech; "
-                                  f"includes the {look:.1f} ms lookahead (window + smoothing + "
-                                  f"live mode's batch of {LIVE_BATCH_FRAMES} frames)"))
-    for block_s in SPEED_BLOCKS_S:
-        _, wall, cpu = _stream(model, audio, rate, block_s)
-        rtf = seconds / wall
-        rows.append(BenchRow("live", f"streaming speed, {block_s * 1000:g} ms blocks", rtf, "x RT",
-                             f">= {AIMS['speed']:.0f}x", bool(rtf >= AIMS["speed"]),
-                             note=f"{seconds:g} s of test speech as fast as possible, live mode's "
-                                  f"batch of {LIVE_BATCH_FRAMES} frames",
-                             cpu=seconds / max(cpu, 1e-9)))
-    _, wall, cpu = _stream(model, audio, rate, BLOCK_S, batch=1)
-    rows.append(BenchRow("live", f"streaming speed, {BLOCK_S * 1000:g} ms blocks, every frame at "
-                         "once (no batch)", seconds / wall, "x RT",
-                         note=f"{seconds:g} s of test speech as fast as possible",
-                         cpu=seconds / max(cpu, 1e-9)))
+    for mode, config in MODES.items():
+        rows += _latency_and_speed(ctx.model, audio, rate, seconds, mode, config)
+    rows += closure_rows(ctx)
     rows += _live_fps(ctx, 3.0 if ctx.smoke else 8.0)
     return rows
+
+
+def _latency_and_speed(model, audio: np.ndarray, rate: int, seconds: float, mode: str,
+                       config: LiveConfig) -> list[BenchRow]:
+    phones = config.phones
+    _stream(model, audio[: rate], rate, BLOCK_S, config)                   # warm-up
+    lat, _, _, stream = _stream(model, audio, rate, BLOCK_S, config)
+    lat_ms = 1000 * np.asarray(lat)
+    look = 1000 * stream.lookahead_s
+    aim = AIMS["latency phones" if phones else "latency"]
+    how = (f"recognizer settling {1000 * config.recognizer.settle_s:.0f} ms behind its front, "
+           f"phones awaited {1000 * config.timing.wait_s:.0f} ms at most, frames in batches of "
+           f"{config.timing.batch}, smoothing" if phones else
+           "window + smoothing + live mode's batch of 5 frames")
+    rows = []
+    for name, value in (("median", np.median(lat_ms)), ("95th percentile", np.percentile(lat_ms, 95))):
+        rows.append(BenchRow("live", f"latency sample -> face frame, {mode}, {name}", float(value),
+                             "ms", f"<= {aim:.0f} ms", bool(value <= aim),
+                             note=f"{BLOCK_S * 1000:.0f} ms blocks, {seconds:g} s of test speech; "
+                                  f"includes the {look:.1f} ms lookahead ({how})"
+                                  + (f"; phones settled in time for "
+                                     f"{100 * stream.labelled_share:.0f} % of the frames"
+                                     if phones else "")))
+    aim = AIMS["speed phones" if phones else "speed"]
+    for block_s in SPEED_BLOCKS_S:
+        _, wall, cpu, stream = _stream(model, audio, rate, block_s, config)
+        rtf = seconds / wall
+        rec = (f"; recognition {100 * stream.recognize_s / wall:.0f} % of it" if phones else "")
+        rows.append(BenchRow("live", f"streaming speed, {mode}, {block_s * 1000:g} ms blocks", rtf,
+                             "x RT", f">= {aim:.0f}x" if block_s == BLOCK_S or not phones else "",
+                             bool(rtf >= aim) if block_s == BLOCK_S or not phones else None,
+                             note=f"{seconds:g} s of test speech as fast as possible{rec}",
+                             cpu=seconds / max(cpu, 1e-9)))
+    return rows
+
+
+def closure_rows(ctx: BenchContext) -> list[BenchRow]:
+    """Lip closure of ``facetraj live --from-file`` on the ARCTIC samples, both modes (the
+    measure of issue 25, through :func:`engine.evaluation.closure_eval.live_closure`)."""
+    from engine.evaluation.closure_eval import ARCTIC_DIR, arctic_references, live_closure
+    from facetraj.paths import shared_path
+
+    folder = shared_path(ARCTIC_DIR)
+    if not folder.is_dir() or ctx.model.closure is None:
+        return [BenchRow("live", "lip closure of live --from-file (ARCTIC samples)", float("nan"),
+                         "%", note=f"skipped: no {ARCTIC_DIR} beside the repository"
+                         if not folder.is_dir() else "skipped: a model without closure statistics")]
+    refs = arctic_references(folder)
+    if ctx.smoke:
+        refs = dict(list(refs.items())[:1])
+    rows = []
+    for mode, config in MODES.items():
+        score = live_closure(ctx.model, refs, config)
+        judged = config.phones and not ctx.smoke
+        note = (f"{score.n} /p b m/ in {len(refs)} recordings, 10 ms blocks; median minimum "
+                f"{score.median_min:.1f} mm against {score.closed:.1f} mm closed; median pause "
+                f"{score.pause:.1f} mm")
+        rows.append(BenchRow("live", f"/p b m/ within 1 mm of closed, live --from-file, {mode}",
+                             100 * score.within, "%", f">= {100 * AIMS['closure']:.0f} %" if judged
+                             else "", bool(score.within >= AIMS["closure"]) if judged else None,
+                             note=note))
+        rows.append(BenchRow("live", f"median vowel maximum, live --from-file, {mode}",
+                             score.vowel_max, "mm", f">= {AIMS['vowel max']:.0f} mm" if judged
+                             else "", bool(score.vowel_max >= AIMS["vowel max"]) if judged else None,
+                             note="the lip aperture's largest value in each vowel, median"))
+    session = live_closure(ctx.model, refs, MODES["phones + acoustics"], session=True)
+    rows.append(BenchRow("live", "/p b m/ within 1 mm of closed, the recordings as takes of one "
+                         "Live window, phones + acoustics", 100 * session.within, "%",
+                         note="the recognizer's running cepstral mean kept from take to take, as "
+                              f"the window keeps it; median vowel maximum {session.vowel_max:.1f} mm"))
+    return rows + comparison_rows(ctx, refs)
+
+
+def comparison_rows(ctx: BenchContext, refs) -> list[BenchRow]:
+    """Live mode against ``facetraj synth`` of the same recordings
+    (:func:`engine.evaluation.live_eval.compare_live_offline`)."""
+    from engine.evaluation.live_eval import compare_live_offline
+
+    c = compare_live_offline(ctx.model, refs)
+    what = f"{len(refs)} ARCTIC recordings, facetraj synth (recognizing their phones) vs live --from-file"
+    return [
+        BenchRow("live", "/p b m/ within 1 mm of closed, facetraj synth (offline)",
+                 100 * c.offline.within, "%", note=f"{what}; live: {100 * c.live.within:.0f} %"),
+        BenchRow("live", "reference /p b m/ found by the recognizer, offline / live",
+                 c.found_offline, f"of {c.n}", note=f"live: {c.found_live} of {c.n}"),
+        BenchRow("live", "speech frames whose recognized phone is the offline one, live", 100 *
+                 c.phones_alike, "%", note="10 ms frames of the offline recognizer's phones"),
+        BenchRow("live", "lip aperture, live minus offline, RMS", c.aperture_rms_mm, "mm",
+                 note=f"{what}; correlation {c.aperture_corr:.3f}; median vowel maximum "
+                      f"{c.offline.vowel_max:.1f} mm offline, {c.live.vowel_max:.1f} mm live"),
+    ]
 
 
 def _live_fps(ctx: BenchContext, seconds: float) -> list[BenchRow]:

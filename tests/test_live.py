@@ -22,22 +22,47 @@ def test_live_from_file_writes_the_offline_synthesis(model_file, default_model, 
     wav = default_corpus.root / f"{default_corpus.info.test[0]}.flac"
     out = tmp_path / "take.tsv"
     assert main(["-q", "live", "--model", str(model_file), "--from-file", str(wav),
-                 "--as-fast-as-possible", "-o", str(out)]) == 0
+                 "--as-fast-as-possible", "--acoustic-only", "-o", str(out)]) == 0
     assert capsys.readouterr().out.strip() == str(out)
     take = read_marker_table(out)
     audio, rate = read_audio(wav)
     offline = synthesize(default_model, audio, rate, None, SynthConfig(mode="acoustic", closure=False))
     assert take.markers.shape == offline.markers.shape
     np.testing.assert_allclose(take.markers, offline.markers, atol=0.006)   # TSV: 3 decimals
+    assert not out.with_suffix(".TextGrid").exists()                      # no phones
     # the take exists: not replaced without --overwrite
     assert main(["-q", "live", "--model", str(model_file), "--from-file", str(wav),
-                 "--as-fast-as-possible", "-o", str(out)]) != 0
+                 "--as-fast-as-possible", "--acoustic-only", "-o", str(out)]) != 0
+
+
+def test_live_from_file_with_phones_writes_them_beside_the_take(model_file, default_model,
+                                                                default_corpus, tmp_path, capsys):
+    from engine.io.labelfiles import read_label_file
+    from engine.streaming.live import stream_file
+
+    wav = default_corpus.root / f"{default_corpus.info.test[1]}.flac"
+    out = tmp_path / "take.tsv"
+    assert main(["-q", "live", "--model", str(model_file), "--from-file", str(wav),
+                 "--as-fast-as-possible", "--block-ms", "100", "-o", str(out)]) == 0
+    audio, rate = read_audio(wav)
+    take = read_marker_table(out)
+    streamed = stream_file(default_model, audio, rate, 0.01)           # blocks do not matter
+    np.testing.assert_allclose(take.markers, streamed.frames.markers, atol=0.006)
+    labels = read_label_file(out.with_suffix(".TextGrid"), rate, len(audio) / rate)
+    assert labels.provenance.kind == "recognized"
+    assert [p.label for p in labels.phones] == [p.label for p in streamed.labels.phones]
+    # the TextGrid is a take's file too: not replaced without --overwrite
+    out.unlink()
+    assert main(["-q", "live", "--model", str(model_file), "--from-file", str(wav),
+                 "--as-fast-as-possible", "-o", str(out)]) == 2
+    assert "take.TextGrid exists" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("args, message", [
     (["-o", "x.tsv"], "add --from-file"),
     (["--from-file", "nothing.wav", "-o", "x.tsv"], "nothing.wav: no such audio file"),
     (["--smoothing", "none", "--from-file", "nothing.wav", "-o", "x.tsv"], "no such audio file"),
+    (["--warp", "0.9", "--from-file", "nothing.wav", "-o", "x.tsv"], "add --acoustic-only"),
 ])
 def test_live_bad_input_exit_2(args, message, model_file, tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
@@ -65,10 +90,14 @@ def test_live_benchmark_rows_and_section(toy_corpus_dir, tmp_path, monkeypatch):
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
     rows = bench.run(load_context(toy_corpus_dir, smoke=True))
     names = [r.name for r in rows]
-    assert names[:2] == ["latency sample -> face frame, median",
-                         "latency sample -> face frame, 95th percentile"]
-    assert all(r.value > 0 for r in rows[:5])
-    assert rows[0].value <= rows[1].value
+    for mode in ("acoustic-only", "phones + acoustics"):
+        k = names.index(f"latency sample -> face frame, {mode}, median")
+        assert names[k + 1] == f"latency sample -> face frame, {mode}, 95th percentile"
+        assert 0 < rows[k].value <= rows[k + 1].value
+        assert all(r.value > 0 for r in rows[k + 2:k + 5]) and "speed" in names[k + 2]
+    lat = {r.name: r.value for r in rows}
+    assert lat["latency sample -> face frame, phones + acoustics, median"] > \
+        lat["latency sample -> face frame, acoustic-only, median"]        # the phones' wait
     assert "skipped" in rows[-1].note                    # no display: no Live window
     doc = tmp_path / "bench.md"
     doc.write_text("# Benchmarks\n\ntable\n")

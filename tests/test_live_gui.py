@@ -36,7 +36,8 @@ def _image_std(image) -> float:
 
 def test_live_window_plays_a_file_and_its_take_reopens(qtbot, default_model, utterance, tmp_path):
     audio, rate = utterance
-    window = live.LiveWindow(default_model, None, (audio, rate), block_s=0.05, fast=True)
+    window = live.LiveWindow(default_model, None, (audio, rate), block_s=0.05, fast=True,
+                             phones=False)                # acoustic-only: equal to offline
     qtbot.addWidget(window)
     window.resize(1200, 700)
     window.show()
@@ -74,6 +75,7 @@ def test_live_window_plays_a_file_and_its_take_reopens(qtbot, default_model, utt
     c3d = read_c3d(path)
     assert c3d.markers.shape == offline.markers.shape and c3d.rate == default_model.marker_rate
     np.testing.assert_allclose(c3d.markers, offline.markers, atol=0.05)
+    qtbot.wait(50)                                      # the panels' last draw
 
 
 def test_no_input_device_gives_the_message(qtbot, default_model, monkeypatch, capsys, tmp_path):
@@ -81,15 +83,18 @@ def test_no_input_device_gives_the_message(qtbot, default_model, monkeypatch, ca
     window = live.LiveWindow(default_model)
     qtbot.addWidget(window)
     window.show()
+    qtbot.waitExposed(window)
+    qtbot.wait(50)                                      # its first draw, before it is deleted
     assert window.message.text() == live.NO_INPUT_DEVICE
     assert not window.start_action.isEnabled()
+    assert window.phones.open_action.isEnabled()        # a recording can be played instead
     window.start()                                      # nothing to start: still the message
     assert window.message.text() == live.NO_INPUT_DEVICE and window.stream is None
     with pytest.raises(FacetrajError, match="no audio input device"):
         live.run_live(lambda: default_model)
     model_file = default_model.save(tmp_path / "m.npz")
     assert main(["-q", "live", "--model", str(model_file)]) == 2
-    assert live.NO_INPUT_DEVICE in capsys.readouterr().err
+    assert live.NO_INPUT_DEVICE_COMMAND in capsys.readouterr().err
 
 
 def test_live_toggle_in_the_main_window(qtbot, default_corpus, trained_cache, monkeypatch):

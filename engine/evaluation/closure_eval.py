@@ -2,7 +2,8 @@
 label source on the default corpus's held-out sentences (with their correlations) and on real
 voices the model was not trained on (CMU ARCTIC sentences, speech only), each synthesized the way
 the commands do it (:func:`engine.method.recording.synthesize_recording` is ``facetraj synth``;
-:func:`engine.streaming.stream_synthesize` is ``facetraj live --from-file``).
+:func:`engine.streaming.live.stream_file` is ``facetraj live --from-file``, with phones
+recognized as they are spoken or ``--acoustic-only``).
 
 The measure is :mod:`engine.evaluation.closure`: /p b m/ within 1 mm of the training talker's
 closed aperture, the median minimum at /p b m/, the median vowel maximum and the median pause
@@ -31,7 +32,8 @@ from ..method.model import Model
 from ..method.modes import choose_mode
 from ..method.pipeline import Synthesis, synthesize
 from ..method.recording import LabelRequest, synthesize_recording
-from ..streaming.synthesizer import stream_synthesize
+from ..streaming.live import LiveConfig, stream_file
+from ..streaming.recognizer import RecognizerConfig, RunningCmn
 from .closure import ClosureScore, closure_score, lip_aperture
 from .scores import speech_mask, trajectory_correlations
 
@@ -140,21 +142,65 @@ ARCTIC_CONDITIONS = (
 )
 
 
-def arctic_rows(model: Model, folder: Path, progress: Callable[[float, str], None]) -> list[ClosureRow]:
-    """The recordings of ``folder`` (each with its ``.txt``) under every condition of
-    :data:`ARCTIC_CONDITIONS`, through ``facetraj synth``'s path, and through live mode's."""
-    wavs = sorted(folder.glob("*.wav"))
+#: Live mode's conditions on the ARCTIC samples: (synthesis shown, its settings, synthesis
+#: settings, the recordings as takes of one session). The three after the first take one running
+#: adaptation away each (issue 27: live mode adapts only where that helps real voices).
+LIVE_CONDITIONS = (
+    ("live mode (facetraj live --from-file): phones + acoustics", LiveConfig(), SynthConfig(),
+     False),
+    ("live mode, the label weight not scaled by the running voice ratio", LiveConfig(),
+     SynthConfig(label_weight_by_voice=False), False),
+    ("live mode, the plain running cepstral mean", LiveConfig(
+        recognizer=RecognizerConfig(cmn_speech_share=None)), SynthConfig(), False),
+    ("live mode, PocketSphinx's own live cepstral mean", LiveConfig(
+        recognizer=RecognizerConfig(cmn_every=None)), SynthConfig(), False),
+    ("live mode, the six as takes of one Live window (cepstral mean kept)", LiveConfig(),
+     SynthConfig(), True),
+    ("live mode, acoustic-only (--acoustic-only)", LiveConfig(phones=False), SynthConfig(), False),
+)
+#: Live mode's audio blocks (a typical audio callback).
+LIVE_BLOCK_S = 0.01
+
+
+def arctic_references(folder: Path) -> dict[Path, tuple[np.ndarray, int, list[PhoneSegment]]]:
+    """Each recording of ``folder`` (with its ``.txt``): its audio, rate and reference phones
+    (the transcript aligned)."""
     refs = {}
-    for w in wavs:
+    for w in sorted(folder.glob("*.wav")):
         audio, rate = read_audio(w)
         refs[w] = (audio, rate, label_audio(audio, rate, "aligned",
                                             read_transcript(w.with_suffix(".txt")), source=w).phones)
+    return refs
+
+
+def live_closure(model: Model, refs: dict[Path, tuple[np.ndarray, int, list[PhoneSegment]]],
+                 config: LiveConfig, block_s: float = LIVE_BLOCK_S,
+                 synth: SynthConfig | None = None, session: bool = False) -> ClosureScore:
+    """The closure of the recordings of ``refs`` streamed as ``facetraj live --from-file
+    --as-fast-as-possible`` streams them (blocks of ``block_s``), each from a cold start, or
+    (``session``) one after the other as takes of one Live window, which keeps the recognizer's
+    running cepstral mean from take to take."""
+    scores = []
+    cmn = RunningCmn(prior_frames=config.recognizer.cmn_prior_frames,
+                     speech_share=config.recognizer.cmn_speech_share) if session else None
+    for audio, rate, ref in refs.values():
+        frames = stream_file(model, audio, rate, block_s, synth, config, cmn=cmn).frames
+        aperture = lip_aperture(frames.markers, model.upper_lip, model.lower_lip)
+        scores.append(closure_score(aperture, frames.times, ref, model.closure.closed))
+    return ClosureScore.pooled(scores)
+
+
+def arctic_rows(model: Model, folder: Path, progress: Callable[[float, str], None]) -> list[ClosureRow]:
+    """The recordings of ``folder`` (each with its ``.txt``) under every condition of
+    :data:`ARCTIC_CONDITIONS`, through ``facetraj synth``'s path, and through live mode's
+    (:data:`LIVE_CONDITIONS`)."""
+    refs = arctic_references(folder)
     rows = []
+    steps = len(ARCTIC_CONDITIONS) + len(LIVE_CONDITIONS)
     for k, (kind, name, how, cfg, explicit) in enumerate(ARCTIC_CONDITIONS):
-        progress(k / (len(ARCTIC_CONDITIONS) + 1), f"closure: ARCTIC {kind}, {name}")
+        progress(k / steps, f"closure: ARCTIC {kind}, {name}")
         scores = []
-        for w in wavs:
-            audio, rate, ref = refs[w]
+        for w, (audio, rate, ref) in refs.items():
             request = LabelRequest(transcript=w.with_suffix(".txt") if how == "transcript" else None,
                                    recognize=how == "recognize")
             with tempfile.TemporaryDirectory() as alone:     # the recording without its .txt
@@ -165,14 +211,11 @@ def arctic_rows(model: Model, folder: Path, progress: Callable[[float, str], Non
                                             audio=(audio, rate))
             scores.append(_scored(model, done.synthesis, ref)[0])
         rows.append(ClosureRow(folder.name, kind, name, ClosureScore.pooled(scores).to_json()))
-    scores = []
-    for w in wavs:                       # facetraj live --from-file: 10 ms blocks, acoustic-only
-        audio, rate, ref = refs[w]
-        frames = stream_synthesize(model, audio, rate, rate // 100)
-        aperture = lip_aperture(frames.markers, model.upper_lip, model.lower_lip)
-        scores.append(closure_score(aperture, frames.times, ref, model.closure.closed))
-    rows.append(ClosureRow(folder.name, "none", "live mode (facetraj live --from-file)",
-                           ClosureScore.pooled(scores).to_json()))
+    for k, (name, config, synth, session) in enumerate(LIVE_CONDITIONS):
+        progress((len(ARCTIC_CONDITIONS) + k) / steps, f"closure: ARCTIC, {name}")
+        score = live_closure(model, refs, config, synth=synth, session=session)
+        rows.append(ClosureRow(folder.name, "recognized, streamed" if config.phones else "none",
+                               name, score.to_json()))
     return rows
 
 

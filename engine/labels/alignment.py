@@ -174,7 +174,13 @@ def pocketsphinx_version() -> str:
 
 
 # --------------------------------------------------------------------------- alignment
-def _label_of(name: str) -> str:
+def phone_label(name: str) -> str:
+    """A PocketSphinx phone or filler as a label: ARPAbet lower case, ``sil`` for silence, fillers
+    and anything else.
+
+    >>> phone_label("B"), phone_label("SIL"), phone_label("+NSN+")
+    ('b', 'sil', 'sil')
+    """
     lab = name.lower()
     return SILENCE if lab == "sil" or lab.startswith("+") or lab not in ARPABET else lab
 
@@ -187,7 +193,7 @@ def _segments(entries: Iterable[tuple[str, int, int, float]], duration: float
     scores: list[float] = []
     frames: list[int] = []
     for name, start, length, score in entries:
-        lab = _label_of(name)
+        lab = phone_label(name)
         t0, t1 = start * FRAME_S, (start + length) * FRAME_S
         if phones and lab == SILENCE and phones[-1].label == SILENCE:
             prev = phones[-1]
@@ -301,10 +307,16 @@ def _mean_score(labels: Labels) -> float:
 
 
 # --------------------------------------------------------------------------- recognition
+def allphone_decoder():
+    """A PocketSphinx decoder of the all-phone search (:data:`ALLPHONE_SETTINGS`, 16 kHz): the one
+    recognition uses, offline here and streamed in live mode (``engine.streaming.recognizer``)."""
+    lm = os.path.join(_pocketsphinx().get_model_path(), "en-us", "en-us-phone.lm.bin")
+    return _decoder(allphone=lm, **ALLPHONE_SETTINGS)
+
+
 def _recognize_segments(pcm: bytes) -> tuple[list[PhoneSegment], np.ndarray, int]:
     """All-phone search, then the phones found re-aligned as a phone sequence (scores)."""
-    lm = os.path.join(_pocketsphinx().get_model_path(), "en-us", "en-us-phone.lm.bin")
-    dec = _decoder(allphone=lm, **ALLPHONE_SETTINGS)
+    dec = allphone_decoder()
     _decode(dec, pcm)
     n_frames = dec.n_frames()
     found = [(s.word, s.start_frame, s.end_frame - s.start_frame + 1) for s in dec.seg()]

@@ -32,7 +32,7 @@ from .smoothing import smooth
 from .speaker import choose_warp, warp_lsf
 from .speech import filtered_energy_db, pauses, speech_mask
 from .synthesis import FrameWeights, gamma_grid, nearest_codewords, weight_frames
-from .voice_match import voice_distance, voice_match
+from .voice_match import label_weight_scale, trust_by_voice, voice_distance, voice_match
 
 log = logging.getLogger(__name__)
 
@@ -141,12 +141,14 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                                          source, config)
         segments, frame_seg, candidates = _eq4(model, segs, times, config)
         if config.mode == "robust":
-            conf = frame_confidence(list(phones), confidence, times)
-            scale = 1.0
-            if config.label_weight_by_voice and np.isfinite(ratio):
-                conf, scale = trust_by_voice(conf, ratio), max(1.0, ratio)
+            conf = trust_by_voice(frame_confidence(list(phones), confidence, times), ratio,
+                                  config.label_weight_by_voice)
             conf[unlabelled[frame_seg]] = 0.0
-            fw = _robust(model, w, candidates, conf, config, scale)
+            scale = label_weight_scale(ratio, config.label_weight_by_voice)
+            fw = robust_weights(model, w, candidates, conf, config, scale)
+            if config.chain_beta > 0:                 # the weights made consistent over time
+                fw.pcs = chain_pcs(fw.weights, fw.candidates, model.codebook.pcs, config.chain_beta,
+                                   model.join_scale)
         else:
             fw = _weighted(model, w, lambda a, b: candidates[a:b], config)
     elif config.mode == "acoustic":
@@ -211,20 +213,24 @@ def _eq4(model: Model, segs: list[PhoneSegment], times: np.ndarray, config: Synt
     return segments, frame_seg, cb.codewords_of(top)[frame_seg]
 
 
-def _robust(model: Model, w: np.ndarray, candidates: np.ndarray, conf: np.ndarray,
-            config: SynthConfig, scale: float = 1.0) -> FrameWeights:
+def robust_weights(model: Model, w: np.ndarray, candidates: np.ndarray, conf: np.ndarray,
+                   config: SynthConfig, scale: float = 1.0, w_ctx: np.ndarray | None = None
+                   ) -> FrameWeights:
     """The robust mode's eqs 5-8 (``engine.method.selection``), its label weight times
-    ``scale`` (the voice's distance ratio: eq 5's distances grow with it), eq 8 over the frames'
-    chain (``engine.method.chain``)."""
-    cb, mc = model.codebook, model.config
+    ``scale`` (the voice's distance ratio: eq 5's distances grow with it); ``w_ctx``: the input
+    frames at :func:`context_offsets` when ``w`` is part of a longer input (a stream). The chain
+    over frames (``engine.method.chain``) is :func:`synthesize`'s, on the whole input."""
+    cb = model.codebook
     near = model.lsf_index().nearest(w, cb.lsf, config.robust_candidates, config.acoustic_probe or 8)
-    fw = robust_frames(w, candidates, near, conf, cb.lsf, cb.pcs, _gammas(config),
-                       config.label_weight * scale, cb.lsf_context,
-                       np.array([-mc.lsf_context_frames, mc.lsf_context_frames]),
-                       config.context_weight)
-    if config.chain_beta > 0:                 # the weights made consistent over time
-        fw.pcs = chain_pcs(fw.weights, fw.candidates, cb.pcs, config.chain_beta, model.join_scale)
-    return fw
+    return robust_frames(w, candidates, near, conf, cb.lsf, cb.pcs, _gammas(config),
+                         config.label_weight * scale, cb.lsf_context, context_offsets(model),
+                         config.context_weight, w_ctx=w_ctx)
+
+
+def context_offsets(model: Model) -> np.ndarray:
+    """The frame offsets of the robust mode's acoustic context (the codewords' stored LSFs)."""
+    k = model.config.lsf_context_frames
+    return np.array([-k, k])
 
 
 def _weighted(model: Model, w: np.ndarray, candidates: Callable[[int, int], np.ndarray],
@@ -282,21 +288,6 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
         intervals, strengths = closure_intervals(segs, trust)
     return ClosurePlan(intervals, strengths, pauses(audio, sample_rate, times, config.rest_pause_s,
                                                     filtered=filtered))
-
-
-def trust_by_voice(confidence: np.ndarray, ratio: float) -> np.ndarray:
-    """Labels weighed by voice (issue 25): ``c' = 1 - (1 - c) m``, ``m`` the voice match of the
-    distance ``ratio``. On the training voice (``m = 1``) a label counts as much as its maker
-    trusted it; on a voice the codebook does not know (``m = 0``) the acoustic distances are the
-    untrustworthy part, and the labels count fully (the recognizer and the aligner were trained
-    on many voices, the codebook on one; their scores drop on such a voice for every phone).
-
-    >>> trust_by_voice(np.array([0.2, 1.0]), 1.0).round(9).tolist()
-    [0.2, 1.0]
-    >>> trust_by_voice(np.array([0.2]), 5.0).tolist()
-    [1.0]
-    """
-    return 1.0 - (1.0 - np.asarray(confidence, dtype=np.float64)) * voice_match(ratio, 1.0)
 
 
 class SpeechEnergy:

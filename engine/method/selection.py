@@ -160,13 +160,15 @@ def robust_frames(w: np.ndarray, phonetic: np.ndarray, acoustic: np.ndarray,
                   confidence: np.ndarray, cb_lsf: np.ndarray, cb_pcs: np.ndarray,
                   gammas: np.ndarray, kappa: float, cb_ctx: np.ndarray | None = None,
                   offsets: np.ndarray | None = None, context_weight: float = 0.0,
-                  chunk: int = 128) -> RobustFrames:
+                  chunk: int = 128, w_ctx: np.ndarray | None = None) -> RobustFrames:
     """The robust mode per frame: candidate union, target cost = :func:`context_distances` +
     :func:`label_penalty`, then eqs 6-8 (:func:`weight_costs`). ``cb_ctx`` ``(5L, O, P)`` holds
-    the codewords' LSFs at ``offsets`` frames (``None``: no context). Chunked over frames."""
+    the codewords' LSFs at ``offsets`` frames (``None``: no context). ``w_ctx`` ``(T, O, P)``:
+    the input frames at those offsets when ``w`` is part of a longer input (a stream), else
+    :func:`context_frames` of ``w``. Chunked over frames."""
     cand, from_labels, valid = candidate_union(phonetic, acoustic)
     use_ctx = cb_ctx is not None and offsets is not None and len(offsets) and context_weight > 0
-    w_ctx_all = context_frames(w, offsets) if use_ctx else None
+    w_ctx_all = (context_frames(w, offsets) if w_ctx is None else w_ctx) if use_ctx else None
     gammas = np.asarray(gammas, dtype=np.float64)
     parts = []
     acost = np.empty(cand.shape)

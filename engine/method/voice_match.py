@@ -64,8 +64,14 @@ def voice_distance(w: np.ndarray, speech: np.ndarray, cb_lsf: np.ndarray,
     if index is None:
         d = nearest_distances(w, cb_lsf, exclude)
         return float(np.median(d)) if np.isfinite(d).all() else float("nan")
-    near = index.nearest(w, cb_lsf, 1, 8)[:, 0]
-    return float(np.median(lsf_distances(w, cb_lsf[near][:, None, :])[:, 0]))
+    return float(np.median(indexed_distances(w, cb_lsf, index)))
+
+
+def indexed_distances(w: np.ndarray, cb_lsf: np.ndarray, index: LsfIndex) -> np.ndarray:
+    """Per frame of ``w`` ``(T, P)``, eq 5's distance to the nearest codeword found through the
+    model's LSF ``index`` (8 cells probed): what :func:`voice_distance` takes the median of."""
+    near = index.nearest(np.asarray(w, dtype=np.float64), cb_lsf, 1, 8)[:, 0]
+    return lsf_distances(w, cb_lsf[near][:, None, :])[:, 0]
 
 
 def training_voice_distance(lsf: Sequence[np.ndarray], speech: Sequence[np.ndarray],
@@ -91,3 +97,34 @@ def voice_match(distance: float, reference: float) -> float:
         return float("nan")
     x = np.log(max(distance, 1e-12) / (MATCH_FULL * reference)) / np.log(MATCH_NONE / MATCH_FULL)
     return float(np.clip(1.0 - x, 0.0, 1.0))
+
+
+def label_weight_scale(ratio: float, by_voice: bool = True) -> float:
+    """The factor of the robust mode's label weight for a voice at distance ratio ``ratio``
+    (``D / D0``): the ratio, at least 1 (eq 5's distances grow on a voice the codebook does not
+    know, and the labels must keep their weight against them); 1 when the ratio is unknown or
+    ``by_voice`` is off (``SynthConfig.label_weight_by_voice``).
+
+    >>> label_weight_scale(4.2), label_weight_scale(0.8), label_weight_scale(float("nan"))
+    (4.2, 1.0, 1.0)
+    """
+    return max(1.0, float(ratio)) if by_voice and np.isfinite(ratio) else 1.0
+
+
+def trust_by_voice(confidence: np.ndarray, ratio: float, by_voice: bool = True) -> np.ndarray:
+    """Labels weighed by voice (issue 25): ``c' = 1 - (1 - c) m``, ``m`` the voice match of the
+    distance ``ratio``. On the training voice (``m = 1``) a label counts as much as its maker
+    trusted it; on a voice the codebook does not know (``m = 0``) the acoustic distances are the
+    untrustworthy part and the labels count fully (the recognizer and the aligner were trained on
+    many voices, the codebook on one; their scores drop on such a voice for every phone). The
+    confidence as it is when the ratio is unknown or ``by_voice`` is off.
+
+    >>> trust_by_voice(np.array([0.2, 1.0]), 1.0).round(9).tolist()
+    [0.2, 1.0]
+    >>> trust_by_voice(np.array([0.2]), 5.0).tolist(), trust_by_voice(np.array([0.2]), 5.0, False).tolist()
+    ([1.0], [0.2])
+    """
+    c = np.asarray(confidence, dtype=np.float64)
+    if not by_voice or not np.isfinite(ratio):
+        return c.copy()
+    return 1.0 - (1.0 - c) * voice_match(ratio, 1.0)

@@ -22,12 +22,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..config import SynthConfig
-from ..method.lsf import ResampleStream, frame_lsf, frame_start, frame_starts, preemphasize
 from ..method.model import Model
 from ..method.pipeline import acoustic_candidates
 from ..method.smoothing import TriangularStream
 from ..method.speaker import warp_lsf
 from ..method.synthesis import gamma_grid, weight_frames
+from .front import LsfFront
 
 log = logging.getLogger(__name__)
 
@@ -95,18 +95,8 @@ class StreamingSynthesizer:
         if cfg.speaker_warp is None:
             raise ValueError("streaming needs a fixed speaker_warp (a number), not None")
         self.synth = cfg
-        mc = model.config
+        self.front = LsfFront(model, self.config.sample_rate)
         self.rate = model.marker_rate
-        self._audio_rate = mc.audio_rate
-        self._resampler = ResampleStream(self.config.sample_rate, mc.audio_rate)
-        self._n = int(round(mc.window_s * mc.audio_rate))          # analysis window, samples
-        self._half = self._n // 2
-        self._hamming = np.hamming(self._n)
-        self._buffer = np.zeros(0)          # pre-emphasized analysis samples from self._first on
-        self._first = 0
-        self._analysed = 0                  # analysis samples received so far
-        self._previous: float | None = None
-        self._received = 0                  # input samples received so far
         self._next = 0                      # the next frame to analyse
         self._smoother = TriangularStream(self.rate, cfg.triangle_s if cfg.smoothing ==
                                           "triangular" else 0.0)
@@ -120,15 +110,13 @@ class StreamingSynthesizer:
     def lookahead_s(self) -> float:
         """Audio needed after a frame's time before the frame is emitted (the algorithm's delay;
         with ``batch_frames > 1`` the most: the first frame of a batch waits for its last)."""
-        resampler = self._resampler.lookahead / self.config.sample_rate
-        window = (self._n - self._half) / self._audio_rate
         batch = (self.config.batch_frames - 1) / self.rate
-        return window + resampler + batch + self._smoother.lookahead / self.rate
+        return self.front.lookahead_s + batch + self._smoother.lookahead / self.rate
 
     @property
     def received_s(self) -> float:
         """Seconds of audio fed so far."""
-        return self._received / self.config.sample_rate
+        return self.front.received_s
 
     @property
     def lsf(self) -> np.ndarray:
@@ -143,26 +131,18 @@ class StreamingSynthesizer:
 
     def feed(self, block: np.ndarray) -> StreamFrames:
         """Face frames completed by the next ``block`` of audio samples (mono)."""
-        block = np.asarray(block, dtype=np.float64).ravel()
-        self._received += len(block)
-        self._append(self._resampler.feed(block))
-        # frame t is complete once its window's last sample has arrived
-        last = self._next
-        while self._window_start(last) + self._n <= self._analysed:
-            last += 1
+        last = self.front.feed(block)           # frame t is complete once its window is in
         if last - self._next < self.config.batch_frames:
             last = self._next                           # not a whole batch yet: wait
-        return self._emit(self._analyse(last, self._analysed), self._smoother.feed)
+        return self._emit(self._analyse(last), self._smoother.feed)
 
     def flush(self) -> StreamFrames:
         """The remaining frames, the audio ended: as many frames in all as offline synthesis makes
         of the same audio (none if it is shorter than two frames)."""
-        self._append(self._resampler.flush())
-        duration = self._received / float(self.config.sample_rate)
-        total = int(np.floor(duration * self.rate + 1e-9)) + 1
-        if total < 2 or duration < 2.0 / self.rate:
+        total = self.front.flush()
+        if total == 0:
             return self._emit(np.zeros((0, self.model.codebook.pcs.shape[1])), self._smoother.feed)
-        raw = self._analyse(total, self._analysed)
+        raw = self._analyse(total)
         frames = self._emit(raw, self._smoother.feed)
         rest = self._emit(np.zeros((0, raw.shape[1])), lambda _: self._smoother.flush())
         return StreamFrames(np.concatenate([frames.index, rest.index]),
@@ -171,33 +151,12 @@ class StreamingSynthesizer:
                             np.concatenate([frames.markers, rest.markers]))
 
     # ------------------------------------------------------------------ the steps
-    def _append(self, samples: np.ndarray) -> None:
-        if len(samples) == 0:
-            return
-        coef = self.model.config.preemphasis
-        emphasized = preemphasize(samples, coef, self._previous)
-        self._previous = float(samples[-1])
-        self._buffer = np.concatenate([self._buffer, emphasized])
-        self._analysed += len(samples)
-
-    def _window_start(self, t: int) -> int:
-        """The first analysis sample of frame t's window (may be negative: zeros before)."""
-        return frame_start(t / self.rate, self._audio_rate) - self._half
-
-    def _analyse(self, stop: int, length: int) -> np.ndarray:
-        """Raw PCs (eqs 5-8) of frames ``self._next .. stop-1``; analysis samples at or beyond
-        ``length`` are zero (only at the end)."""
-        t = np.arange(self._next, stop)
+    def _analyse(self, stop: int) -> np.ndarray:
+        """Raw PCs (eqs 5-8) of frames ``self._next .. stop-1``."""
         k = self.model.codebook.pcs.shape[1]
-        if len(t) == 0:
+        if stop <= self._next:
             return np.zeros((0, k))
-        starts = np.clip(frame_starts(t / self.rate, self._audio_rate), 0, length) - self._half
-        idx = starts[:, None] + np.arange(self._n)[None, :]
-        inside = (idx >= 0) & (idx < length)
-        local = np.clip(idx - self._first, 0, max(len(self._buffer) - 1, 0))
-        values = self._buffer[local] if len(self._buffer) else np.zeros(idx.shape)
-        frames = np.where(inside, values, 0.0) * self._hamming[None, :]
-        w = frame_lsf(frames, self.model.config.lpc_order)
+        w = self.front.lsf(self._next, stop)
         if self.synth.speaker_warp != 1.0:
             w = warp_lsf(w, self.synth.speaker_warp)
         cb = self.model.codebook
@@ -206,10 +165,7 @@ class StreamingSynthesizer:
         self._lsf.append(w)
         self._raw.append(fw.pcs)
         self._next = stop
-        keep = self._window_start(stop)                 # samples before the next window: done
-        if keep > self._first:
-            self._buffer = self._buffer[keep - self._first:]
-            self._first = keep
+        self.front.release(stop)                        # samples before the next window: done
         return fw.pcs
 
     def _emit(self, raw: np.ndarray, smoother) -> StreamFrames:

@@ -1,18 +1,20 @@
 """``facetraj live``: the face follows a microphone, or a file played through the same streaming
-path (``engine.streaming``).
+path (``engine.streaming.live``: phones recognized as they are spoken, the robust mode and the
+closure step; ``--acoustic-only``: the paper's acoustic search alone).
 
-* ``facetraj live``: the app's Live mode (input device, level meter, scrolling lip panels).
+* ``facetraj live``: the app's Live mode (input device, level meter, scrolling lip panels and
+  phones).
 * ``facetraj live --from-file speech.wav``: the same window, fed from the file in real time.
 * ``facetraj live --from-file speech.wav [--as-fast-as-possible] -o take.tsv``: no window; the
   file goes through the streaming path (in real time, or as fast as it runs) and the take is
-  written in any ``synth`` output format.
+  written in any ``synth`` output format, with the recognized phones as ``take.TextGrid`` beside
+  it (their provenance and confidence in its tiers).
 """
 
 from __future__ import annotations
 
 import argparse
 import logging
-import time
 from pathlib import Path
 
 import numpy as np
@@ -37,34 +39,45 @@ def load_model(args: argparse.Namespace):
 
 
 def live_config(args: argparse.Namespace):
-    """The synthesis settings of a stream: acoustic-only, ``--warp`` as the speaker warp."""
-    cfg = synth_config(args).with_(mode="acoustic")
+    """The synthesis settings of a stream (its mode follows ``--acoustic-only``:
+    :func:`engine.streaming.live.live_mode`), ``--warp`` as the speaker warp."""
+    cfg = synth_config(args)
     if args.smoothing == "spline":
         raise FacetrajError("live mode smooths with the triangular window or not at all "
                             "(--smoothing triangular or none)")
+    if args.warp != 1.0 and not args.acoustic_only:
+        raise FacetrajError("--warp applies to the acoustic-only search: add --acoustic-only "
+                            "(with phones, the robust mode weighs the voice by its running match)")
     return cfg.with_(speaker_warp=args.warp)
 
 
-def stream_file(model, audio: np.ndarray, rate: int, cfg, block_s: float,
-                real_time: bool) -> tuple[np.ndarray, float]:
-    """Markers ``(T, M, 3)`` of ``audio`` streamed in blocks of ``block_s`` seconds, paced to the
-    audio clock when ``real_time``; and the wall time it took."""
-    from engine.streaming.synthesizer import LIVE_BATCH_FRAMES, StreamConfig, StreamingSynthesizer
+def write_take(args: argparse.Namespace, model, audio: np.ndarray, rate: int, cfg) -> Path:
+    """Stream ``--from-file`` and write the take to ``-o`` (its phones to a TextGrid beside it)."""
+    from engine.io.export import write_trajectories
+    from engine.io.labelling import write_labels
+    from engine.streaming.live import LiveConfig, stream_file
     from engine.threads import one_blas_thread
 
-    stream = StreamingSynthesizer(model, StreamConfig(rate, cfg, LIVE_BATCH_FRAMES))
-    block = max(1, int(round(block_s * rate)))
-    parts = []
-    t0 = time.perf_counter()
+    textgrid = args.output.with_suffix(".TextGrid")
+    if not args.acoustic_only and textgrid.exists() and not args.overwrite:
+        raise FileExistsError(f"{textgrid} exists (use --overwrite to replace it)")
     with one_blas_thread():                             # small products: threads only cost
-        for a in range(0, len(audio), block):
-            if real_time:                               # the block's last sample "arrives" now
-                delay = t0 + min(a + block, len(audio)) / rate - time.perf_counter()
-                if delay > 0:
-                    time.sleep(delay)
-            parts.append(stream.feed(audio[a:a + block]).markers)
-        parts.append(stream.flush().markers)
-    return np.concatenate(parts), time.perf_counter() - t0
+        take = stream_file(model, audio, rate, args.block_ms / 1000.0, cfg,
+                           LiveConfig(phones=not args.acoustic_only),
+                           real_time=not args.as_fast_as_possible)
+    if len(take.frames) == 0:
+        raise FacetrajError(f"{args.from_file}: the audio is too short to synthesize")
+    out = write_trajectories(args.output, take.frames.markers, model.marker_rate,
+                             model.marker_names, overwrite=args.overwrite)
+    if take.labels is not None:
+        write_labels(textgrid, take.labels, len(audio) / rate, overwrite=args.overwrite)
+    stream = take.stream
+    log.info("%d frames streamed in %.2f s (%.1f x real time); %s", len(take.frames), take.wall_s,
+             len(audio) / rate / max(take.wall_s, 1e-9), stream.choice.describe())
+    if stream.recognizer is not None:
+        log.info("phones settled in time for %.0f %% of the frames; voice match %.2f (D/D0 %.2f)",
+                 100 * stream.labelled_share, stream.voice_match, stream.voice_ratio)
+    return out
 
 
 def cmd_live(args: argparse.Namespace) -> int:
@@ -75,21 +88,10 @@ def cmd_live(args: argparse.Namespace) -> int:
         if args.from_file is None:
             raise FacetrajError("-o writes a take played from a file: add --from-file FILE "
                                 "(a microphone take is saved from the Live window)")
-        from engine.io.export import write_trajectories
-
         if args.output.exists() and not args.overwrite:
             raise FileExistsError(f"{args.output} exists (use --overwrite to replace it)")
         audio, rate = read_audio(args.from_file)
-        model = load_model(args)
-        markers, wall = stream_file(model, audio, rate, cfg, args.block_ms / 1000.0,
-                                    not args.as_fast_as_possible)
-        if len(markers) == 0:
-            raise FacetrajError(f"{args.from_file}: the audio is too short to synthesize")
-        out = write_trajectories(args.output, markers, model.marker_rate, model.marker_names,
-                                 overwrite=args.overwrite)
-        log.info("%d frames streamed in %.2f s (%.1f x real time)", len(markers), wall,
-                 len(audio) / rate / max(wall, 1e-9))
-        print(out)
+        print(write_take(args, load_model(args), audio, rate, cfg))
         return 0
     try:
         from app.live import run_live
@@ -97,7 +99,8 @@ def cmd_live(args: argparse.Namespace) -> int:
         raise FacetrajError(f"the app cannot start: {exc}") from exc
     return run_live(model_loader=lambda: load_model(args), config=cfg, from_file=args.from_file,
                     block_s=args.block_ms / 1000.0, fast=args.as_fast_as_possible,
-                    device=args.device, screenshot=args.screenshot, quit_after=args.quit_after)
+                    device=args.device, screenshot=args.screenshot, quit_after=args.quit_after,
+                    phones=not args.acoustic_only)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -114,13 +117,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--device", help="input device (part of its name; default: the system's)")
     p.add_argument("--block-ms", type=real(0.0625, 10000), default=10.0,
                    help="audio block size in ms (default 10)")
+    p.add_argument("--acoustic-only", action="store_true",
+                   help="the paper's acoustic search alone, without recognizing the phones "
+                        "(lower latency; the lips of a new voice do not close)")
     p.add_argument("--warp", type=real(0.5, 2.0), default=1.0, metavar="ALPHA",
-                   help="speaker warp of the input LSFs (engine.method.speaker; 1 = none, below 1 for a "
-                        "shorter vocal tract than the training voice)")
+                   help="with --acoustic-only: speaker warp of the input LSFs (engine.method.speaker; "
+                        "1 = none, below 1 for a shorter vocal tract than the training voice)")
     p.add_argument("--screenshot", metavar="OUT.png", help=argparse.SUPPRESS)
     p.add_argument("--quit-after", type=real(0, 1e6, lo_open=True), metavar="S",
                    help=argparse.SUPPRESS)
-    g = p.add_argument_group("synthesis (paper 2.3, acoustic-only)")
+    g = p.add_argument_group("synthesis (paper 2.3)")
     g.add_argument("--smoothing", choices=["triangular", "none"])
     g.add_argument("--acoustic-prefilter", type=count_or_all, metavar="K|all",
                    help="weight the K codewords nearest to each frame (default 128)")

@@ -1,0 +1,72 @@
+"""The voice match of a stream, measured as it runs (live mode, issue 27).
+
+Offline, :func:`engine.method.pipeline.input_voice_ratio` takes the median, over (at most 400
+evenly spaced) speech frames of the whole recording, of eq 5's distance to the nearest codeword,
+over the training voice's own figure ``D0`` (:mod:`engine.method.voice_match`). A stream has the
+frames so far: :class:`RunningVoice` keeps the distances of the last ``MAX_FRAMES`` speech frames
+(6.7 s of speech) and gives their median ratio once ``MIN_FRAMES`` have been heard. It is live
+mode's one running adaptation: the robust mode's label weight grows with the ratio
+(``SynthConfig.label_weight_by_voice``) and recognized /p b m/ close as far as the voice does not
+match (:func:`engine.method.closure.closure_strengths`).
+
+Until the voice has been measured, live mode takes it for an unmatched voice (``PRIOR_MATCH``):
+a person at a microphone is not the training voice, which is synthetic (the ARCTIC talkers are at
+3.5-4.8 ``D0``, voice match 0).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+
+import numpy as np
+
+from ..method.voice_match import MAX_FRAMES, label_weight_scale, voice_match
+
+#: Speech frames heard before the running ratio counts (0.5 s of speech at 60 Hz).
+MIN_FRAMES = 30
+#: The voice match assumed until then.
+PRIOR_MATCH = 0.0
+
+
+class RunningVoice:
+    """Distances of speech frames in (:meth:`add`), the running ratio ``D / D0`` and voice match
+    out.
+
+    >>> v = RunningVoice(reference=2.0, min_frames=2)
+    >>> v.ratio, v.match
+    (nan, 0.0)
+    >>> v.add(np.array([4.0, 6.0, 8.0]))
+    >>> v.ratio, v.match
+    (3.0, 0.0)
+    """
+
+    def __init__(self, reference: float, max_frames: int = MAX_FRAMES, min_frames: int = MIN_FRAMES):
+        self.reference = float(reference)
+        self.min_frames = min_frames
+        self._d: deque[float] = deque(maxlen=max_frames)
+        self.heard = 0
+
+    def add(self, distances: np.ndarray) -> None:
+        """The distances of newly heard speech frames."""
+        d = np.asarray(distances, dtype=np.float64)
+        self._d.extend(d[np.isfinite(d)].tolist())
+        self.heard += int(np.isfinite(d).sum())
+
+    @property
+    def ratio(self) -> float:
+        """``D / D0`` of the speech frames kept; NaN before ``min_frames`` (or without ``D0``)."""
+        if len(self._d) < self.min_frames or not (np.isfinite(self.reference) and self.reference > 0):
+            return float("nan")
+        return float(np.median(np.fromiter(self._d, float))) / self.reference
+
+    @property
+    def match(self) -> float:
+        """The voice match in [0, 1] (:func:`engine.method.voice_match.voice_match`), or
+        ``PRIOR_MATCH`` while the ratio is unknown."""
+        r = self.ratio
+        return voice_match(r, 1.0) if np.isfinite(r) else PRIOR_MATCH
+
+    def weight_scale(self, by_voice: bool = True) -> float:
+        """The factor of the robust mode's label weight
+        (:func:`engine.method.voice_match.label_weight_scale` of the running ratio)."""
+        return label_weight_scale(self.ratio, by_voice)
