@@ -72,7 +72,8 @@ def test_label_eval_summary_and_recommendation():
     assert res.best("aligned") == "robust" and res.beats_all("aligned")
     text = format_markdown(res)
     assert "| robust (" in text and "0.7000 ± 0.10" in text
-    assert "With aligned labels, **robust** (above every other method" in text
+    assert "with aligned labels, **robust** (above every other method" in text
+    assert "**Which mode to pick.** Use the default" in text
     res.scores["aligned"].append(_score("phonetic", 0.95))
     assert not res.beats_all("aligned")
 

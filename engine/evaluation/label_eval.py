@@ -303,6 +303,22 @@ def tuning_lines(tuning: dict) -> list[str]:
     return ["", text]
 
 
+def plain_advice(result: LabelEval) -> str:
+    """The advice in one sentence, with the numbers behind its last part (recognized labels
+    against acoustic-only, on the training voice and on the second voice)."""
+    text = ("Use the default, what every command does: hand-checked labels get the paper's "
+            "phonetic mode, aligned or recognized labels the robust mode, and a recording without "
+            "labels has its phones recognized first")
+    vs = []
+    for kind, voice in (("recognized", "the training voice"),
+                        ("recognized, second voice", "the second voice")):
+        if result.rows(kind, "default") and result.rows(kind, "acoustic"):
+            d, a = (result.summary(kind, m)["whole_face"][0] for m in ("default", "acoustic"))
+            vs.append(f"{d:.3f} against {a:.3f} on {voice}")
+    return text + (f" (recognized labels and the default against acoustic-only, whole face: "
+                   f"{'; '.join(vs)})." if vs else ".")
+
+
 def recommendation(result: LabelEval) -> str:
     """Which mode to pick for which labels, said from the numbers, with how much of the robust
     mode's gain over the paper's mode the cross-validated N and smoothing alone give."""
@@ -320,8 +336,7 @@ def recommendation(result: LabelEval) -> str:
             gains.append(f"{kind}: robust {r - p:+.4f} over the paper's mode, of which "
                          f"{t - p:+.4f} from the cross-validated N and smoothing alone")
     joined = "; ".join(parts)
-    text = "**Which mode to pick.** " + joined[:1].upper() + joined[1:] + ". Without labels, acoustic-only " \
-        "(it is above the label-free ridge regression)."
+    text = "**Which mode to pick.** " + plain_advice(result) + " Best per table: " + joined + "."
     if gains:
         text += " Whole face, " + "; ".join(gains) + "."
     return text
