@@ -55,7 +55,7 @@ def test_marker_table_is_what_savetxt_wrote_and_reads_back(tmp_path, suffix):
     assert np.isnan(back.markers[3, 2]).all() and back.names == NAMES
 
 
-def _c3d_frame_by_frame(path, markers, rate, integer):
+def _c3d_frame_by_frame(path, markers, rate, integer, names=NAMES):
     """``write_c3d`` as it was: every frame handed to ``c3d.Writer`` (the reference)."""
     import c3d
 
@@ -74,7 +74,7 @@ def _c3d_frame_by_frame(path, markers, rate, integer):
         p[:, 3] = np.where(finite[t], 0.0, -1.0)
         frames.append((p, np.zeros((0, 0))))
     writer.add_frames(frames)
-    writer.set_point_labels(list(NAMES))
+    writer.set_point_labels(list(names))
     with open(path, "wb") as handle, warnings.catch_warnings():
         warnings.simplefilter("ignore")
         writer.write(handle)
@@ -86,6 +86,31 @@ def test_c3d_is_what_the_frame_by_frame_writer_wrote(tmp_path, integer):
     write_c3d(tmp_path / "new.c3d", m, 60.0, NAMES, integer=integer)
     _c3d_frame_by_frame(tmp_path / "old.c3d", m, 60.0, integer)
     assert (tmp_path / "new.c3d").read_bytes() == (tmp_path / "old.c3d").read_bytes()
+
+
+@pytest.mark.parametrize(("frames", "points", "rate", "integer"), [
+    (1, 1, 60.0, True),            # the smallest file
+    (2, 120, 59.94, False),        # a parameter section of several blocks, long and short names
+    (37, 255, 200.0, True),        # the most points a C3D label parameter holds
+    (65600, 1, 60.0, True),        # over 65,535 frames: POINT:LONG_FRAMES, the header's count capped
+])
+def test_c3d_layout_is_the_c3d_packages_for_every_size(tmp_path, frames, points, rate, integer):
+    names = [f"P{i}" + "x" * (i % 9) for i in range(points)]
+    m = np.random.default_rng(points).standard_normal((frames, points, 3)) * 40.0
+    write_c3d(tmp_path / "new.c3d", m, rate, names, integer=integer)
+    _c3d_frame_by_frame(tmp_path / "old.c3d", m, rate, integer, names)
+    assert (tmp_path / "new.c3d").read_bytes() == (tmp_path / "old.c3d").read_bytes()
+    back = read_c3d(tmp_path / "new.c3d")
+    assert back.markers.shape == (frames, points, 3) and back.names == names
+
+
+def test_c3d_refuses_more_points_than_it_can_name(tmp_path):
+    from engine.errors import InputError
+
+    names = [f"P{i}" for i in range(256)]
+    with pytest.raises(InputError, match="1 to 255 points"):
+        write_c3d(tmp_path / "big.c3d", np.zeros((3, 256, 3)), 60.0, names)
+    assert not list(tmp_path.iterdir())
 
 
 @pytest.mark.parametrize("integer", [True, False])

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import functools
 import io
 import logging
 import os
@@ -16,6 +15,8 @@ from ..errors import InputError, warn_file
 from .c3d_check import MAX_RATE as MAX_C3D_RATE
 from .c3d_check import MIN_RATE as MIN_C3D_RATE
 from .c3d_check import check_c3d
+from .c3d_layout import MAX_POINTS as MAX_C3D_POINTS
+from .c3d_layout import c3d_bytes
 from .files import MAX_TEXT_BYTES, atomic_write, read_text
 from .numtext import fixed_point_lines
 
@@ -84,14 +85,16 @@ def write_c3d(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
     """Write ``(frames, markers, 3)`` mm trajectories as C3D; NaN points are written as unseen.
 
     By default the compact integer form (int16, 0.01 mm steps, half the size of the float form) is
-    used when every coordinate fits in +-327 mm, else the float form. Read back with
-    :func:`read_c3d` (ezc3d), which reads both.
+    used when every coordinate fits in +-327 mm, else the float form. The bytes are those the
+    ``c3d`` package writes (:mod:`.c3d_layout`). Read back with :func:`read_c3d` (ezc3d), which
+    reads both.
     """
-    import warnings
-
     markers = np.asarray(markers, dtype=np.float64)
     if markers.ndim != 3 or markers.shape[2] != 3 or markers.shape[1] != len(names):
         raise ValueError(f"markers must be (frames, {len(names)}, 3), got {markers.shape}")
+    if not 1 <= len(names) <= MAX_C3D_POINTS or max(map(len, names), default=0) > MAX_C3D_POINTS:
+        raise InputError(path, f"C3D holds 1 to {MAX_C3D_POINTS} points with names of at most "
+                               f"{MAX_C3D_POINTS} characters ({len(names)} here): write .tsv or .npz")
     finite = np.isfinite(markers).all(axis=2)
     span = np.abs(markers[finite]).max() if finite.any() else 0.0
     if integer is None:
@@ -101,38 +104,13 @@ def write_c3d(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
         q = np.round(markers / C3D_INT_SCALE) * C3D_INT_SCALE
         markers = q + np.copysign(C3D_INT_SCALE * 1e-3, q)
     raw = np.zeros((*markers.shape[:2], 4), dtype="<i2" if integer else "<f4")
-    with np.errstate(invalid="ignore"):      # the data block of every frame at once, as c3d
+    with np.errstate(invalid="ignore"):      # every frame at once; to int16: toward zero
         raw[..., :3] = np.where(finite[..., None], markers / (C3D_INT_SCALE if integer else 1.0),
-                                0.0)          # casts (to int16: toward zero) frame by frame
+                                0.0)
     raw[..., 3] = np.where(finite, 0, -1)     # residual 0 and no camera bits; -1: unseen
-    writer = _block_writer_class()(raw, point_rate=float(rate), analog_rate=0.0, point_scale=scale,
-                          point_units="mm  ")
-    writer.set_point_labels(list(names))
-    with atomic_write(path, overwrite) as tmp, open(tmp, "wb") as handle, warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        writer.write(handle)
-
-
-@functools.cache
-def _block_writer_class() -> type:
-    """``c3d.Writer`` writing its frames' data block from one array (``c3d`` loops over the
-    frames in Python: 3600 frames took longer than the synthesis)."""
-    import c3d
-
-    class BlockWriter(c3d.Writer):
-        def __init__(self, raw: np.ndarray, **kwargs):
-            super().__init__(**kwargs)
-            self._block = raw
-            frame = (np.zeros((raw.shape[1], 5)), np.zeros((0, 0)))
-            self.add_frames([frame] * len(raw))          # the frame count and point count
-
-        def _write_frames(self, handle) -> None:         # c3d writes the header, then this
-            handle.write(np.ascontiguousarray(self._block).tobytes())
-            extra = handle.tell() % 512
-            if extra:
-                handle.write(b"\0" * (512 - extra))
-
-    return BlockWriter
+    data = c3d_bytes(raw, float(rate), scale, list(names))
+    with atomic_write(path, overwrite) as tmp:
+        tmp.write_bytes(data)
 
 
 def write_marker_tsv(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
