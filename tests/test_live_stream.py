@@ -89,6 +89,42 @@ def test_running_cepstral_mean_is_recovered_from_what_pocketsphinx_reports():
     np.testing.assert_allclose(plain.mean, true)
 
 
+def test_frame_cepstra_average_to_the_mean_offline_recognition_removes(utterance):
+    from engine.evaluation.live_eval import frame_cepstra
+    from engine.labels.alignment import allphone_decoder
+
+    audio, rate, _ = utterance
+    assert rate == 16000
+    cepstra = frame_cepstra(audio, rate)
+    assert abs(len(cepstra) - len(audio) / rate / 0.01) <= 6          # every 10 ms frame
+    decoder = allphone_decoder()                                         # batch CMN, full_utt
+    decoder.start_utt()
+    decoder.process_raw((np.clip(audio, -1, 1) * 32767).astype("<i2").tobytes(), False, True)
+    decoder.end_utt()
+    batch = np.array([float(x) for x in decoder.get_cmn(False).split(",")])
+    np.testing.assert_allclose(cepstra.mean(axis=0), batch, atol=0.5)
+
+
+def test_a_prior_of_some_frames_brings_the_running_mean_nearest_the_whole_mean(utterance):
+    from engine.evaluation.live_eval import frame_cepstra, prior_count_errors
+    from engine.streaming.recognizer import CMN_PRIOR_FRAMES
+
+    audio, rate, _ = utterance
+    errors = prior_count_errors([frame_cepstra(audio, rate)], [0.0, CMN_PRIOR_FRAMES, 1000.0])
+    # no prior: the first blocks' mean is the silence's; a rigid one: PocketSphinx's initial mean
+    assert errors[CMN_PRIOR_FRAMES] < min(errors[0.0], errors[1000.0])
+    assert RecognizerConfig().cmn_prior_frames == RunningCmn().prior == CMN_PRIOR_FRAMES
+
+
+def test_streamed_phones_agree_with_themselves(utterance):
+    from engine.evaluation.live_eval import phone_agreement, streamed_phones
+
+    audio, rate, _ = utterance
+    phones = streamed_phones(audio, rate)
+    assert sum(p.label != "sil" for p in phones) > 10
+    assert phone_agreement({"u": (audio, rate)}, offline={"u": phones}) == 1.0
+
+
 def test_running_mean_weighs_speech_as_a_sentence_does():
     cmn = RunningCmn(prior_frames=0, speech_share=0.8)
     quiet, loud = np.full(13, 30.0), np.full(13, 60.0)

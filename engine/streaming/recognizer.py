@@ -13,8 +13,9 @@ Two things differ from offline recognition, both measured on the CMU ARCTIC samp
   PocketSphinx's live mean stays at its initial value for the first 8 s (it is updated at the end
   of an utterance or after 800 frames), and that value (c0 = 40) is far from real recordings'
   (c0 = 54-60 on the ARCTIC samples). :class:`RunningCmn` estimates the mean from the frames so far
-  and sets it every 5 frames: live mode then closes 69 % of the ARCTIC samples' /p b m/ within
-  1 mm, against 54 % with PocketSphinx's own live mean (``facetraj report --closure``).
+  and sets it every 5 frames, PocketSphinx's initial mean counting as :data:`CMN_PRIOR_FRAMES`
+  frames (the count whose running mean is nearest the whole-utterance mean on PocketSphinx's own
+  test recordings: :func:`engine.evaluation.live_eval.prior_count_errors`).
 * **Utterances.** The search's history grows with the utterance and each partial hypothesis is a
   back-trace over all of it, so the decoder starts a new utterance at the settled frame when the
   settled phones end in a pause (``restart_silence_s``) or the utterance reaches
@@ -43,6 +44,14 @@ FRAME_SAMPLES = int(round(FRAME_S * ALIGN_RATE))
 CMN_WIN = 500
 #: PocketSphinx's initial cepstral mean (its ``cmninit``, 13 coefficients).
 CMN_INIT = np.array([40.0, 3.0, -1.0] + [0.0] * 10)
+#: How many frames :data:`CMN_INIT` counts as in the running mean (a MAP-style prior): the count
+#: of 0 to 200 (steps of 10) whose running mean is nearest (squared error over the 13 coefficients,
+#: every 5-frame block of every recording) each recording's whole-utterance mean on the 16 real
+#: recordings of PocketSphinx 5.1.1's test data (7 sources: goforward, numbers, something,
+#: tidigits, cards, forever, LibriVox), none of them a test recording of this project
+#: (``python -m benchmarks.cmn_prior``; it was 20). It keeps the mean of a stream's first words
+#: from following the few frames of speech heard so far (docs/algorithm.md, "Cepstral mean").
+CMN_PRIOR_FRAMES = 40.0
 
 
 @dataclass(frozen=True)
@@ -57,7 +66,8 @@ class RecognizerConfig:
     cmn_every : the running cepstral mean is set every this many frames (``None``: PocketSphinx's
         own live mean).
     cmn_prior_frames, cmn_speech_share : the initial mean counts as this many frames in the
-        running estimate, speech as this share of it (:class:`RunningCmn`).
+        running estimate (:data:`CMN_PRIOR_FRAMES`), speech as this share of it
+        (:class:`RunningCmn`).
     max_utterance_s, restart_silence_s : a new utterance at the settled frame once the current
         one is this long, or once the settled phones end in a pause this long.
     """
@@ -65,7 +75,7 @@ class RecognizerConfig:
     settle_s: float = 0.1
     partial_every: int = 2
     cmn_every: int | None = 5
-    cmn_prior_frames: float = 20.0
+    cmn_prior_frames: float = CMN_PRIOR_FRAMES
     cmn_speech_share: float | None = 0.78
     max_utterance_s: float = 10.0
     restart_silence_s: float = 0.3
@@ -102,10 +112,13 @@ class RunningCmn:
     the midpoint of their c0 range (5th to 95th percentile) into loud and quiet, and the two means
     weighed ``speech_share`` to ``1 - speech_share`` (the plain mean until the range reaches
     ``MIN_RANGE_C0``, or with ``speech_share=None``); the initial mean counts as ``prior_frames``
-    frames. Only the last ``MAX_BLOCKS`` blocks count. Measured against offline recognition's
-    phones (10 ms speech frames labelled alike) on 140 default-corpus sentences and 7 real ones
-    (the ARCTIC and MOCHA samples): these weighed means 68.8 % and 77.6 %, the plain running mean
-    68.0 % and 76.7 %, PocketSphinx's own live mean 64.8 % and 61.3 %.
+    frames (:data:`CMN_PRIOR_FRAMES`, a MAP-style prior). Only the last ``MAX_BLOCKS`` blocks
+    count. Measured against offline recognition's phones (10 ms speech frames labelled alike,
+    :func:`engine.evaluation.live_eval.phone_agreement`) on the default corpus's 94 test
+    sentences and 7 real ones (the ARCTIC and MOCHA samples), the prior worth 40 frames: these
+    weighed means 65.0 % and 74.5 % (63.8 % and 72.9 % worth 20), the plain running mean 65.0 %
+    and 75.8 %, PocketSphinx's own live mean 61.3 % and 61.1 %; live closure on the ARCTIC
+    samples 77 %, 69 % and 54 %.
 
     >>> cmn = RunningCmn(np.array([40.0]), prior_frames=10, speech_share=None)
     >>> cmn.add(np.array([600.0]), 10).round(3).tolist()       # 10 frames of mean 60
@@ -120,7 +133,7 @@ class RunningCmn:
     MAX_BLOCKS = 400
     MIN_RANGE_C0 = 5.0
 
-    def __init__(self, init: np.ndarray = CMN_INIT, prior_frames: float = 20.0,
+    def __init__(self, init: np.ndarray = CMN_INIT, prior_frames: float = CMN_PRIOR_FRAMES,
                  speech_share: float | None = 0.78):
         self.init = np.asarray(init, dtype=np.float64)
         self.prior = float(prior_frames)
