@@ -14,7 +14,7 @@ from engine.config import SynthConfig
 from engine.errors import InputError
 from engine.evaluation.label_eval import LabelEval, evaluate_kind, format_markdown
 from engine.evaluation.scores import UtteranceScore
-from engine.evaluation.tuning import cross_validate, fold_ids
+from engine.evaluation.tuning import LIMITS, coordinate_search, cross_validate, fold_ids
 from engine.method.modes import tuned_config
 from facetraj.cli import main
 
@@ -40,11 +40,26 @@ def test_cross_validate_uses_training_split_only(toy_corpus):
     for name, curve in tuning.curves.items():
         values = [v for v, _ in curve]
         k = values.index(tuning.settings[name])
-        assert name in tuning.at_end or 0 < k < len(values) - 1
+        assert name in tuning.at_end or 0 < k < len(values) - 1 or values[k] == LIMITS.get(name)
         assert max(s for _, s in curve) == curve[k][1]
     cfg = tuned_config(SynthConfig(mode="robust"), tuning.to_json())
     assert cfg.triangle_s == tuning.settings["triangle_s"]
     assert cfg.label_weight == tuning.settings["label_weight"]
+
+
+def test_a_choice_at_its_settings_own_limit_is_not_at_the_end_of_its_range():
+    """One context-phone or no chain is as far as those settings go; a ladder's other ends are
+    where the search could have gone on."""
+    def score(s):
+        return -s["n_context_phones"] - s["chain_beta"] - (s["gamma_max"] - 0.5) ** 2
+
+    ladders = {"n_context_phones": (1, 2, 3), "chain_beta": (0.0, 0.1, 0.2),
+               "gamma_max": (0.5, 1.0, 2.0)}
+    best, _, ends = coordinate_search(score, ladders, {"n_context_phones": 2,
+                                                       "chain_beta": 0.1, "gamma_max": 1.0})
+    assert best == {"n_context_phones": 1, "chain_beta": 0.0, "gamma_max": 0.5}
+    assert ends == ["gamma_max"]
+    assert coordinate_search(score, ladders, best, limits={})[2] == list(ladders)
 
 
 def _score(method, value, utt="u"):

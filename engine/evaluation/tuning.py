@@ -34,12 +34,15 @@ log = logging.getLogger(__name__)
 
 #: The settings searched, each an ordered ladder of values (robust mode).
 LADDERS: dict[str, tuple] = {
-    "n_context_phones": (1, 2, 3, 4, 6, 8, 12, 16),
+    "n_context_phones": (1, 2, 3, 4, 6, 8, 12, 16, 24, 32),
     "label_weight": (0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0),
     "robust_candidates": (8, 16, 32, 64, 128),
-    "gamma_max": (1.0, 2.0, 3.0, 5.0, 8.0, 12.0),
+    "gamma_max": (0.5, 1.0, 2.0, 3.0, 5.0, 8.0, 12.0),
     "chain_beta": (0.0, 0.03, 0.1, 0.2, 0.4, 0.8),
 }
+#: Values that are their setting's own limit, with nothing beyond them to search: one
+#: context-phone, no chain. A choice there is not "at the end of its range".
+LIMITS: dict[str, object] = {"n_context_phones": 1, "chain_beta": 0.0}
 #: Where the search starts: the defaults of SynthConfig.
 START = {k: getattr(SynthConfig(), k) for k in LADDERS}
 #: Triangular smoothing widths scored on every synthesis (seconds).
@@ -67,12 +70,14 @@ class Tuning:
 
 
 def coordinate_search(score: Callable[[dict], float], ladders: Mapping[str, Sequence],
-                      start: Mapping, rounds: int = 3) -> tuple[dict, dict, list[str]]:
+                      start: Mapping, rounds: int = 3, limits: Mapping[str, object] = LIMITS
+                      ) -> tuple[dict, dict, list[str]]:
     """The settings maximising ``score`` one at a time along their ``ladders``, from ``start``:
     each moves to its best neighbour, the window widened past an edge until the best value has a
     worse one on either side or is the ladder's last; until a round changes nothing. Returns the
     settings, each one's curve (``[[value, score], ...]`` at the final settings) and the settings
-    left at the end of their ladder. ``score`` is called once per distinct settings.
+    left at the end of their ladder (other than at their own ``limits``). ``score`` is called once
+    per distinct settings.
 
     >>> best, curves, ends = coordinate_search(lambda s: -(s["a"] - 3) ** 2 - (s["b"] - 1) ** 2,
     ...                                        {"a": (0, 1, 2, 3, 4, 5), "b": (1, 2, 3)}, {"a": 1, "b": 2})
@@ -100,7 +105,8 @@ def coordinate_search(score: Callable[[dict], float], ladders: Mapping[str, Sequ
     curves = {name: [[v, memo[k]] for v in ladder
                      if (k := tuple(sorted({**current, name: v}.items()))) in memo]
               for name, ladder in ladders.items()}
-    ends = [name for name, ladder in ladders.items() if current[name] in (ladder[0], ladder[-1])]
+    ends = [name for name, ladder in ladders.items()
+            if current[name] in (ladder[0], ladder[-1]) and current[name] != limits.get(name)]
     return current, curves, ends
 
 
