@@ -10,6 +10,7 @@ from itertools import pairwise
 import numpy as np
 
 from ..threads import map_spans
+from .kernels import compiled
 
 #: white-noise correction added to r[0] (a -40 dB noise floor) so that LPC of near-silent or
 #: perfectly periodic frames stays well conditioned.
@@ -423,14 +424,21 @@ def preemphasize(x: np.ndarray, coefficient: float, previous: float | None = Non
     return np.concatenate([before, x[1:] - coefficient * x[:-1]])
 
 
+def padded_signal(audio: np.ndarray, rate: int, times: np.ndarray, window_s: float,
+                  preemphasis: float = 0.0) -> tuple[np.ndarray, np.ndarray, int]:
+    """The pre-emphasized signal with half a window of zeros before it and a window after, the
+    start in it of the frame of ``window_s`` centred on each of ``times``, and the frame length:
+    frame ``t`` is ``pad[starts[t]:starts[t] + n]`` (zero outside the signal)."""
+    x = preemphasize(audio, preemphasis)
+    n = int(round(window_s * rate))
+    pad = np.concatenate([np.zeros(n // 2), x, np.zeros(n)])
+    return pad, np.clip(frame_starts(times, rate), 0, len(x)), n
+
+
 def analysis_frames(audio: np.ndarray, rate: int, times: np.ndarray, window_s: float,
                     preemphasis: float = 0.0) -> np.ndarray:
     """Hamming-windowed frames of ``window_s`` centred on ``times`` (zero outside the signal)."""
-    x = preemphasize(audio, preemphasis)
-    n = int(round(window_s * rate))
-    half = n // 2
-    pad = np.concatenate([np.zeros(half), x, np.zeros(n)])
-    starts = np.clip(frame_starts(times, rate), 0, len(x))
+    pad, starts, n = padded_signal(audio, rate, times, window_s, preemphasis)
     return np.lib.stride_tricks.sliding_window_view(pad, n)[starts] * np.hamming(n)
 
 
@@ -445,7 +453,9 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     """LSF vectors ``(len(times), order)`` from 25 ms Hamming frames centred on ``times``.
 
     The audio is resampled to ``audio_rate`` first (the paper analyses 16 kHz speech). The frames
-    are analysed in ``threads`` spans at once (``None``: :func:`engine.threads.frame_threads`).
+    are analysed by the compiled kernel (``engine.method.compiled_lsf``, equal to this module's
+    functions to rounding) unless :mod:`engine.method.kernels` chooses numpy, in ``threads`` spans
+    at once (``None``: :func:`engine.threads.frame_threads`).
     The LSFs equal one thread's to rounding: BLAS's matrix products (autocorrelation lags, the
     root bracketing grid) may add a row's terms in another order for another number of rows.
 
@@ -460,7 +470,14 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     if 0 < peak < np.inf:  # to a peak in [0.5, 1) by a power of 2: exact, and LPC is scale-free,
         x = np.ldexp(x, -int(np.frexp(peak)[1]))  # so huge samples cannot overflow to inf
     x = resample_audio(x, rate, audio_rate)
-    frames = analysis_frames(x, audio_rate, np.asarray(times, dtype=np.float64), window_s,
-                             preemphasis)
+    times = np.asarray(times, dtype=np.float64)
+    kernel = compiled("compiled_lsf") if order % 2 == 0 and order >= 2 else None
+    if kernel is not None:                         # the same analysis compiled, frame by frame
+        pad, starts, n = padded_signal(x, audio_rate, times, window_s, preemphasis)
+        window = np.hamming(n)
+        return np.concatenate(map_spans(lambda a, b: kernel.frame_lsf(pad, starts[a:b], window,
+                                                                      order, poly2lsf),
+                                        len(starts), threads))
+    frames = analysis_frames(x, audio_rate, times, window_s, preemphasis)
     return np.concatenate(map_spans(lambda a, b: frame_lsf(frames[a:b], order), len(frames),
                                     threads))

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .kernels import compiled
+
 
 def phone_means(pcs: np.ndarray, phone_of: np.ndarray, n_phones: int) -> np.ndarray:
     """Eq 1: ``m_k = (1/T_k) sum_t P_kt``, the mean PC vector of each phone.
@@ -155,7 +157,9 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     :func:`context_similarity`'s order, so the scores are its scores to the bit; then the
     ``count``-th best score of each query (a partition) and a sort of the few scores reaching it.
     The result, including the lower-index-first tie order, is that of the full computation
-    (tested).
+    (tested). The compiled kernel (``engine.method.compiled_search``) scores the same pairs with
+    the same additions, query by query, keeping each query's best ``count`` as it goes, unless
+    :mod:`engine.method.kernels` chooses numpy.
 
     Returns ``(top, scores)``, both ``(Q, count)``.
 
@@ -180,6 +184,14 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     u_size = np.count_nonzero(keep, axis=1)
     u_start = np.cumsum(u_size) - u_size
     cand_all = np.nonzero(keep)[1]
+    cols = np.arange(full - c, full + c + 1)
+    tables = context_weights(c, xi)[:, None, None] * s                       # (2c+1) x n x n
+    kernel = compiled("compiled_search")
+    if kernel is not None:                         # the same scores compiled, query by query
+        return kernel.top_context_scores(np.ascontiguousarray(q, dtype=np.int64),
+                                         np.ascontiguousarray(codebook, dtype=np.int64), tables,
+                                         cols, inverse.astype(np.int64), cand_all, u_start,
+                                         u_size, count)
     # every (query, context) pair, query by query: pair p is query rows[p] and context cand[p]
     sizes = u_size[inverse]
     ends = np.cumsum(sizes)
@@ -188,8 +200,7 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     place = np.arange(ends[-1]) - np.repeat(starts, sizes)                  # within its query
     cand = cand_all[np.repeat(u_start[inverse], sizes) + place]
     # eq 4's terms xi^-i S[query phone, context phone], added column by column
-    cols = np.arange(full - c, full + c + 1)
-    tables = (context_weights(c, xi)[:, None, None] * s).ravel()            # (2c+1) x n x n
+    tables = tables.ravel()
     at = np.take(q.T[cols] * n_ph + (np.arange(len(cols)) * n_ph * n_ph)[:, None], rows, axis=1)
     at += np.take(codebook.T[cols], cand, axis=1)
     terms = tables.take(at)

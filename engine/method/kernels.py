@@ -1,0 +1,111 @@
+"""Which implementation runs the per-frame hot paths of synthesis: the compiled kernels
+(numba; ``engine.method.compiled_lsf``, ``engine.method.compiled_search``) or the numpy
+reference (``engine.method.lsf``, ``engine.method.lsf_index``, ``engine.method.synthesis``).
+
+The numpy functions are the reference: each compiled kernel computes the same formula, frame by
+frame in one loop, and is tested equal to it to rounding (``tests/test_kernels.py``). numba is
+imported here only when a kernel is first asked for, never by importing the engine, so neither
+``facetraj --version`` nor the app's first frame pays its import (0.2-0.5 s) unless they
+synthesize. ``$FACETRAJ_KERNELS=numpy`` (or :func:`use_kernels`) forces the reference; numba
+missing, or failing to import or compile, falls back to it with a warning in the log.
+
+numba keeps the compiled machine code (``cache=True``) beside the modules (``__pycache__``), or
+where ``$NUMBA_CACHE_DIR`` says, or in the user cache folder when the install is read-only; the
+first run after an install compiles (seconds), later ones load the cache.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import threading
+from collections.abc import Iterator
+from contextvars import ContextVar
+from types import ModuleType
+
+log = logging.getLogger(__name__)
+
+#: environment variable choosing the kernels: ``numpy`` (the reference) or ``compiled`` (default)
+KERNELS_ENV = "FACETRAJ_KERNELS"
+CHOICES = ("compiled", "numpy")
+
+_choice: ContextVar[str | None] = ContextVar("kernel_choice", default=None)
+_lock = threading.Lock()
+#: the loaded kernel modules by name; ``None``: failed to load (the reference is used)
+_loaded: dict[str, ModuleType | None] = {}
+
+
+def kernel_choice() -> str:
+    """``compiled`` or ``numpy``: the choice of :func:`use_kernels` in this thread (and context),
+    else ``$FACETRAJ_KERNELS``, else ``compiled``.
+
+    >>> with use_kernels("numpy"):
+    ...     kernel_choice()
+    'numpy'
+    """
+    choice = _choice.get()
+    if choice is not None:
+        return choice
+    env = os.environ.get(KERNELS_ENV, "").strip().lower()
+    return env if env in CHOICES else "compiled"
+
+
+@contextlib.contextmanager
+def use_kernels(choice: str) -> Iterator[None]:
+    """Synthesis in this thread (and its context) uses ``choice`` (``compiled`` or ``numpy``)
+    until the end of the ``with`` block."""
+    if choice not in CHOICES:
+        raise ValueError(f"kernels must be one of {CHOICES}, got {choice!r}")
+    token = _choice.set(choice)
+    try:
+        yield
+    finally:
+        _choice.reset(token)
+
+
+def _load(name: str) -> ModuleType | None:
+    """``engine.method.<name>`` imported (numba with it) once; ``None`` when it cannot be."""
+    with _lock:
+        if name not in _loaded:
+            try:
+                import importlib
+
+                _loaded[name] = importlib.import_module(f"{__package__}.{name}")
+            except Exception as exc:            # numba missing or broken: the reference runs
+                log.warning("compiled kernels unavailable (%s: %s); using numpy", name, exc)
+                _loaded[name] = None
+        return _loaded[name]
+
+
+def compiled(name: str) -> ModuleType | None:
+    """The compiled kernel module ``name`` (``compiled_lsf``, ``compiled_search``) when the
+    compiled kernels are chosen and load, else ``None`` (the caller runs the numpy reference)."""
+    if kernel_choice() != "compiled":
+        return None
+    return _load(name)
+
+
+def loaded() -> bool:
+    """Whether the compiled kernels are already loaded (numba imported, nothing left to load)."""
+    return bool(_loaded) and all(m is not None for m in _loaded.values())
+
+
+def warm_up() -> bool:
+    """Load and run every compiled kernel once on a tiny input (numba's import, and its cache
+    read or compilation), e.g. in a background thread before the first synthesis; whether the
+    compiled kernels are usable."""
+    ok = True
+    for name in ("compiled_lsf", "compiled_search"):
+        module = _load(name)
+        if module is None:
+            ok = False
+            continue
+        try:
+            module.warm_up()
+        except Exception as exc:                # a compile error: use the reference from now on
+            log.warning("compiled kernels failed (%s: %s); using numpy", name, exc)
+            with _lock:
+                _loaded[name] = None
+            ok = False
+    return ok
