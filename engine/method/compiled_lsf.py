@@ -15,23 +15,12 @@ Imported only through :mod:`engine.method.kernels` (it imports numba).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
-from .lsf import ROOT_GRID, WHITE_NOISE_CORRECTION, _root_grid
-
-_FLAGS = {"cache": True, "nogil": True, "error_model": "numpy"}
+from .kernels import jit
+from .lsf import ROOT_GRID, WHITE_NOISE_CORRECTION, root_grid
 
 
-def _jit(fn):
-    """``numba.njit`` with the module's flags; without the machine-code cache when numba finds
-    nowhere writable to keep it (a read-only install without a user cache folder)."""
-    try:
-        return njit(**_FLAGS)(fn)
-    except RuntimeError:                       # "cannot cache function ...: no locator available"
-        return njit(**{**_FLAGS, "cache": False})(fn)
-
-
-@njit(cache=True, nogil=True, fastmath={"reassoc", "contract"})
+@jit(fastmath={"reassoc", "contract"})
 def _autocorrelation(frame: np.ndarray, r: np.ndarray) -> None:
     """``r[k] = sum_n x[n] x[n+k]`` for the lags ``k`` of ``r``, as ``lsf.autocorrelation`` (its
     sums reassociated: vectorised, equal to rounding)."""
@@ -43,7 +32,7 @@ def _autocorrelation(frame: np.ndarray, r: np.ndarray) -> None:
         r[k] = acc
 
 
-@_jit
+@jit
 def _levinson(r: np.ndarray, a: np.ndarray) -> None:
     """Levinson-Durbin on ``r[0..P]`` into ``a[0..P]`` (``a[0] = 1``), as ``lsf.levinson``."""
     order = a.shape[0] - 1
@@ -65,7 +54,7 @@ def _levinson(r: np.ndarray, a: np.ndarray) -> None:
         err = err * (1.0 - k * k)
 
 
-@_jit
+@jit
 def _bracket(c: np.ndarray, basis: np.ndarray, values: np.ndarray, xg: np.ndarray, cr: np.ndarray,
              x: np.ndarray, lo: np.ndarray, hi: np.ndarray, neg_lo: np.ndarray, at: int) -> bool:
     """The grid step of ``lsf.chebyshev_real_roots`` for Chebyshev series ``c``: its values on
@@ -98,7 +87,7 @@ def _bracket(c: np.ndarray, basis: np.ndarray, values: np.ndarray, xg: np.ndarra
     return True
 
 
-@_jit
+@jit
 def _polish(cr: np.ndarray, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, neg_lo: np.ndarray,
             b1: np.ndarray, b2: np.ndarray, d1: np.ndarray, d2: np.ndarray, done: np.ndarray,
             tol: float, max_iter: int) -> bool:
@@ -146,7 +135,7 @@ def _polish(cr: np.ndarray, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, neg_l
     return False
 
 
-@_jit
+@jit
 def _frame_series(a: np.ndarray, g: np.ndarray, cp: np.ndarray, cq: np.ndarray) -> None:
     """The Chebyshev series of P(z) and Q(z) of LPC polynomial ``a``, trivial roots divided out,
     as ``lsf._sum_difference`` and ``lsf.lsf_chebyshev_series``."""
@@ -163,7 +152,7 @@ def _frame_series(a: np.ndarray, g: np.ndarray, cp: np.ndarray, cq: np.ndarray) 
             c[k] = 2.0 * g[half - k]
 
 
-@_jit
+@jit
 def lsf_frames(pad: np.ndarray, starts: np.ndarray, window: np.ndarray, order: int,
                xg: np.ndarray, basis: np.ndarray, tol: float, max_iter: int
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -217,7 +206,7 @@ def frame_lsf(pad: np.ndarray, starts: np.ndarray, window: np.ndarray, order: in
               fallback) -> np.ndarray:
     """:func:`lsf_frames` with the reference's grid and tolerances; the frames it flags solved
     by ``fallback`` (``lsf.poly2lsf``) from their LPC polynomials."""
-    xg, basis = _root_grid(order // 2, ROOT_GRID)
+    xg, basis = root_grid(order // 2, ROOT_GRID)
     lsf, polys, ok = lsf_frames(pad, np.ascontiguousarray(starts, dtype=np.int64), window, order,
                                 xg, np.ascontiguousarray(basis), 1e-9, 12)
     if not ok.all():

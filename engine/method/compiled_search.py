@@ -17,21 +17,11 @@ Imported only through :mod:`engine.method.kernels` (it imports numba).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
-_FLAGS = {"cache": True, "nogil": True, "error_model": "numpy"}
-
-
-def _jit(fn):
-    """``numba.njit`` with the module's flags; without the machine-code cache when numba finds
-    nowhere writable to keep it."""
-    try:
-        return njit(**_FLAGS)(fn)
-    except RuntimeError:
-        return njit(**{**_FLAGS, "cache": False})(fn)
+from .kernels import jit
 
 
-@_jit
+@jit
 def _weights32(w: np.ndarray, h: np.ndarray, wc: np.ndarray) -> None:
     """Eq 5's weights of LSF vector ``w`` (as ``synthesis.perceptual_weights``, in float64) and
     ``w`` itself, both rounded to float32 into ``h`` and ``wc``."""
@@ -43,7 +33,7 @@ def _weights32(w: np.ndarray, h: np.ndarray, wc: np.ndarray) -> None:
         wc[k] = np.float32(w[k])
 
 
-@_jit
+@jit
 def _distances(h: np.ndarray, wc: np.ndarray, cols: np.ndarray, lo: int, out: np.ndarray) -> None:
     """Eq 5 in float32 from ``wc`` (weights ``h``) to the columns ``lo:lo + len(out)`` of
     ``cols`` (``(P, n)``, C order) into ``out``: ``sum_k h_k |w_k - L_k|``, the terms added in
@@ -56,7 +46,7 @@ def _distances(h: np.ndarray, wc: np.ndarray, cols: np.ndarray, lo: int, out: np
             out[j] += hk * abs(wk - col[j])
 
 
-@_jit
+@jit
 def _kth_smallest(v: np.ndarray, kth: int) -> np.float32:
     """The ``kth`` smallest (from 0) of ``v``, which it reorders: Hoare's selection."""
     lo, hi = 0, v.shape[0] - 1
@@ -81,7 +71,7 @@ def _kth_smallest(v: np.ndarray, kth: int) -> np.float32:
     return v[kth]
 
 
-@_jit
+@jit
 def _kth_value(d: np.ndarray, kth: int, scratch: np.ndarray) -> np.float32:
     """The ``kth`` smallest (from 0) of ``d``: the values counted into 256 bins between their
     least and greatest (a monotone binning, so the ``kth`` lies in the bin where the counts
@@ -106,7 +96,7 @@ def _kth_value(d: np.ndarray, kth: int, scratch: np.ndarray) -> np.float32:
     return _kth_smallest(scratch[:n], kth - below)
 
 
-@_jit
+@jit
 def _first_smallest(d: np.ndarray, count: int, keep: np.ndarray, scratch: np.ndarray) -> None:
     """The places of the ``count`` smallest of ``d`` into ``keep``, as ``lsf_index._smallest``:
     the ``count``-th smallest value, then the places at or below it, the first ones (the
@@ -133,7 +123,7 @@ def _first_smallest(d: np.ndarray, count: int, keep: np.ndarray, scratch: np.nda
                 break
 
 
-@_jit
+@jit
 def _nearest_cells(dc: np.ndarray, probe: int, opened: np.ndarray) -> None:
     """The ``probe`` cells of smallest distance ``dc`` into ``opened``, nearest first (of equal
     distances, the lower cell first)."""
@@ -149,7 +139,7 @@ def _nearest_cells(dc: np.ndarray, probe: int, opened: np.ndarray) -> None:
         n = min(n + 1, probe)
 
 
-@_jit
+@jit
 def nearest_frames(w: np.ndarray, centroids: np.ndarray, cell_lsf: np.ndarray,
                    offsets: np.ndarray, order: np.ndarray, count: int, probe: int) -> np.ndarray:
     """``LsfIndex.nearest`` of LSF vectors ``w`` (``(T, P)``, float64): ``(T, count)`` codebook
@@ -195,7 +185,7 @@ def warm_up() -> None:
                    np.arange(12), 5, 2)
 
 
-@_jit
+@jit
 def top_context_scores(q: np.ndarray, codebook: np.ndarray, tables: np.ndarray, cols: np.ndarray,
                        inverse: np.ndarray, cand_all: np.ndarray, u_start: np.ndarray,
                        u_size: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:

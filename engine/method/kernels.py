@@ -64,6 +64,48 @@ def use_kernels(choice: str) -> Iterator[None]:
         _choice.reset(token)
 
 
+#: seconds of speech from which the compiled kernels save a new process more than loading them
+#: costs it (numba's import and cache read, about 0.5 s of CPU and 140 MiB; they save about
+#: 0.6 ms of CPU a second of speech in the phonetic mode, 2.3 ms in the modes that search the
+#: LSF index: docs/benchmarks.md)
+PAYS_OFF_S = {"phonetic": 800.0, "acoustic": 200.0, "robust": 200.0}
+
+
+def choice_for(seconds: float, mode: str) -> str:
+    """The kernels for a process that synthesizes ``seconds`` of speech in ``mode`` and exits
+    (the command line): ``compiled`` when they are loaded already or pay for their loading
+    (:data:`PAYS_OFF_S`), else ``numpy``; a choice made by :func:`use_kernels` or
+    ``$FACETRAJ_KERNELS`` stands.
+
+    >>> choice_for(60.0, "phonetic") if not loaded() else "numpy"
+    'numpy'
+    >>> with use_kernels("compiled"):
+    ...     choice_for(1.0, "phonetic")
+    'compiled'
+    """
+    made = _choice.get() or os.environ.get(KERNELS_ENV, "").strip().lower()
+    if made in CHOICES:
+        return made
+    return "compiled" if loaded() or seconds >= PAYS_OFF_S.get(mode, 200.0) else "numpy"
+
+
+def jit(fn=None, **flags):
+    """``numba.njit`` as the kernel modules compile: ``cache=True`` (the machine code kept for
+    the next process), ``nogil=True`` (frame threads run side by side), ``error_model="numpy"``
+    (a division by zero gives inf or NaN, as in numpy), and ``flags``; without the cache when
+    numba finds nowhere writable to keep it (a read-only install without a user cache folder:
+    the kernels are compiled again in every process)."""
+    if fn is None:
+        return lambda f: jit(f, **flags)
+    from numba import njit
+
+    flags = {"cache": True, "nogil": True, "error_model": "numpy", **flags}
+    try:
+        return njit(**flags)(fn)
+    except RuntimeError:                       # "cannot cache function ...: no locator available"
+        return njit(**{**flags, "cache": False})(fn)
+
+
 def _load(name: str) -> ModuleType | None:
     """``engine.method.<name>`` imported (numba with it) once; ``None`` when it cannot be."""
     with _lock:

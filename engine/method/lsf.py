@@ -157,7 +157,7 @@ def _clenshaw(c: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 @lru_cache(maxsize=8)
-def _root_grid(m: int, grid: int) -> tuple[np.ndarray, np.ndarray]:
+def root_grid(m: int, grid: int) -> tuple[np.ndarray, np.ndarray]:
     """The grid ``x = cos(w)`` of :func:`chebyshev_real_roots` and ``T_k(x) = cos(k w)``,
     ``(m+1, grid+1)``."""
     w = np.linspace(0.0, np.pi, grid + 1)
@@ -189,7 +189,7 @@ def chebyshev_real_roots(c: np.ndarray, grid: int = ROOT_GRID, tol: float = 1e-9
     """
     c = np.asarray(c, dtype=np.float64)
     n_rows, m = c.shape[0], c.shape[1] - 1
-    xg, basis = _root_grid(m, grid)
+    xg, basis = root_grid(m, grid)
     values = c @ basis                                             # (B, grid+1)
     neg = values < 0
     change = neg[:, 1:] != neg[:, :-1]
