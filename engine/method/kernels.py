@@ -24,6 +24,8 @@ from collections.abc import Iterator
 from contextvars import ContextVar
 from types import ModuleType
 
+from ..fanout import before_fork
+
 log = logging.getLogger(__name__)
 
 #: environment variable choosing the kernels: ``numpy`` (the reference) or ``compiled`` (default)
@@ -151,3 +153,13 @@ def warm_up() -> bool:
                 _loaded[name] = None
             ok = False
     return ok
+
+
+def _before_fork() -> None:
+    """Worker processes about to fork (``engine.fanout``): the compiled kernels loaded here
+    once, when chosen, rather than in every worker (half a second of CPU each)."""
+    if kernel_choice() == "compiled":
+        warm_up()
+
+
+before_fork(_before_fork)
