@@ -198,17 +198,18 @@ def _worker_run(pair: tuple[Path, Path]) -> Outcome:
                    float(res.times[-1]), details)
 
 
-def choose_kernels(job: SynthJob, inputs: Iterable[Path]) -> SynthJob:
-    """``job`` with the kernels that pay for themselves in this process on ``inputs``
-    (``engine.method.kernels.choice_for``: numba's loading costs about half a second, the
-    compiled kernels save it back on minutes of speech); their durations read from the files'
-    headers, only as far as needed (an unreadable one counts nothing: its synthesis says why)."""
+def choose_kernels(job: SynthJob, inputs: Iterable[Path], workers: int = 1) -> SynthJob:
+    """``job`` with the kernels that pay for themselves on ``inputs`` shared by ``workers``
+    processes (``engine.method.kernels.choice_for``: numba's loading costs about half a second,
+    paid before the workers fork, and the kernels save it back on minutes of speech in each
+    worker); the durations read from the files' headers, only as far as needed (an unreadable
+    one counts nothing: its synthesis says why)."""
     import soundfile as sf
 
     from engine.method.kernels import PAYS_OFF_S, choice_for
 
     mode = job.config.mode
-    enough, seconds = PAYS_OFF_S.get(mode, 200.0), 0.0
+    enough, seconds = PAYS_OFF_S.get(mode, 150.0) * workers, 0.0
     for path in inputs:
         try:
             seconds += sf.info(str(path)).duration
@@ -216,15 +217,15 @@ def choose_kernels(job: SynthJob, inputs: Iterable[Path]) -> SynthJob:
             continue
         if seconds >= enough:
             break
-    choice = choice_for(seconds, mode)
-    log.debug("%s kernels (%.0f s of speech counted)", choice, seconds)
+    choice = choice_for(seconds / workers, mode)
+    log.debug("%s kernels (%.0f s of speech counted, %d workers)", choice, seconds, workers)
     return replace(job, kernels=choice)
 
 
 def _preload(job: SynthJob) -> None:
     """Import what every input's synthesis imports (and load the compiled kernels when chosen)
-    once, before the workers fork: each worker would import it again, 60-100 ms of CPU (74
-    modules: the label readers and praatio, the audio reader, the writers)."""
+    once, before the workers fork, not in each worker (74 modules: the label readers and
+    praatio, the audio reader, the writers; about 60 ms in a profile of one file's run)."""
     import praatio.textgrid  # noqa: F401  (engine.io.labelfiles reads TextGrids with it)
     import soundfile  # noqa: F401
 
@@ -297,7 +298,7 @@ def run_batch(model_path: Path, specs: Sequence[str], outdir: Path, fmt: str, jo
     workers = max(1, min(jobs, len(todo)))
     log.info("%d inputs: %d to synthesize in %d process%s, %d skipped (output exists)",
              len(inputs), len(todo), workers, "es" * (workers > 1), len(outcomes))
-    job = choose_kernels(job, (src for src, _ in todo))
+    job = choose_kernels(job, (src for src, _ in todo), workers)
     if workers > 1:
         _preload(job)
     _WORKER.update(path=model_path, model=model)          # shared by forked workers

@@ -67,17 +67,17 @@ def use_kernels(choice: str) -> Iterator[None]:
 
 
 #: seconds of speech from which the compiled kernels save a new process more than loading them
-#: costs it (numba's import and cache read, about 0.5 s of CPU and 140 MiB; they save about
-#: 0.6 ms of CPU a second of speech in the phonetic mode, 2.3 ms in the modes that search the
-#: LSF index: docs/benchmarks.md)
-PAYS_OFF_S = {"phonetic": 800.0, "acoustic": 200.0, "robust": 200.0}
+#: costs it (numba's import and cache read: about 0.5 s of CPU and 140 MiB). On 100 files of
+#: 3-5 s through ``facetraj synth`` they saved about 1.5 ms of CPU a second of speech in the
+#: phonetic mode and 3 ms in the modes that search the LSF index (benchmarks/profile_notes.md)
+PAYS_OFF_S = {"phonetic": 300.0, "acoustic": 150.0, "robust": 150.0}
 
 
 def choice_for(seconds: float, mode: str) -> str:
     """The kernels for a process that synthesizes ``seconds`` of speech in ``mode`` and exits
-    (the command line): ``compiled`` when they are loaded already or pay for their loading
-    (:data:`PAYS_OFF_S`), else ``numpy``; a choice made by :func:`use_kernels` or
-    ``$FACETRAJ_KERNELS`` stands.
+    (the command line; for work split between processes, the seconds of one): ``compiled``
+    when they are loaded already or pay for their loading (:data:`PAYS_OFF_S`), else ``numpy``;
+    a choice made by :func:`use_kernels` or ``$FACETRAJ_KERNELS`` stands.
 
     >>> choice_for(60.0, "phonetic") if not loaded() else "numpy"
     'numpy'
@@ -88,7 +88,7 @@ def choice_for(seconds: float, mode: str) -> str:
     made = _choice.get() or os.environ.get(KERNELS_ENV, "").strip().lower()
     if made in CHOICES:
         return made
-    return "compiled" if loaded() or seconds >= PAYS_OFF_S.get(mode, 200.0) else "numpy"
+    return "compiled" if loaded() or seconds >= PAYS_OFF_S.get(mode, 150.0) else "numpy"
 
 
 def jit(fn=None, **flags):
