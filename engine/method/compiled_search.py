@@ -9,7 +9,7 @@ smallest kept by a selection (the ``count``-th smallest value, then the codeword
 it, in the opened cells' order). The reference sums each distance's 18 terms by a BLAS matrix
 product, this kernel in LSF order: the two differ by float32 rounding, so a codeword at the
 edge of the ``count`` chosen can differ when two distances are equal to float32 rounding (no
-frame of the default corpus's test speech).
+frame of 60 s of the default corpus's test speech).
 
 Imported only through :mod:`engine.method.kernels` (it imports numba).
 """
