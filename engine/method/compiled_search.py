@@ -186,22 +186,52 @@ def warm_up() -> None:
 
 
 @jit
-def top_context_scores(q: np.ndarray, codebook: np.ndarray, tables: np.ndarray, cols: np.ndarray,
-                       inverse: np.ndarray, cand_all: np.ndarray, u_start: np.ndarray,
-                       u_size: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+def _winnable(u: int, codebook: np.ndarray, s: np.ndarray, full: int, bound: float, count: int,
+              out: np.ndarray) -> int:
+    """The codebook contexts a query of centre phone ``u`` can pick (eq 4's bound, as
+    ``similarity.top_context_phones``), ascending, into ``out``; their number."""
+    n_cb = codebook.shape[0]
+    best = -np.inf
+    for j in range(n_cb):
+        best = max(best, s[u, codebook[j, full]])
+    reach = 0
+    for j in range(n_cb):
+        if s[u, codebook[j, full]] >= best:
+            reach += 1
+    low = best - bound - 1e-12
+    n = 0
+    for j in range(n_cb):
+        if reach < count or s[u, codebook[j, full]] >= low:
+            out[n] = j
+            n += 1
+    return n
+
+
+@jit
+def top_context_scores(q: np.ndarray, codebook: np.ndarray, s: np.ndarray, tables: np.ndarray,
+                       cols: np.ndarray, bound: float, count: int) -> tuple[np.ndarray, np.ndarray]:
     """Eq 4's ``count`` best codebook contexts of each query (row of ``q``), best first, of
-    equal scores the lower index first, as ``similarity.top_context_phones``: query ``i`` is
-    scored against the contexts ``cand_all[u_start[u]:][:u_size[u]]`` (``u = inverse[i]``, its
-    centre phone's contexts that can win, ascending), each score the terms
-    ``tables[j, q[i, cols[j]], codebook[l, cols[j]]]`` (``xi^-i S``) added in column order."""
-    n_q = q.shape[0]
+    equal scores the lower index first, as ``similarity.top_context_phones``: a query is scored
+    against the contexts its centre phone can pick (:func:`_winnable`, found once per centre),
+    each score the terms ``tables[j, q[i, cols[j]], codebook[l, cols[j]]]`` (``xi^-i S``) added
+    in column order."""
+    n_q, n_cb = q.shape[0], codebook.shape[0]
+    full = (q.shape[1] - 1) // 2
     top = np.empty((n_q, count), dtype=np.int64)
     best = np.empty((n_q, count))
+    found = np.full(s.shape[0], -1, dtype=np.int64)        # centre phone -> its row of winnable
+    winnable = np.empty((min(s.shape[0], n_q), n_cb), dtype=np.int64)
+    sizes = np.empty(winnable.shape[0], dtype=np.int64)
+    rows = 0
     for i in range(n_q):
-        u = inverse[i]
+        u = q[i, full]
+        if found[u] < 0:
+            found[u] = rows
+            sizes[rows] = _winnable(u, codebook, s, full, bound, count, winnable[rows])
+            rows += 1
+        cand = winnable[found[u], :sizes[found[u]]]
         filled = 0
-        for p in range(u_start[u], u_start[u] + u_size[u]):
-            ctx = cand_all[p]
+        for ctx in cand:
             n = tables[0, q[i, cols[0]], codebook[ctx, cols[0]]]
             for j in range(1, cols.shape[0]):
                 n += tables[j, q[i, cols[j]], codebook[ctx, cols[j]]]

@@ -157,9 +157,9 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     :func:`context_similarity`'s order, so the scores are its scores to the bit; then the
     ``count``-th best score of each query (a partition) and a sort of the few scores reaching it.
     The result, including the lower-index-first tie order, is that of the full computation
-    (tested). The compiled kernel (``engine.method.compiled_search``) scores the same pairs with
-    the same additions, query by query, keeping each query's best ``count`` as it goes, unless
-    :mod:`engine.method.kernels` chooses numpy.
+    (tested). The compiled kernel (``engine.method.compiled_search``) finds the same contexts
+    per centre phone and scores them with the same additions, query by query, keeping each
+    query's best ``count`` as it goes, unless :mod:`engine.method.kernels` chooses numpy.
 
     Returns ``(top, scores)``, both ``(Q, count)``.
 
@@ -175,6 +175,14 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     c = full if context is None else min(context, full)
     bound = 2.0 * sum(xi ** (-i) for i in range(1, c + 1))
     count = min(count, n_cb)
+    cols = np.arange(full - c, full + c + 1)
+    tables = context_weights(c, xi)[:, None, None] * s                       # (2c+1) x n x n
+    kernel = compiled("compiled_search")
+    if kernel is not None and n_q > 0:             # the same scores compiled, query by query
+        return kernel.top_context_scores(np.ascontiguousarray(q, dtype=np.int64),
+                                         np.ascontiguousarray(codebook, dtype=np.int64),
+                                         np.ascontiguousarray(s, dtype=np.float64), tables, cols,
+                                         bound, count)
     # the contexts that can win, per distinct query centre u: cand_all[u_start[u]:][:u_size[u]]
     centres, inverse = np.unique(q[:, full], return_inverse=True)
     sim = s[centres][:, codebook[:, full]]                                  # (U, L)
@@ -184,14 +192,6 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     u_size = np.count_nonzero(keep, axis=1)
     u_start = np.cumsum(u_size) - u_size
     cand_all = np.nonzero(keep)[1]
-    cols = np.arange(full - c, full + c + 1)
-    tables = context_weights(c, xi)[:, None, None] * s                       # (2c+1) x n x n
-    kernel = compiled("compiled_search")
-    if kernel is not None:                         # the same scores compiled, query by query
-        return kernel.top_context_scores(np.ascontiguousarray(q, dtype=np.int64),
-                                         np.ascontiguousarray(codebook, dtype=np.int64), tables,
-                                         cols, inverse.astype(np.int64), cand_all, u_start,
-                                         u_size, count)
     # every (query, context) pair, query by query: pair p is query rows[p] and context cand[p]
     sizes = u_size[inverse]
     ends = np.cumsum(sizes)
