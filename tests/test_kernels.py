@@ -147,6 +147,25 @@ def test_lsf_index_search_small_and_exhaustive():
     assert fast.shape == ref.shape == (0, 7)
 
 
+def test_eqs_5_to_8_equal_the_reference(default_model, default_corpus):
+    from engine.method.synthesis import gamma_grid, weight_frames
+
+    m = default_model
+    cb = m.codebook
+    utt = default_corpus.utterance(next(iter(default_corpus.info.test)))
+    w = m.input_lsf(utt.audio, utt.sample_rate, frame_times(utt.audio, utt.sample_rate))
+    cand = np.random.default_rng(4).integers(0, len(cb.lsf), (len(w), 15))
+    for gammas in (gamma_grid(), gamma_grid(0.5, 1.0, 3), np.array([0.2, 0.3, 1.7])):
+        ref, fast = both(weight_frames, w, cand, cb.lsf, cb.pcs, gammas)
+        np.testing.assert_array_equal(fast.gamma, ref.gamma)
+        np.testing.assert_array_equal(fast.candidates, ref.candidates)
+        for name in ("pcs", "weights", "lsf_hat", "error"):
+            np.testing.assert_allclose(getattr(fast, name), getattr(ref, name), rtol=1e-10,
+                                       atol=1e-12, err_msg=name)
+    ref, fast = both(weight_frames, w[:1], cand[:1], cb.lsf, cb.pcs, gamma_grid())     # one frame
+    np.testing.assert_allclose(fast.pcs, ref.pcs, rtol=1e-10, atol=1e-12)
+
+
 @pytest.mark.parametrize("mode", ["phonetic", "acoustic"])
 def test_synthesized_trajectories_equal_the_reference(default_model, default_corpus, mode):
     utt = default_corpus.utterance(list(default_corpus.info.test)[1])

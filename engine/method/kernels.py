@@ -1,5 +1,5 @@
 """Which implementation runs the per-frame hot paths of synthesis: the compiled kernels
-(numba; ``engine.method.compiled_lsf``, ``engine.method.compiled_search``) or the numpy
+(numba; ``engine.method.compiled_lsf``, ``compiled_search``, ``compiled_weights``) or the numpy
 reference (``engine.method.lsf``, ``engine.method.lsf_index``, ``engine.method.synthesis``).
 
 The numpy functions are the reference: each compiled kernel computes the same formula, frame by
@@ -140,7 +140,7 @@ def warm_up() -> bool:
     read or compilation), e.g. in a background thread before the first synthesis; whether the
     compiled kernels are usable."""
     ok = True
-    for name in ("compiled_lsf", "compiled_search"):
+    for name in ("compiled_lsf", "compiled_search", "compiled_weights"):
         module = _load(name)
         if module is None:
             ok = False
