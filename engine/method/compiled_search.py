@@ -186,22 +186,23 @@ def warm_up() -> None:
 
 
 @jit
-def _winnable(u: int, codebook: np.ndarray, s: np.ndarray, full: int, bound: float, count: int,
+def _winnable(u: int, centres: np.ndarray, s: np.ndarray, bound: float, count: int,
               out: np.ndarray) -> int:
     """The codebook contexts a query of centre phone ``u`` can pick (eq 4's bound, as
-    ``similarity.top_context_phones``), ascending, into ``out``; their number."""
-    n_cb = codebook.shape[0]
-    best = -np.inf
-    for j in range(n_cb):
-        best = max(best, s[u, codebook[j, full]])
-    reach = 0
-    for j in range(n_cb):
-        if s[u, codebook[j, full]] >= best:
+    ``similarity.top_context_phones``; ``centres`` the codebook contexts' centre phones),
+    ascending, into ``out``; their number."""
+    row = s[u]
+    best, reach = -np.inf, 0
+    for j in range(centres.shape[0]):
+        v = row[centres[j]]
+        if v > best:
+            best, reach = v, 1
+        elif v == best:
             reach += 1
     low = best - bound - 1e-12
     n = 0
-    for j in range(n_cb):
-        if reach < count or s[u, codebook[j, full]] >= low:
+    for j in range(centres.shape[0]):
+        if reach < count or row[centres[j]] >= low:
             out[n] = j
             n += 1
     return n
@@ -222,12 +223,13 @@ def top_context_scores(q: np.ndarray, codebook: np.ndarray, s: np.ndarray, table
     found = np.full(s.shape[0], -1, dtype=np.int64)        # centre phone -> its row of winnable
     winnable = np.empty((min(s.shape[0], n_q), n_cb), dtype=np.int64)
     sizes = np.empty(winnable.shape[0], dtype=np.int64)
+    centres = codebook[:, full].copy()
     rows = 0
     for i in range(n_q):
         u = q[i, full]
         if found[u] < 0:
             found[u] = rows
-            sizes[rows] = _winnable(u, codebook, s, full, bound, count, winnable[rows])
+            sizes[rows] = _winnable(u, centres, s, bound, count, winnable[rows])
             rows += 1
         cand = winnable[found[u], :sizes[found[u]]]
         filled = 0

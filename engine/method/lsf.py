@@ -164,6 +164,12 @@ def root_grid(m: int, grid: int) -> tuple[np.ndarray, np.ndarray]:
     return _frozen(np.cos(w)), _frozen(np.cos(np.outer(np.arange(m + 1), w)))
 
 
+@lru_cache(maxsize=8)
+def hamming(n: int) -> np.ndarray:
+    """``np.hamming(n)``, made once per length (read-only: shared by every caller)."""
+    return _frozen(np.hamming(n))
+
+
 def _frozen(a: np.ndarray) -> np.ndarray:
     """``a`` made read-only: a cached table is shared by every caller."""
     a.setflags(write=False)
@@ -474,7 +480,7 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     kernel = compiled("compiled_lsf") if order % 2 == 0 and order >= 2 else None
     if kernel is not None:                         # the same analysis compiled, frame by frame
         pad, starts, n = padded_signal(x, audio_rate, times, window_s, preemphasis)
-        window = np.hamming(n)
+        window = hamming(n)
         return np.concatenate(map_spans(lambda a, b: kernel.frame_lsf(pad, starts[a:b], window,
                                                                       order, poly2lsf),
                                         len(starts), threads))

@@ -166,7 +166,7 @@ def weight_frames(w: np.ndarray, candidates: np.ndarray, cb_lsf: np.ndarray, cb_
     steps = np.diff(gammas)
     few = not shared and n_cand <= COMPILED_MAX_CANDIDATES and len(gammas) >= 3
     kernel = compiled("compiled_weights") if few else None
-    if kernel is not None and np.allclose(steps, steps[0], rtol=1e-12, atol=0.0):
+    if kernel is not None and np.all(np.abs(steps - steps[0]) <= 1e-12 * abs(steps[0])):
         # the same equations compiled, frame by frame, on grid_weights' evenly spaced grid
         pcs, best, weights, lsf_hat, err = kernel.weight_frames(
             np.ascontiguousarray(w, dtype=np.float64), np.ascontiguousarray(candidates, dtype=np.int64),
