@@ -166,6 +166,21 @@ def test_eqs_5_to_8_equal_the_reference(default_model, default_corpus):
     np.testing.assert_allclose(fast.pcs, ref.pcs, rtol=1e-10, atol=1e-12)
 
 
+def test_eqs_5_to_8_where_gammas_tie(toy_model):
+    """One codeword dominating: every gamma's error equal to rounding, so the kernel and the
+    reference may choose different gammas; the weights and PCs agree to rounding."""
+    from engine.method.synthesis import gamma_grid, weight_frames
+
+    cb = toy_model.codebook
+    rng = np.random.default_rng(1)
+    w = cb.lsf[rng.choice(len(cb.lsf), 6)] + 0.01
+    cand = rng.choice(len(cb.lsf), (6, 9))
+    ref, fast = both(weight_frames, w, cand, cb.lsf, cb.pcs, gamma_grid())
+    np.testing.assert_allclose(fast.pcs, ref.pcs, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(fast.weights, ref.weights, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(fast.error, ref.error, rtol=1e-9, atol=1e-12)
+
+
 @pytest.mark.parametrize("mode", ["phonetic", "acoustic"])
 def test_synthesized_trajectories_equal_the_reference(default_model, default_corpus, mode):
     utt = default_corpus.utterance(list(default_corpus.info.test)[1])
