@@ -5,13 +5,16 @@ reference (``engine.method.lsf``, ``engine.method.lsf_index``, ``engine.method.s
 The numpy functions are the reference: each compiled kernel computes the same formula, frame by
 frame in one loop, and is tested equal to it to rounding (``tests/test_kernels.py``). numba is
 imported here only when a kernel is first asked for, never by importing the engine, so neither
-``facetraj --version`` nor the app's first frame pays its import (0.2-0.5 s) unless they
-synthesize. ``$FACETRAJ_KERNELS=numpy`` (or :func:`use_kernels`) forces the reference; numba
-missing, or failing to import or compile, falls back to it with a warning in the log.
+``facetraj --version`` nor the app's first frame pays for it (its import and first call: about
+0.5 s of CPU and 140 MiB); the command line uses the kernels only where they pay that back
+(:func:`choice_for`), and work fanned out over processes loads them once before forking.
+``$FACETRAJ_KERNELS=numpy`` (or :func:`use_kernels`) forces the reference; numba missing, or
+failing to import or compile, falls back to it with a warning in the log.
 
 numba keeps the compiled machine code (``cache=True``) beside the modules (``__pycache__``), or
 where ``$NUMBA_CACHE_DIR`` says, or in the user cache folder when the install is read-only; the
-first run after an install compiles (seconds), later ones load the cache.
+first run after an install compiles (about 10 s), later ones load the cache; where nothing can be
+written the kernels compile without a cache in every process (:func:`jit`).
 """
 
 from __future__ import annotations
