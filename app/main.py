@@ -122,6 +122,7 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
 
         window.set_error_handler(fail)     # no dialogs in screenshot mode
         window.set_correlation_sweep(False)  # one frame: nothing to compute in the background
+        window.warm_kernels = False
 
         def shoot() -> None:
             if window.view is None:

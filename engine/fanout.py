@@ -94,6 +94,18 @@ def portable(exc: BaseException) -> BaseException:
         return RuntimeError(f"{type(exc).__name__}: {exc}")
 
 
+#: called in the parent before worker processes fork: what every worker would otherwise load
+#: for itself (``engine.method.kernels`` loads the compiled kernels here), loaded once
+_BEFORE_FORK: list[Callable[[], None]] = []
+
+
+def before_fork(fn: Callable[[], None]) -> None:
+    """Have ``fn()`` called in the parent before :func:`fan_out` forks its workers (once per
+    registration, whatever the number of calls)."""
+    if fn not in _BEFORE_FORK:
+        _BEFORE_FORK.append(fn)
+
+
 #: what a worker process runs, inherited by fork (not pickled)
 _WORKER: tuple[Callable[[Any], Any], Sequence[Any]] | None = None
 
@@ -162,6 +174,8 @@ def _in_processes(fn: Callable[[I], R], items: list[I], workers: int, skip: Skip
     from concurrent.futures.process import BrokenProcessPool
 
     out: list[tuple[I, R]] = []
+    for prepare in _BEFORE_FORK:
+        prepare()
     pool = ProcessPoolExecutor(workers, mp.get_context("fork"), initializer=_worker_init,
                                initargs=(fn, items))
     try:

@@ -18,6 +18,7 @@ here, once.
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import os
 from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
@@ -120,7 +121,9 @@ def frame_spans(n_frames: int, threads: int | None = None) -> list[tuple[int, in
 
 def map_spans(fn: Callable[[int, int], T], n_frames: int, threads: int | None = None) -> list[T]:
     """``fn(start, stop)`` for each of :func:`frame_spans`, in threads when there are several;
-    the results in span order. An exception in a span is raised here. (The threads' matrix
+    the results in span order, each span run in a copy of the caller's context (its
+    :func:`limit_frame_threads` and ``engine.method.kernels.use_kernels`` hold there). An
+    exception in a span is raised here. (The threads' matrix
     products are small: callers that run beside other work run BLAS on one thread, as the app,
     live mode and the evaluation do, :func:`one_blas_thread`.)
 
@@ -133,5 +136,6 @@ def map_spans(fn: Callable[[int, int], T], n_frames: int, threads: int | None = 
     global _pool
     if _pool is None or _pool[1] < len(spans):
         _pool = (ThreadPoolExecutor(len(spans), thread_name_prefix="facetraj-frames"), len(spans))
-    futures = [_pool[0].submit(fn, a, b) for a, b in spans]
+    # each span in a copy of the caller's context: its choices (frame threads, kernels) hold there
+    futures = [_pool[0].submit(contextvars.copy_context().run, fn, a, b) for a, b in spans]
     return [f.result() for f in futures]

@@ -10,6 +10,7 @@ from itertools import pairwise
 import numpy as np
 
 from ..threads import map_spans
+from .kernels import compiled
 
 #: white-noise correction added to r[0] (a -40 dB noise floor) so that LPC of near-silent or
 #: perfectly periodic frames stays well conditioned.
@@ -156,11 +157,17 @@ def _clenshaw(c: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 @lru_cache(maxsize=8)
-def _root_grid(m: int, grid: int) -> tuple[np.ndarray, np.ndarray]:
+def root_grid(m: int, grid: int) -> tuple[np.ndarray, np.ndarray]:
     """The grid ``x = cos(w)`` of :func:`chebyshev_real_roots` and ``T_k(x) = cos(k w)``,
     ``(m+1, grid+1)``."""
     w = np.linspace(0.0, np.pi, grid + 1)
     return _frozen(np.cos(w)), _frozen(np.cos(np.outer(np.arange(m + 1), w)))
+
+
+@lru_cache(maxsize=8)
+def hamming(n: int) -> np.ndarray:
+    """``np.hamming(n)``, made once per length (read-only: shared by every caller)."""
+    return _frozen(np.hamming(n))
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:
@@ -188,7 +195,7 @@ def chebyshev_real_roots(c: np.ndarray, grid: int = ROOT_GRID, tol: float = 1e-9
     """
     c = np.asarray(c, dtype=np.float64)
     n_rows, m = c.shape[0], c.shape[1] - 1
-    xg, basis = _root_grid(m, grid)
+    xg, basis = root_grid(m, grid)
     values = c @ basis                                             # (B, grid+1)
     neg = values < 0
     change = neg[:, 1:] != neg[:, :-1]
@@ -423,14 +430,21 @@ def preemphasize(x: np.ndarray, coefficient: float, previous: float | None = Non
     return np.concatenate([before, x[1:] - coefficient * x[:-1]])
 
 
+def padded_signal(audio: np.ndarray, rate: int, times: np.ndarray, window_s: float,
+                  preemphasis: float = 0.0) -> tuple[np.ndarray, np.ndarray, int]:
+    """The pre-emphasized signal with half a window of zeros before it and a window after, the
+    start in it of the frame of ``window_s`` centred on each of ``times``, and the frame length:
+    frame ``t`` is ``pad[starts[t]:starts[t] + n]`` (zero outside the signal)."""
+    x = preemphasize(audio, preemphasis)
+    n = int(round(window_s * rate))
+    pad = np.concatenate([np.zeros(n // 2), x, np.zeros(n)])
+    return pad, np.clip(frame_starts(times, rate), 0, len(x)), n
+
+
 def analysis_frames(audio: np.ndarray, rate: int, times: np.ndarray, window_s: float,
                     preemphasis: float = 0.0) -> np.ndarray:
     """Hamming-windowed frames of ``window_s`` centred on ``times`` (zero outside the signal)."""
-    x = preemphasize(audio, preemphasis)
-    n = int(round(window_s * rate))
-    half = n // 2
-    pad = np.concatenate([np.zeros(half), x, np.zeros(n)])
-    starts = np.clip(frame_starts(times, rate), 0, len(x))
+    pad, starts, n = padded_signal(audio, rate, times, window_s, preemphasis)
     return np.lib.stride_tricks.sliding_window_view(pad, n)[starts] * np.hamming(n)
 
 
@@ -445,7 +459,9 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     """LSF vectors ``(len(times), order)`` from 25 ms Hamming frames centred on ``times``.
 
     The audio is resampled to ``audio_rate`` first (the paper analyses 16 kHz speech). The frames
-    are analysed in ``threads`` spans at once (``None``: :func:`engine.threads.frame_threads`).
+    are analysed by the compiled kernel (``engine.method.compiled_lsf``, equal to this module's
+    functions to rounding) unless :mod:`engine.method.kernels` chooses numpy, in ``threads`` spans
+    at once (``None``: :func:`engine.threads.frame_threads`).
     The LSFs equal one thread's to rounding: BLAS's matrix products (autocorrelation lags, the
     root bracketing grid) may add a row's terms in another order for another number of rows.
 
@@ -460,7 +476,14 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     if 0 < peak < np.inf:  # to a peak in [0.5, 1) by a power of 2: exact, and LPC is scale-free,
         x = np.ldexp(x, -int(np.frexp(peak)[1]))  # so huge samples cannot overflow to inf
     x = resample_audio(x, rate, audio_rate)
-    frames = analysis_frames(x, audio_rate, np.asarray(times, dtype=np.float64), window_s,
-                             preemphasis)
+    times = np.asarray(times, dtype=np.float64)
+    kernel = compiled("compiled_lsf") if order % 2 == 0 and order >= 2 else None
+    if kernel is not None:                         # the same analysis compiled, frame by frame
+        pad, starts, n = padded_signal(x, audio_rate, times, window_s, preemphasis)
+        window = hamming(n)
+        return np.concatenate(map_spans(lambda a, b: kernel.frame_lsf(pad, starts[a:b], window,
+                                                                      order, poly2lsf),
+                                        len(starts), threads))
+    frames = analysis_frames(x, audio_rate, times, window_s, preemphasis)
     return np.concatenate(map_spans(lambda a, b: frame_lsf(frames[a:b], order), len(frames),
                                     threads))

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .kernels import compiled
 from .synthesis import perceptual_weights
 
 log = logging.getLogger(__name__)
@@ -126,7 +127,9 @@ class LsfIndex:
         laid out ``(P, size)`` so that the innermost loops run along the cell's codewords, and in
         float32 (half the memory traffic of the search's largest arrays; the distances only rank
         the codewords: eqs 5-8 are computed again in float64 on the ``count`` found). ``grouped``
-        may pass :meth:`grouped` of ``cb_lsf``, computed once.
+        may pass :meth:`grouped` of ``cb_lsf``, computed once. The compiled kernel
+        (``engine.method.compiled_search``) runs this search frame by frame unless
+        :mod:`engine.method.kernels` chooses numpy.
 
         Examples
         --------
@@ -139,11 +142,21 @@ class LsfIndex:
         if cb_lsf.shape[0] != self.n_codewords:
             raise ValueError(f"the index covers {self.n_codewords} codewords, the codebook has "
                              f"{cb_lsf.shape[0]}: rebuild it (build_index)")
-        n_frames, order = w.shape[0], w.shape[1]
         count = min(count, self.n_codewords)
         probe = min(max(probe, self.min_probe(count)), self.n_cells)
-        sizes = self.sizes
         cell_lsf = self._cell_lsf(cb_lsf, grouped)                        # (P, 5L) by cell
+        kernel = compiled("compiled_search")
+        if kernel is not None:                     # the same search compiled, frame by frame
+            return kernel.nearest_frames(np.ascontiguousarray(w, dtype=np.float64),
+                                         np.ascontiguousarray(self.centroids.T, dtype=np.float32),
+                                         cell_lsf, self.offsets, self.order, count, probe)
+        return self._search(w, cell_lsf, count, probe, chunk)
+
+    def _search(self, w: np.ndarray, cell_lsf: np.ndarray, count: int, probe: int,
+                chunk: int | None) -> np.ndarray:
+        """:meth:`nearest` in numpy (the reference of the compiled kernel), chunk by chunk."""
+        n_frames, order = w.shape[0], w.shape[1]
+        sizes = self.sizes
         width_max = int(np.sort(sizes)[-probe:].sum())
         chunk = chunk or max(1, min(1024, int(4e6 // max(self.n_cells * order, width_max))))
         out = np.empty((n_frames, count), dtype=np.int64)

@@ -87,7 +87,12 @@ def speech_mask(audio: np.ndarray, rate: int, times: np.ndarray,
     config = config or EvalConfig()
     if filtered is None:
         filtered = filtered_energy_db(audio, rate, config)
-    floor, peak = np.percentile(filtered, [5, 99])
+    return _above(filtered, times, config, *np.percentile(filtered, [5, 99]))
+
+
+def _above(filtered: np.ndarray, times: np.ndarray, config: EvalConfig, floor: float,
+           peak: float) -> np.ndarray:
+    """:func:`speech_mask` from the energy's 5th and 99th percentiles ``floor`` and ``peak``."""
     threshold = floor + config.threshold_fraction * (peak - floor)
     idx = np.clip(np.round(np.asarray(times) / config.energy_hop_s).astype(int), 0,
                   len(filtered) - 1)
@@ -127,4 +132,5 @@ def pauses(audio: np.ndarray, rate: int, times: np.ndarray, min_s: float = 0.15,
     floor, peak = np.percentile(filtered, [5, 99])
     if peak - floor < min_range_db:
         return np.zeros((0, 2))
-    return speech_runs(~speech_mask(audio, rate, times, config, filtered), times, min_s)
+    mask = _above(filtered, times, config or EvalConfig(), floor, peak)     # the percentiles once
+    return speech_runs(~mask, times, min_s)

@@ -37,11 +37,12 @@ def cmd_synth(args: argparse.Namespace) -> int:
     from engine.io.files import check_output_path
     from engine.method.model import Model
 
-    from ..batch import synthesize_file
+    from ..batch import choose_kernels, synthesize_file
 
     check_output_path(args.output, args.overwrite)       # before the work, not after
     model = Model.load(args.model)
-    res = synthesize_file(model, Path(args.inputs[0]), args.output, _job(args)).synthesis
+    source = Path(args.inputs[0])
+    res = synthesize_file(model, source, args.output, choose_kernels(_job(args), [source])).synthesis
     log.info("%d frames (%.2f s) synthesized, %s smoothing", len(res.times), res.times[-1],
              res.config.smoothing)
     print(args.output)

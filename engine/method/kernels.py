@@ -1,0 +1,168 @@
+"""Which implementation runs the per-frame hot paths of synthesis: the compiled kernels
+(numba; ``engine.method.compiled_lsf``, ``compiled_search``, ``compiled_weights``) or the numpy
+reference (``engine.method.lsf``, ``engine.method.lsf_index``, ``engine.method.synthesis``).
+
+The numpy functions are the reference: each compiled kernel computes the same formula, frame by
+frame in one loop, and is tested equal to it to rounding (``tests/test_kernels.py``). numba is
+imported here only when a kernel is first asked for, never by importing the engine, so neither
+``facetraj --version`` nor the app's first frame pays for it (its import and first call: about
+0.5 s of CPU and 140 MiB); the command line uses the kernels only where they pay that back
+(:func:`choice_for`), and work fanned out over processes loads them once before forking.
+``$FACETRAJ_KERNELS=numpy`` (or :func:`use_kernels`) forces the reference; numba missing, or
+failing to import or compile, falls back to it with a warning in the log.
+
+numba keeps the compiled machine code (``cache=True``) beside the modules (``__pycache__``), or
+where ``$NUMBA_CACHE_DIR`` says, or in the user cache folder when the install is read-only; the
+first run after an install compiles (about 10 s), later ones load the cache; where nothing can be
+written the kernels compile without a cache in every process (:func:`jit`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import threading
+from collections.abc import Iterator
+from contextvars import ContextVar
+from types import ModuleType
+
+from ..fanout import before_fork
+
+log = logging.getLogger(__name__)
+
+#: environment variable choosing the kernels: ``numpy`` (the reference) or ``compiled`` (default)
+KERNELS_ENV = "FACETRAJ_KERNELS"
+CHOICES = ("compiled", "numpy")
+
+_choice: ContextVar[str | None] = ContextVar("kernel_choice", default=None)
+_lock = threading.Lock()
+#: the loaded kernel modules by name; ``None``: failed to load (the reference is used)
+_loaded: dict[str, ModuleType | None] = {}
+
+
+def kernel_choice() -> str:
+    """``compiled`` or ``numpy``: the choice of :func:`use_kernels` in this thread (and context),
+    else ``$FACETRAJ_KERNELS``, else ``compiled``.
+
+    >>> with use_kernels("numpy"):
+    ...     kernel_choice()
+    'numpy'
+    """
+    choice = _choice.get()
+    if choice is not None:
+        return choice
+    env = os.environ.get(KERNELS_ENV, "").strip().lower()
+    return env if env in CHOICES else "compiled"
+
+
+@contextlib.contextmanager
+def use_kernels(choice: str) -> Iterator[None]:
+    """Synthesis in this thread (and its context) uses ``choice`` (``compiled`` or ``numpy``)
+    until the end of the ``with`` block."""
+    if choice not in CHOICES:
+        raise ValueError(f"kernels must be one of {CHOICES}, got {choice!r}")
+    token = _choice.set(choice)
+    try:
+        yield
+    finally:
+        _choice.reset(token)
+
+
+#: seconds of speech from which the compiled kernels save a new process more than loading them
+#: costs it (numba's import and cache read: about 0.5 s of CPU and 140 MiB). On 100 files of
+#: 3-5 s through ``facetraj synth`` they saved about 1.5 ms of CPU a second of speech in the
+#: phonetic mode and 3 ms in the modes that search the LSF index (benchmarks/profile_notes.md)
+PAYS_OFF_S = {"phonetic": 300.0, "acoustic": 150.0, "robust": 150.0}
+
+
+def choice_for(seconds: float, mode: str) -> str:
+    """The kernels for a process that synthesizes ``seconds`` of speech in ``mode`` and exits
+    (the command line; for work split between processes, the seconds of one): ``compiled``
+    when they are loaded already or pay for their loading (:data:`PAYS_OFF_S`), else ``numpy``;
+    a choice made by :func:`use_kernels` or ``$FACETRAJ_KERNELS`` stands.
+
+    >>> choice_for(60.0, "phonetic") if not loaded() else "numpy"
+    'numpy'
+    >>> with use_kernels("compiled"):
+    ...     choice_for(1.0, "phonetic")
+    'compiled'
+    """
+    made = _choice.get() or os.environ.get(KERNELS_ENV, "").strip().lower()
+    if made in CHOICES:
+        return made
+    return "compiled" if loaded() or seconds >= PAYS_OFF_S.get(mode, 150.0) else "numpy"
+
+
+def jit(fn=None, **flags):
+    """``numba.njit`` as the kernel modules compile: ``cache=True`` (the machine code kept for
+    the next process), ``nogil=True`` (frame threads run side by side), ``error_model="numpy"``
+    (a division by zero gives inf or NaN, as in numpy), and ``flags``; without the cache when
+    numba finds nowhere writable to keep it (a read-only install without a user cache folder:
+    the kernels are compiled again in every process)."""
+    if fn is None:
+        return lambda f: jit(f, **flags)
+    from numba import njit
+
+    flags = {"cache": True, "nogil": True, "error_model": "numpy", **flags}
+    try:
+        return njit(**flags)(fn)
+    except RuntimeError:                       # "cannot cache function ...: no locator available"
+        return njit(**{**flags, "cache": False})(fn)
+
+
+def _load(name: str) -> ModuleType | None:
+    """``engine.method.<name>`` imported (numba with it) once; ``None`` when it cannot be."""
+    with _lock:
+        if name not in _loaded:
+            try:
+                import importlib
+
+                _loaded[name] = importlib.import_module(f"{__package__}.{name}")
+            except Exception as exc:            # numba missing or broken: the reference runs
+                log.warning("compiled kernels unavailable (%s: %s); using numpy", name, exc)
+                _loaded[name] = None
+        return _loaded[name]
+
+
+def compiled(name: str) -> ModuleType | None:
+    """The compiled kernel module ``name`` (``compiled_lsf``, ``compiled_search``) when the
+    compiled kernels are chosen and load, else ``None`` (the caller runs the numpy reference)."""
+    if kernel_choice() != "compiled":
+        return None
+    return _load(name)
+
+
+def loaded() -> bool:
+    """Whether the compiled kernels are already loaded (numba imported, nothing left to load)."""
+    return bool(_loaded) and all(m is not None for m in _loaded.values())
+
+
+def warm_up() -> bool:
+    """Load and run every compiled kernel once on a tiny input (numba's import, and its cache
+    read or compilation), e.g. in a background thread before the first synthesis; whether the
+    compiled kernels are usable."""
+    ok = True
+    for name in ("compiled_lsf", "compiled_search", "compiled_weights"):
+        module = _load(name)
+        if module is None:
+            ok = False
+            continue
+        try:
+            module.warm_up()
+        except Exception as exc:                # a compile error: use the reference from now on
+            log.warning("compiled kernels failed (%s: %s); using numpy", name, exc)
+            with _lock:
+                _loaded[name] = None
+            ok = False
+    return ok
+
+
+def _before_fork() -> None:
+    """Worker processes about to fork (``engine.fanout``): the compiled kernels loaded here
+    once, when chosen, rather than in every worker (half a second of CPU each)."""
+    if kernel_choice() == "compiled":
+        warm_up()
+
+
+before_fork(_before_fork)
