@@ -106,6 +106,13 @@ def before_fork(fn: Callable[[], None]) -> None:
         _BEFORE_FORK.append(fn)
 
 
+def prepare_fork() -> None:
+    """Run the :func:`before_fork` hooks: call it right before any ``fork`` (``fan_out`` does):
+    no thread is then half-way through loading what a child would inherit locked."""
+    for prepare in _BEFORE_FORK:
+        prepare()
+
+
 #: what a worker process runs, inherited by fork (not pickled)
 _WORKER: tuple[Callable[[Any], Any], Sequence[Any]] | None = None
 
@@ -174,8 +181,7 @@ def _in_processes(fn: Callable[[I], R], items: list[I], workers: int, skip: Skip
     from concurrent.futures.process import BrokenProcessPool
 
     out: list[tuple[I, R]] = []
-    for prepare in _BEFORE_FORK:
-        prepare()
+    prepare_fork()
     pool = ProcessPoolExecutor(workers, mp.get_context("fork"), initializer=_worker_init,
                                initargs=(fn, items))
     try:

@@ -260,3 +260,66 @@ def test_the_choice_holds_in_the_frame_threads():
         assert map_spans(lambda a, b: kernel_choice(), 3000, 2) == ["numpy", "numpy"]
     with use_kernels("compiled"):
         assert map_spans(lambda a, b: kernel_choice(), 3000, 2) == ["compiled", "compiled"]
+
+
+def test_a_live_stream_never_waits_for_the_kernels_to_load(toy_model, tmp_path):
+    """A fresh process streams with numpy's reference (numba not even imported) until the kernels
+    are loaded, then with the compiled ones; the frames equal a stream of numpy's throughout."""
+    code = """
+import sys
+import numpy as np
+from engine.method import kernels
+from engine.method.model import Model
+from engine.streaming.synthesizer import StreamingSynthesizer
+model = Model.load(sys.argv[1])
+audio = np.random.default_rng(1).standard_normal(16000) * 0.1
+def stream(between):
+    s = StreamingSynthesizer(model)
+    first = s.feed(audio[:8000]).pcs
+    between()
+    return np.concatenate([first, s.feed(audio[8000:]).pcs, s.flush().pcs])
+cold = stream(lambda: None)
+print("numba" in sys.modules, kernels.loaded())
+warmed = stream(kernels.warm_up)
+print("numba" in sys.modules, kernels.loaded())
+with kernels.use_kernels("numpy"):
+    ref = stream(lambda: None)
+print(np.abs(cold - ref).max() < 1e-9, np.abs(warmed - ref).max() < 1e-9)
+"""
+    toy_model.save(tmp_path / "toy.npz")
+    env = {k: v for k, v in os.environ.items() if k != kernels.KERNELS_ENV}
+    out = subprocess.run([sys.executable, "-c", code, str(tmp_path / "toy.npz")],
+                         capture_output=True, text=True, cwd=ROOT, timeout=600, env=env)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.split() == ["False", "False", "True", "True", "True", "True"]
+
+
+def test_a_fork_waits_for_a_warm_up_under_way_in_another_thread(monkeypatch):
+    """The app warms the kernels in a background thread; work forked meanwhile (``fan_out``,
+    whose hooks ``prepare_fork`` runs) waits until it is done, whatever this thread's choice, so
+    no child inherits numba's locks held mid-compile."""
+    import threading
+
+    from engine.fanout import prepare_fork
+    from engine.method import compiled_lsf
+
+    started, release = threading.Event(), threading.Event()
+    order = []
+    real = compiled_lsf.warm_up
+
+    def slow_warm_up():                    # the compile of the first kernel, made slow
+        started.set()
+        release.wait(5)
+        real()
+        order.append("warm-up done")
+
+    monkeypatch.setattr(compiled_lsf, "warm_up", slow_warm_up)
+    t = threading.Thread(target=kernels.warm_up)
+    t.start()
+    assert started.wait(5)
+    threading.Timer(0.2, release.set).start()
+    with use_kernels("numpy"):
+        prepare_fork()
+    order.append("fork")
+    t.join()
+    assert order == ["warm-up done", "fork"]

@@ -20,12 +20,14 @@ written the kernels compile without a cache in every process (:func:`jit`).
 from __future__ import annotations
 
 import contextlib
+import functools
 import logging
 import os
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextvars import ContextVar
 from types import ModuleType
+from typing import TypeVar
 
 from ..fanout import before_fork
 
@@ -37,6 +39,8 @@ CHOICES = ("compiled", "numpy")
 
 _choice: ContextVar[str | None] = ContextVar("kernel_choice", default=None)
 _lock = threading.Lock()
+#: held while :func:`warm_up` compiles or reads the cache (one warm-up at a time)
+_warming = threading.Lock()
 #: the loaded kernel modules by name; ``None``: failed to load (the reference is used)
 _loaded: dict[str, ModuleType | None] = {}
 
@@ -94,6 +98,36 @@ def choice_for(seconds: float, mode: str) -> str:
     return "compiled" if loaded() or seconds >= PAYS_OFF_S.get(mode, 150.0) else "numpy"
 
 
+def ready_choice() -> str:
+    """The kernels for work that must not wait for numba's import or compiling (a live stream,
+    fed as the audio comes): a choice made by :func:`use_kernels` or ``$FACETRAJ_KERNELS``
+    stands, else ``compiled`` once :func:`loaded`, else ``numpy``.
+
+    >>> with use_kernels("numpy"):
+    ...     ready_choice()
+    'numpy'
+    """
+    made = _choice.get() or os.environ.get(KERNELS_ENV, "").strip().lower()
+    if made in CHOICES:
+        return made
+    return "compiled" if loaded() else "numpy"
+
+
+F = TypeVar("F", bound=Callable)
+
+
+def never_waiting(method: F) -> F:
+    """``method`` (a stream's ``feed`` or ``flush``) runs with :func:`ready_choice`: the numpy
+    reference until the compiled kernels are loaded (by :func:`warm_up`, in the background),
+    never a block held up for half a second, or ten on the first run after an install."""
+    @functools.wraps(method)
+    def run(*args, **kwargs):
+        with use_kernels(ready_choice()):
+            return method(*args, **kwargs)
+
+    return run  # type: ignore[return-value]
+
+
 def jit(fn=None, **flags):
     """``numba.njit`` as the kernel modules compile: ``cache=True`` (the machine code kept for
     the next process), ``nogil=True`` (frame threads run side by side), ``error_model="numpy"``
@@ -142,27 +176,33 @@ def warm_up() -> bool:
     """Load and run every compiled kernel once on a tiny input (numba's import, and its cache
     read or compilation), e.g. in a background thread before the first synthesis; whether the
     compiled kernels are usable."""
-    ok = True
-    for name in ("compiled_lsf", "compiled_search", "compiled_weights"):
-        module = _load(name)
-        if module is None:
-            ok = False
-            continue
-        try:
-            module.warm_up()
-        except Exception as exc:                # a compile error: use the reference from now on
-            log.warning("compiled kernels failed (%s: %s); using numpy", name, exc)
-            with _lock:
-                _loaded[name] = None
-            ok = False
-    return ok
+    with _warming:
+        ok = True
+        for name in ("compiled_lsf", "compiled_search", "compiled_weights"):
+            module = _load(name)
+            if module is None:
+                ok = False
+                continue
+            try:
+                module.warm_up()
+            except Exception as exc:                # a compile error: use the reference from now on
+                log.warning("compiled kernels failed (%s: %s); using numpy", name, exc)
+                with _lock:
+                    _loaded[name] = None
+                ok = False
+        return ok
 
 
 def _before_fork() -> None:
     """Worker processes about to fork (``engine.fanout``): the compiled kernels loaded here
-    once, when chosen, rather than in every worker (half a second of CPU each)."""
+    once, when chosen, rather than in every worker (half a second of CPU each); a warm-up under
+    way in another thread (the app's, in the background) finishes first either way, so that no
+    child inherits numba half-way through compiling (its locks held by a thread it has not)."""
     if kernel_choice() == "compiled":
         warm_up()
+    else:
+        with _warming:
+            pass
 
 
 before_fork(_before_fork)

@@ -33,6 +33,7 @@ from ..config import SynthConfig
 from ..labels.phoneset import SILENCE, map_labels
 from ..method.closure import BILABIALS, ClosurePlan, closure_strengths
 from ..method.context import context_ids, segment_index
+from ..method.kernels import never_waiting
 from ..method.model import Model
 from ..method.pipeline import acoustic_candidates, context_offsets, frame_confidence, robust_weights
 from ..method.similarity import top_context_phones
@@ -148,6 +149,7 @@ class PhoneticSynthesizer:
         return self.front.received_s
 
     # ------------------------------------------------------------------ blocks
+    @never_waiting
     def feed(self, block: np.ndarray) -> StreamFrames:
         """Face frames completed by the next ``block`` of audio samples (mono)."""
         complete = self.front.feed(block)
@@ -158,6 +160,7 @@ class PhoneticSynthesizer:
         raw = self._analyse(stop, None) if stop - self._next >= self.timing.batch else None
         return self._emit(self._smoother.feed(raw) if raw is not None else None, final=False)
 
+    @never_waiting
     def flush(self) -> StreamFrames:
         """The remaining frames, the audio ended (as many as offline synthesis makes)."""
         total = self.front.flush()

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..config import SynthConfig
+from ..method.kernels import never_waiting
 from ..method.model import Model
 from ..method.pipeline import acoustic_candidates
 from ..method.smoothing import TriangularStream
@@ -129,6 +130,7 @@ class StreamingSynthesizer:
         k = self.model.codebook.pcs.shape[1]
         return np.concatenate(self._raw) if self._raw else np.zeros((0, k))
 
+    @never_waiting
     def feed(self, block: np.ndarray) -> StreamFrames:
         """Face frames completed by the next ``block`` of audio samples (mono)."""
         last = self.front.feed(block)           # frame t is complete once its window is in
@@ -136,6 +138,7 @@ class StreamingSynthesizer:
             last = self._next                           # not a whole batch yet: wait
         return self._emit(self._analyse(last), self._smoother.feed)
 
+    @never_waiting
     def flush(self) -> StreamFrames:
         """The remaining frames, the audio ended: as many frames in all as offline synthesis makes
         of the same audio (none if it is shorter than two frames)."""
