@@ -3,6 +3,7 @@ phones (a user's label map first, then the nearest CMU phone for extended ARPAbe
 
 from __future__ import annotations
 
+import functools
 import logging
 import re
 from collections.abc import Mapping, Sequence
@@ -31,8 +32,10 @@ FALLBACK = {
 }
 
 
+@functools.lru_cache(maxsize=4096)
 def normalise_label(label: str) -> str:
-    """Lower-case, strip ARPAbet stress digits, map silence labels to ``sil``.
+    """Lower-case, strip ARPAbet stress digits, map silence labels to ``sil`` (remembered: a
+    phone set has a few dozen labels, met again in every file).
 
     Examples
     --------

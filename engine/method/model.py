@@ -115,8 +115,18 @@ class Model:
         return self.phones.index(label)
 
     def similarity(self, nu: float | None = None) -> np.ndarray:
-        """The visual phoneme similarity matrix S (eq 3) for ``nu`` (default: the trained one)."""
-        return similarity_matrix(self.distances, self.config.nu if nu is None else nu, self.scale)
+        """The visual phoneme similarity matrix S (eq 3) for ``nu`` (default: the trained one,
+        made once and read-only)."""
+        if nu is None or nu == self.config.nu:
+            return self.trained_similarity
+        return similarity_matrix(self.distances, nu, self.scale)
+
+    @cached_property
+    def trained_similarity(self) -> np.ndarray:
+        """S (eq 3) at the trained ``nu``, read-only (eq 4 reads it for every input)."""
+        s = similarity_matrix(self.distances, self.config.nu, self.scale)
+        s.flags.writeable = False
+        return s
 
     def neutral_face(self) -> np.ndarray:
         """The PCA mean face, ``(M, 3)``."""

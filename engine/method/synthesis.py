@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, fields
 
 import numpy as np
@@ -96,9 +97,17 @@ def approximate_lsf(v: np.ndarray, codewords: np.ndarray) -> np.ndarray:
     return np.einsum("...i,...ik->...k", v, codewords)
 
 
+@functools.lru_cache(maxsize=64)
 def gamma_grid(lo: float = 0.2, hi: float = 2.0, steps: int = 10) -> np.ndarray:
-    """The incremental search grid for gamma (eq 7's criterion): ``steps`` values in [lo, hi]."""
-    return np.linspace(lo, hi, steps)
+    """The incremental search grid for gamma (eq 7's criterion): ``steps`` values in [lo, hi]
+    (made once per grid, read-only).
+
+    >>> gamma_grid(0.2, 2.0, 10)[[0, 1, -1]].round(2).tolist(), gamma_grid().flags.writeable
+    ([0.2, 0.4, 2.0], False)
+    """
+    grid = np.linspace(lo, hi, steps)
+    grid.flags.writeable = False
+    return grid
 
 
 @dataclass
