@@ -101,7 +101,7 @@ def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig,
     n_frames = utt.n_frames or None
     # the compiled kernels once loaded (in the background, after the first frame: numba's import
     # and cache read would delay it by about half a second), the numpy reference until then
-    with use_kernels("compiled" if kernels.loaded() else "numpy"):
+    with use_kernels(kernels.ready_choice()):
         res = synthesize(model, utt.audio, utt.sample_rate, utt.phones if utt.phones else None,
                          config, n_frames=n_frames, source=utt.name, confidence=utt.confidence,
                          provenance=utt.provenance, voice=True)

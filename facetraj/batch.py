@@ -223,20 +223,21 @@ def choose_kernels(job: SynthJob, inputs: Iterable[Path], workers: int = 1) -> S
 
 
 def _preload(job: SynthJob) -> None:
-    """Import what every input's synthesis imports (and load the compiled kernels when chosen)
-    once, before the workers fork, not in each worker (74 modules: the label readers and
-    praatio, the audio reader, the writers; about 60 ms in a profile of one file's run)."""
+    """Import what every input's synthesis imports (74 modules: the label readers and praatio,
+    the audio reader, the writers; about 60 ms in a profile of one file's run) and run the
+    engine's before-fork hooks (the compiled kernels loaded when chosen), once, before the
+    workers fork, not in each worker."""
     import praatio.textgrid  # noqa: F401  (engine.io.labelfiles reads TextGrids with it)
     import soundfile  # noqa: F401
 
     import engine.io.export
     import engine.io.labelling
     import engine.method.recording  # noqa: F401
+    from engine.fanout import prepare_fork
+    from engine.method.kernels import use_kernels
 
-    if job.kernels == "compiled":
-        from engine.method.kernels import warm_up
-
-        warm_up()
+    with use_kernels(job.kernels):                # the kernels loaded here when chosen
+        prepare_fork()
 
 
 # --------------------------------------------------------------------------- fan-out

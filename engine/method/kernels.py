@@ -53,11 +53,14 @@ def kernel_choice() -> str:
     ...     kernel_choice()
     'numpy'
     """
-    choice = _choice.get()
-    if choice is not None:
-        return choice
-    env = os.environ.get(KERNELS_ENV, "").strip().lower()
-    return env if env in CHOICES else "compiled"
+    return _made() or "compiled"
+
+
+def _made() -> str | None:
+    """The choice made by :func:`use_kernels` in this context, else by ``$FACETRAJ_KERNELS``;
+    ``None`` when neither made one."""
+    choice = _choice.get() or os.environ.get(KERNELS_ENV, "").strip().lower()
+    return choice if choice in CHOICES else None
 
 
 @contextlib.contextmanager
@@ -92,10 +95,9 @@ def choice_for(seconds: float, mode: str) -> str:
     ...     choice_for(1.0, "phonetic")
     'compiled'
     """
-    made = _choice.get() or os.environ.get(KERNELS_ENV, "").strip().lower()
-    if made in CHOICES:
-        return made
-    return "compiled" if loaded() or seconds >= PAYS_OFF_S.get(mode, 150.0) else "numpy"
+    if _made() is None and seconds >= PAYS_OFF_S.get(mode, 150.0):
+        return "compiled"
+    return ready_choice()
 
 
 def ready_choice() -> str:
@@ -107,10 +109,7 @@ def ready_choice() -> str:
     ...     ready_choice()
     'numpy'
     """
-    made = _choice.get() or os.environ.get(KERNELS_ENV, "").strip().lower()
-    if made in CHOICES:
-        return made
-    return "compiled" if loaded() else "numpy"
+    return _made() or ("compiled" if loaded() else "numpy")
 
 
 F = TypeVar("F", bound=Callable)
