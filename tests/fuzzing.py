@@ -78,6 +78,12 @@ class Outcome:
     seconds: float = 0.0
     max_rss: int = 0
     error_line: str = ""   # the error (exit 2) or the skip summary (exit 3), for -j 1 vs -j 2
+    rss_at_fork: int = 0   # a forked child starts with its parent's pages: they are not its own
+
+    @property
+    def grown(self) -> int:
+        """The peak resident size the case itself added (bytes): ``max_rss`` less the fork's start."""
+        return max(0, self.max_rss - self.rss_at_fork)
 
     @property
     def failed(self) -> bool:
@@ -1156,6 +1162,7 @@ def run_forked(case: Case, timeout: float = TIMEOUT_S, memory: int = MEMORY_LIMI
     err_path = case_workdir(case) / ".stderr"
     t0 = time.perf_counter()
     prepare_fork()            # as facetraj forks: nothing half-loaded in another thread
+    at_fork = vm_rss()
     pid = os.fork()
     if pid == 0:  # the child: never returns
         code = 1
@@ -1199,9 +1206,9 @@ def run_forked(case: Case, timeout: float = TIMEOUT_S, memory: int = MEMORY_LIMI
         status = f"signal {-code}"
     outcome = _judge(case, code, err, status)
     outcome.seconds = time.perf_counter() - t0
-    outcome.max_rss = usage.ru_maxrss * 1024
-    if outcome.max_rss > memory and not outcome.failed:
-        outcome.status, outcome.detail = "memory", f"{outcome.max_rss / 2**30:.2f} GiB"
+    outcome.max_rss, outcome.rss_at_fork = usage.ru_maxrss * 1024, at_fork
+    if outcome.grown > memory and not outcome.failed:
+        outcome.status, outcome.detail = "memory", f"{outcome.grown / 2**30:.2f} GiB"
     return outcome
 
 
@@ -1212,12 +1219,23 @@ def case_workdir(case: Case) -> Path:
     return case.cwd
 
 
-def _vm_size() -> int:
+def _status_bytes(key: str) -> int:
+    """A size from /proc/self/status (``VmSize``, ``VmRSS``) in bytes; 0 where there is none."""
     with open("/proc/self/status") as fh:
         for line in fh:
-            if line.startswith("VmSize:"):
+            if line.startswith(key + ":"):
                 return int(line.split()[1]) * 1024
     return 0
+
+
+def _vm_size() -> int:
+    return _status_bytes("VmSize")
+
+
+def vm_rss() -> int:
+    """This process's resident size now (bytes)."""
+    return _status_bytes("VmRSS")
+
 
 
 def run_case(case: Case, runner: Callable[[Case], Outcome]) -> Outcome:
