@@ -14,6 +14,13 @@ $(VENV)/.installed-run: pyproject.toml | $(BIN)/python
 	$(BIN)/pip install -q -e .
 	touch $@
 
+# the compiled kernels built ahead of time for this machine (engine/method/aot.py; about 15 s):
+# without them numba compiles or loads its kernels in every process that uses them
+KERNEL_SOURCES := $(wildcard engine/method/compiled_*.py) engine/method/aot.py engine/method/lsf.py
+$(VENV)/.kernels: $(KERNEL_SOURCES) | $(VENV)/.installed-run
+	$(BIN)/python -m engine.method.aot
+	touch $@
+
 # the tests include the corpus generator's bit-for-bit reproduction check, hence the corpus extra
 $(VENV)/.installed-test: pyproject.toml | $(BIN)/python
 	$(BIN)/pip install -q -e ".[test,corpus]"
@@ -23,16 +30,16 @@ $(VENV)/.installed-corpus: pyproject.toml | $(BIN)/python
 	$(BIN)/pip install -q -e ".[test,corpus]"
 	touch $@
 
-run: $(VENV)/.installed-run
+run: $(VENV)/.installed-run $(VENV)/.kernels
 	$(BIN)/facetraj gui data_samples
 
 lint: $(VENV)/.installed-test
 	$(BIN)/ruff check .
 
-test: lint
+test: lint $(VENV)/.kernels
 	$(XVFB) $(BIN)/python -m pytest
 
-bench: $(VENV)/.installed-test
+bench: $(VENV)/.installed-test $(VENV)/.kernels
 	$(XVFB) $(BIN)/python -m benchmarks
 
 # the long bad-input fuzz run (tests/fuzzing.py): thousands of mutated inputs through the command
@@ -41,7 +48,7 @@ bench: $(VENV)/.installed-test
 # (docs/bad-input.md)
 FUZZ_CASES ?= 3300
 FUZZ_SEED  ?= 14
-fuzz: $(VENV)/.installed-test
+fuzz: $(VENV)/.installed-test $(VENV)/.kernels
 	$(XVFB) $(BIN)/python tests/fuzzing.py --cases $(FUZZ_CASES) --seed $(FUZZ_SEED)
 
 corpus: $(VENV)/.installed-corpus
@@ -57,4 +64,4 @@ report: $(VENV)/.installed-test
 	$(BIN)/facetraj report data_samples -o docs
 
 clean:
-	rm -rf $(VENV) build *.egg-info .pytest_cache .ruff_cache
+	rm -rf $(VENV) build *.egg-info .pytest_cache .ruff_cache engine/method/_kernels_aot.*

@@ -22,7 +22,7 @@ from collections.abc import Iterator, Sequence
 from unittest import mock
 
 from engine.config import SynthConfig
-from engine.method import compiled_lsf, kernels, lsf, pipeline
+from engine.method import kernels, lsf, pipeline
 from engine.method.lsf_index import LsfIndex
 from engine.method.model import Model
 from engine.method.pipeline import Synthesis, synthesize
@@ -40,8 +40,8 @@ STAGES = (
     ("LSF analysis: framing (analysis_frames)", lsf, "analysis_frames"),
     ("LSF analysis: LPC (autocorrelation + Levinson)", lsf, "lpc"),
     ("LSF analysis: LSF roots (poly2lsf)", lsf, "poly2lsf"),
-    ("LSF analysis, compiled (window, LPC and roots: compiled_lsf.frame_lsf)", compiled_lsf,
-     "frame_lsf"),
+    ("LSF analysis, compiled (window, LPC and roots: lsf.compiled_frame_lsf)", lsf,
+     "compiled_frame_lsf"),
     ("eq 4 search (top_context_phones)", pipeline, "top_context_phones"),
     ("LSF index search (acoustic candidates)", LsfIndex, "nearest"),
     ("eqs 5-8 (weight_frames)", pipeline, "weight_frames"),

@@ -222,20 +222,26 @@ def choose_kernels(job: SynthJob, inputs: Iterable[Path], workers: int = 1) -> S
     return replace(job, kernels=choice)
 
 
-def _preload(job: SynthJob) -> None:
-    """Import what every input's synthesis imports (74 modules: the label readers and praatio,
-    the audio reader, the writers; about 60 ms in a profile of one file's run) and run the
-    engine's before-fork hooks (the compiled kernels loaded when chosen), once, before the
-    workers fork, not in each worker."""
-    import praatio.textgrid  # noqa: F401  (engine.io.labelfiles reads TextGrids with it)
+def import_synthesis() -> None:
+    """Import what every input's synthesis imports (the audio reader, the label readers, the
+    writers, and ``numpy.ma``, which ``numpy.percentile`` imports on its first call): the
+    command's start-up, paid once before a batch's workers fork, not in each worker."""
+    import numpy.ma  # noqa: F401
     import soundfile  # noqa: F401
 
     import engine.io.export
     import engine.io.labelling
+    import engine.io.textgrid
     import engine.method.recording  # noqa: F401
+
+
+def _preload(job: SynthJob) -> None:
+    """:func:`import_synthesis`, and the engine's before-fork hooks run (the compiled kernels
+    loaded when chosen), once, before the workers fork."""
     from engine.fanout import prepare_fork
     from engine.method.kernels import use_kernels
 
+    import_synthesis()
     with use_kernels(job.kernels):                # the kernels loaded here when chosen
         prepare_fork()
 

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from engine.config import SynthConfig
-from engine.method import kernels
+from engine.method import aot, kernels
 from engine.method.kernels import kernel_choice, use_kernels
 from engine.method.lsf import lsf2poly, lsf_at, poly2lsf
 from engine.method.lsf_index import build_index
@@ -26,11 +26,20 @@ ROOT = Path(__file__).resolve().parent.parent
 LSF_ATOL = 1e-10
 
 
-def both(fn, *args, **kwargs):
-    """``fn`` run with the numpy reference and with the compiled kernels."""
+@pytest.fixture(params=["compiled", "jit"])
+def kind(request):
+    """The compiled kernels each comparison runs: the prebuilt extension (``make`` builds it:
+    ``python -m engine.method.aot``) and numba's just-in-time ones (an install without it)."""
+    if request.param == "compiled" and kernels.prebuilt() is None:
+        pytest.fail("the prebuilt kernels are missing or stale: python -m engine.method.aot")
+    return request.param
+
+
+def both(kind, fn, *args, **kwargs):
+    """``fn`` run with the numpy reference and with the compiled kernels ``kind``."""
     with use_kernels("numpy"):
         ref = fn(*args, **kwargs)
-    with use_kernels("compiled"):
+    with use_kernels(kind):
         fast = fn(*args, **kwargs)
     return ref, fast
 
@@ -40,21 +49,27 @@ def frame_times(audio: np.ndarray, rate: int, marker_rate: float = 60.0) -> np.n
 
 
 def test_the_compiled_kernels_load_here():
+    """Both ways: the prebuilt extension (built by make) and numba's just-in-time kernels."""
+    assert kernels.prebuilt() is not None, "python -m engine.method.aot builds them"
     assert kernels.warm_up()
     assert kernels.loaded()
+    with use_kernels("jit"):
+        assert kernels.warm_up() and kernels.loaded()
+        assert kernels.compiled("compiled_lsf") is not kernels.prebuilt()
+    assert kernels.compiled("compiled_lsf") is kernels.prebuilt()
 
 
-def test_lsf_analysis_equals_the_reference_on_corpus_speech(default_corpus):
+def test_lsf_analysis_equals_the_reference_on_corpus_speech(default_corpus, kind):
     for utt_id in list(default_corpus.info.test)[:3]:
         utt = default_corpus.utterance(utt_id)
         times = frame_times(utt.audio, utt.sample_rate)
-        ref, fast = both(lsf_at, utt.audio, utt.sample_rate, times)
+        ref, fast = both(kind, lsf_at, utt.audio, utt.sample_rate, times)
         assert fast.shape == ref.shape and np.isfinite(fast).all()
         np.testing.assert_allclose(fast, ref, rtol=0, atol=LSF_ATOL)
 
 
 @pytest.mark.parametrize("rate", [16000, 44100])
-def test_lsf_analysis_equals_the_reference_on_edge_cases(rate):
+def test_lsf_analysis_equals_the_reference_on_edge_cases(rate, kind):
     rng = np.random.default_rng(3)
     noise = rng.standard_normal(rate // 2)
     cases = {
@@ -67,15 +82,15 @@ def test_lsf_analysis_equals_the_reference_on_edge_cases(rate):
     }
     for name, audio in cases.items():
         times = frame_times(audio, rate)[:1] if name == "one frame" else frame_times(audio, rate)
-        ref, fast = both(lsf_at, audio, rate, times)
+        ref, fast = both(kind, lsf_at, audio, rate, times)
         assert np.isfinite(fast).all(), name
         np.testing.assert_allclose(fast, ref, rtol=0, atol=LSF_ATOL, err_msg=name)
 
 
-def test_a_frame_the_grid_cannot_bracket_goes_to_the_reference():
+def test_a_frame_the_grid_cannot_bracket_goes_to_the_reference(kind, monkeypatch):
     """Two LSFs closer than a grid cell (pi/128): the kernel flags the frame, the reference's
     eigenvalues solve it."""
-    from engine.method import compiled_lsf
+    from engine.method import lsf as lsf_module
 
     lsf = np.linspace(0.2, 2.9, 18)
     lsf[5] = lsf[4] + 0.004
@@ -92,7 +107,10 @@ def test_a_frame_the_grid_cannot_bracket_goes_to_the_reference():
 
     x = lfilter([1.0], a, rng.standard_normal(4000))
     pad = np.r_[np.zeros(200), x, np.zeros(400)]
-    got = compiled_lsf.frame_lsf(pad, np.array([2000]), np.hamming(400), 18, fallback)
+    monkeypatch.setattr(lsf_module, "poly2lsf", fallback)
+    with use_kernels(kind):
+        got = lsf_module.compiled_frame_lsf(kernels.compiled("compiled_lsf"), pad,
+                                            np.array([2000]), np.hamming(400), 18)
     with use_kernels("numpy"):
         from engine.method.lsf import lpc
 
@@ -102,14 +120,14 @@ def test_a_frame_the_grid_cannot_bracket_goes_to_the_reference():
     assert sum(calls) <= 1
 
 
-def test_eq4_search_equals_the_reference_to_the_bit(default_model):
+def test_eq4_search_equals_the_reference_to_the_bit(default_model, kind):
     m = default_model
     cb = m.codebook
     rng = np.random.default_rng(1)
     query = rng.integers(0, len(m.phones), (300, cb.contexts.shape[1]))
     s = m.similarity(10.0)
     for xi, context, count in ((20.0, 3, 3), (2.0, 1, 5), (20.0, 0, 1)):
-        (top0, n0), (top1, n1) = both(top_context_phones, query, cb.contexts, s, xi, context, count)
+        (top0, n0), (top1, n1) = both(kind, top_context_phones, query, cb.contexts, s, xi, context, count)
         np.testing.assert_array_equal(top1, top0)
         np.testing.assert_array_equal(n1, n0)
     # and the full computation it replaces
@@ -117,37 +135,37 @@ def test_eq4_search_equals_the_reference_to_the_bit(default_model):
     np.testing.assert_array_equal(top1[:20], top_contexts(full, 1))
 
 
-def test_eq4_ties_the_lower_index_first():
+def test_eq4_ties_the_lower_index_first(kind):
     s = np.array([[1.0, 0.5], [0.5, 1.0]])
     cb = np.array([[1, 0, 1], [0, 0, 0], [1, 0, 1]])
-    (top0, n0), (top1, n1) = both(top_context_phones, np.array([[0, 0, 1]]), cb, s, 10.0, 1, 2)
+    (top0, n0), (top1, n1) = both(kind, top_context_phones, np.array([[0, 0, 1]]), cb, s, 10.0, 1, 2)
     assert top1.tolist() == top0.tolist() == [[0, 1]]          # all three score 1.15
     np.testing.assert_array_equal(n1, n0)
 
 
-def test_lsf_index_search_chooses_the_reference_codewords(default_model, default_corpus):
+def test_lsf_index_search_chooses_the_reference_codewords(default_model, default_corpus, kind):
     m = default_model
     ix, cb = m.lsf_index(), m.codebook.lsf
     utt = default_corpus.utterance(next(iter(default_corpus.info.test)))
     w = m.input_lsf(utt.audio, utt.sample_rate, frame_times(utt.audio, utt.sample_rate))
     for count, probe in ((128, 8), (1, 8), (40, 1), (128, ix.n_cells)):
-        ref, fast = both(ix.nearest, w, cb, count, probe)
+        ref, fast = both(kind, ix.nearest, w, cb, count, probe)
         assert fast.shape == ref.shape
         np.testing.assert_array_equal(fast, ref, err_msg=f"count {count}, probe {probe}")
 
 
-def test_lsf_index_search_small_and_exhaustive():
+def test_lsf_index_search_small_and_exhaustive(kind):
     lsf = np.sort(np.random.default_rng(2).uniform(0.1, 3.0, (500, 6)), axis=1)
     ix = build_index(lsf)
     w = np.sort(np.random.default_rng(5).uniform(0.1, 3.0, (50, 6)), axis=1)
     for count, probe in ((1, 1), (7, 3), (500, 1), (30, ix.n_cells)):
-        ref, fast = both(ix.nearest, w, lsf, count, probe)
+        ref, fast = both(kind, ix.nearest, w, lsf, count, probe)
         np.testing.assert_array_equal(fast, ref)
-    ref, fast = both(ix.nearest, w[:0], lsf, 7, 3)
+    ref, fast = both(kind, ix.nearest, w[:0], lsf, 7, 3)
     assert fast.shape == ref.shape == (0, 7)
 
 
-def test_eqs_5_to_8_equal_the_reference(default_model, default_corpus):
+def test_eqs_5_to_8_equal_the_reference(default_model, default_corpus, kind):
     from engine.method.synthesis import gamma_grid, weight_frames
 
     m = default_model
@@ -156,17 +174,17 @@ def test_eqs_5_to_8_equal_the_reference(default_model, default_corpus):
     w = m.input_lsf(utt.audio, utt.sample_rate, frame_times(utt.audio, utt.sample_rate))
     cand = np.random.default_rng(4).integers(0, len(cb.lsf), (len(w), 15))
     for gammas in (gamma_grid(), gamma_grid(0.5, 1.0, 3), np.array([0.2, 0.3, 1.7])):
-        ref, fast = both(weight_frames, w, cand, cb.lsf, cb.pcs, gammas)
+        ref, fast = both(kind, weight_frames, w, cand, cb.lsf, cb.pcs, gammas)
         np.testing.assert_array_equal(fast.gamma, ref.gamma)
         np.testing.assert_array_equal(fast.candidates, ref.candidates)
         for name in ("pcs", "weights", "lsf_hat", "error"):
             np.testing.assert_allclose(getattr(fast, name), getattr(ref, name), rtol=1e-10,
                                        atol=1e-12, err_msg=name)
-    ref, fast = both(weight_frames, w[:1], cand[:1], cb.lsf, cb.pcs, gamma_grid())     # one frame
+    ref, fast = both(kind, weight_frames, w[:1], cand[:1], cb.lsf, cb.pcs, gamma_grid())     # one frame
     np.testing.assert_allclose(fast.pcs, ref.pcs, rtol=1e-10, atol=1e-12)
 
 
-def test_eqs_5_to_8_where_gammas_tie(toy_model):
+def test_eqs_5_to_8_where_gammas_tie(toy_model, kind):
     """One codeword dominating: every gamma's error equal to rounding, so the kernel and the
     reference may choose different gammas; the weights and PCs agree to rounding."""
     from engine.method.synthesis import gamma_grid, weight_frames
@@ -175,16 +193,16 @@ def test_eqs_5_to_8_where_gammas_tie(toy_model):
     rng = np.random.default_rng(1)
     w = cb.lsf[rng.choice(len(cb.lsf), 6)] + 0.01
     cand = rng.choice(len(cb.lsf), (6, 9))
-    ref, fast = both(weight_frames, w, cand, cb.lsf, cb.pcs, gamma_grid())
+    ref, fast = both(kind, weight_frames, w, cand, cb.lsf, cb.pcs, gamma_grid())
     np.testing.assert_allclose(fast.pcs, ref.pcs, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(fast.weights, ref.weights, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(fast.error, ref.error, rtol=1e-9, atol=1e-12)
 
 
 @pytest.mark.parametrize("mode", ["phonetic", "acoustic"])
-def test_synthesized_trajectories_equal_the_reference(default_model, default_corpus, mode):
+def test_synthesized_trajectories_equal_the_reference(default_model, default_corpus, mode, kind):
     utt = default_corpus.utterance(list(default_corpus.info.test)[1])
-    ref, fast = both(synthesize, default_model, utt.audio, utt.sample_rate,
+    ref, fast = both(kind, synthesize, default_model, utt.audio, utt.sample_rate,
                      utt.phones if mode == "phonetic" else None, SynthConfig(mode=mode), voice=True)
     np.testing.assert_array_equal(fast.frames.candidates, ref.frames.candidates)
     np.testing.assert_allclose(fast.lsf, ref.lsf, rtol=0, atol=LSF_ATOL)
@@ -206,6 +224,7 @@ def test_the_choice_by_environment_and_by_context(monkeypatch):
 
 
 def test_a_kernel_module_that_fails_to_load_falls_back_to_numpy(monkeypatch, caplog):
+    """numba's kernels failing to import (no prebuilt ones: ``jit``) give numpy's results."""
     monkeypatch.setattr(kernels, "_loaded", {})
     real = __import__("importlib").import_module
 
@@ -215,10 +234,11 @@ def test_a_kernel_module_that_fails_to_load_falls_back_to_numpy(monkeypatch, cap
         return real(name, *args)
 
     monkeypatch.setattr("importlib.import_module", broken)
-    assert kernels.compiled("compiled_lsf") is None
+    with use_kernels("jit"):
+        assert kernels.compiled("compiled_lsf") is None
     assert "using numpy" in caplog.text
     audio = np.random.default_rng(0).standard_normal(8000)
-    ref, fast = both(lsf_at, audio, 16000, frame_times(audio, 16000))
+    ref, fast = both("jit", lsf_at, audio, 16000, frame_times(audio, 16000))
     np.testing.assert_array_equal(fast, ref)
 
 
@@ -230,6 +250,50 @@ def test_numba_is_not_imported_by_the_engine_nor_the_command_line():
     assert not [m for m in json.loads(out.stdout) if m.split(".")[0] == "numba"]
 
 
+def test_a_synthesis_with_the_prebuilt_kernels_imports_no_numba(toy_model, tmp_path):
+    """A new process synthesizes with the prebuilt kernels from its first call: numba is never
+    imported, and the result equals the reference's."""
+    code = """
+import sys
+import numpy as np
+from engine.method import kernels
+from engine.method.model import Model
+from engine.config import SynthConfig
+from engine.method.pipeline import synthesize
+model = Model.load(sys.argv[1])
+audio = np.random.default_rng(1).standard_normal(16000) * 0.1
+config = SynthConfig(mode="acoustic")
+fast = synthesize(model, audio, 16000, None, config).pcs
+print("numba" in sys.modules, kernels.compiled("compiled_lsf") is kernels.prebuilt() is not None)
+with kernels.use_kernels("numpy"):
+    ref = synthesize(model, audio, 16000, None, config).pcs
+print(np.abs(fast - ref).max() < 1e-9)
+"""
+    toy_model.save(tmp_path / "toy.npz")
+    env = {k: v for k, v in os.environ.items() if k != kernels.KERNELS_ENV}
+    out = subprocess.run([sys.executable, "-c", code, str(tmp_path / "toy.npz")],
+                         capture_output=True, text=True, cwd=ROOT, timeout=600, env=env)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.split() == ["False", "True", "True"]
+
+
+def test_prebuilt_kernels_missing_broken_or_stale_give_way_to_numba(monkeypatch, tmp_path, caplog):
+    """No extension where it is looked for, a file that is not one, or one built from other
+    sources: each is refused (the last two with a warning naming the file), numba's kernels run."""
+    monkeypatch.setenv(aot.DIR_ENV, str(tmp_path))
+    assert aot.load() is None
+    broken = tmp_path / f"{aot.MODULE}{__import__('importlib').machinery.EXTENSION_SUFFIXES[0]}"
+    broken.write_bytes(b"\x7fELF not really")
+    assert aot.load() is None
+    assert "unusable" in caplog.text and str(broken) in caplog.text
+    monkeypatch.delenv(aot.DIR_ENV)
+    assert aot.load() is not None
+    monkeypatch.setattr(aot, "fingerprint", lambda: 12345)
+    assert aot.load() is None
+    assert "stale" in caplog.text
+    assert aot.main(["--check"]) == 1
+
+
 def test_a_read_only_install_does_not_crash():
     """Nowhere to keep numba's cache (a read-only install without a user cache folder: numba
     finds no cache locator, here by being told to try only one that never applies): the kernels
@@ -239,7 +303,7 @@ import numpy as np
 from engine.method.kernels import use_kernels
 from engine.method.lsf import lsf_at
 x = np.random.default_rng(0).standard_normal(8000)
-with use_kernels("compiled"):
+with use_kernels("jit"):
     fast = lsf_at(x, 16000, np.arange(10) / 60)
 with use_kernels("numpy"):
     ref = lsf_at(x, 16000, np.arange(10) / 60)
@@ -268,7 +332,7 @@ def test_a_live_stream_never_waits_for_the_kernels_to_load(toy_model, tmp_path):
     code = """
 import sys
 import numpy as np
-from engine.method import kernels
+from engine.method import aot, kernels
 from engine.method.model import Model
 from engine.streaming.synthesizer import StreamingSynthesizer
 model = Model.load(sys.argv[1])
@@ -288,6 +352,7 @@ print(np.abs(cold - ref).max() < 1e-9, np.abs(warmed - ref).max() < 1e-9)
 """
     toy_model.save(tmp_path / "toy.npz")
     env = {k: v for k, v in os.environ.items() if k != kernels.KERNELS_ENV}
+    env[aot.DIR_ENV] = str(tmp_path)                    # an install without prebuilt kernels
     out = subprocess.run([sys.executable, "-c", code, str(tmp_path / "toy.npz")],
                          capture_output=True, text=True, cwd=ROOT, timeout=600, env=env)
     assert out.returncode == 0, out.stderr[-2000:]
@@ -303,6 +368,7 @@ def test_a_fork_waits_for_a_warm_up_under_way_in_another_thread(monkeypatch):
     from engine.fanout import prepare_fork
     from engine.method import compiled_lsf
 
+    monkeypatch.setenv(kernels.KERNELS_ENV, "jit")      # numba's kernels, compiled when asked
     started, release = threading.Event(), threading.Event()
     order = []
     real = compiled_lsf.warm_up
@@ -318,6 +384,7 @@ def test_a_fork_waits_for_a_warm_up_under_way_in_another_thread(monkeypatch):
     t.start()
     assert started.wait(5)
     threading.Timer(0.2, release.set).start()
+    monkeypatch.delenv(kernels.KERNELS_ENV)
     with use_kernels("numpy"):
         prepare_fork()
     order.append("fork")

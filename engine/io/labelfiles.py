@@ -13,57 +13,37 @@ from ..errors import InputError
 from ..labels.alphabets import to_arpabet
 from ..labels.provenance import PROVENANCE_TIER, Labels, labels_from_tiers, parse_provenance
 from .files import atomic_write, read_text
+from .textgrid import TextGridSyntaxError, Tier, parse_textgrid
 
 LABEL_SUFFIXES = (".textgrid", ".lab", ".phn")
 
 
 def read_textgrid_tiers(path: str | os.PathLike[str]) -> dict[str, list[PhoneSegment]]:
-    """Read every interval tier of a Praat TextGrid (long or short text form)."""
-    from praatio import textgrid
-
+    """Read every interval tier of a Praat TextGrid (long or short text form,
+    :mod:`engine.io.textgrid`); intervals out of order or overlapping are refused."""
     path = Path(path)
-    _check_interval_order(path, read_text(path))  # our own messages, before praatio's
     try:
-        tg = textgrid.openTextgrid(str(path), includeEmptyIntervals=True)
-    except Exception as exc:
-        raise InputError(path, f"not a readable TextGrid ({exc})") from exc
+        parsed = parse_textgrid(read_text(path))
+    except TextGridSyntaxError as exc:
+        raise InputError(path, f"not a readable TextGrid ({exc})") from None
     tiers: dict[str, list[PhoneSegment]] = {}
-    for name in tg.tierNames:
-        tier = tg.getTier(name)
-        if tier.tierType != textgrid.INTERVAL_TIER:
+    for tier in parsed:
+        if tier.kind != "IntervalTier":
             continue
-        tiers[name] = [PhoneSegment(float(s), float(e), str(lab).strip())
-                       for s, e, lab in tier.entries]
+        _check_interval_order(path, tier)
+        tiers[tier.name] = [PhoneSegment(s, e, lab.strip()) for s, e, lab in tier.entries]
     return tiers
 
 
-def _check_interval_order(path: Path, text: str) -> None:
-    """Refuse interval tiers whose intervals are out of order, overlap or are not numbers (praatio
-    would sort them silently, or fail with its own text)."""
-    from praatio.utilities import textgrid_io
-
-    try:
-        parsed = textgrid_io.parseTextgridStr(text, includeEmptyIntervals=True)
-    except Exception as exc:  # praatio raises several types for malformed text
-        raise InputError(path, f"not a readable TextGrid ({exc})") from exc
-    for tier in parsed.get("tiers", []):
-        if tier.get("class") != "IntervalTier":
-            continue
-        prev_end = -np.inf
-        for i, (start, end, label) in enumerate(tier["entries"]):
-            try:
-                start, end = float(start), float(end)
-            except ValueError:
-                raise InputError(path, f"tier {tier['name']!r}: interval {i + 1} has a time that "
-                                       f"is not a number ({start} {end})") from None
-            if not (np.isfinite(start) and np.isfinite(end)):
-                raise InputError(path, f"tier {tier['name']!r}: interval {i + 1} has a time that "
-                                       f"is not a finite number ({start} {end})")
-            if start < prev_end - 1e-6:
-                raise InputError(path, f"tier {tier['name']!r}: interval {i + 1} ({label!r}) at "
-                                       f"{start:.3f} s overlaps or precedes the one before, "
-                                       f"ending {prev_end:.3f} s")
-            prev_end = max(prev_end, end)
+def _check_interval_order(path: Path, tier: Tier) -> None:
+    """Refuse an interval tier whose intervals are out of order or overlap."""
+    prev_end = -np.inf
+    for i, (start, end, label) in enumerate(tier.entries):
+        if start < prev_end - 1e-6:
+            raise InputError(path, f"tier {tier.name!r}: interval {i + 1} ({label!r}) at "
+                                   f"{start:.3f} s overlaps or precedes the one before, "
+                                   f"ending {prev_end:.3f} s")
+        prev_end = max(prev_end, end)
 
 
 def read_textgrid(path: str | os.PathLike[str], tier: str = "phones") -> list[PhoneSegment]:

@@ -279,9 +279,9 @@ def _checked_array(path: Path, name: str, arr: np.ndarray, kind: str,
     if kind == "i":
         if arr.dtype.kind == "u" and arr.size and arr.max() > np.iinfo(np.int64).max:
             raise ModelFileError(path, f"array {name!r} holds indices outside 0..2^63")
-        return arr.astype(np.int64)
+        return arr.astype(np.int64, copy=False)        # the file's own copy: no second one
     with np.errstate(over="ignore"):
-        out = arr.astype(np.float64)
+        out = arr.astype(np.float64, copy=False)
     if not np.all(np.isfinite(out)):
         raise ModelFileError(path, f"array {name!r} holds NaN or infinite values")
     return out
@@ -295,7 +295,7 @@ def _check_indices(path: Path, meta: dict, a: dict[str, np.ndarray]) -> None:
     for name, hi in ranges.items():
         if a[name].size and (a[name].min() < 0 or a[name].max() >= hi):
             raise ModelFileError(path, f"array {name!r} holds indices outside 0..{hi - 1}")
-    if len(np.unique(a["fixed"])) != len(a["fixed"]):
+    if np.any(np.diff(np.sort(a["fixed"])) == 0):
         raise ModelFileError(path, "array 'fixed' names a marker twice")
 
 

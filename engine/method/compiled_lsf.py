@@ -202,20 +202,8 @@ def lsf_frames(pad: np.ndarray, starts: np.ndarray, window: np.ndarray, order: i
     return lsf, polys, ok
 
 
-def frame_lsf(pad: np.ndarray, starts: np.ndarray, window: np.ndarray, order: int,
-              fallback) -> np.ndarray:
-    """:func:`lsf_frames` with the reference's grid and tolerances; the frames it flags solved
-    by ``fallback`` (``lsf.poly2lsf``) from their LPC polynomials."""
-    xg, basis = root_grid(order // 2, ROOT_GRID)
-    lsf, polys, ok = lsf_frames(pad, np.ascontiguousarray(starts, dtype=np.int64), window, order,
-                                xg, np.ascontiguousarray(basis), 1e-9, 12)
-    if not ok.all():
-        bad = ~ok
-        lsf[bad] = fallback(polys[bad])
-    return lsf
-
-
 def warm_up() -> None:
     """Run the kernel once on a tiny input (loads or compiles it)."""
-    pad = np.sin(np.arange(64.0))
-    frame_lsf(pad, np.array([0, 8]), np.hamming(32), 18, lambda p: np.zeros((len(p), 18)))
+    xg, basis = root_grid(9, ROOT_GRID)
+    lsf_frames(np.sin(np.arange(64.0)), np.array([0, 8]), np.hamming(32), 18, xg,
+               np.ascontiguousarray(basis), 1e-9, 12)

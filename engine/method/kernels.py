@@ -1,18 +1,26 @@
 """Which implementation runs the per-frame hot paths of synthesis: the compiled kernels
-(numba; ``engine.method.compiled_lsf``, ``compiled_search``, ``compiled_weights``) or the numpy
+(``engine.method.compiled_lsf``, ``compiled_search``, ``compiled_weights``) or the numpy
 reference (``engine.method.lsf``, ``engine.method.lsf_index``, ``engine.method.synthesis``).
 
 The numpy functions are the reference: each compiled kernel computes the same formula, frame by
-frame in one loop, and is tested equal to it to rounding (``tests/test_kernels.py``). numba is
-imported here only when a kernel is first asked for, never by importing the engine, so neither
-``facetraj --version`` nor the app's first frame pays for it (its import and first call: about
-0.5 s of CPU and 140 MiB); the command line uses the kernels only where they pay that back
-(:func:`choice_for`), and work fanned out over processes loads them once before forking.
-``$FACETRAJ_KERNELS=numpy`` (or :func:`use_kernels`) forces the reference; numba missing, or
-failing to import or compile, falls back to it with a warning in the log.
+frame in one loop, and is tested equal to it to rounding (``tests/test_kernels.py``). The
+kernels come two ways, the same source compiled by numba either way:
 
-numba keeps the compiled machine code (``cache=True``) beside the modules (``__pycache__``), or
-where ``$NUMBA_CACHE_DIR`` says, or in the user cache folder when the install is read-only; the
+- prebuilt (:mod:`engine.method.aot`): compiled at install into an extension that loads in
+  about a millisecond without numba; used whenever it is built and current;
+- just in time: numba imported when a kernel is first asked for, never by importing the engine
+  (its import and first call: about 0.5 s of CPU and 140 MiB), so where they are not prebuilt
+  neither ``facetraj --version`` nor the app's first frame pays for it, and the command line
+  uses them only where they pay that back (:func:`choice_for`); work fanned out over processes
+  loads them once before forking.
+
+``$FACETRAJ_KERNELS`` (or :func:`use_kernels`) chooses: ``compiled`` (the default: prebuilt,
+else just in time), ``jit`` (numba's just-in-time kernels even where prebuilt ones exist) or
+``numpy`` (the reference); numba missing, or failing to import or compile, falls back to the
+reference with a warning in the log.
+
+numba keeps the just-in-time machine code (``cache=True``) beside the modules (``__pycache__``),
+or where ``$NUMBA_CACHE_DIR`` says, or in the user cache folder when the install is read-only; the
 first run after an install compiles (about 10 s), later ones load the cache; where nothing can be
 written the kernels compile without a cache in every process (:func:`jit`).
 """
@@ -33,21 +41,23 @@ from ..fanout import before_fork
 
 log = logging.getLogger(__name__)
 
-#: environment variable choosing the kernels: ``numpy`` (the reference) or ``compiled`` (default)
+#: environment variable choosing the kernels: ``compiled`` (default), ``jit`` or ``numpy``
 KERNELS_ENV = "FACETRAJ_KERNELS"
-CHOICES = ("compiled", "numpy")
+CHOICES = ("compiled", "jit", "numpy")
 
 _choice: ContextVar[str | None] = ContextVar("kernel_choice", default=None)
 _lock = threading.Lock()
 #: held while :func:`warm_up` compiles or reads the cache (one warm-up at a time)
 _warming = threading.Lock()
-#: the loaded kernel modules by name; ``None``: failed to load (the reference is used)
+#: the loaded just-in-time kernel modules by name; ``None``: failed to load (the reference is used)
 _loaded: dict[str, ModuleType | None] = {}
+#: the prebuilt extension once looked for (``None``: not built, stale or broken)
+_prebuilt: list[ModuleType | None] = []
 
 
 def kernel_choice() -> str:
-    """``compiled`` or ``numpy``: the choice of :func:`use_kernels` in this thread (and context),
-    else ``$FACETRAJ_KERNELS``, else ``compiled``.
+    """``compiled``, ``jit`` or ``numpy``: the choice of :func:`use_kernels` in this thread (and
+    context), else ``$FACETRAJ_KERNELS``, else ``compiled``.
 
     >>> with use_kernels("numpy"):
     ...     kernel_choice()
@@ -65,8 +75,8 @@ def _made() -> str | None:
 
 @contextlib.contextmanager
 def use_kernels(choice: str) -> Iterator[None]:
-    """Synthesis in this thread (and its context) uses ``choice`` (``compiled`` or ``numpy``)
-    until the end of the ``with`` block."""
+    """Synthesis in this thread (and its context) uses ``choice`` (``compiled``, ``jit`` or
+    ``numpy``) until the end of the ``with`` block."""
     if choice not in CHOICES:
         raise ValueError(f"kernels must be one of {CHOICES}, got {choice!r}")
     token = _choice.set(choice)
@@ -76,8 +86,8 @@ def use_kernels(choice: str) -> Iterator[None]:
         _choice.reset(token)
 
 
-#: seconds of speech from which the compiled kernels save a new process more than loading them
-#: costs it (numba's import and cache read: about 0.5 s of CPU and 140 MiB). On 100 files of
+#: seconds of speech from which the just-in-time kernels save a new process more than loading
+#: them costs it (numba's import and cache read: about 0.5 s of CPU and 140 MiB). On 100 files of
 #: 3-5 s through ``facetraj synth`` they saved about 1.5 ms of CPU a second of speech in the
 #: phonetic mode and 3 ms in the modes that search the LSF index (benchmarks/profile_notes.md)
 PAYS_OFF_S = {"phonetic": 300.0, "acoustic": 150.0, "robust": 150.0}
@@ -86,11 +96,9 @@ PAYS_OFF_S = {"phonetic": 300.0, "acoustic": 150.0, "robust": 150.0}
 def choice_for(seconds: float, mode: str) -> str:
     """The kernels for a process that synthesizes ``seconds`` of speech in ``mode`` and exits
     (the command line; for work split between processes, the seconds of one): ``compiled``
-    when they are loaded already or pay for their loading (:data:`PAYS_OFF_S`), else ``numpy``;
-    a choice made by :func:`use_kernels` or ``$FACETRAJ_KERNELS`` stands.
+    when they are prebuilt or loaded already or pay for their loading (:data:`PAYS_OFF_S`), else
+    ``numpy``; a choice made by :func:`use_kernels` or ``$FACETRAJ_KERNELS`` stands.
 
-    >>> choice_for(60.0, "phonetic") if not loaded() else "numpy"
-    'numpy'
     >>> with use_kernels("compiled"):
     ...     choice_for(1.0, "phonetic")
     'compiled'
@@ -103,7 +111,7 @@ def choice_for(seconds: float, mode: str) -> str:
 def ready_choice() -> str:
     """The kernels for work that must not wait for numba's import or compiling (a live stream,
     fed as the audio comes): a choice made by :func:`use_kernels` or ``$FACETRAJ_KERNELS``
-    stands, else ``compiled`` once :func:`loaded`, else ``numpy``.
+    stands, else ``compiled`` when they are prebuilt or once :func:`loaded`, else ``numpy``.
 
     >>> with use_kernels("numpy"):
     ...     ready_choice()
@@ -158,23 +166,42 @@ def _load(name: str) -> ModuleType | None:
         return _loaded[name]
 
 
+def prebuilt() -> ModuleType | None:
+    """The prebuilt kernels (:func:`engine.method.aot.load`, looked for once), or ``None``."""
+    with _lock:
+        if not _prebuilt:
+            from . import aot
+
+            _prebuilt.append(aot.load())
+        return _prebuilt[0]
+
+
 def compiled(name: str) -> ModuleType | None:
-    """The compiled kernel module ``name`` (``compiled_lsf``, ``compiled_search``) when the
-    compiled kernels are chosen and load, else ``None`` (the caller runs the numpy reference)."""
-    if kernel_choice() != "compiled":
+    """What holds the compiled kernels of module ``name`` (``compiled_lsf``, ``compiled_search``,
+    ``compiled_weights``) when they are chosen and load: the prebuilt extension (every kernel,
+    same names) or the just-in-time module; else ``None`` (the caller runs the numpy reference)."""
+    choice = kernel_choice()
+    if choice == "numpy":
         return None
+    if choice == "compiled" and prebuilt() is not None:
+        return prebuilt()
     return _load(name)
 
 
 def loaded() -> bool:
-    """Whether the compiled kernels are already loaded (numba imported, nothing left to load)."""
+    """Whether the compiled kernels are ready to run without a wait: prebuilt, or numba's
+    imported with nothing left to load."""
+    if prebuilt() is not None and _made() != "jit":
+        return True
     return bool(_loaded) and all(m is not None for m in _loaded.values())
 
 
 def warm_up() -> bool:
-    """Load and run every compiled kernel once on a tiny input (numba's import, and its cache
-    read or compilation), e.g. in a background thread before the first synthesis; whether the
-    compiled kernels are usable."""
+    """Load and run every just-in-time kernel once on a tiny input (numba's import, and its
+    cache read or compilation), e.g. in a background thread before the first synthesis, unless
+    prebuilt ones are there (and not ``jit`` chosen); whether the compiled kernels are usable."""
+    if _made() != "jit" and prebuilt() is not None:
+        return True
     with _warming:
         ok = True
         for name in ("compiled_lsf", "compiled_search", "compiled_weights"):
@@ -197,7 +224,7 @@ def _before_fork() -> None:
     once, when chosen, rather than in every worker (half a second of CPU each); a warm-up under
     way in another thread (the app's, in the background) finishes first either way, so that no
     child inherits numba half-way through compiling (its locks held by a thread it has not)."""
-    if kernel_choice() == "compiled":
+    if kernel_choice() != "numpy":
         warm_up()
     else:
         with _warming:

@@ -453,6 +453,20 @@ def frame_lsf(frames: np.ndarray, order: int) -> np.ndarray:
     return poly2lsf(lpc(frames, order))
 
 
+def compiled_frame_lsf(kernel, pad: np.ndarray, starts: np.ndarray, window: np.ndarray,
+                       order: int) -> np.ndarray:
+    """The compiled analysis (``kernel.lsf_frames``, ``engine.method.compiled_lsf``) of the frames
+    ``pad[s:s + n] * window`` with this module's root grid and tolerances; the frames it flags
+    (roots the grid cannot bracket) solved by :func:`poly2lsf` from their LPC polynomials."""
+    xg, basis = root_grid(order // 2, ROOT_GRID)
+    lsf, polys, ok = kernel.lsf_frames(pad, np.ascontiguousarray(starts, dtype=np.int64), window,
+                                       order, xg, np.ascontiguousarray(basis), 1e-9, 12)
+    if not ok.all():
+        bad = ~ok
+        lsf[bad] = poly2lsf(polys[bad])
+    return lsf
+
+
 def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
            window_s: float = 0.025, audio_rate: int = 16000,
            preemphasis: float = 0.97, threads: int | None = 1) -> np.ndarray:
@@ -481,8 +495,8 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     if kernel is not None:                         # the same analysis compiled, frame by frame
         pad, starts, n = padded_signal(x, audio_rate, times, window_s, preemphasis)
         window = hamming(n)
-        return np.concatenate(map_spans(lambda a, b: kernel.frame_lsf(pad, starts[a:b], window,
-                                                                      order, poly2lsf),
+        return np.concatenate(map_spans(lambda a, b: compiled_frame_lsf(kernel, pad, starts[a:b],
+                                                                        window, order),
                                         len(starts), threads))
     frames = analysis_frames(x, audio_rate, times, window_s, preemphasis)
     return np.concatenate(map_spans(lambda a, b: frame_lsf(frames[a:b], order), len(frames),
