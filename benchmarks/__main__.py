@@ -187,8 +187,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--smoke", action="store_true", help="tiny size for CI")
     parser.add_argument("--corpus", type=Path, default=None, help="corpus folder (default data_samples/)")
     parser.add_argument("--out", type=Path, default=None,
-                        help=f"Markdown output (default {DEFAULT_OUT.relative_to(REPO)}; "
-                             f"none in smoke mode)")
+                        help=f"Markdown output (default {DEFAULT_OUT.relative_to(REPO)} when "
+                             f"every group runs; none in smoke mode or with --only)")
     parser.add_argument("--only", nargs="+", choices=GROUPS, default=list(GROUPS))
     parser.add_argument("--factors", nargs="+", type=int, default=None,
                         help="codebook growth factors of the scaling benchmark (default 1 4 16)")
@@ -203,7 +203,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     rows = run_all(ctx, args.only, args.factors, args.prefilters)
     prof = profiles(ctx) if "synth" in args.only else None
     print(format_table(rows))
-    out = args.out if args.out is not None else (None if args.smoke else DEFAULT_OUT)
+    partial = set(args.only) != set(GROUPS)          # a part never replaces the whole table
+    out = args.out if args.out is not None else (None if args.smoke or partial else DEFAULT_OUT)
     if out is not None:
         write_markdown(out, rows, ctx, time.perf_counter() - t0, info, prof)
         print(f"written {out}")

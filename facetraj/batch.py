@@ -200,15 +200,17 @@ def _worker_run(pair: tuple[Path, Path]) -> Outcome:
 
 def choose_kernels(job: SynthJob, inputs: Iterable[Path], workers: int = 1) -> SynthJob:
     """``job`` with the kernels that pay for themselves on ``inputs`` shared by ``workers``
-    processes (``engine.method.kernels.choice_for``: numba's loading costs about half a second,
-    paid before the workers fork, and the kernels save it back on minutes of speech in each
-    worker); the durations read from the files' headers, only as far as needed (an unreadable
-    one counts nothing: its synthesis says why)."""
-    import soundfile as sf
-
-    from engine.method.kernels import PAYS_OFF_S, choice_for
+    processes (``engine.method.kernels.choice_for``): the prebuilt ones whenever they are there;
+    else numba's, whose loading costs about half a second, paid before the workers fork, when
+    they save it back on minutes of speech in each worker, the durations read from the files'
+    headers only as far as needed (an unreadable one counts nothing: its synthesis says why)."""
+    from engine.method.kernels import PAYS_OFF_S, choice_for, ready_choice
 
     mode = job.config.mode
+    if ready_choice() == "compiled":                   # prebuilt (or loaded): nothing to count
+        return replace(job, kernels=choice_for(0.0, mode))
+    import soundfile as sf
+
     enough, seconds = PAYS_OFF_S.get(mode, 150.0) * workers, 0.0
     for path in inputs:
         try:
@@ -248,35 +250,21 @@ def _preload(job: SynthJob) -> None:
 
 # --------------------------------------------------------------------------- fan-out
 def fan_out(fn: Callable[[Any], Any], items: Sequence[Any], workers: int,
-            initializer: Callable[..., None], initargs: tuple) -> Iterator[Any]:
-    """``fn(item)`` for every item, the results as they finish: in this process when
-    ``workers`` is 1, else in that many processes (forked where the platform can: the parent's
-    modules and model are shared, not loaded again), each set up once by ``initializer``.
-    ``fn`` must not raise (its errors are results)."""
+            initializer: Callable[..., None], initargs: tuple) -> Iterator[tuple[Any, Any]]:
+    """``(item, fn(item))`` for every item, as they finish: in this process when ``workers`` is
+    1, else in that many forked processes (``engine.fanout.forked_map``: the parent's modules and
+    model are shared, not loaded again), each set up once by ``initializer``; an item whose
+    worker died comes with an ``engine.fanout.WorkerDied``. ``fn`` must not raise (its errors
+    are results)."""
     if workers <= 1 or len(items) <= 1:
         initializer(*initargs)
         for item in items:
-            yield fn(item)
+            yield item, fn(item)
         return
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-    from concurrent.futures.process import BrokenProcessPool
+    from engine.fanout import forked_map
 
-    ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
-    with ProcessPoolExecutor(min(workers, len(items)), ctx, initializer=initializer,
-                             initargs=initargs) as pool:
-        futures = [pool.submit(fn, item) for item in items]
-        try:
-            for fut in as_completed(futures):
-                try:
-                    yield fut.result()
-                except BrokenProcessPool:          # a worker killed (out of memory, a crash)
-                    raise FacetrajError("a worker process stopped unexpectedly (out of memory, "
-                                        "or a crash in a file reader); run with --jobs 1 to see "
-                                        "which file it was") from None
-        finally:                                  # interrupted: drop what has not started
-            for fut in futures:
-                fut.cancel()
+    for i, result in forked_map(fn, items, workers, initializer, initargs):
+        yield items[i], result
 
 
 # --------------------------------------------------------------------------- the run
@@ -286,6 +274,7 @@ def run_batch(model_path: Path, specs: Sequence[str], outdir: Path, fmt: str, jo
     """Synthesize every input of ``specs`` into ``outdir`` (made when missing) with ``jobs``
     worker processes; the outcomes in input order. The model is loaded (and checked) here once
     before any worker starts."""
+    from engine.fanout import WorkerDied
     from engine.method.model import Model
 
     inputs = collect_inputs(specs)
@@ -311,7 +300,9 @@ def run_batch(model_path: Path, specs: Sequence[str], outdir: Path, fmt: str, jo
     _WORKER.update(path=model_path, model=model)          # shared by forked workers
     t0 = time.perf_counter()
     results = fan_out(_worker_run, todo, workers, _worker_init, (model_path, job, workers > 1))
-    for k, outcome in enumerate(results, 1):
+    for k, ((src, out), outcome) in enumerate(results, 1):
+        if isinstance(outcome, WorkerDied):         # a crash in a file reader, out of memory
+            outcome = Outcome(str(src), str(out), "failed", f"{src}: {outcome.describe()}")
         outcomes[Path(outcome.input)] = outcome
         if outcome.status == "failed":
             log.info("%s", outcome.reason)          # and in the summary at the end

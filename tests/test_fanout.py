@@ -93,9 +93,12 @@ def _dies_on_b(item: str) -> str:
 
 
 def test_a_worker_that_dies_is_a_clean_error():
-    with pytest.raises(FacetrajError, match="a worker process stopped unexpectedly .* run with "
-                                            "--jobs 1 to see which file it was"):
+    with pytest.raises(FacetrajError, match="a worker process stopped unexpectedly .* while "
+                                            "working on b; run with --jobs 1 to see why"):
         fan_out(_dies_on_b, ["a", "b", "c"], 2)
+    skip = Skips()
+    assert fan_out(_dies_on_b, ["a", "b", "c"], 2, skip=skip) == [("a", "a"), ("c", "c")]
+    assert list(skip.bad) == ["b"]
 
 
 class _TwoArgError(Exception):
@@ -294,10 +297,67 @@ def test_corpus_show_lists_the_good_utterances_with_skip_bad(corpus_with_a_bad_f
     assert code == 2 and err.startswith(f"facetraj: error: {root / BAD}")
 
 
-def test_a_dying_worker_of_the_synth_batch_is_a_clean_error():
-    """facetraj synth's batch (facetraj.batch, issue 28) fans out too: a worker killed is an
-    error of one line, not a BrokenProcessPool traceback."""
+def test_a_dying_worker_of_the_synth_batch_fails_its_item_only():
+    """facetraj synth's batch (facetraj.batch, issue 28) fans out too: a worker killed while on
+    an item is that item's failure (a WorkerDied naming how it stopped); another worker takes
+    its place and the rest are done."""
+    from engine.fanout import WorkerDied
     from facetraj.batch import fan_out as batch_fan_out
 
-    with pytest.raises(FacetrajError, match="a worker process stopped unexpectedly"):
-        list(batch_fan_out(_dies_on_b, ["a", "b", "c"], 2, lambda: None, ()))
+    got = dict(batch_fan_out(_dies_on_b, ["a", "b", "c", "d"], 2, lambda: None, ()))
+    assert {k: v for k, v in got.items() if k != "b"} == {"a": "a", "c": "c", "d": "d"}
+    assert isinstance(got["b"], WorkerDied) and got["b"].status == 9
+    assert "exit status 9" in got["b"].describe()
+
+
+def _square_noting_pid(i: int) -> tuple[int, int]:
+    return i * i, os.getpid()
+
+
+def test_forked_map_gives_every_item_once_from_several_workers():
+    from engine.fanout import forked_map
+
+    got = list(forked_map(_square_noting_pid, list(range(200)), 3))
+    assert sorted(i for i, _ in got) == list(range(200))
+    assert all(r[0] == i * i for i, r in got)
+    pids = {r[1] for _, r in got}
+    assert os.getpid() not in pids and 1 <= len(pids) <= 3
+
+
+def _raises_on_3(i: int) -> int:
+    if i == 3:
+        raise ValueError("three")
+    return i
+
+
+def test_forked_map_raises_what_fn_raised_and_leaves_no_child(capfd):
+    from engine.fanout import forked_map
+
+    with pytest.raises(ValueError, match="three"):
+        list(forked_map(_raises_on_3, list(range(8)), 2))
+    assert "ValueError: three" in capfd.readouterr().err     # the worker's traceback
+    with pytest.raises(ChildProcessError):
+        os.waitpid(-1, os.WNOHANG)                            # every worker reaped
+
+
+def _slow_note(path_and_i: tuple[str, int]) -> int:
+    path, i = path_and_i
+    with open(path, "a") as fh:
+        fh.write(f"{i}\n")
+    return i
+
+
+def test_forked_map_closed_early_takes_no_more_items(tmp_path):
+    """The consumer stops after the first result (an error, Ctrl-C): the items in work finish,
+    no further item is started, every worker is reaped."""
+    from engine.fanout import forked_map
+
+    log_file = str(tmp_path / "started")
+    items = [(log_file, i) for i in range(5000)]
+    it = forked_map(_slow_note, items, 2)
+    first = next(it)
+    it.close()
+    started = (tmp_path / "started").read_text().split()
+    assert first[1] in range(5000) and len(started) < 5000
+    with pytest.raises(ChildProcessError):
+        os.waitpid(-1, os.WNOHANG)

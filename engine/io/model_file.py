@@ -14,9 +14,11 @@ file, before anything uses the model.
 
 from __future__ import annotations
 
+import io
 import json
 import math
 import os
+import struct
 import zipfile
 import zlib
 from pathlib import Path
@@ -36,12 +38,13 @@ _COMPRESSIONS = (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED)
 
 
 def read_members(path: Path) -> tuple[dict, dict[str, np.ndarray]]:
-    """The metadata dict and the arrays of a model archive, each header checked first."""
+    """The metadata dict and the arrays of a model archive, each header checked first; a stored
+    member read once, straight into the buffer its array keeps (checksum checked), a deflated
+    one (older files) through ``zipfile``."""
     try:
-        with zipfile.ZipFile(path) as zf:
-            infos = zf.infolist()
+        with zipfile.ZipFile(path) as zf, open(path, "rb") as raw:
             arrays: dict[str, np.ndarray] = {}
-            for info in infos:
+            for info in zf.infolist():
                 name = info.filename.removesuffix(".npy")
                 if info.compress_type not in _COMPRESSIONS:
                     raise ModelFileError(path, f"entry {name!r} uses an unsupported compression "
@@ -50,8 +53,9 @@ def read_members(path: Path) -> tuple[dict, dict[str, np.ndarray]]:
                 if info.file_size > limit + 4096:
                     raise ModelFileError(path, f"entry {name!r} is {info.file_size} bytes, more than "
                                                f"a model holds (at most {limit})")
-                with zf.open(info) as handle:
-                    arrays[name] = _read_npy(path, name, handle, info.file_size, limit)
+                data = (_stored(path, name, raw, info) if info.compress_type == zipfile.ZIP_STORED
+                        else bytearray(zf.read(info)))
+                arrays[name] = _npy_array(path, name, data, limit)
     except ModelFileError:
         raise
     except OSError as exc:
@@ -74,9 +78,30 @@ def read_members(path: Path) -> tuple[dict, dict[str, np.ndarray]]:
     return meta, arrays
 
 
-def _read_npy(path: Path, name: str, handle, member_size: int, limit: int) -> np.ndarray:
-    """One ``.npy`` member: header checked (version, dtype, shape, size) before reading."""
+def _stored(path: Path, name: str, raw, info: zipfile.ZipInfo) -> bytearray:
+    """The bytes of a stored (uncompressed) member, read from after its local header; its
+    CRC-32 checked as ``zipfile`` checks it."""
+    raw.seek(info.header_offset)
+    head = raw.read(30)
+    if len(head) != 30 or head[:4] != b"PK\x03\x04":
+        raise ModelFileError(path, f"not a readable facetraj model (entry {name!r} has no local "
+                                   f"header where the directory says)")
+    name_len, extra_len = struct.unpack("<HH", head[26:30])
+    raw.seek(info.header_offset + 30 + name_len + extra_len)
+    data = bytearray(info.file_size)
+    if raw.readinto(data) != info.file_size:
+        raise ModelFileError(path, f"entry {name!r} is shorter than the archive says (truncated?)")
+    if zlib.crc32(data) != info.CRC:
+        raise ModelFileError(path, f"not a readable facetraj model (entry {name!r} is damaged: "
+                                   f"its CRC-32 does not match)")
+    return data
+
+
+def _npy_array(path: Path, name: str, data: bytearray, limit: int) -> np.ndarray:
+    """One ``.npy`` member's array: header checked (version, dtype, shape, size) before it is
+    used; the array a view of ``data`` (no copy) unless stored in Fortran order."""
     fmt = np.lib.format
+    handle = io.BytesIO(memoryview(data)[:1 << 16])
     version = fmt.read_magic(handle)
     if version == (1, 0):
         shape, fortran, dtype = fmt.read_array_header_1_0(handle)
@@ -92,16 +117,13 @@ def _read_npy(path: Path, name: str, handle, member_size: int, limit: int) -> np
     if nbytes > limit:
         raise ModelFileError(path, f"entry {name!r} asks for {nbytes} bytes ({shape}), more than a "
                                    f"model holds (at most {limit})")
-    if nbytes > member_size:
+    start = handle.tell()
+    if nbytes > len(data) - start:
         raise ModelFileError(path, f"entry {name!r} is shorter than its header says (truncated?)")
-    data = handle.read(nbytes)
-    if len(data) != nbytes:
-        raise ModelFileError(path, f"entry {name!r} is shorter than its header says (truncated?)")
-    handle.read(1 << 16)  # to the member's end, where the zip checks its CRC
-    arr = np.frombuffer(data, dtype=dtype)
+    arr = np.frombuffer(data, dtype=dtype, count=math.prod(shape), offset=start)
     if fortran:
         return arr.reshape(shape[::-1]).T.copy()
-    return arr.reshape(shape).copy()
+    return arr.reshape(shape)
 
 
 # --------------------------------------------------------------------------- the metadata
