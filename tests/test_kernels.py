@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from engine.config import SynthConfig
-from engine.method import aot, kernels
+from engine.method import aot, kernels, prebuilt
 from engine.method.kernels import kernel_choice, use_kernels
 from engine.method.lsf import lsf2poly, lsf_at, poly2lsf
 from engine.method.lsf_index import build_index
@@ -280,16 +280,16 @@ print(np.abs(fast - ref).max() < 1e-9)
 def test_prebuilt_kernels_missing_broken_or_stale_give_way_to_numba(monkeypatch, tmp_path, caplog):
     """No extension where it is looked for, a file that is not one, or one built from other
     sources: each is refused (the last two with a warning naming the file), numba's kernels run."""
-    monkeypatch.setenv(aot.DIR_ENV, str(tmp_path))
-    assert aot.load() is None
-    broken = tmp_path / f"{aot.MODULE}{__import__('importlib').machinery.EXTENSION_SUFFIXES[0]}"
+    monkeypatch.setenv(prebuilt.DIR_ENV, str(tmp_path))
+    assert prebuilt.load() is None
+    broken = tmp_path / f"{prebuilt.MODULE}{__import__('importlib').machinery.EXTENSION_SUFFIXES[0]}"
     broken.write_bytes(b"\x7fELF not really")
-    assert aot.load() is None
+    assert prebuilt.load() is None
     assert "unusable" in caplog.text and str(broken) in caplog.text
-    monkeypatch.delenv(aot.DIR_ENV)
-    assert aot.load() is not None
-    monkeypatch.setattr(aot, "fingerprint", lambda: 12345)
-    assert aot.load() is None
+    monkeypatch.delenv(prebuilt.DIR_ENV)
+    assert prebuilt.load() is not None
+    monkeypatch.setattr(prebuilt, "fingerprint", lambda: 12345)
+    assert prebuilt.load() is None
     assert "stale" in caplog.text
     assert aot.main(["--check"]) == 1
 
@@ -332,7 +332,7 @@ def test_a_live_stream_never_waits_for_the_kernels_to_load(toy_model, tmp_path):
     code = """
 import sys
 import numpy as np
-from engine.method import aot, kernels
+from engine.method import aot, kernels, prebuilt
 from engine.method.model import Model
 from engine.streaming.synthesizer import StreamingSynthesizer
 model = Model.load(sys.argv[1])
@@ -352,7 +352,7 @@ print(np.abs(cold - ref).max() < 1e-9, np.abs(warmed - ref).max() < 1e-9)
 """
     toy_model.save(tmp_path / "toy.npz")
     env = {k: v for k, v in os.environ.items() if k != kernels.KERNELS_ENV}
-    env[aot.DIR_ENV] = str(tmp_path)                    # an install without prebuilt kernels
+    env[prebuilt.DIR_ENV] = str(tmp_path)                    # an install without prebuilt kernels
     out = subprocess.run([sys.executable, "-c", code, str(tmp_path / "toy.npz")],
                          capture_output=True, text=True, cwd=ROOT, timeout=600, env=env)
     assert out.returncode == 0, out.stderr[-2000:]

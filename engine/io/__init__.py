@@ -1,7 +1,8 @@
 """Data in and out: every file facetraj reads or writes, checked at the boundary.
 
 - ``files``: atomic writes (never a half-written file), output path checks, small JSON files;
-- ``audio``, ``labelfiles``, ``markerfiles`` (with ``c3d_check``): the file formats;
+- ``audio``, ``labelfiles`` (with ``textgrid``, Praat's TextGrid grammar), ``markerfiles`` (with
+  ``c3d_check``, ``c3d_layout``): the file formats;
 - ``corpus``: a corpus folder (``corpus.json`` and its recordings), ``hash_memo`` its content
   hashes, ``cachedir`` where recomputable things are kept;
 - ``model_file``: a model file's arrays and metadata checked before use (no pickle);

@@ -327,7 +327,7 @@ def _check_values(path: Path, meta: dict, a: dict[str, np.ndarray]) -> None:
     for name in ("cb_lsf", "cb_lsf_context", "ix_centroids"):
         lsf = a.get(name)
         if lsf is not None and lsf.size and (lsf.min() < 0 or lsf.max() > np.pi
-                                             or np.any(np.diff(lsf, axis=-1) < 0)):
+                                             or np.any(lsf[..., 1:] < lsf[..., :-1])):
             raise ModelFileError(path, f"array {name!r} holds LSFs outside 0..pi or out of order")
     if np.any(a["cb_token_start"] < 0) or np.any(a["cb_token_end"] < a["cb_token_start"]):
         raise ModelFileError(path, "arrays 'cb_token_start' and 'cb_token_end' hold a phone token "

@@ -11,8 +11,10 @@ the LSF index (acoustic-only) or both (``selection``, the robust mode beyond the
 ``modes.choose_mode`` is the one rule for which mode the labels allow.
 
 Equation modules are plain array functions, each naming its equation, with doctests; fast
-kernels are tested against the reference formula. Imports shared modules, ``engine.labels`` and
-``engine.io``; never ``engine.evaluation`` or above.
+kernels (``compiled_lsf``, ``compiled_search``, ``compiled_weights``; ``kernels`` chooses them,
+``aot`` builds them at install, ``prebuilt`` loads those) are tested against the reference
+formula. Imports shared modules, ``engine.labels`` and ``engine.io``; never
+``engine.evaluation`` or above.
 """
 
 from .. import lazy_exports

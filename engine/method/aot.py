@@ -5,9 +5,9 @@
 
 The extension holds the same functions compiled from the same source by the same compiler as
 the just-in-time kernels, for this machine's processor; it is used only while it matches its
-source: :func:`fingerprint` (the three kernel modules, this one, the constants they take from
-``lsf`` and the processor) is compiled into it (``built_from``) and checked at load. A missing or
-stale extension falls back to numba's just-in-time kernels (:mod:`engine.method.kernels`).
+source: ``prebuilt.fingerprint`` is compiled into it (``built_from``) and checked when
+:mod:`engine.method.prebuilt` loads it. A missing or stale extension falls back to numba's
+just-in-time kernels (:mod:`engine.method.kernels`).
 
 Built by ``python -m engine.method.aot`` (``make`` does it after installing) into this folder, or
 into ``$FACETRAJ_KERNELS_DIR`` where it is looked for too (a read-only install).
@@ -16,24 +16,16 @@ into ``$FACETRAJ_KERNELS_DIR`` where it is looked for too (a read-only install).
 from __future__ import annotations
 
 import argparse
-import hashlib
-import importlib.machinery
-import importlib.util
 import logging
 import os
-import platform
 import shutil
 import sys
 import tempfile
 from pathlib import Path
-from types import ModuleType
+
+from .prebuilt import DIR_ENV, HERE, MODULE, fingerprint, folder, load
 
 log = logging.getLogger(__name__)
-
-#: the extension's module name (``PyInit__kernels_aot``)
-MODULE = "_kernels_aot"
-DIR_ENV = "FACETRAJ_KERNELS_DIR"
-HERE = Path(__file__).resolve().parent
 
 #: the exported kernels: module, numba signature (the arrays' layouts as the callers pass them)
 EXPORTS = {
@@ -47,76 +39,6 @@ EXPORTS = {
     "weight_frames": ("compiled_weights", "Tuple((f8[:,:], i8[:], f8[:,:], f8[:,:], f8[:]))"
                                           "(f8[:,::1], i8[:,::1], f8[:,:], f8[:,:], f8, f8, i8)"),
 }
-
-
-def folder() -> Path:
-    """Where the extension is built and looked for: ``$FACETRAJ_KERNELS_DIR``, else beside
-    this module."""
-    env = os.environ.get(DIR_ENV, "").strip()
-    return Path(env) if env else HERE
-
-
-def _processor() -> str:
-    """What the machine code was compiled for: the processor's model and feature flags (Linux),
-    else what ``platform`` says."""
-    try:
-        with open("/proc/cpuinfo") as fh:
-            lines = []
-            for line in fh:
-                if not line.strip():
-                    break                                   # the first processor is enough
-                if line.startswith(("model name", "flags", "Features", "CPU part")):
-                    lines.append(line.strip())
-        if lines:
-            return "\n".join(lines)
-    except OSError:
-        pass
-    return f"{platform.machine()} {platform.processor()}"
-
-
-def fingerprint() -> int:
-    """A 60-bit digest of what the extension was compiled from: the kernels' sources, this
-    module, the ``lsf`` constants they read, Python's and numba's ABI tags, the processor."""
-    from . import lsf
-
-    h = hashlib.sha256()
-    for name in ("compiled_lsf", "compiled_search", "compiled_weights", "aot"):
-        h.update((HERE / f"{name}.py").read_bytes())
-    h.update(repr((lsf.ROOT_GRID, lsf.WHITE_NOISE_CORRECTION)).encode())
-    h.update(importlib.machinery.EXTENSION_SUFFIXES[0].encode())
-    h.update(_processor().encode())
-    return int(h.hexdigest()[:15], 16)
-
-
-def _path() -> Path | None:
-    for suffix in importlib.machinery.EXTENSION_SUFFIXES:
-        path = folder() / f"{MODULE}{suffix}"
-        if path.is_file():
-            return path
-    return None
-
-
-def load() -> ModuleType | None:
-    """The built extension when it is there and matches :func:`fingerprint`, else ``None``
-    (logged: the just-in-time kernels are used)."""
-    path = _path()
-    if path is None:
-        log.debug("no prebuilt kernels in %s (python -m engine.method.aot builds them)", folder())
-        return None
-    try:
-        spec = importlib.util.spec_from_file_location(MODULE, path)
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        built_from = module.built_from()
-    except Exception as exc:                   # a broken file: the just-in-time kernels run
-        log.warning("prebuilt kernels %s unusable (%s); rebuild with python -m engine.method.aot",
-                    path, exc)
-        return None
-    if built_from != fingerprint():
-        log.warning("prebuilt kernels %s are stale (their source, or the processor, changed); "
-                    "rebuild with python -m engine.method.aot", path)
-        return None
-    return module
 
 
 def build(into: Path | None = None) -> Path:

@@ -6,8 +6,9 @@ The numpy functions are the reference: each compiled kernel computes the same fo
 frame in one loop, and is tested equal to it to rounding (``tests/test_kernels.py``). The
 kernels come two ways, the same source compiled by numba either way:
 
-- prebuilt (:mod:`engine.method.aot`): compiled at install into an extension that loads in
-  about a millisecond without numba; used whenever it is built and current;
+- prebuilt (:mod:`engine.method.aot` builds them, :mod:`engine.method.prebuilt` loads them):
+  compiled at install into an extension that loads in about 2 ms without numba; used whenever
+  it is built and current;
 - just in time: numba imported when a kernel is first asked for, never by importing the engine
   (its import and first call: about 0.5 s of CPU and 140 MiB), so where they are not prebuilt
   neither ``facetraj --version`` nor the app's first frame pays for it, and the command line
@@ -167,12 +168,12 @@ def _load(name: str) -> ModuleType | None:
 
 
 def prebuilt() -> ModuleType | None:
-    """The prebuilt kernels (:func:`engine.method.aot.load`, looked for once), or ``None``."""
+    """The prebuilt kernels (:func:`engine.method.prebuilt.load`, looked for once), or ``None``."""
     with _lock:
         if not _prebuilt:
-            from . import aot
+            from .prebuilt import load
 
-            _prebuilt.append(aot.load())
+            _prebuilt.append(load())
         return _prebuilt[0]
 
 

@@ -435,9 +435,16 @@ def padded_signal(audio: np.ndarray, rate: int, times: np.ndarray, window_s: flo
     """The pre-emphasized signal with half a window of zeros before it and a window after, the
     start in it of the frame of ``window_s`` centred on each of ``times``, and the frame length:
     frame ``t`` is ``pad[starts[t]:starts[t] + n]`` (zero outside the signal)."""
-    x = preemphasize(audio, preemphasis)
+    x = np.asarray(audio, dtype=np.float64)
     n = int(round(window_s * rate))
-    pad = np.concatenate([np.zeros(n // 2), x, np.zeros(n)])
+    pad = np.zeros(n // 2 + len(x) + n)
+    body = pad[n // 2:n // 2 + len(x)]              # preemphasize(x), written in place
+    if len(x) and preemphasis:
+        np.multiply(x[:-1], -preemphasis, out=body[1:])
+        body[1:] += x[1:]
+        body[0] = x[0]
+    else:
+        body[:] = x
     return pad, np.clip(frame_starts(times, rate), 0, len(x)), n
 
 
@@ -486,7 +493,7 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     (1, 10)
     """
     x = np.asarray(audio, dtype=np.float64)
-    peak = float(np.max(np.abs(x))) if x.size else 0.0
+    peak = max(float(x.max()), -float(x.min())) if x.size else 0.0     # max |x|, no copy
     if 0 < peak < np.inf:  # to a peak in [0.5, 1) by a power of 2: exact, and LPC is scale-free,
         x = np.ldexp(x, -int(np.frexp(peak)[1]))  # so huge samples cannot overflow to inf
     x = resample_audio(x, rate, audio_rate)
