@@ -50,10 +50,13 @@ def read_audio(path: str | os.PathLike[str]) -> tuple[np.ndarray, int]:
             _check_header(path, f.format, f.subtype, rate, channels, frames)
             samples = np.empty(frames)
             done = 0
-            for block in f.blocks(max(1, _BLOCK_SAMPLES // channels), dtype="float64",
-                                  always_2d=True, frames=frames):
-                samples[done:done + len(block)] = block.mean(axis=1)
-                done += len(block)
+            if channels == 1:                           # straight into place, one call
+                done = len(f.read(frames, dtype="float64", out=samples))
+            else:
+                for block in f.blocks(max(1, _BLOCK_SAMPLES // channels), dtype="float64",
+                                      always_2d=True, frames=frames):
+                    samples[done:done + len(block)] = block.mean(axis=1)
+                    done += len(block)
     except InputError:
         raise
     except Exception as exc:  # soundfile raises several types for corrupt data
