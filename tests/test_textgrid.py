@@ -65,6 +65,8 @@ def test_utf16_as_praat_writes_it(tmp_path):
      "class 'Tier'"),
     ('File type = "ooTextFile"\nObject class = "TextGrid"\n0\n1e999\n', "not a finite number"),
     ("", "the file type"),
+    ('File type = "ooTextFile"\nObject class = "TextGrid"\n"0\n' + "x" * 5000 + '"\n',
+     "expected the start time, found '0\\n" + "x" * 38 + "...'"),
 ])
 def test_what_is_not_a_textgrid_is_refused_with_its_place(text, where):
     with pytest.raises(TextGridSyntaxError) as err:
@@ -78,3 +80,19 @@ def test_the_label_reader_names_the_file(tmp_path):
     with pytest.raises(InputError, match="bad.TextGrid.*not a readable TextGrid .*end time"):
         read_textgrid_tiers(bad)
     assert parse_textgrid('File type = "ooTextFile"\nObject class = "TextGrid"\n0\n1\n<absent>\n') == []
+
+
+@pytest.mark.parametrize("damage, where", [
+    ("xmin = 0.4", "xmin = 0.4O5"),          # a letter in a number: not read as 0.4
+    ("xmax = 0.4", "xmax = 0.4m"),
+    ("xmin = 0.4", "xmin |= 0.4"),           # a stray character between the values
+])
+def test_a_damaged_token_is_refused_not_guessed(tmp_path, damage, where):
+    path = _praatio_file(tmp_path, "long_textgrid")
+    text = path.read_text(encoding="utf-8")
+    assert damage in text
+    bad = text.replace(damage, where, 1)
+    with pytest.raises(TextGridSyntaxError):
+        parse_textgrid(bad)
+    with pytest.raises(TextGridSyntaxError, match="after the last tier"):
+        parse_textgrid(text + "\n1.5\n")
