@@ -445,7 +445,8 @@ def padded_signal(audio: np.ndarray, rate: int, times: np.ndarray, window_s: flo
         body[0] = x[0]
     else:
         body[:] = x
-    return pad, np.clip(frame_starts(times, rate), 0, len(x)), n
+    starts = np.minimum(np.maximum(frame_starts(times, rate), 0), len(x))   # clip, without its checks
+    return pad, starts, n
 
 
 def analysis_frames(audio: np.ndarray, rate: int, times: np.ndarray, window_s: float,

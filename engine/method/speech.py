@@ -4,9 +4,19 @@ closure step (:mod:`engine.method.closure`) rests the face in the long pauses.""
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from ..config import EvalConfig
+
+
+@functools.lru_cache(maxsize=8)
+def _squared_window(n: int) -> np.ndarray:
+    """``np.hamming(n) ** 2 / n``, made once per length (read-only)."""
+    w = np.hamming(n) ** 2 / n
+    w.flags.writeable = False
+    return w
 
 
 def short_time_energy_db(audio: np.ndarray, rate: int, window_s: float = 0.02,
@@ -33,7 +43,7 @@ def short_time_energy_db(audio: np.ndarray, rate: int, window_s: float = 0.02,
     x2 = np.zeros((count - 1 + blocks) * hop)
     x2[n // 2:n // 2 + len(x)] = x[:len(x2) - n // 2] ** 2
     w2 = np.zeros(blocks * hop)
-    w2[:n] = np.hamming(n) ** 2 / n
+    w2[:n] = _squared_window(n)
     parts = x2.reshape(-1, hop) @ w2.reshape(blocks, hop).T       # (count - 1 + blocks, blocks)
     energy = parts[:count, 0].copy()
     for j in range(1, blocks):
@@ -94,8 +104,8 @@ def _above(filtered: np.ndarray, times: np.ndarray, config: EvalConfig, floor: f
            peak: float) -> np.ndarray:
     """:func:`speech_mask` from the energy's 5th and 99th percentiles ``floor`` and ``peak``."""
     threshold = floor + config.threshold_fraction * (peak - floor)
-    idx = np.clip(np.round(np.asarray(times) / config.energy_hop_s).astype(int), 0,
-                  len(filtered) - 1)
+    idx = np.round(np.asarray(times) / config.energy_hop_s).astype(int)
+    idx = np.minimum(np.maximum(idx, 0), len(filtered) - 1)         # clip, without its checks
     return filtered[idx] > threshold
 
 

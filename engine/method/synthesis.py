@@ -179,7 +179,8 @@ def weight_frames(w: np.ndarray, candidates: np.ndarray, cb_lsf: np.ndarray, cb_
         # the same equations compiled, frame by frame, on grid_weights' evenly spaced grid
         pcs, best, weights, lsf_hat, err = kernel.weight_frames(
             np.ascontiguousarray(w, dtype=np.float64), np.ascontiguousarray(candidates, dtype=np.int64),
-            cb_lsf, cb_pcs, float(gammas[0]), float(steps[0]), len(gammas))
+            np.ascontiguousarray(cb_lsf, dtype=np.float64), np.ascontiguousarray(cb_pcs, dtype=np.float64),
+            float(gammas[0]), float(steps[0]), len(gammas))
         return FrameWeights(pcs, gammas[best], weights, np.asarray(candidates), lsf_hat, err)
     budget = 4e6 if shared else 3e5          # values per chunk array: gathered ones stay in cache
     chunk = max(1, min(chunk, int(budget // max(1, n_cand * max(w.shape[1], len(gammas))))))
