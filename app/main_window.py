@@ -373,8 +373,10 @@ class MainWindow(QMainWindow):
 
     def _warm_kernels(self) -> None:
         """Load the compiled kernels (``engine.method.kernels``: numba's import and cache read,
-        about half a second) once, in the background after the first frame (numpy's)."""
-        if not self._kernels_warming and self.warm_kernels and kernels.kernel_choice() == "compiled":
+        about half a second) once, in the background after the first frame (numpy's), unless
+        they are ready already (prebuilt at install: nothing to load)."""
+        if not self._kernels_warming and self.warm_kernels and \
+                kernels.kernel_choice() == "compiled" and not kernels.loaded():
             self._kernels_warming, gate = True, self.tasks.foreground_idle
             self.run_task(lambda p: (p.wait_open(gate), kernels.warm_up()), None,
                           "loading the compiled kernels", background=True)
