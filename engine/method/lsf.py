@@ -414,9 +414,11 @@ def frame_start(time: float, rate: int) -> int:
     return int(round(float(time) * rate))
 
 
-def preemphasize(x: np.ndarray, coefficient: float, previous: float | None = None) -> np.ndarray:
+def preemphasize(x: np.ndarray, coefficient: float, previous: float | None = None,
+                 out: np.ndarray | None = None) -> np.ndarray:
     """First-order pre-emphasis ``y[i] = x[i] - c x[i-1]``; the first sample is kept as it is, or
-    uses ``previous`` (the sample before ``x``, when a signal arrives in blocks).
+    uses ``previous`` (the sample before ``x``, when a signal arrives in blocks). ``out``: where
+    to write ``y`` (as long as ``x``, not overlapping it; e.g. the middle of a padded buffer).
 
     >>> preemphasize(np.array([1.0, 2.0, 4.0]), 0.5).tolist()
     [1.0, 1.5, 3.0]
@@ -425,9 +427,15 @@ def preemphasize(x: np.ndarray, coefficient: float, previous: float | None = Non
     """
     x = np.asarray(x, dtype=np.float64)
     if not coefficient or len(x) == 0:
-        return x
-    before = x[:1] if previous is None else np.array([x[0] - coefficient * previous])
-    return np.concatenate([before, x[1:] - coefficient * x[:-1]])
+        if out is None:
+            return x
+        out[:] = x
+        return out
+    out = np.empty_like(x) if out is None else out
+    np.multiply(x[:-1], -coefficient, out=out[1:])
+    out[1:] += x[1:]
+    out[0] = x[0] if previous is None else x[0] - coefficient * previous
+    return out
 
 
 def padded_signal(audio: np.ndarray, rate: int, times: np.ndarray, window_s: float,
@@ -438,13 +446,7 @@ def padded_signal(audio: np.ndarray, rate: int, times: np.ndarray, window_s: flo
     x = np.asarray(audio, dtype=np.float64)
     n = int(round(window_s * rate))
     pad = np.zeros(n // 2 + len(x) + n)
-    body = pad[n // 2:n // 2 + len(x)]              # preemphasize(x), written in place
-    if len(x) and preemphasis:
-        np.multiply(x[:-1], -preemphasis, out=body[1:])
-        body[1:] += x[1:]
-        body[0] = x[0]
-    else:
-        body[:] = x
+    preemphasize(x, preemphasis, out=pad[n // 2:n // 2 + len(x)])
     starts = np.minimum(np.maximum(frame_starts(times, rate), 0), len(x))   # clip, without its checks
     return pad, starts, n
 
