@@ -206,6 +206,12 @@ class _Worker:
             yield message
 
 
+def can_fork() -> bool:
+    """Whether :func:`forked_map` can run here (``fork`` exists: not on Windows); where it
+    cannot, the work runs in this process."""
+    return hasattr(os, "fork")
+
+
 def forked_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int,
                initializer: Callable[..., None] | None = None, initargs: tuple = ()
                ) -> Iterator[tuple[int, Any]]:
@@ -307,9 +313,7 @@ def fan_out(fn: Callable[[I], R], items: Sequence[I], workers: int = 1, *,
     if skip is not None:
         skip.tried.update(items)
     workers = max(1, min(workers, len(items)))
-    import multiprocessing as mp  # here: the app imports this module at start
-
-    if workers > 1 and "fork" in mp.get_all_start_methods():
+    if workers > 1 and can_fork():
         return _in_processes(fn, items, workers, skip, progress, describe)
     out: list[tuple[I, R]] = []
     for k, item in enumerate(items):

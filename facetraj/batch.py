@@ -252,16 +252,17 @@ def _preload(job: SynthJob) -> None:
 def fan_out(fn: Callable[[Any], Any], items: Sequence[Any], workers: int,
             initializer: Callable[..., None], initargs: tuple) -> Iterator[tuple[Any, Any]]:
     """``(item, fn(item))`` for every item, as they finish: in this process when ``workers`` is
-    1, else in that many forked processes (``engine.fanout.forked_map``: the parent's modules and
-    model are shared, not loaded again), each set up once by ``initializer``; an item whose
-    worker died comes with an ``engine.fanout.WorkerDied``. ``fn`` must not raise (its errors
-    are results)."""
-    if workers <= 1 or len(items) <= 1:
+    1 or fork is missing (``engine.fanout.can_fork``), else in that many forked processes
+    (``engine.fanout.forked_map``: the parent's modules and model are shared, not loaded again),
+    each set up once by ``initializer``; an item whose worker died comes with an
+    ``engine.fanout.WorkerDied``. ``fn`` must not raise (its errors are results)."""
+    from engine.fanout import can_fork, forked_map
+
+    if workers <= 1 or len(items) <= 1 or not can_fork():
         initializer(*initargs)
         for item in items:
             yield item, fn(item)
         return
-    from engine.fanout import forked_map
 
     for i, result in forked_map(fn, items, workers, initializer, initargs):
         yield items[i], result

@@ -386,3 +386,16 @@ def test_forked_map_closed_early_takes_no_more_items(tmp_path, monkeypatch):
     started = (tmp_path / "started").read_text().split()
     assert first[1] in range(5000) and len(started) < 5000
     assert len(pids) == 2 and _all_reaped(pids)
+
+
+def test_without_fork_both_fan_outs_run_here(monkeypatch):
+    """Where ``fork`` is missing (Windows), the corpus commands' and the batch's fan-outs run
+    their items in this process, by the one rule ``can_fork``."""
+    from engine import fanout
+    from facetraj.batch import fan_out as batch_fan_out
+
+    monkeypatch.setattr(fanout, "can_fork", lambda: False)
+    pids = _forks_noted(monkeypatch)
+    assert fan_out(_square_noting_pid, [1, 2, 3], 2) == [(i, (i * i, os.getpid())) for i in (1, 2, 3)]
+    got = dict(batch_fan_out(_square_noting_pid, [1, 2, 3], 2, lambda: None, ()))
+    assert got == {i: (i * i, os.getpid()) for i in (1, 2, 3)} and pids == []
