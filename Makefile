@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 XVFB   := $(if $(DISPLAY),,xvfb-run -a -s "-screen 0 1600x1200x24")
 
-.PHONY: run test lint bench fuzz corpus report clean
+.PHONY: run test lint bench fuzz corpus report clean kernels
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -14,11 +14,11 @@ $(VENV)/.installed-run: pyproject.toml | $(BIN)/python
 	$(BIN)/pip install -q -e .
 	touch $@
 
-# the compiled kernels built ahead of time for this machine (engine/method/aot.py; about 15 s):
-# without them numba compiles or loads its kernels in every process that uses them
-KERNEL_SOURCES := $(wildcard engine/method/compiled_*.py) engine/method/aot.py engine/method/lsf.py
-$(VENV)/.kernels: $(KERNEL_SOURCES) | $(VENV)/.installed-run
-	@$(BIN)/python -m engine.method.aot && touch $@ || \
+# the compiled kernels built ahead of time for this machine (engine/method/aot.py; about 15 s),
+# again whenever their fingerprint (engine/method/prebuilt.py: sources, processor) says they are
+# stale; without them numba compiles or loads its kernels in every process that uses them
+kernels: $(VENV)/.installed-run
+	@$(BIN)/python -m engine.method.aot || \
 	  echo "facetraj: prebuilt kernels not built (no C compiler?): numba's just-in-time ones will run"
 
 # the tests include the corpus generator's bit-for-bit reproduction check, hence the corpus extra
@@ -30,16 +30,16 @@ $(VENV)/.installed-corpus: pyproject.toml | $(BIN)/python
 	$(BIN)/pip install -q -e ".[test,corpus]"
 	touch $@
 
-run: $(VENV)/.installed-run $(VENV)/.kernels
+run: $(VENV)/.installed-run kernels
 	$(BIN)/facetraj gui data_samples
 
 lint: $(VENV)/.installed-test
 	$(BIN)/ruff check .
 
-test: lint $(VENV)/.kernels
+test: lint kernels
 	$(XVFB) $(BIN)/python -m pytest
 
-bench: $(VENV)/.installed-test $(VENV)/.kernels
+bench: $(VENV)/.installed-test kernels
 	$(XVFB) $(BIN)/python -m benchmarks
 
 # the long bad-input fuzz run (tests/fuzzing.py): thousands of mutated inputs through the command
@@ -48,7 +48,7 @@ bench: $(VENV)/.installed-test $(VENV)/.kernels
 # (docs/bad-input.md)
 FUZZ_CASES ?= 3300
 FUZZ_SEED  ?= 14
-fuzz: $(VENV)/.installed-test $(VENV)/.kernels
+fuzz: $(VENV)/.installed-test kernels
 	$(XVFB) $(BIN)/python tests/fuzzing.py --cases $(FUZZ_CASES) --seed $(FUZZ_SEED)
 
 corpus: $(VENV)/.installed-corpus

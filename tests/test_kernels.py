@@ -294,6 +294,17 @@ def test_prebuilt_kernels_missing_broken_or_stale_give_way_to_numba(monkeypatch,
     assert aot.main(["--check"]) == 1
 
 
+def test_the_build_runs_only_when_the_fingerprint_says_stale(monkeypatch):
+    """``python -m engine.method.aot`` (what ``make`` runs every time) builds nothing while the
+    extension is current, and builds when it is stale or ``--force`` is given."""
+    built = []
+    monkeypatch.setattr(aot, "build", lambda: built.append(1) or prebuilt.folder())
+    assert aot.main([]) == 0 and built == []
+    assert aot.main(["--force"]) == 0 and built == [1]
+    monkeypatch.setattr(prebuilt, "fingerprint", lambda: 12345)
+    assert aot.main([]) == 0 and built == [1, 1]
+
+
 def test_a_read_only_install_does_not_crash():
     """Nowhere to keep numba's cache (a read-only install without a user cache folder: numba
     finds no cache locator, here by being told to try only one that never applies): the kernels

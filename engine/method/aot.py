@@ -98,19 +98,21 @@ def _constant(value: int):
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m engine.method.aot [--check] [--into DIR]``: build the extension, or say
-    whether it is there and current (exit 0) or not (exit 1)."""
+    """``python -m engine.method.aot [--check] [--force] [--into DIR]``: build the extension
+    unless it is there and current (``--force``: build anyway), or only say whether it is
+    (``--check``: exit 0) or not (exit 1)."""
     parser = argparse.ArgumentParser(prog="python -m engine.method.aot", description=__doc__.split("\n\n")[0])
     parser.add_argument("--check", action="store_true", help="only say whether it is current")
+    parser.add_argument("--force", action="store_true", help="build even when it is current")
     parser.add_argument("--into", type=Path, help=f"the folder (default: ${DIR_ENV} or {HERE})")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     if args.into is not None:
         os.environ[DIR_ENV] = str(args.into)
-    if args.check:
-        ok = load() is not None
-        log.info("prebuilt kernels in %s: %s", folder(), "current" if ok else "missing or stale")
-        return 0 if ok else 1
+    current = load() is not None            # the fingerprint: the one rule for "stale"
+    if args.check or (current and not args.force):
+        log.info("prebuilt kernels in %s: %s", folder(), "current" if current else "missing or stale")
+        return 0 if current else 1
     try:
         path = build()
     except Exception as exc:     # no compiler, no numba.pycc: the just-in-time kernels will run
