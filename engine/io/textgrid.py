@@ -56,8 +56,7 @@ class _Tokens:
             raise TextGridSyntaxError(f"the text ends where {what} was expected")
         value, got = self.items[self.at]
         if got != kind:
-            shown = value if len(value) <= 40 else value[:40] + "..."    # a stray quote's string
-            raise TextGridSyntaxError(f"expected {what}, found {shown!r}")
+            raise TextGridSyntaxError(f"expected {what}, found {_shown(value)}")
         self.at += 1
         return value
 
@@ -79,15 +78,20 @@ class _Tokens:
     def end(self) -> None:
         """Nothing but labels may follow the last tier."""
         if self.at < len(self.items):
-            value = self.items[self.at][0]
-            shown = value if len(value) <= 40 else value[:40] + "..."
-            raise TextGridSyntaxError(f"unexpected {shown!r} after the last tier")
+            raise TextGridSyntaxError(f"unexpected {_shown(self.items[self.at][0])} after the "
+                                      f"last tier")
 
     def flag(self) -> str | None:
         if self.at < len(self.items) and self.items[self.at][1] == "flag":
             self.at += 1
             return self.items[self.at - 1][0]
         return None
+
+
+def _shown(value: str) -> str:
+    """A token as an error shows it: quoted, cut after 40 characters (a stray quote's string
+    runs to the next quote)."""
+    return repr(value if len(value) <= 40 else value[:40] + "...")
 
 
 def parse_textgrid(text: str) -> list[Tier]:
