@@ -208,7 +208,7 @@ def choose_kernels(job: SynthJob, inputs: Iterable[Path], workers: int = 1) -> S
 
     mode = job.config.mode
     if ready_choice() == "compiled":                   # prebuilt (or loaded): nothing to count
-        return replace(job, kernels=choice_for(0.0, mode))
+        return replace(job, kernels="compiled")
     import soundfile as sf
 
     enough, seconds = PAYS_OFF_S.get(mode, 150.0) * workers, 0.0
