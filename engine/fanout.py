@@ -136,10 +136,13 @@ class WorkerDied:
 
     status: int
 
+    def how(self) -> str:
+        return f"killed by signal {-self.status}" if self.status < 0 else \
+            f"exit status {self.status}"
+
     def describe(self) -> str:
-        how = f"killed by signal {-self.status}" if self.status < 0 else f"exit status {self.status}"
-        return f"the worker process stopped while working on it ({how}: out of memory, or a " \
-               f"crash in a file reader)"
+        return f"the worker process stopped while working on it ({self.how()}: out of memory, " \
+               f"or a crash in a file reader)"
 
 
 class _Raised:
@@ -261,11 +264,15 @@ def forked_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int,
                 os.close(key.fd)
                 del running[key.fd]
                 _, status = os.waitpid(worker.pid, 0)
+                code = os.waitstatus_to_exitcode(status)
                 if worker.working is not None:
                     left -= 1
-                    yield worker.working, WorkerDied(os.waitstatus_to_exitcode(status))
+                    yield worker.working, WorkerDied(code)
                     if counter.value < len(items):      # another in its place
                         spawn()
+                elif code != 0:                         # before its first item: its set-up
+                    raise FacetrajError(f"a worker process stopped as it was set up "
+                                        f"({WorkerDied(code).how()}); run with --jobs 1 to see why")
         if left > 0:
             raise RuntimeError(f"{left} items were neither done nor reported")
     finally:

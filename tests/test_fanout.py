@@ -399,3 +399,17 @@ def test_without_fork_both_fan_outs_run_here(monkeypatch):
     assert fan_out(_square_noting_pid, [1, 2, 3], 2) == [(i, (i * i, os.getpid())) for i in (1, 2, 3)]
     got = dict(batch_fan_out(_square_noting_pid, [1, 2, 3], 2, lambda: None, ()))
     assert got == {i: (i * i, os.getpid()) for i in (1, 2, 3)} and pids == []
+
+
+def _exits_at_setup() -> None:
+    os._exit(5)
+
+
+def test_a_worker_that_fails_its_set_up_is_a_clean_error(monkeypatch):
+    from engine.fanout import forked_map
+
+    pids = _forks_noted(monkeypatch)
+    with pytest.raises(FacetrajError, match=r"a worker process stopped as it was set up "
+                                            r"\(exit status 5\); run with --jobs 1"):
+        list(forked_map(_square_noting_pid, [1, 2, 3], 2, _exits_at_setup))
+    assert _all_reaped(pids)
