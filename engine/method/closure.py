@@ -171,7 +171,8 @@ def close_lips(pcs: np.ndarray, times: np.ndarray, plan: ClosurePlan, stats: Clo
     """Step 1: for each interval j, the aperture's minimum over its frames ``m_j`` and the move
     ``c_j = s_j min(0, closed - m_j)`` (mm, at most 0); the PCs move by ``c(t) d``, ``c(t)`` the
     most negative ``c_j bump_j(t)``. With strength 1 the minimum inside each interval reaches the
-    closed aperture exactly; frames away from every interval are unchanged.
+    closed aperture exactly; frames away from every interval are unchanged. ``times``: the
+    frames' times, ascending.
 
     >>> st = ClosureStats(1.0, np.array([1.0]), np.array([0.0]))
     >>> plan = ClosurePlan(np.array([[0.2, 0.3]]), np.array([1.0]), np.zeros((0, 2)))
@@ -180,22 +181,37 @@ def close_lips(pcs: np.ndarray, times: np.ndarray, plan: ClosurePlan, stats: Clo
     [3.0, 3.0, 1.0, 1.0, 3.0, 3.0]
     """
     pcs = np.asarray(pcs, dtype=np.float64)
+    times = np.asarray(times, dtype=np.float64)
     a = a0 + pcs @ g
     c = np.zeros(len(pcs))
     for (t0, t1), s in zip(plan.intervals, plan.strengths, strict=True):
-        idx = np.flatnonzero((times >= t0) & (times < t1))
-        if idx.size == 0:                                # shorter than a frame: its nearest one
-            idx = np.array([int(np.argmin(np.abs(times - 0.5 * (t0 + t1))))])
-        move = s * min(0.0, stats.closed - float(a[idx].min()))
+        lo, hi = np.searchsorted(times, (t0, t1))        # the frames in [t0, t1)
+        if lo == hi:                                     # shorter than a frame: its nearest one
+            lo = int(np.argmin(np.abs(times - 0.5 * (t0 + t1))))
+            hi = lo + 1
+        move = s * min(0.0, stats.closed - float(a[lo:hi].min()))
         if move < 0:
-            c = np.minimum(c, move * bump(times, t0, t1, taper_s))
+            near = _support(times, t0, t1, taper_s)
+            c[near] = np.minimum(c[near], move * bump(times[near], t0, t1, taper_s))
     return pcs + c[:, None] * stats.direction[None, :]
+
+
+def _support(times: np.ndarray, start: float, end: float, taper_s: float) -> slice:
+    """The frames of ascending ``times`` where :func:`bump` of ``[start, end]`` and ``taper_s``
+    may be non-zero (0 everywhere else): each interval's work is its own frames, not the input's.
+
+    >>> _support(np.arange(10) / 10, 0.3, 0.4, 0.15)
+    slice(2, 6, None)
+    """
+    taper = max(taper_s, 0.0)
+    lo = np.searchsorted(times, start - taper, side="left")
+    return slice(int(lo), int(np.searchsorted(times, end + taper, side="right")))
 
 
 def rest_in_pauses(pcs: np.ndarray, times: np.ndarray, plan: ClosurePlan, stats: ClosureStats,
                    taper_s: float) -> np.ndarray:
     """Step 2: in each pause the PCs blend towards the rest face with weight ``b(t)`` (1 inside
-    the pause, raised-cosine tapers of ``taper_s`` inside it, 0 outside).
+    the pause, raised-cosine tapers of ``taper_s`` inside it, 0 outside; ``times`` ascending).
 
     >>> st = ClosureStats(1.0, np.array([1.0]), np.array([0.0]))
     >>> plan = ClosurePlan(np.zeros((0, 2)), np.zeros(0), np.array([[0.1, 0.5]]))
@@ -203,9 +219,11 @@ def rest_in_pauses(pcs: np.ndarray, times: np.ndarray, plan: ClosurePlan, stats:
     [2.0, 2.0, 1.0, 0.0, 1.0, 2.0, 2.0]
     """
     pcs = np.asarray(pcs, dtype=np.float64)
+    times = np.asarray(times, dtype=np.float64)
     b = np.zeros(len(pcs))
     for t0, t1 in plan.pauses:
-        b = np.maximum(b, bump(times, t0, t1, taper_s, inside=True))
+        near = _support(times, t0, t1, taper_s)
+        b[near] = np.maximum(b[near], bump(times[near], t0, t1, taper_s, inside=True))
     return pcs + b[:, None] * (stats.rest[None, :] - pcs)
 
 

@@ -445,8 +445,10 @@ def padded_signal(audio: np.ndarray, rate: int, times: np.ndarray, window_s: flo
     frame ``t`` is ``pad[starts[t]:starts[t] + n]`` (zero outside the signal)."""
     x = np.asarray(audio, dtype=np.float64)
     n = int(round(window_s * rate))
-    pad = np.zeros(n // 2 + len(x) + n)
+    pad = np.empty(n // 2 + len(x) + n)                      # written once, not zeroed first
+    pad[:n // 2] = 0.0
     preemphasize(x, preemphasis, out=pad[n // 2:n // 2 + len(x)])
+    pad[n // 2 + len(x):] = 0.0
     starts = np.minimum(np.maximum(frame_starts(times, rate), 0), len(x))   # clip, without its checks
     return pad, starts, n
 

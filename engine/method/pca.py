@@ -38,8 +38,11 @@ class PCA:
         return (np.asarray(x) - self.mean) @ self.components.T
 
     def inverse(self, coeffs: np.ndarray) -> np.ndarray:
-        """Vectors ``(..., D)`` from coefficients ``(..., K)``."""
-        return self.mean + np.asarray(coeffs) @ self.components
+        """Vectors ``(..., D)`` from coefficients ``(..., K)`` (the mean added in place: no second
+        array of the result's size)."""
+        out = np.asarray(coeffs) @ self.components
+        out += self.mean
+        return out
 
 
 def fit_pca(x: np.ndarray, n_components: int | None = 20, variance_target: float = 0.99) -> PCA:
