@@ -439,24 +439,31 @@ def preemphasize(x: np.ndarray, coefficient: float, previous: float | None = Non
 
 
 def padded_signal(audio: np.ndarray, rate: int, times: np.ndarray, window_s: float,
-                  preemphasis: float = 0.0) -> tuple[np.ndarray, np.ndarray, int]:
+                  preemphasis: float = 0.0, exponent: int = 0) -> tuple[np.ndarray, np.ndarray, int]:
     """The pre-emphasized signal with half a window of zeros before it and a window after, the
     start in it of the frame of ``window_s`` centred on each of ``times``, and the frame length:
-    frame ``t`` is ``pad[starts[t]:starts[t] + n]`` (zero outside the signal)."""
+    frame ``t`` is ``pad[starts[t]:starts[t] + n]`` (zero outside the signal). ``exponent``: the
+    signal is scaled by ``2 ** exponent`` after its pre-emphasis, in place (exact: as if scaled
+    before it, without a copy of the signal; a caller scales down before, where the pre-emphasis
+    could overflow)."""
     x = np.asarray(audio, dtype=np.float64)
     n = int(round(window_s * rate))
     pad = np.empty(n // 2 + len(x) + n)                      # written once, not zeroed first
     pad[:n // 2] = 0.0
-    preemphasize(x, preemphasis, out=pad[n // 2:n // 2 + len(x)])
+    signal = pad[n // 2:n // 2 + len(x)]
+    preemphasize(x, preemphasis, out=signal)
+    if exponent:
+        np.ldexp(signal, exponent, out=signal)
     pad[n // 2 + len(x):] = 0.0
     starts = np.minimum(np.maximum(frame_starts(times, rate), 0), len(x))   # clip, without its checks
     return pad, starts, n
 
 
 def analysis_frames(audio: np.ndarray, rate: int, times: np.ndarray, window_s: float,
-                    preemphasis: float = 0.0) -> np.ndarray:
-    """Hamming-windowed frames of ``window_s`` centred on ``times`` (zero outside the signal)."""
-    pad, starts, n = padded_signal(audio, rate, times, window_s, preemphasis)
+                    preemphasis: float = 0.0, exponent: int = 0) -> np.ndarray:
+    """Hamming-windowed frames of ``window_s`` centred on ``times`` (zero outside the signal;
+    ``exponent`` as :func:`padded_signal`'s)."""
+    pad, starts, n = padded_signal(audio, rate, times, window_s, preemphasis, exponent)
     return np.lib.stride_tricks.sliding_window_view(pad, n)[starts] * np.hamming(n)
 
 
@@ -499,17 +506,20 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     """
     x = np.asarray(audio, dtype=np.float64)
     peak = max(float(x.max()), -float(x.min())) if x.size else 0.0     # max |x|, no copy
-    if 0 < peak < np.inf:  # to a peak in [0.5, 1) by a power of 2: exact, and LPC is scale-free,
-        x = np.ldexp(x, -int(np.frexp(peak)[1]))  # so huge samples cannot overflow to inf
+    # to a peak in [0.5, 1) by a power of 2: exact, and LPC is scale-free, so huge samples cannot
+    # overflow to inf; up after the pre-emphasis (padded_signal), down or to resample before
+    exponent = -int(np.frexp(peak)[1]) if 0 < peak < np.inf else 0
+    if exponent < 0 or (exponent and rate != audio_rate):
+        x, exponent = np.ldexp(x, exponent), 0
     x = resample_audio(x, rate, audio_rate)
     times = np.asarray(times, dtype=np.float64)
     kernel = compiled("compiled_lsf") if order % 2 == 0 and order >= 2 else None
     if kernel is not None:                         # the same analysis compiled, frame by frame
-        pad, starts, n = padded_signal(x, audio_rate, times, window_s, preemphasis)
+        pad, starts, n = padded_signal(x, audio_rate, times, window_s, preemphasis, exponent)
         window = hamming(n)
         return np.concatenate(map_spans(lambda a, b: compiled_frame_lsf(kernel, pad, starts[a:b],
                                                                         window, order),
                                         len(starts), threads))
-    frames = analysis_frames(x, audio_rate, times, window_s, preemphasis)
+    frames = analysis_frames(x, audio_rate, times, window_s, preemphasis, exponent)
     return np.concatenate(map_spans(lambda a, b: frame_lsf(frames[a:b], order), len(frames),
                                     threads))
