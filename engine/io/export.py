@@ -11,6 +11,7 @@ import numpy as np
 from ..errors import InputError
 from .files import atomic_write
 from .markerfiles import write_c3d, write_marker_tsv
+from .npz import write_npz
 
 
 def write_trajectories(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
@@ -35,7 +36,10 @@ def write_trajectories(path: str | os.PathLike[str], markers: np.ndarray, rate: 
         out = {"markers": markers, "marker_names": np.array(list(names)), "which": np.array(which)}
         out.update(arrays or {})
         with atomic_write(path, overwrite) as tmp, open(tmp, "wb") as handle:
-            (np.savez_compressed if compress else np.savez)(handle, **out)
+            if compress:
+                np.savez_compressed(handle, **out)
+            else:
+                write_npz(handle, out)
     else:
         raise InputError(path, "unknown format (use .c3d, .tsv, .csv or .npz)")
     return path

@@ -20,6 +20,7 @@ from ..config import TrainConfig
 from ..errors import ModelFileError
 from ..io.files import atomic_write
 from ..io.model_file import read_model_file
+from ..io.npz import write_npz
 from .chain import join_scale
 from .closure import ClosureStats
 from .codebook import Codebook
@@ -221,7 +222,7 @@ class Model:
             arrays.update(ix_centroids=self.index.centroids, ix_order=self.index.order,
                           ix_offsets=self.index.offsets)
         with atomic_write(path, overwrite) as tmp, open(tmp, "wb") as handle:
-            np.savez(handle, **arrays)
+            write_npz(handle, arrays)
         return path
 
     @classmethod
