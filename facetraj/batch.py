@@ -237,13 +237,15 @@ def import_synthesis() -> None:
     import engine.method.recording  # noqa: F401
 
 
-def _preload(job: SynthJob) -> None:
-    """:func:`import_synthesis`, and the engine's before-fork hooks run (the compiled kernels
-    loaded when chosen), once, before the workers fork."""
+def _preload(job: SynthJob, model: Any) -> None:
+    """:func:`import_synthesis`, the engine's before-fork hooks run (the compiled kernels loaded
+    when chosen) and the model's search layout made, once, before the workers fork (each
+    worker's first input made that layout for itself: 1,700 page faults)."""
     from engine.fanout import prepare_fork
     from engine.method.kernels import use_kernels
 
     import_synthesis()
+    model.prepare_search()
     with use_kernels(job.kernels):                # the kernels loaded here when chosen
         prepare_fork()
 
@@ -297,7 +299,7 @@ def run_batch(model_path: Path, specs: Sequence[str], outdir: Path, fmt: str, jo
              len(inputs), len(todo), workers, "es" * (workers > 1), len(outcomes))
     job = choose_kernels(job, (src for src, _ in todo), workers)
     if workers > 1:
-        _preload(job)
+        _preload(job, model)
     _WORKER.update(path=model_path, model=model)          # shared by forked workers
     t0 = time.perf_counter()
     results = fan_out(_worker_run, todo, workers, _worker_init, (model_path, job, workers > 1))

@@ -106,6 +106,12 @@ class LsfIndex:
         search a few frames at a time and pass it to :meth:`nearest` on every call."""
         return np.asarray(cb_lsf, dtype=np.float64)[self.order]
 
+    def prepare(self, cb_lsf: np.ndarray) -> None:
+        """Make now the search layout of ``cb_lsf`` that the first :meth:`nearest` on it would
+        make (1.5 MB for the default corpus's codebook): before worker processes fork, so that
+        they share it instead of each making its own on its first input."""
+        self._cell_lsf(cb_lsf, None)
+
     def _cell_lsf(self, cb_lsf: np.ndarray, grouped: np.ndarray | None) -> np.ndarray:
         """:meth:`grouped` transposed, ``(P, 5L)``, in float32 for the search, made once per
         codebook array: a cell's codewords are the columns ``offsets[c]:offsets[c + 1]``."""

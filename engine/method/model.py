@@ -154,6 +154,12 @@ class Model:
             self.index = build_index(self.codebook.lsf, self.config.index_cells)
         return self.index
 
+    def prepare_search(self) -> None:
+        """Build now what the first search of the codebook by LSF builds (the index when the file
+        has none, its search layout): before worker processes fork (``facetraj synth``'s batch),
+        so that they share it."""
+        self.lsf_index().prepare(self.codebook.lsf)
+
     @property
     def lsf_mean(self) -> np.ndarray:
         """The training speaker's mean LSF vector (mean over the codewords), ``(P,)``."""
