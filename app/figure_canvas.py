@@ -17,14 +17,17 @@ drawing thread just before the draw (it may use the figure and plain data, never
 
 from __future__ import annotations
 
+import functools
 import logging
 import threading
+import weakref
 from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
 
 from matplotlib.backends.backend_agg import RendererAgg
 from matplotlib.backends.backend_qtagg import FigureCanvasQTAgg
 from matplotlib.figure import Figure
+from PyQt6 import sip
 from PyQt6.QtCore import QObject, QRectF, QSize, QTimer, pyqtSignal
 from PyQt6.QtGui import QColor, QImage, QPainter
 
@@ -43,9 +46,28 @@ def _run_builds(builds: list[Callable], figure: Figure) -> None:
 
 
 class _Relay(QObject):
-    """Carries a finished draw from the drawing thread to the GUI thread (a queued signal)."""
+    """Carries finished draws from the drawing thread to their canvases on the GUI thread (a
+    queued signal). One for the process, made on the GUI thread and never deleted: a relay that
+    was a child of its canvas could be deleted with a closed window while the drawing thread
+    emitted on it, a segmentation fault (seen once in CI, as a test opened its window)."""
 
-    finished = pyqtSignal(object)      # the future of the draw
+    finished = pyqtSignal(object)      # (weak reference to the canvas, the future of its draw)
+
+    def __init__(self):
+        super().__init__()
+        self.finished.connect(self._deliver)
+
+    def _deliver(self, item: tuple) -> None:
+        ref, future = item
+        canvas = ref()
+        if canvas is not None and not sip.isdeleted(canvas):
+            canvas.take_draw(future)
+
+
+@functools.cache
+def _relay() -> _Relay:
+    """The process's relay, made on first use (by a canvas, on the GUI thread)."""
+    return _Relay()
 
 
 class BackgroundCanvas(FigureCanvasQTAgg):
@@ -71,8 +93,7 @@ class BackgroundCanvas(FigureCanvasQTAgg):
         super().__init__(figure)
         w, h = self.get_width_height()
         self._hint = QSize(w, h)                 # the figure's size when made: see sizeHint
-        self._relay = _Relay(self)
-        self._relay.finished.connect(self._on_finished)
+        self._relay = _relay()
 
     def sizeHint(self) -> QSize:
         """The figure's first size. (Matplotlib's canvas hints its present size: in a layout whose
@@ -135,7 +156,7 @@ class BackgroundCanvas(FigureCanvasQTAgg):
         changed on this thread)."""
         future = self._drawing
         if future is not None:
-            self._on_finished(future)
+            self.take_draw(future)
 
     def finish(self) -> None:
         """Bring the pixels up to date now, on this thread (a screenshot, an export): the running
@@ -176,15 +197,16 @@ class BackgroundCanvas(FigureCanvasQTAgg):
 
         self._drawing = future = _DRAWER.submit(work)
 
-        def done(_future) -> None:      # in the worker: to the GUI thread
-            try:
-                self._relay.finished.emit(future)
-            except RuntimeError:        # the canvas was deleted meanwhile
-                pass
+        relay, canvas = self._relay, weakref.ref(self)
+
+        def done(_future) -> None:      # in the worker: to the GUI thread (the relay lives on)
+            relay.finished.emit((canvas, future))
 
         future.add_done_callback(done)
 
-    def _on_finished(self, future: Future) -> None:
+    def take_draw(self, future: Future) -> None:
+        """Take the pixels of a finished background draw (on the GUI thread: the relay calls
+        it, as does :meth:`wait`)."""
         if future is not self._drawing:
             return                      # taken already (wait)
         key, renderer, error = future.result()
