@@ -66,7 +66,8 @@ class _Relay(QObject):
 
 @functools.cache
 def _relay() -> _Relay:
-    """The process's relay, made on first use (by a canvas, on the GUI thread)."""
+    """The process's relay, made on first use (by a canvas starting a draw, on the GUI
+    thread)."""
     return _Relay()
 
 
@@ -93,7 +94,6 @@ class BackgroundCanvas(FigureCanvasQTAgg):
         super().__init__(figure)
         w, h = self.get_width_height()
         self._hint = QSize(w, h)                 # the figure's size when made: see sizeHint
-        self._relay = _relay()
 
     def sizeHint(self) -> QSize:
         """The figure's first size. (Matplotlib's canvas hints its present size: in a layout whose
@@ -197,7 +197,7 @@ class BackgroundCanvas(FigureCanvasQTAgg):
 
         self._drawing = future = _DRAWER.submit(work)
 
-        relay, canvas = self._relay, weakref.ref(self)
+        relay, canvas = _relay(), weakref.ref(self)
 
         def done(_future) -> None:      # in the worker: to the GUI thread (the relay lives on)
             relay.finished.emit((canvas, future))
