@@ -25,13 +25,31 @@ EXIT_BAD_INPUT = 2
 
 #: The subcommand modules, in the order ``facetraj --help`` lists them.
 COMMANDS = (gui, train, synth, align, evaluate, render, corpus, live)
+#: Each subcommand's module (a test checks it against what the modules register)
+COMMAND_MODULES = {"gui": gui, "train": train, "synth": synth, "align": align, "eval": evaluate,
+                   "sweep": evaluate, "similarity": evaluate, "report": render, "video": render,
+                   "corpus": corpus, "live": live}
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
+    """The command's parser: every subcommand, or only the one ``argv`` names (registering
+    them all took 4-5 ms of every run, issue 28); the same parse of ``argv`` either way."""
+    parser = _top_parser(argparse.ArgumentParser)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    command = None if argv is None else _command_named(argv)
+    for module in (COMMAND_MODULES[command],) if command else COMMANDS:
+        module.register(sub)
+    for subparser in subcommand_parsers(parser):
+        _add_verbosity(subparser)
+    return parser
+
+
+def _top_parser(kind: type[argparse.ArgumentParser], **kwargs) -> argparse.ArgumentParser:
+    """The options before the subcommand."""
+    parser = kind(
         prog="facetraj",
         description="Speech-driven 3-D face point trajectory synthesis (Arslan & Talkin). "
-                    "Without a subcommand, opens the app on the default corpus.")
+                    "Without a subcommand, opens the app on the default corpus.", **kwargs)
     parser.add_argument("-v", "--verbose", action="count", default=0,
                         help="log details (-vv: also the libraries' own debug messages)")
     parser.add_argument("-q", "--quiet", action="store_true", help="log only errors")
@@ -40,12 +58,31 @@ def build_parser() -> argparse.ArgumentParser:
                         help="render the app window to a PNG and exit")
     parser.add_argument("--utterance", help="utterance shown first")
     parser.add_argument("--time", type=SECONDS, help="cursor time in seconds")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for module in COMMANDS:
-        module.register(sub)
-    for subparser in subcommand_parsers(parser):
-        _add_verbosity(subparser)
     return parser
+
+
+class _Probe(argparse.ArgumentParser):
+    """A parser whose errors are exceptions, not a message and an exit."""
+
+    def error(self, message: str):
+        raise ValueError(message)
+
+
+def _command_named(argv: Sequence[str]) -> str | None:
+    """The subcommand ``argv`` names after the top-level options, if it is one of
+    :data:`COMMAND_MODULES` and no help is asked for before it; else ``None`` (then every
+    subcommand is registered, for the help and the errors that list them)."""
+    probe = _top_parser(_Probe, add_help=False)
+    probe.add_argument("command", nargs="?")
+    try:
+        known, _rest = probe.parse_known_args(list(argv))
+    except ValueError:
+        return None
+    command = known.command
+    if command not in COMMAND_MODULES:
+        return None
+    before = list(argv)[:list(argv).index(command)]
+    return None if {"-h", "--help"} & set(before) else command
 
 
 class _Version(argparse.Action):
@@ -104,8 +141,8 @@ def configure_logging(verbose: int = 0, quiet: bool = False) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser(argv).parse_args(argv)
     configure_logging(args.verbose, args.quiet)
     if args.command is None:
         args.corpus = default_corpus()

@@ -95,9 +95,12 @@ def test_median_filter_with_nan_is_nan_where_the_window_holds_it():
 
 
 @pytest.mark.parametrize("rate, n", [(16000, 48000), (16000, 5), (44100, 44100 * 2 + 7),
-                                     (8000, 8001), (22050, 1)])
+                                     (8000, 8001), (22050, 1), (16000, 16000 * 20 + 13),
+                                     (16000, 64 * 2048 - 200)])
 def test_short_time_energy_equals_the_sum_over_windowed_frames(rate, n):
-    """The block-product energy equals each frame's windowed sum of squares (the definition)."""
+    """The block-product energy equals each frame's windowed sum of squares (the definition),
+    in one chunk of blocks and in several (20 s; a chunk's last blocks half signal, half
+    padding)."""
     from engine.method.speech import short_time_energy_db
 
     x = np.random.default_rng(n).standard_normal(n) * 0.1

@@ -9,13 +9,17 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import functools
+import io
 import os
 import signal
 import stat
+import sys
 import tempfile
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import BinaryIO
 
 from ..errors import InputError, OutputError, OutputExistsError
 
@@ -133,6 +137,61 @@ def atomic_write(path: str | os.PathLike[str], overwrite: bool = True) -> Iterat
         with contextlib.suppress(OSError):
             if tmp_path.exists():
                 tmp_path.unlink()
+
+
+@functools.cache
+def _fallocate() -> Callable[[int, int, int, int], int] | None:
+    """The C library's ``fallocate(fd, mode, offset, len)`` (Linux), else ``None``. Not
+    ``os.posix_fallocate``: where a file system has no fallocate, glibc writes zeros instead."""
+    if not sys.platform.startswith("linux"):
+        return None
+    import ctypes
+
+    try:
+        fn = ctypes.CDLL(None, use_errno=True).fallocate
+    except (OSError, AttributeError):
+        return None
+    fn.argtypes = (ctypes.c_int, ctypes.c_int, ctypes.c_int64, ctypes.c_int64)
+    fn.restype = ctypes.c_int
+    return fn
+
+
+@contextlib.contextmanager
+def preallocated(handle: BinaryIO, nbytes: int) -> Iterator[BinaryIO]:
+    """``handle`` (a file open for writing, not appending) with ``nbytes`` from its position
+    given their disk blocks before the block writes them; the file cut where the block stopped
+    writing, so the size may be a guess. Best effort: elsewhere than Linux, on a file system
+    without fallocate or on an in-memory handle, the writes are as without it.
+
+    Why (issue 28): ext4, the usual Linux file system, writes out a new file's data blocks when
+    a rename replaces an existing file (its ``auto_da_alloc``), which :func:`atomic_write` does on
+    every overwrite; for the 6.4 MB of a 60 s synthesis, writing and renaming took 1.5 + 4-6 ms,
+    and 0.9 + 0.4 ms with the blocks given first.
+
+    >>> import tempfile, pathlib
+    >>> out = pathlib.Path(tempfile.mkdtemp()) / "x.bin"
+    >>> with open(out, "wb") as f, preallocated(f, 1000):
+    ...     _ = f.write(b"abc")
+    >>> out.read_bytes()
+    b'abc'
+    """
+    fn = _fallocate()
+    try:
+        fd = -1 if "a" in getattr(handle, "mode", "") else handle.fileno()   # appends: as they are
+    except (AttributeError, OSError, io.UnsupportedOperation):
+        fd = -1
+    if fn is not None and fd >= 0 and nbytes > 0:
+        handle.flush()
+        fn(fd, 0, handle.tell(), nbytes)       # a failure (no support, no space) changes nothing
+    yield handle
+    handle.truncate()
+
+
+def write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
+    """``data`` written to ``path`` (:func:`preallocated`): the temporary file of
+    :func:`atomic_write`."""
+    with open(path, "wb") as handle, preallocated(handle, len(data)):
+        handle.write(data)
 
 
 def write_json(path: str | os.PathLike[str], data: object, overwrite: bool = True) -> Path:

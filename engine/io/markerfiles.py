@@ -17,7 +17,7 @@ from .c3d_check import MIN_RATE as MIN_C3D_RATE
 from .c3d_check import check_c3d
 from .c3d_layout import MAX_POINTS as MAX_C3D_POINTS
 from .c3d_layout import c3d_bytes
-from .files import MAX_TEXT_BYTES, atomic_write, read_text
+from .files import MAX_TEXT_BYTES, atomic_write, read_text, write_bytes
 from .numtext import fixed_point_lines
 
 log = logging.getLogger(__name__)
@@ -110,7 +110,7 @@ def write_c3d(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
     raw[..., 3] = np.where(finite, 0, -1)     # residual 0 and no camera bits; -1: unseen
     data = c3d_bytes(raw, float(rate), scale, list(names))
     with atomic_write(path, overwrite) as tmp:
-        tmp.write_bytes(data)
+        write_bytes(tmp, data)
 
 
 def write_marker_tsv(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
@@ -123,7 +123,7 @@ def write_marker_tsv(path: str | os.PathLike[str], markers: np.ndarray, rate: fl
     sep = "," if Path(path).suffix.lower() == ".csv" else "\t"
     text = fixed_point_lines(table, [6] + [4] * (table.shape[1] - 1), sep)   # what savetxt wrote
     with atomic_write(path, overwrite) as tmp:
-        tmp.write_bytes((sep.join(header) + "\n").encode() + text)
+        write_bytes(tmp, (sep.join(header) + "\n").encode() + text)
 
 
 def _rate_of(path: Path, times: np.ndarray) -> float:

@@ -19,6 +19,11 @@ def _squared_window(n: int) -> np.ndarray:
     return w
 
 
+#: the hops of signal squared and multiplied at a time by :func:`short_time_energy_db` (1 MB of
+#: squares: a 60 s input's whole squared signal, 7.7 MB of new memory, took 5.5 ms against 2.3)
+ENERGY_CHUNK_HOPS = 2048
+
+
 def short_time_energy_db(audio: np.ndarray, rate: int, window_s: float = 0.02,
                          hop_s: float = 0.004) -> tuple[np.ndarray, np.ndarray]:
     """Short-time energy in dB and its frame-centre times: frame ``i`` is the ``window_s``
@@ -26,8 +31,9 @@ def short_time_energy_db(audio: np.ndarray, rate: int, window_s: float = 0.02,
     its energy the mean of their squares.
 
     Computed without a copy per frame: the squared signal cut into blocks of one hop, each block
-    times the squared window's matching part (one matrix product), and a frame's energy the sum
-    of its window's blocks (the sum of the frames' squares to rounding, tested).
+    times the squared window's matching part (a matrix product, :data:`ENERGY_CHUNK_HOPS` blocks
+    at a time), and a frame's energy the sum of its window's blocks (the sum of the frames'
+    squares to rounding, tested).
 
     >>> e, t = short_time_energy_db(np.ones(16), 1000, window_s=0.004, hop_s=0.002)
     >>> e.round(2).tolist()
@@ -40,14 +46,22 @@ def short_time_energy_db(audio: np.ndarray, rate: int, window_s: float = 0.02,
     hop = max(1, int(round(hop_s * rate)))
     count = len(x) // hop + 1
     blocks = -(-n // hop)                                   # the hops a window spans
-    x2 = np.empty((count - 1 + blocks) * hop)               # written once: no zeros, no x ** 2
-    m = min(len(x), len(x2) - n // 2)
-    x2[:n // 2] = 0.0
-    np.square(x[:m], out=x2[n // 2:n // 2 + m])
-    x2[n // 2 + m:] = 0.0
+    rows = count - 1 + blocks                               # blocks of the padded signal
     w2 = np.zeros(blocks * hop)
     w2[:n] = _squared_window(n)
-    parts = x2.reshape(-1, hop) @ w2.reshape(blocks, hop).T       # (count - 1 + blocks, blocks)
+    w2t = w2.reshape(blocks, hop).T.copy()
+    parts = np.empty((rows, blocks))                        # block r times the window's part j
+    chunk = np.empty(min(rows, ENERGY_CHUNK_HOPS) * hop)
+    for r0 in range(0, rows, ENERGY_CHUNK_HOPS):
+        r1 = min(rows, r0 + ENERGY_CHUNK_HOPS)
+        a, b = r0 * hop, r1 * hop                           # these blocks' span of the padded signal
+        lo = min(max(a, n // 2), b)                         # the signal's part of it: [lo, hi)
+        hi = max(lo, min(b, n // 2 + len(x)))
+        sq = chunk[:b - a]
+        sq[:lo - a] = 0.0
+        np.square(x[lo - n // 2:hi - n // 2], out=sq[lo - a:hi - a])
+        sq[hi - a:] = 0.0
+        np.matmul(sq.reshape(-1, hop), w2t, out=parts[r0:r1])
     energy = parts[:count, 0].copy()
     for j in range(1, blocks):
         energy += parts[j:j + count, j]
