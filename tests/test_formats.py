@@ -40,6 +40,8 @@ def test_audio_round_trip_and_stereo_mixdown(tmp_path, caplog):
     ("corrupt", "cannot read audio"),
     ("low_rate", "below the 8000 Hz minimum"),
     ("no_samples", "no samples"),
+    ("nan_float", "NaN or infinite samples"),
+    ("inf_double", "NaN or infinite samples"),
 ])
 def test_bad_audio(tmp_path, case, message):
     p = tmp_path / f"{case}.wav"
@@ -51,6 +53,10 @@ def test_bad_audio(tmp_path, case, message):
         sf.write(p, np.zeros(400), 4000)
     elif case == "no_samples":
         sf.write(p, np.zeros(0), 16000)
+    elif case in ("nan_float", "inf_double"):       # float encodings are checked (whole: need not)
+        x = np.zeros(1600)
+        x[700] = np.nan if case == "nan_float" else np.inf
+        sf.write(p, x, 16000, subtype="FLOAT" if case == "nan_float" else "DOUBLE")
     with pytest.raises(InputError, match=message) as err:
         read_audio(p)
     assert str(p) in str(err.value)

@@ -177,7 +177,15 @@ def test_prepare_makes_the_search_layout_once(monkeypatch):
     def again(self, cb_lsf):
         raise AssertionError("the codebook was grouped again")
 
-    monkeypatch.setattr(LsfIndex, "grouped", again)
+    monkeypatch.setattr(LsfIndex, "layout", again)
     assert np.array_equal(ix.nearest(lsf[:9] + 1e-3, lsf, 4, 3), expected)
     with pytest.raises(AssertionError, match="grouped again"):
         build_index(lsf, 12).nearest(lsf[:9], lsf, 4, 3)        # without prepare: it would
+
+
+def test_the_layout_is_the_grouped_codebook_transposed_in_float32():
+    lsf = np.sort(np.random.default_rng(6).uniform(0.1, 3.0, (300, 8)), axis=1)
+    ix = build_index(lsf, 10)
+    want = np.ascontiguousarray(ix.grouped(lsf).astype(np.float32).T)
+    got = ix.layout(lsf)
+    assert got.dtype == np.float32 and got.flags.c_contiguous and np.array_equal(got, want)

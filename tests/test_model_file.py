@@ -64,6 +64,12 @@ def _late_start(a, meta=None):
     return b
 
 
+def _one(a, value):
+    b = a.copy()
+    b.flat[b.size // 2] = value
+    return b
+
+
 # name, how the array is changed, what the error says
 DAMAGE = [
     ("cb_contexts", lambda a, m: a.astype(np.float64), "array 'cb_contexts' has data type float64, "
@@ -78,6 +84,9 @@ DAMAGE = [
     ("means", lambda a, m: np.full_like(a, np.nan), "array 'means' holds NaN or infinite values"),
     ("reference", lambda a, m: a.astype(np.longdouble) * np.longdouble(1e308) * 10,
      "array 'reference' holds NaN or infinite values"),
+    ("cb_pcs", lambda a, m: _one(a, np.inf), "array 'cb_pcs' holds NaN or infinite values"),
+    ("cb_lsf_context", lambda a, m: _one(a, np.nan), "array 'cb_lsf_context' holds NaN or "
+                                                     "infinite values"),
     ("cb_contexts", lambda a, m: a + len(m["phones"]), "array 'cb_contexts' holds indices outside "
                                                        "0.."),
     ("cb_contexts", lambda a, m: a - 100, "array 'cb_contexts' holds indices outside 0.."),
@@ -122,6 +131,16 @@ def test_each_damage_is_refused_with_its_message(saved, tmp_path, name, damage, 
         Model.load(bad)
     assert phrase in str(exc.value)
     assert str(exc.value).startswith(str(bad) + ": ")
+
+
+def test_finite_values_whose_sum_overflows_are_read(saved, tmp_path):
+    """The finite check sums each array first (NaN and inf reach the sum); a sum that overflows
+    on finite values is not taken for a damaged array."""
+    a = _arrays(saved)
+    pcs = a["cb_pcs"].copy()
+    pcs[:2, 0] = 1.7e308
+    ok = edited_model_file(saved, tmp_path / "huge.npz", cb_pcs=pcs)
+    assert Model.load(ok).codebook.pcs[1, 0] == 1.7e308
 
 
 @pytest.mark.parametrize("edit, phrase", [

@@ -25,6 +25,8 @@ _SAMPLE_BYTES = {"PCM_S8": 1, "PCM_U8": 1, "PCM_16": 2, "PCM_24": 3, "PCM_32": 4
                  "DOUBLE": 8, "ULAW": 1, "ALAW": 1}
 #: containers whose samples are compressed (their subtype names the decoded depth)
 _COMPRESSED = {"FLAC", "OGG", "MPEG"}
+#: encodings of whole numbers: their samples, as floats, are finite (no check: 1 ms a minute)
+_INTEGER_SUBTYPES = {"PCM_S8", "PCM_U8", "PCM_16", "PCM_24", "PCM_32", "ULAW", "ALAW"}
 #: samples (all channels) decoded per block while mixing down
 _BLOCK_SAMPLES = 1 << 20
 
@@ -47,6 +49,7 @@ def read_audio(path: str | os.PathLike[str]) -> tuple[np.ndarray, int]:
     try:
         with sf.SoundFile(str(path)) as f:
             rate, channels, frames = int(f.samplerate), int(f.channels), int(f.frames)
+            whole = f.subtype in _INTEGER_SUBTYPES
             _check_header(path, f.format, f.subtype, rate, channels, frames)
             samples = np.empty(frames)
             done = 0
@@ -66,7 +69,7 @@ def read_audio(path: str | os.PathLike[str]) -> tuple[np.ndarray, int]:
     if channels > 1:
         warn_file(log, path, "channels mixed down to mono", f"{channels} channels mixed down to mono")
     samples = samples[:done]
-    if not np.all(np.isfinite(samples)):
+    if not whole and not np.all(np.isfinite(samples)):
         raise InputError(path, "the audio holds NaN or infinite samples")
     return samples, rate
 

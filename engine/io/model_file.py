@@ -305,7 +305,8 @@ def _checked_array(path: Path, name: str, arr: np.ndarray, kind: str,
         return arr.astype(np.int64, copy=False)        # the file's own copy: no second one
     with np.errstate(over="ignore"):
         out = arr.astype(np.float64, copy=False)
-    if not np.all(np.isfinite(out)):
+        finite = np.isfinite(out.sum())    # NaN and inf reach the sum: one pass, nothing made
+    if not finite and not np.all(np.isfinite(out)):   # (a sum that overflows: each value)
         raise ModelFileError(path, f"array {name!r} holds NaN or infinite values")
     return out
 
@@ -358,7 +359,8 @@ def _check_index(path: Path, a: dict[str, np.ndarray]) -> None:
         raise ModelFileError(path, _DAMAGED_INDEX)
     n, order, offsets = a["cb_lsf"].shape[0], a["ix_order"], a["ix_offsets"]
     if not (n > 0 and offsets[0] == 0 and offsets[-1] == n and np.all(np.diff(offsets) >= 0)
-            and np.array_equal(np.sort(order), np.arange(n))):
+            and len(order) == n and order.min() >= 0 and order.max() < n     # a permutation:
+            and np.all(np.bincount(order, minlength=n) == 1)):              # each index once
         raise ModelFileError(path, _DAMAGED_INDEX)
 
 
