@@ -132,16 +132,19 @@ def output_paths(inputs: Sequence[Path], outdir: Path, fmt: str) -> list[Path]:
 
 
 # --------------------------------------------------------------------------- one input
-def synthesize_file(model: Any, audio: Path, output: Path, job: SynthJob) -> Any:
-    """One recording to one trajectory file, as ``facetraj synth`` does for every input;
-    returns the :class:`~engine.method.recording.RecordingSynthesis` (logged)."""
+def synthesize_file(model: Any, audio: Path, output: Path, job: SynthJob,
+                    samples: tuple[Any, int] | None = None, early: Any = None) -> Any:
+    """One recording to one trajectory file, as ``facetraj synth`` does for every input
+    (``samples``, ``early``: its audio when read, its input LSFs being analysed, as
+    :func:`~engine.method.recording.synthesize_recording` takes them); returns the
+    :class:`~engine.method.recording.RecordingSynthesis` (logged)."""
     from engine.io.export import write_trajectories
     from engine.method.kernels import use_kernels
     from engine.method.recording import synthesize_recording
 
     with use_kernels(job.kernels):
         done = synthesize_recording(model, audio, job.config, job.request, explicit=job.explicit,
-                                    keep=list(job.keep))
+                                    keep=list(job.keep), audio=samples, early=early)
     log.info("%s", done.describe())
     res = done.synthesis
     write_trajectories(output, res.markers, model.marker_rate, model.marker_names, res.arrays(),

@@ -75,13 +75,15 @@ def test_evaluate_in_two_processes_equals_serial(toy_model, toy_corpus):
     assert seen[-1] == 1.0 and seen == sorted(seen)
 
 
-@pytest.mark.parametrize("k", [1, 3, 29])
-def test_median_filter_equals_scipy_medfilt(k):
+@pytest.mark.parametrize("k, n", [(1, 500), (3, 500), (29, 500), (29, 1024 * 3 + 5),
+                                  (3, 1024), (29, 20)])
+def test_median_filter_equals_scipy_medfilt(k, n):
+    """scipy's values, in one chunk of windows and in several (a last part chunk)."""
     from scipy.signal import medfilt
 
     from engine.method.speech import median_filter
 
-    x = np.random.default_rng(k).standard_normal(500) * 20 - 40      # an energy contour in dB
+    x = np.random.default_rng(k).standard_normal(n) * 20 - 40      # an energy contour in dB
     np.testing.assert_array_equal(median_filter(x, k), medfilt(x, k))
 
 

@@ -19,7 +19,7 @@ from .. import __version__
 from ..config import TrainConfig
 from ..errors import ModelFileError
 from ..io.files import atomic_write
-from ..io.model_file import read_model_file
+from ..io.model_file import read_model_file, read_model_meta
 from ..io.npz import write_npz
 from .chain import join_scale
 from .closure import ClosureStats
@@ -143,9 +143,7 @@ class Model:
                   threads: int | None = 1) -> np.ndarray:
         """The input LSF vectors w (eq 5) at ``times``, analysed as in training, ``(T, P)``, in
         ``threads`` spans of frames (``None``: :func:`engine.threads.frame_threads`)."""
-        mc = self.config
-        return lsf_at(audio, sample_rate, times, mc.lpc_order, mc.window_s, mc.audio_rate,
-                      mc.preemphasis, threads)
+        return analysed_lsf(self.config, audio, sample_rate, times, threads)
 
     def lsf_index(self) -> LsfIndex:
         """The coarse LSF index of the codebook (``engine.method.lsf_index``), built here and kept if the
@@ -231,6 +229,13 @@ class Model:
             write_npz(handle, arrays)
         return path
 
+    @staticmethod
+    def read_settings(path: str | os.PathLike[str]) -> tuple[TrainConfig, float]:
+        """The training settings and the marker rate of a model file, its metadata checked, its
+        arrays not read (what analyses an input before they are: ``EarlyLsf``)."""
+        meta = read_model_meta(path, MODEL_VERSION, MODEL_FORMAT)
+        return TrainConfig.from_dict(meta["config"]), float(meta["marker_rate"])
+
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> Model:
         """Read a model written by :meth:`save`; a wrong, truncated, damaged or newer file is
@@ -263,3 +268,10 @@ class Model:
         except KeyError as exc:
             raise ModelFileError(path, f"model file is incomplete: missing {exc}") from exc
 
+
+def analysed_lsf(config: TrainConfig, audio: np.ndarray, sample_rate: int, times: np.ndarray,
+                 threads: int | None = 1) -> np.ndarray:
+    """The input LSF vectors w (eq 5) at ``times``, analysed by ``config``'s settings (order,
+    window, rate, pre-emphasis) as a model trained with them analyses its training audio."""
+    return lsf_at(audio, sample_rate, times, config.lpc_order, config.window_s,
+                  config.audio_rate, config.preemphasis, threads)

@@ -87,6 +87,16 @@ class Synthesis:
                 "config": np.array(json.dumps(self.config.to_dict()))}
 
 
+def frame_count(n_samples: int, sample_rate: int, marker_rate: float) -> int:
+    """The marker frames synthesized from ``n_samples`` of audio: every frame inside it, the
+    first at 0 s.
+
+    >>> frame_count(16000, 16000, 60.0)
+    61
+    """
+    return int(np.floor(n_samples / float(sample_rate) * marker_rate + 1e-9)) + 1
+
+
 def check_length(model: Model, n_samples: int, sample_rate: int, source: str | None,
                  n_frames: int = 2) -> None:
     """Refuse audio shorter than two of the model's marker frames (nothing to smooth or
@@ -167,10 +177,9 @@ def _input(model: Model, audio: np.ndarray, sample_rate: int, n_frames: int | No
            ) -> tuple[np.ndarray, np.ndarray, float]:
     """The frame times, the input LSFs (computed here unless given; speaker-normalised) and the
     speaker warp."""
-    duration = len(audio) / float(sample_rate)
     rate = model.marker_rate
     if n_frames is None:
-        n_frames = int(np.floor(duration * rate + 1e-9)) + 1
+        n_frames = frame_count(len(audio), sample_rate, rate)
     check_length(model, len(audio), sample_rate, source, n_frames)
     times = np.arange(n_frames) / rate
     order = model.config.lpc_order

@@ -5,21 +5,26 @@ labels_for_audio`), the rule for the mode (:func:`engine.method.modes.choose_mod
 
 from __future__ import annotations
 
+import contextvars
+import logging
 import os
+import threading
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from ..config import SynthConfig
+from ..config import SynthConfig, TrainConfig
 from ..io.audio import read_audio
 from ..io.labelling import labels_for_audio
 from ..labels.labelmap import read_label_map
 from ..labels.provenance import Labels
-from .model import Model
+from .model import Model, analysed_lsf
 from .modes import ModeChoice, choose_mode
-from .pipeline import Synthesis, check_length, synthesize
+from .pipeline import Synthesis, check_length, frame_count, synthesize
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -57,14 +62,82 @@ class RecordingSynthesis:
         return f"{self.audio_path.name}: labels {labels}; {self.choice.describe()}{match}"
 
 
+@dataclass(frozen=True)
+class _Analysis:
+    """What the input LSFs of a recording depend on in a model: its analysis settings, its
+    marker rate."""
+
+    audio_rate: int
+    lpc_order: int
+    window_s: float
+    preemphasis: float
+    marker_rate: float
+
+    @classmethod
+    def of(cls, config: TrainConfig, marker_rate: float) -> _Analysis:
+        return cls(config.audio_rate, config.lpc_order, config.window_s, config.preemphasis,
+                   float(marker_rate))
+
+
+class EarlyLsf:
+    """A recording's input LSFs (eq 5's w), analysed in a background thread from the moment the
+    model file's settings (its checked metadata, :meth:`Model.read_settings`) and the audio are
+    read, while the caller reads the model's arrays and the labels: the compiled analysis lets
+    go of the interpreter lock, so on a 60 s file its 13 ms ran beside the model file's 15 ms
+    and the labels' 5 ms (issue 28). :meth:`for_model` gives them to a model of the same
+    analysis settings (else ``None``: computed again, as without this); an analysis that fails
+    here gives ``None`` too, and fails again where the synthesis computes it, as it would have.
+    The thread is a daemon: an error elsewhere does not wait for it."""
+
+    def __init__(self, config: TrainConfig, marker_rate: float, samples: np.ndarray, rate: int,
+                 kernels: str = "compiled"):
+        self._analysis = _Analysis.of(config, marker_rate)
+        n = frame_count(len(samples), rate, marker_rate)
+        self._result: np.ndarray | None = None
+        args = (config, samples, rate, np.arange(n) / float(marker_rate), kernels)
+        run = contextvars.copy_context().run
+        self._thread = threading.Thread(target=run, args=(self._analyse, *args), daemon=True,
+                                        name="facetraj-early-lsf")
+        self._thread.start()
+
+    @classmethod
+    def start(cls, model_path: str | os.PathLike[str], audio_path: str | os.PathLike[str],
+              kernels: str = "compiled") -> tuple[EarlyLsf, tuple[np.ndarray, int]]:
+        """The model file's settings read, then the audio (each refused as it is when the
+        command reads it), the analysis started; the early analysis and the audio read."""
+        config, marker_rate = Model.read_settings(model_path)
+        samples, rate = read_audio(audio_path)
+        return cls(config, marker_rate, samples, rate, kernels), (samples, rate)
+
+    def _analyse(self, config: TrainConfig, samples: np.ndarray, rate: int, times: np.ndarray,
+                 kernels: str) -> None:
+        from .kernels import use_kernels
+
+        try:
+            with use_kernels(kernels):
+                self._result = analysed_lsf(config, samples, rate, times, threads=1)
+        except Exception:                           # computed again, where it fails as it would
+            log.debug("the early LSF analysis failed", exc_info=True)
+
+    def for_model(self, model: Model) -> np.ndarray | None:
+        """The LSFs, once analysed, if ``model`` analyses its inputs as the settings read did;
+        else ``None``."""
+        self._thread.join()
+        if _Analysis.of(model.config, model.marker_rate) != self._analysis:
+            return None
+        return self._result
+
+
 def synthesize_recording(model: Model, audio_path: str | os.PathLike[str],
                          config: SynthConfig | None = None, request: LabelRequest | None = None,
                          explicit: bool = False, keep: Sequence[str] = (),
-                         audio: tuple[np.ndarray, int] | None = None) -> RecordingSynthesis:
+                         audio: tuple[np.ndarray, int] | None = None,
+                         early: EarlyLsf | None = None) -> RecordingSynthesis:
     """Synthesize the recording at ``audio_path`` (``audio``: its samples and rate, when already
-    read) as every command does: its labels by the label rule (none when the mode is acoustic
-    and ``explicit``), the mode by the mode rule (``explicit``: the user chose ``config.mode``;
-    ``keep``: the settings the user set, which the model's tuned ones must not replace)."""
+    read; ``early``: its input LSFs being analysed, :class:`EarlyLsf`) as every command does: its
+    labels by the label rule (none when the mode is acoustic and ``explicit``), the mode by the
+    mode rule (``explicit``: the user chose ``config.mode``; ``keep``: the settings the user
+    set, which the model's tuned ones must not replace)."""
     config = config or SynthConfig()
     request = request or LabelRequest()
     audio_path = Path(audio_path)
@@ -83,6 +156,7 @@ def synthesize_recording(model: Model, audio_path: str | os.PathLike[str],
     label_map = read_label_map(request.label_map) if request.label_map and labels and \
         labels.source == "file" else None
     res = synthesize(model, samples, rate, labels.phones if labels else None, choice.config,
+                     lsf=early.for_model(model) if early else None,
                      label_map=label_map, source=str(request.labels or audio_path),
                      audio_source=str(audio_path), confidence=labels.trust() if labels else None,
                      provenance=labels.provenance if labels else None, voice=True)

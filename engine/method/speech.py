@@ -68,6 +68,11 @@ def short_time_energy_db(audio: np.ndarray, rate: int, window_s: float = 0.02,
     return 10 * np.log10(energy + 1e-12), np.arange(count) * hop / rate
 
 
+#: windows partitioned at a time by :func:`median_filter` (a minute's 15,000 windows of 29 at
+#: once: 2.9 ms, a copy of 3.5 MB; 1,024 at a time: 1.3 ms)
+MEDIAN_CHUNK = 1024
+
+
 def median_filter(x: np.ndarray, k: int) -> np.ndarray:
     """Running median of odd length ``k``, zero-padded at both ends (the values of
     ``scipy.signal.medfilt``, tested; here so that the app's first frame does not wait 1-2 s for
@@ -84,7 +89,10 @@ def median_filter(x: np.ndarray, k: int) -> np.ndarray:
     windows = np.lib.stride_tricks.sliding_window_view(padded, k)
     if not np.isfinite(x).all():                    # NaN: the median of its windows is NaN
         return np.median(windows, axis=1)
-    return np.partition(windows, half, axis=1)[:, half]     # the middle value: 8x np.median's speed
+    out = np.empty(len(x))                 # the middle value: 8x np.median's speed; a chunk of
+    for a in range(0, len(x), MEDIAN_CHUNK):         # windows at a time (its copy stays in cache)
+        out[a:a + MEDIAN_CHUNK] = np.partition(windows[a:a + MEDIAN_CHUNK], half, axis=1)[:, half]
+    return out
 
 
 def filtered_energy_db(audio: np.ndarray, rate: int, config: EvalConfig | None = None

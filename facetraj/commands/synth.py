@@ -36,13 +36,16 @@ def cmd_synth(args: argparse.Namespace) -> int:
         return _cmd_batch(args)
     from engine.io.files import check_output_path
     from engine.method.model import Model
+    from engine.method.recording import EarlyLsf
 
     from ..batch import choose_kernels, synthesize_file
 
     check_output_path(args.output, args.overwrite)       # before the work, not after
-    model = Model.load(args.model)
     source = Path(args.inputs[0])
-    res = synthesize_file(model, source, args.output, choose_kernels(_job(args), [source])).synthesis
+    job = choose_kernels(_job(args), [source])
+    early, samples = EarlyLsf.start(args.model, source, job.kernels)   # beside what follows
+    model = Model.load(args.model)
+    res = synthesize_file(model, source, args.output, job, samples, early).synthesis
     log.info("%d frames (%.2f s) synthesized, %s smoothing", len(res.times), res.times[-1],
              res.config.smoothing)
     print(args.output)
