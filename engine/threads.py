@@ -20,8 +20,9 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import os
+import threading
 from collections.abc import Callable, Iterator
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import AbstractContextManager
 from contextvars import ContextVar
 from itertools import pairwise
@@ -139,3 +140,30 @@ def map_spans(fn: Callable[[int, int], T], n_frames: int, threads: int | None = 
     # each span in a copy of the caller's context: its choices (frame threads, kernels) hold there
     futures = [_pool[0].submit(contextvars.copy_context().run, fn, a, b) for a, b in spans]
     return [f.result() for f in futures]
+
+
+def beside(fn: Callable[[], T]) -> Callable[[], T]:
+    """``fn()`` begun in a thread of its own, in a copy of the caller's context, when synthesis
+    may use more than one thread (:func:`frame_threads`), else run here; returns what waits for
+    its result (raising its exception). For work that lets go of the interpreter lock, run beside
+    other work that does not need its result yet. The thread is a daemon: a caller that fails
+    before asking does not wait for it.
+
+    >>> result = beside(lambda: 6 * 7)
+    >>> result()
+    42
+    """
+    future: Future = Future()
+    run = contextvars.copy_context().run
+
+    def work() -> None:
+        try:
+            future.set_result(run(fn))
+        except BaseException as exc:                    # given to the caller by result()
+            future.set_exception(exc)
+
+    if frame_threads() > 1:
+        threading.Thread(target=work, name="facetraj-beside", daemon=True).start()
+    else:
+        work()
+    return future.result

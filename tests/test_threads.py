@@ -113,3 +113,39 @@ def test_evaluation_synthesizes_on_one_frame_thread(default_model, default_corpu
     corpus = type(default_corpus)(default_corpus.root, sub)
     evaluate(default_model, corpus, ("train", "test"), [SynthConfig()], ("triangular",))
     assert seen and set(seen) == {1}
+
+
+def test_beside_runs_in_a_thread_of_its_own_and_gives_its_result_or_its_error():
+    import threading
+
+    from engine.threads import beside, limit_frame_threads
+
+    where = beside(lambda: threading.current_thread().name)
+    assert where() == "facetraj-beside"
+
+    def fails():
+        raise KeyError("lost")
+
+    result = beside(fails)
+    with pytest.raises(KeyError, match="lost"):
+        result()
+    with limit_frame_threads(1):                # one thread for synthesis: run here, at once
+        assert beside(lambda: threading.current_thread().name)() == \
+            threading.current_thread().name
+
+
+def test_the_phonetic_synthesis_with_its_voice_match_beside_equals_one_in_line(toy_model,
+                                                                                toy_corpus):
+    """The voice match is computed beside eqs 4-8 in the phonetic mode: the same synthesis and
+    the same voice match as with one thread, where it is computed in line."""
+    from engine.config import SynthConfig
+    from engine.method.pipeline import synthesize
+    from engine.threads import limit_frame_threads
+
+    utt = toy_corpus.utterance(toy_corpus.info.test[0])
+    config = SynthConfig(mode="phonetic")
+    both = synthesize(toy_model, utt.audio, utt.sample_rate, utt.phones, config, voice=True)
+    with limit_frame_threads(1):
+        inline = synthesize(toy_model, utt.audio, utt.sample_rate, utt.phones, config, voice=True)
+    assert np.isfinite(both.voice_match) and both.voice_match == inline.voice_match
+    np.testing.assert_array_equal(both.markers, inline.markers)

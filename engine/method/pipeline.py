@@ -21,7 +21,7 @@ from ..data import PhoneSegment, Provenance
 from ..errors import InputError
 from ..io.labelfiles import validate_phones
 from ..labels.phoneset import SILENCE, map_labels, normalise_label
-from ..threads import frame_threads, map_spans
+from ..threads import beside, frame_threads, map_spans
 from .chain import chain_pcs
 from .closure import ClosurePlan, aperture_functional, apply_closure, closure_intervals, closure_strengths
 from .context import context_ids, segment_index
@@ -141,7 +141,7 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                             audio_source or source)
     segs: list[PhoneSegment] | None = None
     energy = SpeechEnergy(audio, sample_rate)
-    ratio = _voice_ratio(model, energy, times, w, config, provenance, voice)
+    voice_ratio = _voice_ratio_of(model, energy, times, w, config, provenance, voice)
     segments: list[SegmentChoice] = []
     frame_seg = None
     if config.mode in ("phonetic", "robust"):
@@ -151,10 +151,10 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                                          source, config)
         segments, frame_seg, candidates = _eq4(model, segs, times, config)
         if config.mode == "robust":
-            conf = trust_by_voice(frame_confidence(list(phones), confidence, times), ratio,
-                                  config.label_weight_by_voice)
+            conf = trust_by_voice(frame_confidence(list(phones), confidence, times),
+                                  voice_ratio(), config.label_weight_by_voice)
             conf[unlabelled[frame_seg]] = 0.0
-            scale = label_weight_scale(ratio, config.label_weight_by_voice)
+            scale = label_weight_scale(voice_ratio(), config.label_weight_by_voice)
             fw = robust_weights(model, w, candidates, conf, config, scale)
             if config.chain_beta > 0:                 # the weights made consistent over time
                 fw.pcs = chain_pcs(fw.weights, fw.candidates, model.codebook.pcs, config.chain_beta,
@@ -165,6 +165,7 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         fw = _weighted(model, w, lambda a, b: acoustic_candidates(model, w[a:b], config), config)
     else:
         raise ValueError(f"unknown mode {config.mode!r} (phonetic, acoustic or robust)")
+    ratio = voice_ratio()
     plan = plan_closure(model, audio, sample_rate, times, segs, provenance, voice_match(ratio, 1.0),
                         config, energy.filtered if config.closure else None)
     res = _finish(model, times, w, fw, config, segments, frame_seg, warp, plan)
@@ -311,17 +312,27 @@ class SpeechEnergy:
         return filtered_energy_db(self.audio, self.sample_rate)
 
 
-def _voice_ratio(model: Model, energy: SpeechEnergy, times: np.ndarray, w: np.ndarray,
-                 config: SynthConfig, provenance: Provenance | None, wanted: bool) -> float:
-    """The input's voice distance ratio when the synthesis weighs by it (the robust mode's label
-    weight, the closure step's trust in recognized labels) or it is ``wanted``, else NaN (not
-    computed)."""
+def _voice_ratio_of(model: Model, energy: SpeechEnergy, times: np.ndarray, w: np.ndarray,
+                    config: SynthConfig, provenance: Provenance | None, wanted: bool
+                    ) -> Callable[[], float]:
+    """What gives the input's voice distance ratio when the synthesis weighs by it (the robust
+    mode's label weight, the closure step's trust in recognized labels) or it is ``wanted``,
+    else NaN (not computed). In the phonetic mode eqs 4-8 do not use it: it is computed beside
+    them (:func:`engine.threads.beside`; its energy, index layout and search let go of the
+    interpreter lock), else here."""
     recognized = provenance is not None and provenance.kind == "recognized"
-    if wanted or (config.mode == "robust" and config.label_weight_by_voice) or \
-            (config.closure and recognized):
+    if not (wanted or (config.mode == "robust" and config.label_weight_by_voice) or
+            (config.closure and recognized)):
+        return lambda: float("nan")
+
+    def ratio() -> float:
         return input_voice_ratio(model, energy.audio, energy.sample_rate, times, w,
                                  energy.filtered)
-    return float("nan")
+
+    if config.mode == "phonetic":
+        return beside(ratio)
+    value = ratio()
+    return lambda: value
 
 
 def input_voice_ratio(model: Model, audio: np.ndarray, sample_rate: int,

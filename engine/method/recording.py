@@ -5,10 +5,8 @@ labels_for_audio`), the rule for the mode (:func:`engine.method.modes.choose_mod
 
 from __future__ import annotations
 
-import contextvars
 import logging
 import os
-import threading
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -20,6 +18,7 @@ from ..io.audio import read_audio
 from ..io.labelling import labels_for_audio
 from ..labels.labelmap import read_label_map
 from ..labels.provenance import Labels
+from ..threads import beside
 from .model import Model, analysed_lsf
 from .modes import ModeChoice, choose_mode
 from .pipeline import Synthesis, check_length, frame_count, synthesize
@@ -80,52 +79,48 @@ class _Analysis:
 
 
 class EarlyLsf:
-    """A recording's input LSFs (eq 5's w), analysed in a background thread from the moment the
-    model file's settings (its checked metadata, :meth:`Model.read_settings`) and the audio are
-    read, while the caller reads the model's arrays and the labels: the compiled analysis lets
-    go of the interpreter lock, so on a 60 s file its 13 ms ran beside the model file's 15 ms
-    and the labels' 5 ms (issue 28). :meth:`for_model` gives them to a model of the same
-    analysis settings (else ``None``: computed again, as without this); an analysis that fails
-    here gives ``None`` too, and fails again where the synthesis computes it, as it would have.
-    The thread is a daemon: an error elsewhere does not wait for it."""
+    """A recording's input LSFs (eq 5's w), analysed beside other work (:func:`engine.threads.
+    beside`) from the moment the model file's settings (its checked metadata,
+    :meth:`Model.read_settings`) and the audio are read, while the caller reads the model's
+    arrays and the labels: the compiled analysis lets go of the interpreter lock, so on a 60 s
+    file its 13 ms ran beside the model file's 15 ms and the labels' 5 ms (issue 28).
+    :meth:`for_model` gives them to a model of the same analysis settings (else ``None``:
+    computed again, as without this); an analysis that fails here gives ``None`` too, and fails
+    again where the synthesis computes it, as it would have."""
 
     def __init__(self, config: TrainConfig, marker_rate: float, samples: np.ndarray, rate: int,
                  kernels: str = "compiled"):
+        from .kernels import use_kernels
+
         self._analysis = _Analysis.of(config, marker_rate)
-        n = frame_count(len(samples), rate, marker_rate)
-        self._result: np.ndarray | None = None
-        args = (config, samples, rate, np.arange(n) / float(marker_rate), kernels)
-        run = contextvars.copy_context().run
-        self._thread = threading.Thread(target=run, args=(self._analyse, *args), daemon=True,
-                                        name="facetraj-early-lsf")
-        self._thread.start()
+        times = np.arange(frame_count(len(samples), rate, marker_rate)) / float(marker_rate)
+
+        def analyse() -> np.ndarray | None:
+            try:
+                with use_kernels(kernels):
+                    return analysed_lsf(config, samples, rate, times, threads=1)
+            except Exception:                       # computed again, where it fails as it would
+                log.debug("the early LSF analysis failed", exc_info=True)
+                return None
+
+        self._result = beside(analyse)
 
     @classmethod
     def start(cls, model_path: str | os.PathLike[str], audio_path: str | os.PathLike[str],
               kernels: str = "compiled") -> tuple[EarlyLsf, tuple[np.ndarray, int]]:
         """The model file's settings read, then the audio (each refused as it is when the
-        command reads it), the analysis started; the early analysis and the audio read."""
+        command reads it), the analysis begun; the early analysis and the audio read."""
         config, marker_rate = Model.read_settings(model_path)
         samples, rate = read_audio(audio_path)
         return cls(config, marker_rate, samples, rate, kernels), (samples, rate)
 
-    def _analyse(self, config: TrainConfig, samples: np.ndarray, rate: int, times: np.ndarray,
-                 kernels: str) -> None:
-        from .kernels import use_kernels
-
-        try:
-            with use_kernels(kernels):
-                self._result = analysed_lsf(config, samples, rate, times, threads=1)
-        except Exception:                           # computed again, where it fails as it would
-            log.debug("the early LSF analysis failed", exc_info=True)
-
     def for_model(self, model: Model) -> np.ndarray | None:
         """The LSFs, once analysed, if ``model`` analyses its inputs as the settings read did;
         else ``None``."""
-        self._thread.join()
+        lsf = self._result()
         if _Analysis.of(model.config, model.marker_rate) != self._analysis:
             return None
-        return self._result
+        return lsf
 
 
 def synthesize_recording(model: Model, audio_path: str | os.PathLike[str],
