@@ -142,12 +142,13 @@ def map_spans(fn: Callable[[int, int], T], n_frames: int, threads: int | None = 
     return [f.result() for f in futures]
 
 
-def beside(fn: Callable[[], T]) -> Callable[[], T]:
+def beside(fn: Callable[[], T], frames: int | None = None) -> Callable[[], T]:
     """``fn()`` begun in a thread of its own, in a copy of the caller's context, when synthesis
-    may use more than one thread (:func:`frame_threads`), else run here; returns what waits for
-    its result (raising its exception). For work that lets go of the interpreter lock, run beside
-    other work that does not need its result yet. The thread is a daemon: a caller that fails
-    before asking does not wait for it.
+    may use more than one thread (:func:`frame_threads`) and its input has ``frames`` enough to
+    pay for one (:data:`MIN_FRAMES_PER_THREAD`, as :func:`frame_spans` rules; ``None``: enough),
+    else run here; returns what waits for its result (raising its exception). For work that lets
+    go of the interpreter lock, run beside other work that does not need its result yet. The
+    thread is a daemon: a caller that fails before asking does not wait for it.
 
     >>> result = beside(lambda: 6 * 7)
     >>> result()
@@ -162,7 +163,7 @@ def beside(fn: Callable[[], T]) -> Callable[[], T]:
         except BaseException as exc:                    # given to the caller by result()
             future.set_exception(exc)
 
-    if frame_threads() > 1:
+    if frame_threads() > 1 and (frames is None or frames >= MIN_FRAMES_PER_THREAD):
         threading.Thread(target=work, name="facetraj-beside", daemon=True).start()
     else:
         work()

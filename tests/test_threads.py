@@ -129,23 +129,29 @@ def test_beside_runs_in_a_thread_of_its_own_and_gives_its_result_or_its_error():
     result = beside(fails)
     with pytest.raises(KeyError, match="lost"):
         result()
+    here = threading.current_thread().name
     with limit_frame_threads(1):                # one thread for synthesis: run here, at once
-        assert beside(lambda: threading.current_thread().name)() == \
-            threading.current_thread().name
+        assert beside(lambda: threading.current_thread().name)() == here
+    assert beside(lambda: threading.current_thread().name, frames=599)() == here  # too few
+    assert beside(lambda: threading.current_thread().name, frames=600)() == "facetraj-beside"
 
 
 def test_the_phonetic_synthesis_with_its_voice_match_beside_equals_one_in_line(toy_model,
                                                                                 toy_corpus):
     """The voice match is computed beside eqs 4-8 in the phonetic mode: the same synthesis and
     the same voice match as with one thread, where it is computed in line."""
-    from engine.config import SynthConfig
-    from engine.method.pipeline import synthesize
-    from engine.threads import limit_frame_threads
+    from engine.data import PhoneSegment
 
     utt = toy_corpus.utterance(toy_corpus.info.test[0])
+    span = len(utt.audio) / utt.sample_rate
+    copies = int(np.ceil(12.0 / span))             # over 600 frames: a thread of its own
+    audio = np.tile(utt.audio, copies)
+    phones = [PhoneSegment(p.start + k * span, p.end + k * span, p.label)
+              for k in range(copies) for p in utt.phones]
     config = SynthConfig(mode="phonetic")
-    both = synthesize(toy_model, utt.audio, utt.sample_rate, utt.phones, config, voice=True)
+    both = synthesize(toy_model, audio, utt.sample_rate, phones, config, voice=True)
     with limit_frame_threads(1):
-        inline = synthesize(toy_model, utt.audio, utt.sample_rate, utt.phones, config, voice=True)
+        inline = synthesize(toy_model, audio, utt.sample_rate, phones, config, voice=True)
+    assert len(both.times) >= 600
     assert np.isfinite(both.voice_match) and both.voice_match == inline.voice_match
     np.testing.assert_array_equal(both.markers, inline.markers)

@@ -330,7 +330,7 @@ def _voice_ratio_of(model: Model, energy: SpeechEnergy, times: np.ndarray, w: np
                                  energy.filtered)
 
     if config.mode == "phonetic":
-        return beside(ratio)
+        return beside(ratio, len(times))
     value = ratio()
     return lambda: value
 

@@ -103,7 +103,7 @@ class EarlyLsf:
                 log.debug("the early LSF analysis failed", exc_info=True)
                 return None
 
-        self._result = beside(analyse)
+        self._result = beside(analyse, len(times))
 
     @classmethod
     def start(cls, model_path: str | os.PathLike[str], audio_path: str | os.PathLike[str],
