@@ -69,3 +69,17 @@ def test_preallocated_gives_the_blocks_before_the_writes(tmp_path) -> None:
     with open(path, "ab") as handle, preallocated(handle, 10):
         handle.write(b"yz")                                # an append is left as it is
     assert path.read_bytes() == b"x" * 1000 + b"yz"
+
+
+def test_preallocated_leaves_a_pipe_and_memory_as_they_are() -> None:
+    """Nothing to give blocks to: no fallocate, and no truncate (a pipe cannot be cut)."""
+    from engine.io.files import preallocated
+
+    read, write = os.pipe()
+    with open(write, "wb") as handle, preallocated(handle, 1 << 16):
+        handle.write(b"through a pipe")
+    with open(read, "rb") as handle:
+        assert handle.read() == b"through a pipe"
+    memory = io.BytesIO()
+    write_npz(memory, _arrays())
+    assert np.load(io.BytesIO(memory.getvalue()))["markers"].shape == (361, 54, 3)

@@ -161,7 +161,7 @@ def preallocated(handle: BinaryIO, nbytes: int) -> Iterator[BinaryIO]:
     """``handle`` (a file open for writing, not appending) with ``nbytes`` from its position
     given their disk blocks before the block writes them; the file cut where the block stopped
     writing, so the size may be a guess. Best effort: elsewhere than Linux, on a file system
-    without fallocate or on an in-memory handle, the writes are as without it.
+    without fallocate, on a pipe or an in-memory handle, the writes are as without it.
 
     Why (issue 28): ext4, the usual Linux file system, writes out a new file's data blocks when
     a rename replaces an existing file (its ``auto_da_alloc``), which :func:`atomic_write` does on
@@ -176,15 +176,17 @@ def preallocated(handle: BinaryIO, nbytes: int) -> Iterator[BinaryIO]:
     b'abc'
     """
     fn = _fallocate()
-    try:
-        fd = -1 if "a" in getattr(handle, "mode", "") else handle.fileno()   # appends: as they are
+    try:                                       # appends and pipes: as they are
+        fd = handle.fileno() if handle.seekable() and "a" not in getattr(handle, "mode", "") else -1
     except (AttributeError, OSError, io.UnsupportedOperation):
         fd = -1
-    if fn is not None and fd >= 0 and nbytes > 0:
+    given = fn is not None and fd >= 0 and nbytes > 0
+    if given:
         handle.flush()
-        fn(fd, 0, handle.tell(), nbytes)       # a failure (no support, no space) changes nothing
+        fn(fd, 0, handle.tell(), nbytes)       # a failure (no support, no space): as without it
     yield handle
-    handle.truncate()
+    if given:                                  # the file may reach past what was written
+        handle.truncate()
 
 
 def write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
