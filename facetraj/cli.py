@@ -23,12 +23,13 @@ log = logging.getLogger("facetraj")
 
 EXIT_BAD_INPUT = 2
 
-#: The subcommand modules, in the order ``facetraj --help`` lists them.
-COMMANDS = (gui, train, synth, align, evaluate, render, corpus, live)
-#: Each subcommand's module (a test checks it against what the modules register)
+#: Each subcommand's module, in the order ``facetraj --help`` lists them (a test checks it
+#: against what the modules register)
 COMMAND_MODULES = {"gui": gui, "train": train, "synth": synth, "align": align, "eval": evaluate,
                    "sweep": evaluate, "similarity": evaluate, "report": render, "video": render,
                    "corpus": corpus, "live": live}
+#: The subcommand modules, each once, in that order.
+COMMANDS = tuple(dict.fromkeys(COMMAND_MODULES.values()))
 
 
 def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
@@ -72,17 +73,16 @@ def _command_named(argv: Sequence[str]) -> str | None:
     """The subcommand ``argv`` names after the top-level options, if it is one of
     :data:`COMMAND_MODULES` and no help is asked for before it; else ``None`` (then every
     subcommand is registered, for the help and the errors that list them)."""
+    argv = list(argv)
     probe = _top_parser(_Probe, add_help=False)
     probe.add_argument("command", nargs="?")
     try:
-        known, _rest = probe.parse_known_args(list(argv))
+        command = probe.parse_known_args(argv)[0].command
     except ValueError:
         return None
-    command = known.command
-    if command not in COMMAND_MODULES:
+    if command not in COMMAND_MODULES or {"-h", "--help"} & set(argv[:argv.index(command)]):
         return None
-    before = list(argv)[:list(argv).index(command)]
-    return None if {"-h", "--help"} & set(before) else command
+    return command
 
 
 class _Version(argparse.Action):

@@ -61,38 +61,21 @@ class RecordingSynthesis:
         return f"{self.audio_path.name}: labels {labels}; {self.choice.describe()}{match}"
 
 
-@dataclass(frozen=True)
-class _Analysis:
-    """What the input LSFs of a recording depend on in a model: its analysis settings, its
-    marker rate."""
-
-    audio_rate: int
-    lpc_order: int
-    window_s: float
-    preemphasis: float
-    marker_rate: float
-
-    @classmethod
-    def of(cls, config: TrainConfig, marker_rate: float) -> _Analysis:
-        return cls(config.audio_rate, config.lpc_order, config.window_s, config.preemphasis,
-                   float(marker_rate))
-
-
 class EarlyLsf:
     """A recording's input LSFs (eq 5's w), analysed beside other work (:func:`engine.threads.
     beside`) from the moment the model file's settings (its checked metadata,
     :meth:`Model.read_settings`) and the audio are read, while the caller reads the model's
     arrays and the labels: the compiled analysis lets go of the interpreter lock, so on a 60 s
     file its 13 ms ran beside the model file's 15 ms and the labels' 5 ms (issue 28).
-    :meth:`for_model` gives them to a model of the same analysis settings (else ``None``:
-    computed again, as without this); an analysis that fails here gives ``None`` too, and fails
-    again where the synthesis computes it, as it would have."""
+    :meth:`for_model` gives them to a model of the same settings and marker rate (else
+    ``None``: computed again, as without this); an analysis that fails here gives ``None`` too,
+    and fails again where the synthesis computes it, as it would have."""
 
     def __init__(self, config: TrainConfig, marker_rate: float, samples: np.ndarray, rate: int,
                  kernels: str = "compiled"):
         from .kernels import use_kernels
 
-        self._analysis = _Analysis.of(config, marker_rate)
+        self._settings = (config, float(marker_rate))
         times = np.arange(frame_count(len(samples), rate, marker_rate)) / float(marker_rate)
 
         def analyse() -> np.ndarray | None:
@@ -115,12 +98,10 @@ class EarlyLsf:
         return cls(config, marker_rate, samples, rate, kernels), (samples, rate)
 
     def for_model(self, model: Model) -> np.ndarray | None:
-        """The LSFs, once analysed, if ``model`` analyses its inputs as the settings read did;
-        else ``None``."""
+        """The LSFs, once analysed, if ``model`` has the settings and marker rate read first
+        (the file was not replaced between the two reads); else ``None``."""
         lsf = self._result()
-        if _Analysis.of(model.config, model.marker_rate) != self._analysis:
-            return None
-        return lsf
+        return lsf if (model.config, float(model.marker_rate)) == self._settings else None
 
 
 def synthesize_recording(model: Model, audio_path: str | os.PathLike[str],
