@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 XVFB   := $(if $(DISPLAY),,xvfb-run -a -s "-screen 0 1600x1200x24")
 
-.PHONY: run test lint bench fuzz corpus report clean kernels
+.PHONY: run test lint bench fuzz corpus report clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -13,13 +13,6 @@ $(BIN)/python:
 $(VENV)/.installed-run: pyproject.toml | $(BIN)/python
 	$(BIN)/pip install -q -e .
 	touch $@
-
-# the compiled kernels built ahead of time for this machine (engine/method/aot.py; about 15 s),
-# again whenever their fingerprint (engine/method/prebuilt.py: sources, processor) says they are
-# stale; without them numba compiles or loads its kernels in every process that uses them
-kernels: $(VENV)/.installed-run
-	@$(BIN)/python -m engine.method.aot || \
-	  echo "facetraj: prebuilt kernels not built (no C compiler?): numba's just-in-time ones will run"
 
 # the tests include the corpus generator's bit-for-bit reproduction check, hence the corpus extra
 $(VENV)/.installed-test: pyproject.toml | $(BIN)/python
@@ -30,16 +23,16 @@ $(VENV)/.installed-corpus: pyproject.toml | $(BIN)/python
 	$(BIN)/pip install -q -e ".[test,corpus]"
 	touch $@
 
-run: $(VENV)/.installed-run kernels
+run: $(VENV)/.installed-run
 	$(BIN)/facetraj gui data_samples
 
 lint: $(VENV)/.installed-test
 	$(BIN)/ruff check .
 
-test: lint kernels
+test: lint
 	$(XVFB) $(BIN)/python -m pytest
 
-bench: $(VENV)/.installed-test kernels
+bench: $(VENV)/.installed-test
 	$(XVFB) $(BIN)/python -m benchmarks
 
 # the long bad-input fuzz run (tests/fuzzing.py): thousands of mutated inputs through the command
@@ -48,7 +41,7 @@ bench: $(VENV)/.installed-test kernels
 # (docs/bad-input.md)
 FUZZ_CASES ?= 3300
 FUZZ_SEED  ?= 14
-fuzz: $(VENV)/.installed-test kernels
+fuzz: $(VENV)/.installed-test
 	$(XVFB) $(BIN)/python tests/fuzzing.py --cases $(FUZZ_CASES) --seed $(FUZZ_SEED)
 
 corpus: $(VENV)/.installed-corpus
@@ -64,4 +57,4 @@ report: $(VENV)/.installed-test
 	$(BIN)/facetraj report data_samples -o docs
 
 clean:
-	rm -rf $(VENV) build *.egg-info .pytest_cache .ruff_cache engine/method/_kernels_aot.*
+	rm -rf $(VENV) build *.egg-info .pytest_cache .ruff_cache

@@ -275,7 +275,6 @@ def live_figure(out: Path) -> list[Path]:
     model = load_or_train(corpus)
     audio = read_audio(audio_path(corpus.root, "s002"))
     window = LiveWindow(model, None, audio, block_s=0.05, fast=True)
-    window.warm_kernels = False
     window.resize(1400, 800)
     window.show()
     done = []

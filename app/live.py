@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import logging
 import sys
-import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -42,7 +41,6 @@ from engine.config import SynthConfig
 from engine.errors import FacetrajError
 from engine.io.audio import read_audio, write_audio
 from engine.io.export import write_trajectories
-from engine.method import kernels
 from engine.method.model import Model
 
 from .live_input import MIC_RATE, FileFeeder, InputHealth, InputLost, MicFeeder, input_devices
@@ -82,7 +80,6 @@ class LiveWindow(QMainWindow):
         self.config = config or SynthConfig()
         self.from_file, self.block_s, self.fast = from_file, block_s, fast
         self.stream = None                  # the take's engine.streaming.live.LiveStream
-        self.warm_kernels = True            # off: a screenshot (the process ends with the take)
         self.feeder: FileFeeder | MicFeeder | None = None
         self.rate = MIC_RATE
         self._new_take()
@@ -192,19 +189,10 @@ class LiveWindow(QMainWindow):
             self.open_recording(name)
 
     # ------------------------------------------------------------------ a take
-    def _warm_kernels(self) -> None:
-        """Load the compiled kernels in the background (numba: half a second, ten on the first
-        run after an install); the stream runs numpy's until they are in, never waiting
-        (``engine.method.kernels.never_waiting``)."""
-        if self.warm_kernels and kernels.kernel_choice() == "compiled" and not kernels.loaded():
-            self.warm_kernels = False
-            threading.Thread(target=kernels.warm_up, name="facetraj-kernels", daemon=True).start()
-
     def start(self) -> None:
         """Begin a take (the previous one is dropped)."""
         from engine.streaming.live import LiveConfig, LiveStream  # the recognizer: with a take
 
-        self._warm_kernels()
 
         index = self.device_box.currentIndex() - (self.device_box.count() - len(self.devices))
         try:
@@ -364,7 +352,7 @@ class LiveWindow(QMainWindow):
         now = time.perf_counter()
         if now - self._last_plot >= PLOT_EVERY_S or self.stream is None:
             # the panels and the meter together: any repaint beside the OpenGL view recomposes
-            # the window (measured 4-35 ms under Xvfb/Mesa), so they are not repainted per frame
+            # the window (docs/benchmarks.md), so they are not repainted per frame
             self._last_plot = now
             self.level.setValue(self._level)
             self._level = -60
@@ -469,7 +457,6 @@ def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = Non
     if audio is None and not input_devices():
         raise FacetrajError(NO_INPUT_DEVICE_COMMAND)
     window = LiveWindow(model, config, audio, block_s, fast, device, phones)
-    window.warm_kernels = not screenshot
     window.resize(1400, 800)
     window.show()
 

@@ -23,8 +23,7 @@ WINDOW_SIZE = (1600, 1000)
 def long_lived_objects() -> Iterator[None]:
     """A block that makes objects living as long as the process (the window's imports: some
     250,000 objects): the cyclic garbage collector pauses during it and leaves its objects out of
-    later passes (``gc.freeze``); its full passes over them took 0.2-0.3 s of the first frame
-    (issue #15)."""
+    later passes (``gc.freeze``): full passes over them held up the first frame (issue #15)."""
     was_enabled = gc.isenabled()
     gc.disable()
     try:
@@ -122,7 +121,6 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
 
         window.set_error_handler(fail)     # no dialogs in screenshot mode
         window.set_correlation_sweep(False)  # one frame: nothing to compute in the background
-        window.warm_kernels = False
 
         def shoot() -> None:
             if window.view is None:

@@ -72,7 +72,6 @@ from engine.config import SynthConfig
 from engine.data import Utterance
 from engine.errors import FacetrajError
 from engine.io.corpus import Corpus, load_corpus
-from engine.method import kernels
 from engine.method.model import Model
 
 from .browser import UtteranceBrowser
@@ -192,7 +191,6 @@ class MainWindow(QMainWindow):
         self.status_label, self.progress = self.status.label, self.status.progress
         self.dimensions_label = self.status.dimensions_label
         self.scores = BrowserScores(self.browser, self.tasks, self.playback.idle)
-        self.warm_kernels, self._kernels_warming = True, False     # off: a one-frame screenshot
 
     def _build_transport(self) -> TransportBar:
         bar = TransportBar()
@@ -371,19 +369,8 @@ class MainWindow(QMainWindow):
 
         self.run_task(request.run, done, "synthesizing")
 
-    def _warm_kernels(self) -> None:
-        """Load the compiled kernels (``engine.method.kernels``: numba's import and cache read,
-        about half a second) once, in the background after the first frame (numpy's), unless
-        they are ready already (prebuilt at install: nothing to load)."""
-        if not self._kernels_warming and self.warm_kernels and \
-                kernels.kernel_choice() == "compiled" and not kernels.loaded():
-            self._kernels_warming, gate = True, self.tasks.foreground_idle
-            self.run_task(lambda p: (p.wait_open(gate), kernels.warm_up()), None,
-                          "loading the compiled kernels", background=True)
-
     def _apply_view(self, view: UtteranceView, new_utterance: bool) -> None:
         mark("synthesis done")
-        self._warm_kernels()
         t = 0.0 if new_utterance else self.clock.time()
         was_playing = self.clock.playing and not new_utterance
         if new_utterance:

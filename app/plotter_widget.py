@@ -4,8 +4,8 @@ On X11 (Qt's ``xcb`` platform, Xvfb included) the plotter renders into a native 
 (:class:`NativePlotter`: VTK's own ``QVTKRenderWindowInteractor`` with PyVista's plotter API).
 pyvistaqt's ``QtInteractor`` is a ``QOpenGLWidget`` instead, and once a ``QOpenGLWidget`` is in a
 window, Qt composes the *whole* window through OpenGL at every flush: with a software renderer
-(Mesa llvmpipe under Xvfb) that costs more than the 3-D render itself (12-20 ms per flush of a
-1600x1000 window, measured; docs/benchmarks.md, "Playback"). In a native child window VTK swaps
+(Mesa llvmpipe under Xvfb) that costs more than the 3-D render itself (docs/benchmarks.md,
+"Playback"). In a native child window VTK swaps
 only its own pixels, and the rest of the window stays a raster backing store whose flushes copy
 only what changed (a moving cursor, a label). Other platforms (Wayland) keep ``QtInteractor``;
 ``FACETRAJ_3D_WIDGET=opengl`` chooses it on X11 too.

@@ -13,26 +13,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from engine.config import SynthConfig
+from engine.method.modes import SEARCHES, search_of
 
-#: The searches the settings offer, by key (:func:`search_key`): the title's name of each.
-SEARCH_NAMES = {
-    "robust": "robust",
-    "phonetic": "phonetic (the paper)",
-    "acoustic": "acoustic only, indexed",
-    "acoustic-full": "acoustic only, whole codebook (the paper)",
-}
-
-#: One line per search, shown under the selector.
-MODE_NOTES = {
-    "robust": "robust: eq 4's and the acoustically nearest codewords together; each label counts "
-              "as much as the aligner/recognizer trusts it (default for automatic labels).",
-    "phonetic": "phonetic (the paper): the labels alone pick the N context-phones searched "
-                "(eq 4); best with hand-checked labels.",
-    "acoustic": "acoustic only: no labels; the codewords nearest to each frame by eq 5, found "
-                "in the model's LSF index (fast).",
-    "acoustic-full": "acoustic only, whole codebook: eqs 5-8 over every codeword, as the paper "
-                     "(slow).",
-}
+#: The searches the settings offer, by key (:func:`search_key`): the title's name of each, and one
+#: line on each, shown under the selector (both from the modes' one home, ``engine.method.modes``).
+SEARCH_NAMES = {key: s.title for key, s in SEARCHES.items()}
+MODE_NOTES = {key: s.note for key, s in SEARCHES.items()}
 
 
 def search_key(config: SynthConfig) -> str:
@@ -43,9 +29,7 @@ def search_key(config: SynthConfig) -> str:
     ...                                                                acoustic_prefilter=None))
     ('acoustic', 'acoustic-full')
     """
-    if config.mode == "acoustic" and config.acoustic_prefilter is None:
-        return "acoustic-full"
-    return config.mode
+    return search_of(config).key
 
 
 def search_title(config: SynthConfig) -> str:
@@ -55,7 +39,7 @@ def search_title(config: SynthConfig) -> str:
     'acoustic only, indexed (K = 128)'
     """
     key = search_key(config)
-    name = SEARCH_NAMES.get(key, key)
+    name = SEARCH_NAMES[key]
     return f"{name} (K = {config.acoustic_prefilter})" if key == "acoustic" else name
 
 

@@ -24,10 +24,15 @@ from PyQt6.QtWidgets import (
 )
 
 from engine.config import SynthConfig
+from engine.method.modes import MODES, SEARCHES, TUNED_FIELDS
 
 from .provenance import MODE_NOTES, mode_reason, search_key
 
 __all__ = ["MODE_NOTES", "SynthSettingsPanel"]
+
+#: the settings the panel has a control for (a model's cross-validated values of these show in
+#: their controls, editable; the others apply as they are)
+PANEL_FIELDS = ("n_context_phones", "context", "xi", "nu", "smoothing")
 
 class SynthSettingsPanel(QWidget):
     """Edits a :class:`SynthConfig`; emits ``configChanged`` after a short pause in editing."""
@@ -69,17 +74,9 @@ class SynthSettingsPanel(QWidget):
         self.nu.setToolTip("ν: eq 3 constant of the visual phoneme similarity")
         self.mode = QComboBox()
         # short: the line under the box explains the search (the box fits a narrow dock)
-        self.mode.addItem("robust (labels weighted)", "robust")
-        self.mode.addItem("phonetic (the paper)", "phonetic")
-        self.mode.addItem("acoustic only, indexed", "acoustic")
-        self.mode.addItem("acoustic only, whole codebook", "acoustic-full")
-        self.mode.setToolTip(
-            "phonetic: eq 4 picks N context-phones from the labels, eqs 5-8 weight their codewords.\n"
-            "acoustic only, indexed: no labels; eqs 6-8 weight the codewords nearest to each frame by\n"
-            "eq 5, found in the model's LSF index (docs/algorithm.md gives the accuracy cost).\n"
-            "acoustic only, whole codebook: eqs 5-8 over every codeword, as the paper does.\n"
-            "robust: eq 4's codewords and the acoustically nearest together, eq 5 with acoustic\n"
-            "context plus a penalty for codewords eq 4 did not choose, times the label's confidence.")
+        for search in SEARCHES.values():
+            self.mode.addItem(search.label, search.key)
+        self.mode.setToolTip("\n".join(search.note for search in SEARCHES.values()))
         self.mode_note = QLabel("")
         self.mode_note.setWordWrap(True)
         self.mode_reason = QLabel("")
@@ -142,7 +139,7 @@ class SynthSettingsPanel(QWidget):
         show with the robust search only."""
         key = self.mode.currentData()
         self.mode_note.setText(MODE_NOTES.get(key, ""))
-        self.tuned_label.setVisible(key == "robust")
+        self.tuned_label.setVisible(MODES[SEARCHES[key].mode].tuned)
 
     def _search_chosen(self, index: int) -> None:
         """The user picked a search (also the one shown): that is what the settings ask for now,
@@ -150,7 +147,7 @@ class SynthSettingsPanel(QWidget):
         self._timer.stop()
         self._requested = self.mode.itemData(index)
         n = self._tuned.get("settings", {}).get("n_context_phones")
-        if self._requested == "robust" and n is not None:
+        if MODES[SEARCHES[self._requested].mode].tuned and n is not None:
             self.n.blockSignals(True)
             self.n.setValue(int(n))                  # the cross-validated N, still editable
             self.n.blockSignals(False)
@@ -223,21 +220,19 @@ class SynthSettingsPanel(QWidget):
     def config(self) -> SynthConfig:
         """The settings as edited, with the search they ask for (not necessarily the one shown:
         see ``show_used``)."""
-        key = self._requested
-        search = {}
-        if key == "acoustic-full":
-            search = {"acoustic_prefilter": None}
-        elif self._base.acoustic_prefilter is None:      # back from the whole codebook: the default K
-            search = {"acoustic_prefilter": SynthConfig().acoustic_prefilter}
-        if key == "robust":       # the cross-validated settings the panel has no control for
-            search.update({k: v for k, v in self._tuned.get("settings", {}).items()
-                           if k in ("label_weight", "context_weight", "robust_candidates", "gamma_max",
-                                    "triangle_s")})
+        search = SEARCHES[self._requested]
+        default, changes = SynthConfig(), {}
+        for other in SEARCHES.values():      # back from another search's settings: the defaults
+            changes.update({k: getattr(default, k) for k, v in other.settings.items()
+                            if getattr(self._base, k) == v})
+        changes.update(search.settings)
+        if MODES[search.mode].tuned:   # the cross-validated settings the panel has no control for
+            changes.update({k: v for k, v in self._tuned.get("settings", {}).items()
+                            if k in TUNED_FIELDS and k not in PANEL_FIELDS})
         return self._base.with_(
             n_context_phones=self.n.value(), context=self.c.value(), xi=self.xi.value(),
-            nu=None if self.nu_default.isChecked() else self.nu.value(),
-            mode="acoustic" if key == "acoustic-full" else key,
-            smoothing=self.smoothing.currentData(), **search)
+            nu=None if self.nu_default.isChecked() else self.nu.value(), mode=search.mode,
+            smoothing=self.smoothing.currentData(), **changes)
 
     def _on_nu_default(self, checked: bool) -> None:
         self.nu.setEnabled(not checked)

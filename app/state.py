@@ -13,8 +13,6 @@ import numpy as np
 from engine.config import SynthConfig
 from engine.data import Utterance
 from engine.evaluation.scores import speech_mask
-from engine.method import kernels
-from engine.method.kernels import use_kernels
 from engine.method.model import Model
 from engine.method.pipeline import Synthesis, resmooth, synthesize
 
@@ -99,12 +97,9 @@ def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig,
     every track the window shows (slow: run in a worker). Raises the engine's
     :class:`~engine.errors.FacetrajError` on bad input."""
     n_frames = utt.n_frames or None
-    # the compiled kernels once loaded (in the background, after the first frame: numba's import
-    # and cache read would delay it by about half a second), the numpy reference until then
-    with use_kernels(kernels.ready_choice()):
-        res = synthesize(model, utt.audio, utt.sample_rate, utt.phones if utt.phones else None,
-                         config, n_frames=n_frames, source=utt.name, confidence=utt.confidence,
-                         provenance=utt.provenance, voice=True)
+    res = synthesize(model, utt.audio, utt.sample_rate, utt.phones if utt.phones else None,
+                     config, n_frames=n_frames, source=utt.name, confidence=utt.confidence,
+                     provenance=utt.provenance, voice=True)
     original = model.normalise_markers(utt.markers) if utt.markers is not None else None
     triangular = res.markers if config.smoothing == "triangular" else resmooth(model, res, "triangular")
     spline = res.markers if config.smoothing == "spline" else resmooth(model, res, "spline")

@@ -27,7 +27,7 @@ from engine.evaluation.paper import FIGURE4_TEXT
 from engine.evaluation.scores import evaluate_utterance
 from engine.io.corpus import Corpus, label_path
 from engine.method.model import Model
-from engine.method.modes import choose_mode
+from engine.method.modes import MODES, choose_mode
 from engine.progress import Progress
 
 from .phases import mark
@@ -257,7 +257,7 @@ def view_title(view: UtteranceView) -> str:
     utt, cfg = view.utterance, view.synthesis.config
     origin = view.label_origin
     text = f" — “{utt.text}”" if utt.text and origin.source != "recognized" else ""
-    n = f", N={cfg.n_context_phones}" if cfg.mode in ("phonetic", "robust") else ""
+    n = f", N={cfg.n_context_phones}" if MODES[cfg.mode].needs_labels else ""
     return (f"{utt.name} ({view.split}){text}    ·    3-D: {SMOOTHING_NAMES[cfg.smoothing]} synthesis, "
             f"{search_title(cfg)}{n};  labels: {origin.text()}")
 

@@ -10,7 +10,8 @@ shared          ``config`` (settings), ``data`` (an utterance), ``errors``, ``fa
 ``io``          files in and out: audio, label and marker files, corpus folders, model files,
                 exports, caches, and which labels an input gets
 ``method``      the paper (sections 2.1-2.3): LSF, PCA, codebook, similarity (eqs 1-3),
-                eq 4, eqs 5-8, smoothing, training, the model, the synthesis pipeline
+                eq 4, eqs 5-8, smoothing, training, the model, the modes, the pipeline
+``workflow``    a recording in, a face out: its labels and mode by the rules, its synthesis
 ``streaming``   the method on audio blocks as they arrive (live mode)
 ``evaluation``  the paper's section 3 and beyond: scores, baselines, tuning, automatic labels,
                 other voices, kinematics, the paper's own numbers
@@ -36,7 +37,8 @@ from collections.abc import Callable
 __version__ = "0.1.0"
 
 #: The stages, lowest first: a module may import from its own stage and the ones before it.
-STAGES = ("labels", "io", "method", "streaming", "evaluation", ("analysis", "report", "corpusgen"))
+STAGES = ("labels", "io", "method", "workflow", "streaming", "evaluation",
+          ("analysis", "report", "corpusgen"))
 
 
 def lazy_exports(package: str, table: dict[str, str]) -> tuple[Callable, Callable, list[str]]:

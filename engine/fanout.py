@@ -124,8 +124,7 @@ def prepare_fork() -> None:
 # they share, runs ``fn`` on it and sends the result back through its own pipe; the parent only
 # reads. With a pool that hands items out itself (``concurrent.futures``) a worker waits for the
 # parent's thread between items, and where the workers fill the cores that thread waits for a
-# core: a batch of 100 files took 0.52 s with two workers, against 0.42 s for two separate
-# processes of 50 files each (benchmarks/profile_notes.md).
+# core (benchmarks/profile_notes.md measures it).
 _LENGTH = struct.Struct("<Q")
 
 

@@ -4,9 +4,8 @@ between.
 OpenBLAS keeps a thread per core and lets idle ones spin while they wait for work. Our matrix
 products are small (frames x codewords), so a second BLAS thread buys little, and when the cores
 are busy (the evaluation's worker processes, the app's synthesis beside its rendering, other
-programs) the spinning threads take the cores from the work: a whole-codebook synthesis measured
-0.65 s of CPU with one BLAS thread and 2.2-10.5 s with two, on the 2-core machine under load
-(docs/benchmarks.md). Work that runs beside other work therefore uses one BLAS thread.
+programs) the spinning threads take the cores from the work (docs/benchmarks.md measures it).
+Work that runs beside other work therefore uses one BLAS thread.
 
 Synthesis parallelises above BLAS instead: its per-frame stages (the LSF analysis, the LSF index
 search, eqs 5-8) are independent from frame to frame, and numpy releases the interpreter lock
@@ -20,9 +19,8 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import os
-import threading
 from collections.abc import Callable, Iterator
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import AbstractContextManager
 from contextvars import ContextVar
 from itertools import pairwise
@@ -123,7 +121,7 @@ def frame_spans(n_frames: int, threads: int | None = None) -> list[tuple[int, in
 def map_spans(fn: Callable[[int, int], T], n_frames: int, threads: int | None = None) -> list[T]:
     """``fn(start, stop)`` for each of :func:`frame_spans`, in threads when there are several;
     the results in span order, each span run in a copy of the caller's context (its
-    :func:`limit_frame_threads` and ``engine.method.kernels.use_kernels`` hold there). An
+    :func:`limit_frame_threads` holds there). An
     exception in a span is raised here. (The threads' matrix
     products are small: callers that run beside other work run BLAS on one thread, as the app,
     live mode and the evaluation do, :func:`one_blas_thread`.)
@@ -137,34 +135,6 @@ def map_spans(fn: Callable[[int, int], T], n_frames: int, threads: int | None = 
     global _pool
     if _pool is None or _pool[1] < len(spans):
         _pool = (ThreadPoolExecutor(len(spans), thread_name_prefix="facetraj-frames"), len(spans))
-    # each span in a copy of the caller's context: its choices (frame threads, kernels) hold there
+    # each span in a copy of the caller's context: its frame-thread limit holds there
     futures = [_pool[0].submit(contextvars.copy_context().run, fn, a, b) for a, b in spans]
     return [f.result() for f in futures]
-
-
-def beside(fn: Callable[[], T], frames: int | None = None) -> Callable[[], T]:
-    """``fn()`` begun in a thread of its own, in a copy of the caller's context, when synthesis
-    may use more than one thread (:func:`frame_threads`) and its input has ``frames`` enough to
-    pay for one (:data:`MIN_FRAMES_PER_THREAD`, as :func:`frame_spans` rules; ``None``: enough),
-    else run here; returns what waits for its result (raising its exception). For work that lets
-    go of the interpreter lock, run beside other work that does not need its result yet. The
-    thread is a daemon: a caller that fails before asking does not wait for it.
-
-    >>> result = beside(lambda: 6 * 7)
-    >>> result()
-    42
-    """
-    future: Future = Future()
-    run = contextvars.copy_context().run
-
-    def work() -> None:
-        try:
-            future.set_result(run(fn))
-        except BaseException as exc:                    # given to the caller by result()
-            future.set_exception(exc)
-
-    if frame_threads() > 1 and (frames is None or frames >= MIN_FRAMES_PER_THREAD):
-        threading.Thread(target=work, name="facetraj-beside", daemon=True).start()
-    else:
-        work()
-    return future.result

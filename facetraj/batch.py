@@ -2,7 +2,7 @@
 
 Every input goes through :func:`synthesize_file`, the one path of ``facetraj synth`` for a
 recording (its labels and mode by the same rules as one file,
-:func:`engine.method.recording.synthesize_recording`), in ``jobs`` worker processes that each
+:func:`engine.workflow.recording.synthesize_recording`), in ``jobs`` worker processes that each
 hold the model (loaded once; forked workers share the parent's copy). An input whose output
 exists is skipped unless ``overwrite`` (outputs are written whole or not at all, so an interrupted
 run resumes where it stopped); an input that fails is reported with its one-line reason and the
@@ -18,7 +18,7 @@ import math
 import os
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -37,8 +37,8 @@ _GLOB_CHARS = frozenset("*?[")
 @dataclass(frozen=True)
 class SynthJob:
     """What every input of a run shares: the synthesis settings and how outputs are written
-    (``request``: :class:`~engine.method.recording.LabelRequest`; ``explicit``, ``keep``: as
-    :func:`~engine.method.recording.synthesize_recording` takes them)."""
+    (``request``: :class:`~engine.workflow.recording.LabelRequest`; ``explicit``, ``keep``: as
+    :func:`~engine.workflow.recording.synthesize_recording` takes them)."""
 
     config: Any
     request: Any
@@ -46,8 +46,6 @@ class SynthJob:
     keep: tuple[str, ...] = ()
     overwrite: bool = False
     compress: bool = False
-    #: ``compiled`` or ``numpy`` (``engine.method.kernels``): chosen for the whole run
-    kernels: str = "compiled"
 
 
 @dataclass
@@ -132,19 +130,14 @@ def output_paths(inputs: Sequence[Path], outdir: Path, fmt: str) -> list[Path]:
 
 
 # --------------------------------------------------------------------------- one input
-def synthesize_file(model: Any, audio: Path, output: Path, job: SynthJob,
-                    samples: tuple[Any, int] | None = None, early: Any = None) -> Any:
-    """One recording to one trajectory file, as ``facetraj synth`` does for every input
-    (``samples``, ``early``: its audio when read, its input LSFs being analysed, as
-    :func:`~engine.method.recording.synthesize_recording` takes them); returns the
-    :class:`~engine.method.recording.RecordingSynthesis` (logged)."""
+def synthesize_file(model: Any, audio: Path, output: Path, job: SynthJob) -> Any:
+    """One recording to one trajectory file, as ``facetraj synth`` does for every input;
+    returns the :class:`~engine.workflow.recording.RecordingSynthesis` (logged)."""
     from engine.io.export import write_trajectories
-    from engine.method.kernels import use_kernels
-    from engine.method.recording import synthesize_recording
+    from engine.workflow.recording import synthesize_recording
 
-    with use_kernels(job.kernels):
-        done = synthesize_recording(model, audio, job.config, job.request, explicit=job.explicit,
-                                    keep=list(job.keep), audio=samples, early=early)
+    done = synthesize_recording(model, audio, job.config, job.request, explicit=job.explicit,
+                                keep=list(job.keep))
     log.info("%s", done.describe())
     res = done.synthesis
     write_trajectories(output, res.markers, model.marker_rate, model.marker_names, res.arrays(),
@@ -158,7 +151,7 @@ _WORKER: dict[str, Any] = {}
 
 def _worker_init(model_path: Path, job: SynthJob, one_thread: bool) -> None:
     """A worker process: the model loaded once (unless inherited from the parent), one BLAS
-    thread (the products are small: more threads spin, measured 1.7x the CPU time on a batch),
+    thread (the products are small: more threads spin, ``engine.threads``),
     and one frame thread when the workers share the cores (``one_thread``)."""
     from engine.threads import THREADS_ENV, one_blas_thread
 
@@ -201,56 +194,17 @@ def _worker_run(pair: tuple[Path, Path]) -> Outcome:
                    float(res.times[-1]), details)
 
 
-def choose_kernels(job: SynthJob, inputs: Iterable[Path], workers: int = 1) -> SynthJob:
-    """``job`` with the kernels that pay for themselves on ``inputs`` shared by ``workers``
-    processes (``engine.method.kernels.choice_for``): the prebuilt ones whenever they are there;
-    else numba's, whose loading costs about half a second, paid before the workers fork, when
-    they save it back on minutes of speech in each worker, the durations read from the files'
-    headers only as far as needed (an unreadable one counts nothing: its synthesis says why)."""
-    from engine.method.kernels import PAYS_OFF_S, choice_for, ready_choice
-
-    mode = job.config.mode
-    if ready_choice() == "compiled":                   # prebuilt (or loaded): nothing to count
-        return replace(job, kernels="compiled")
-    import soundfile as sf
-
-    enough, seconds = PAYS_OFF_S.get(mode, 150.0) * workers, 0.0
-    for path in inputs:
-        try:
-            seconds += sf.info(str(path)).duration
-        except Exception:                                     # soundfile raises several types
-            continue
-        if seconds >= enough:
-            break
-    choice = choice_for(seconds / workers, mode)
-    log.debug("%s kernels (%.0f s of speech counted, %d workers)", choice, seconds, workers)
-    return replace(job, kernels=choice)
-
-
 def import_synthesis() -> None:
     """Import what every input's synthesis imports (the audio reader, the label readers, the
-    writers, and ``numpy.ma``, which ``numpy.percentile`` imports on its first call): the
-    command's start-up, paid once before a batch's workers fork, not in each worker."""
+    writers, and ``numpy.ma``, which ``numpy.percentile`` imports on its first call): paid once
+    before a batch's workers fork, not in each worker (and the benchmarks' start-up)."""
     import numpy.ma  # noqa: F401
     import soundfile  # noqa: F401
 
     import engine.io.export
     import engine.io.labelling
     import engine.io.textgrid
-    import engine.method.recording  # noqa: F401
-
-
-def _preload(job: SynthJob, model: Any) -> None:
-    """:func:`import_synthesis`, the engine's before-fork hooks run (the compiled kernels loaded
-    when chosen) and the model's search layout made, once, before the workers fork (each
-    worker's first input made that layout for itself: 1,700 page faults)."""
-    from engine.fanout import prepare_fork
-    from engine.method.kernels import use_kernels
-
-    import_synthesis()
-    model.prepare_search()
-    with use_kernels(job.kernels):                # the kernels loaded here when chosen
-        prepare_fork()
+    import engine.workflow.recording  # noqa: F401
 
 
 # --------------------------------------------------------------------------- fan-out
@@ -300,9 +254,8 @@ def run_batch(model_path: Path, specs: Sequence[str], outdir: Path, fmt: str, jo
     workers = max(1, min(jobs, len(todo)))
     log.info("%d inputs: %d to synthesize in %d process%s, %d skipped (output exists)",
              len(inputs), len(todo), workers, "es" * (workers > 1), len(outcomes))
-    job = choose_kernels(job, (src for src, _ in todo), workers)
     if workers > 1:
-        _preload(job, model)
+        import_synthesis()
     _WORKER.update(path=model_path, model=model)          # shared by forked workers
     t0 = time.perf_counter()
     results = fan_out(_worker_run, todo, workers, _worker_init, (model_path, job, workers > 1))

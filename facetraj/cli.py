@@ -23,34 +23,28 @@ log = logging.getLogger("facetraj")
 
 EXIT_BAD_INPUT = 2
 
-#: Each subcommand's module, in the order ``facetraj --help`` lists them (a test checks it
-#: against what the modules register)
-COMMAND_MODULES = {"gui": gui, "train": train, "synth": synth, "align": align, "eval": evaluate,
-                   "sweep": evaluate, "similarity": evaluate, "report": render, "video": render,
-                   "corpus": corpus, "live": live}
-#: The subcommand modules, each once, in that order.
-COMMANDS = tuple(dict.fromkeys(COMMAND_MODULES.values()))
+#: The subcommand modules, in the order ``facetraj --help`` lists what they register.
+COMMANDS = (gui, train, synth, align, evaluate, render, corpus, live)
 
 
-def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
-    """The command's parser: every subcommand, or only the one ``argv`` names (registering
-    them all took 4-5 ms of every run, issue 28); the same parse of ``argv`` either way."""
-    parser = _top_parser(argparse.ArgumentParser)
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    command = None if argv is None else _command_named(argv)
-    for module in (COMMAND_MODULES[command],) if command else COMMANDS:
-        module.register(sub)
-    for subparser in subcommand_parsers(parser):
-        _add_verbosity(subparser)
-    return parser
+class SubcommandParser(argparse.ArgumentParser):
+    """A subcommand's parser: ``-v``/``-q`` after the subcommand too (``SUPPRESS`` keeps the value
+    given before it). Nested subcommands (``corpus init``) are made of this class as well."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.add_argument("-v", "--verbose", action="count", default=argparse.SUPPRESS,
+                          help="log details (-vv: also the libraries' own debug messages)")
+        self.add_argument("-q", "--quiet", action="store_true", default=argparse.SUPPRESS,
+                          help="log only errors")
 
 
-def _top_parser(kind: type[argparse.ArgumentParser], **kwargs) -> argparse.ArgumentParser:
-    """The options before the subcommand."""
-    parser = kind(
+def build_parser() -> argparse.ArgumentParser:
+    """The command's parser, every subcommand registered."""
+    parser = argparse.ArgumentParser(
         prog="facetraj",
         description="Speech-driven 3-D face point trajectory synthesis (Arslan & Talkin). "
-                    "Without a subcommand, opens the app on the default corpus.", **kwargs)
+                    "Without a subcommand, opens the app on the default corpus.")
     parser.add_argument("-v", "--verbose", action="count", default=0,
                         help="log details (-vv: also the libraries' own debug messages)")
     parser.add_argument("-q", "--quiet", action="store_true", help="log only errors")
@@ -59,35 +53,15 @@ def _top_parser(kind: type[argparse.ArgumentParser], **kwargs) -> argparse.Argum
                         help="render the app window to a PNG and exit")
     parser.add_argument("--utterance", help="utterance shown first")
     parser.add_argument("--time", type=SECONDS, help="cursor time in seconds")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=SubcommandParser)
+    for module in COMMANDS:
+        module.register(sub)
     return parser
-
-
-class _Probe(argparse.ArgumentParser):
-    """A parser whose errors are exceptions, not a message and an exit."""
-
-    def error(self, message: str):
-        raise ValueError(message)
-
-
-def _command_named(argv: Sequence[str]) -> str | None:
-    """The subcommand ``argv`` names after the top-level options, if it is one of
-    :data:`COMMAND_MODULES` and no help is asked for before it; else ``None`` (then every
-    subcommand is registered, for the help and the errors that list them)."""
-    argv = list(argv)
-    probe = _top_parser(_Probe, add_help=False)
-    probe.add_argument("command", nargs="?")
-    try:
-        command = probe.parse_known_args(argv)[0].command
-    except ValueError:
-        return None
-    if command not in COMMAND_MODULES or {"-h", "--help"} & set(argv[:argv.index(command)]):
-        return None
-    return command
 
 
 class _Version(argparse.Action):
     """``--version``: the installed package's version, looked up only when asked
-    (``importlib.metadata`` costs every other command 40 ms)."""
+    (``importlib.metadata`` is slow to import)."""
 
     def __call__(self, parser, namespace, values, option_string=None):
         from importlib.metadata import PackageNotFoundError, version
@@ -99,27 +73,8 @@ class _Version(argparse.Action):
         parser.exit(message=f"facetraj {text}\n")
 
 
-def subcommand_parsers(parser: argparse.ArgumentParser) -> list[argparse.ArgumentParser]:
-    """Every (nested) subcommand parser under ``parser``, each once, in registration order."""
-    found: list[argparse.ArgumentParser] = []
-    for action in parser._actions:  # argparse offers no public walk over subparsers
-        if isinstance(action, argparse._SubParsersAction):
-            for child in dict.fromkeys(action.choices.values()):
-                found.append(child)
-                found.extend(subcommand_parsers(child))
-    return found
-
-
-def _add_verbosity(p: argparse.ArgumentParser) -> None:
-    """``-v``/``-q`` after the subcommand too; SUPPRESS keeps the value given before it."""
-    p.add_argument("-v", "--verbose", action="count", default=argparse.SUPPRESS,
-                   help="log details (-vv: also the libraries' own debug messages)")
-    p.add_argument("-q", "--quiet", action="store_true", default=argparse.SUPPRESS,
-                   help="log only errors")
-
-
 #: The packages whose messages ``-v`` shows (facetraj's own); every other logger (matplotlib's font
-#: matching, PIL, numba, ...) logs warnings and errors only, unless ``-vv`` is given.
+#: matching, PIL, ...) logs warnings and errors only, unless ``-vv`` is given.
 OWN_LOGGERS = ("facetraj", "engine", "app", "benchmarks")
 
 
@@ -142,7 +97,7 @@ def configure_logging(verbose: int = 0, quiet: bool = False) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
-    args = build_parser(argv).parse_args(argv)
+    args = build_parser().parse_args(argv)
     configure_logging(args.verbose, args.quiet)
     if args.command is None:
         args.corpus = default_corpus()

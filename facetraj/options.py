@@ -13,6 +13,7 @@ import math
 from collections.abc import Callable
 
 from engine.config import SynthConfig, TrainConfig
+from engine.method.modes import MODES
 
 ALL = -1
 
@@ -146,11 +147,9 @@ def add_synth_options(p: argparse.ArgumentParser, nu: bool = True) -> None:
     if nu:
         g.add_argument("--nu", type=POSITIVE, help="override eq 3's constant")
     g.add_argument("--synth-context", type=CONTEXT, help="context C used in eq 4 (default 3)")
-    g.add_argument("--mode", choices=["phonetic", "acoustic", "robust"],
-                   help="phonetic: the paper's eq 4, labels trusted (default for hand-checked "
-                        "labels); robust: eq 4 and acoustic candidates weighted by label "
-                        "confidence (default for aligned or recognized labels); acoustic: no "
-                        "labels (default: chosen by the labels, docs/labels.md)")
+    g.add_argument("--mode", choices=list(MODES),
+                   help="; ".join(f"{m.name}: {m.help}" for m in MODES.values()) +
+                        " (default: chosen by the labels, docs/labels.md)")
     g.add_argument("--no-closure", dest="closure", action="store_false", default=None,
                    help="no closure step: the lips are not closed at /p b m/ nor the face rested "
                         "in pauses (the paper's synthesis as it is)")

@@ -23,10 +23,6 @@ ROOT = Path(__file__).resolve().parent.parent
 NOT_IN_FIRST_FRAME = (
     "scipy.signal", "scipy.stats", "scipy.interpolate", "scipy.optimize", "scipy.ndimage",
     "scipy.spatial", "multiprocessing", "concurrent.futures.process",
-    # numba: the first frame is synthesized by the prebuilt kernels (no numba), or where they
-    # are missing by the numpy reference, numba's kernels loaded in the background afterwards
-    # (engine.method.kernels)
-    "numba", "engine.method.compiled_lsf", "engine.method.compiled_search",
     "engine.method.training", "engine.labels.alignment", "engine.io.labelling", "engine.report",
     # the analysis views' numbers (engine.analysis.lips, the lips at closure, is the 3-D view's:
     # under a millisecond to import, its package's __init__ a docstring)

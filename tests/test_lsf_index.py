@@ -9,7 +9,7 @@ from conftest import edited_model_file
 
 from engine.config import SynthConfig
 from engine.method.codebook import Codebook
-from engine.method.lsf_index import LsfIndex, build_index, kmeans
+from engine.method.lsf_index import build_index, kmeans
 from engine.method.model import Model
 from engine.method.pipeline import synthesize
 from engine.method.synthesis import perceptual_weights
@@ -164,23 +164,6 @@ def test_the_nearest_alone_is_the_first_of_the_nearest_few():
     h = perceptual_weights(w)
     d = (np.abs(w[:, None, :] - lsf[few]) * h[:, None, :]).sum(axis=2)
     np.testing.assert_array_equal(one, few[np.arange(len(w)), d.argmin(axis=1)])
-
-
-def test_prepare_makes_the_search_layout_once(monkeypatch):
-    """``prepare`` (called before a batch's workers fork) makes the layout ``nearest`` uses, so
-    that no worker makes it again: after it, the codebook is not grouped again."""
-    lsf = np.sort(np.random.default_rng(5).uniform(0.1, 3.0, (400, 6)), axis=1)
-    ix = build_index(lsf, 12)
-    expected = build_index(lsf, 12).nearest(lsf[:9] + 1e-3, lsf, 4, 3)
-    ix.prepare(lsf)
-
-    def again(self, cb_lsf):
-        raise AssertionError("the codebook was grouped again")
-
-    monkeypatch.setattr(LsfIndex, "layout", again)
-    assert np.array_equal(ix.nearest(lsf[:9] + 1e-3, lsf, 4, 3), expected)
-    with pytest.raises(AssertionError, match="grouped again"):
-        build_index(lsf, 12).nearest(lsf[:9], lsf, 4, 3)        # without prepare: it would
 
 
 def test_the_layout_is_the_grouped_codebook_transposed_in_float32():

@@ -1,5 +1,5 @@
 """The robust mode (issue 16, engine.method.selection): each new equation on a hand-checked example, the
-fast kernels against plain loops, the mode rule, and the model file keeping its new parts."""
+vectorised code against plain loops, the mode rule, and the model file keeping its new parts."""
 
 from __future__ import annotations
 
@@ -9,7 +9,6 @@ from conftest import edited_model_file
 
 from engine.config import SynthConfig
 from engine.data import PhoneSegment, Provenance
-from engine.method.kernels import use_kernels
 from engine.method.model import Model
 from engine.method.modes import choose_mode
 from engine.method.pipeline import frame_confidence, synthesize
@@ -100,10 +99,7 @@ def test_weight_costs_is_eqs_6_to_8_on_eq5(toy_model):
     w = cb.lsf[rng.choice(len(cb.lsf), 6)] + 0.01
     cand = rng.choice(len(cb.lsf), (6, 9))
     gam = gamma_grid()
-    # the numpy reference: where one codeword dominates, two gammas' errors are equal to
-    # rounding and the compiled kernel's sums may pick the other (the PCs equal to rounding)
-    with use_kernels("numpy"):
-        ref = weight_frames(w, cand, cb.lsf, cb.pcs, gam)
+    ref = weight_frames(w, cand, cb.lsf, cb.pcs, gam)
     d = context_distances(w, None, cb.lsf[cand], None, 0.0)
     got = weight_costs(w, cand, d, cb.lsf, cb.pcs, gam)
     np.testing.assert_allclose(got.pcs, ref.pcs)

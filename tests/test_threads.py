@@ -97,61 +97,19 @@ def test_evaluation_synthesizes_on_one_frame_thread(default_model, default_corpu
     """evaluate() scores are independent of its worker processes to the bit: each utterance is
     synthesized on one frame thread, whatever the process would use."""
     from engine.evaluation.scores import evaluate
-    from engine.method import pipeline
+    from engine.method import search
 
     seen = []
-    real = pipeline.frame_threads
+    real = search.frame_threads
 
     def spy() -> int:
         seen.append(real())
         return seen[-1]
 
-    monkeypatch.setattr(pipeline, "frame_threads", spy)
+    monkeypatch.setattr(search, "frame_threads", spy)
     monkeypatch.setenv(THREADS_ENV, "2")
     info = default_corpus.info
     sub = type(info)(**{**info.__dict__, "train": info.train[:2], "test": info.test[:2]})
     corpus = type(default_corpus)(default_corpus.root, sub)
     evaluate(default_model, corpus, ("train", "test"), [SynthConfig()], ("triangular",))
     assert seen and set(seen) == {1}
-
-
-def test_beside_runs_in_a_thread_of_its_own_and_gives_its_result_or_its_error():
-    import threading
-
-    from engine.threads import beside, limit_frame_threads
-
-    where = beside(lambda: threading.current_thread().name)
-    assert where() == "facetraj-beside"
-
-    def fails():
-        raise KeyError("lost")
-
-    result = beside(fails)
-    with pytest.raises(KeyError, match="lost"):
-        result()
-    here = threading.current_thread().name
-    with limit_frame_threads(1):                # one thread for synthesis: run here, at once
-        assert beside(lambda: threading.current_thread().name)() == here
-    assert beside(lambda: threading.current_thread().name, frames=599)() == here  # too few
-    assert beside(lambda: threading.current_thread().name, frames=600)() == "facetraj-beside"
-
-
-def test_the_phonetic_synthesis_with_its_voice_match_beside_equals_one_in_line(toy_model,
-                                                                                toy_corpus):
-    """The voice match is computed beside eqs 4-8 in the phonetic mode: the same synthesis and
-    the same voice match as with one thread, where it is computed in line."""
-    from engine.data import PhoneSegment
-
-    utt = toy_corpus.utterance(toy_corpus.info.test[0])
-    span = len(utt.audio) / utt.sample_rate
-    copies = int(np.ceil(12.0 / span))             # over 600 frames: a thread of its own
-    audio = np.tile(utt.audio, copies)
-    phones = [PhoneSegment(p.start + k * span, p.end + k * span, p.label)
-              for k in range(copies) for p in utt.phones]
-    config = SynthConfig(mode="phonetic")
-    both = synthesize(toy_model, audio, utt.sample_rate, phones, config, voice=True)
-    with limit_frame_threads(1):
-        inline = synthesize(toy_model, audio, utt.sample_rate, phones, config, voice=True)
-    assert len(both.times) >= 600
-    assert np.isfinite(both.voice_match) and both.voice_match == inline.voice_match
-    np.testing.assert_array_equal(both.markers, inline.markers)

@@ -115,8 +115,8 @@ def heat_item(value: float, lo: float, hi: float, fmt: str = "{:.2f}", cmap: str
 
 def heat_items(values: np.ndarray, lo: float, hi: float, fmt: str = "{:.2f}",
                cmap: str = "YlOrRd") -> list[list[NumberItem]]:
-    """Heat-coloured cells of a 2-D array of values (a 40 x 40 similarity matrix coloured one
-    cell at a time took 120 ms)."""
+    """Heat-coloured cells of a 2-D array of values, coloured all at once (one colour map call,
+    not one per cell)."""
     values = np.asarray(values, dtype=np.float64)
     rgb, dark_text = heat_colors(values, lo, hi, cmap)
     black, white = QColor("black"), QColor("white")

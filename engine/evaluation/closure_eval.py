@@ -1,7 +1,7 @@
 """Lips that close, measured for the report (issue 25): the closure of every synthesis mode and
 label source on the default corpus's held-out sentences (with their correlations) and on real
 voices the model was not trained on (CMU ARCTIC sentences, speech only), each synthesized the way
-the commands do it (:func:`engine.method.recording.synthesize_recording` is ``facetraj synth``;
+the commands do it (:func:`engine.workflow.recording.synthesize_recording` is ``facetraj synth``;
 :func:`engine.streaming.live.stream_file` is ``facetraj live --from-file``, with phones
 recognized as they are spoken or ``--acoustic-only``).
 
@@ -31,9 +31,9 @@ from ..io.labelling import label_audio, read_transcript, relabelled
 from ..method.model import Model
 from ..method.modes import choose_mode
 from ..method.pipeline import Synthesis, synthesize
-from ..method.recording import LabelRequest, synthesize_recording
 from ..streaming.live import LiveConfig, stream_file
 from ..streaming.recognizer import RecognizerConfig, RunningCmn
+from ..workflow.recording import LabelRequest, synthesize_recording
 from .closure import ClosureScore, closure_score, lip_aperture
 from .scores import speech_mask, trajectory_correlations
 

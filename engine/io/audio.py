@@ -25,7 +25,7 @@ _SAMPLE_BYTES = {"PCM_S8": 1, "PCM_U8": 1, "PCM_16": 2, "PCM_24": 3, "PCM_32": 4
                  "DOUBLE": 8, "ULAW": 1, "ALAW": 1}
 #: containers whose samples are compressed (their subtype names the decoded depth)
 _COMPRESSED = {"FLAC", "OGG", "MPEG"}
-#: encodings of whole numbers: their samples, as floats, are finite (no check: 1 ms a minute)
+#: encodings of whole numbers: their samples, as floats, are finite (not checked for NaN)
 _INTEGER_SUBTYPES = {"PCM_S8", "PCM_U8", "PCM_16", "PCM_24", "PCM_32", "ULAW", "ALAW"}
 #: samples (all channels) decoded per block while mixing down
 _BLOCK_SAMPLES = 1 << 20

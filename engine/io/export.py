@@ -9,9 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from .files import atomic_write
+from .files import atomic_write, write_npz
 from .markerfiles import write_c3d, write_marker_tsv
-from .npz import write_npz
 
 
 def write_trajectories(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
@@ -23,9 +22,9 @@ def write_trajectories(path: str | os.PathLike[str], markers: np.ndarray, rate: 
     :meth:`~engine.method.pipeline.Synthesis.arrays`: times, smoothed and raw PCs, gamma, input LSF
     and settings), and says ``which`` trajectories it holds (synthesized or original).
 
-    The NPZ is stored uncompressed unless ``compress``: on 60 s of synthesized speech, deflate
-    made it 17 % smaller (6.4 -> 5.3 MB; the coordinates are 64-bit floats whose low bits do not
-    compress) and took 156 ms against 4 ms, longer than the synthesis (issue 28)."""
+    The NPZ is stored uncompressed unless ``compress``: the coordinates are 64-bit floats whose
+    low bits do not compress, so deflate saves little and takes longer than the synthesis
+    (docs/benchmarks.md)."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".c3d":

@@ -9,17 +9,17 @@ from __future__ import annotations
 
 import contextlib
 import errno
-import functools
-import io
 import os
 import signal
 import stat
-import sys
 import tempfile
 import threading
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator, Mapping
 from pathlib import Path
-from typing import BinaryIO
+from typing import TYPE_CHECKING, BinaryIO
+
+if TYPE_CHECKING:
+    import numpy as np
 
 from ..errors import InputError, OutputError, OutputExistsError
 
@@ -139,61 +139,31 @@ def atomic_write(path: str | os.PathLike[str], overwrite: bool = True) -> Iterat
                 tmp_path.unlink()
 
 
-@functools.cache
-def _fallocate() -> Callable[[int, int, int, int], int] | None:
-    """The C library's ``fallocate(fd, mode, offset, len)`` (Linux), else ``None``. Not
-    ``os.posix_fallocate``: where a file system has no fallocate, glibc writes zeros instead."""
-    if not sys.platform.startswith("linux"):
-        return None
-    import ctypes
-
-    try:
-        fn = ctypes.CDLL(None, use_errno=True).fallocate
-    except (OSError, AttributeError):
-        return None
-    fn.argtypes = (ctypes.c_int, ctypes.c_int, ctypes.c_int64, ctypes.c_int64)
-    fn.restype = ctypes.c_int
-    return fn
-
-
-@contextlib.contextmanager
-def preallocated(handle: BinaryIO, nbytes: int) -> Iterator[BinaryIO]:
-    """``handle`` (a file open for writing, not appending) with ``nbytes`` from its position
-    given their disk blocks before the block writes them; the file cut where the block stopped
-    writing, so the size may be a guess. Best effort: elsewhere than Linux, on a file system
-    without fallocate, on a pipe or an in-memory handle, the writes are as without it.
-
-    Why (issue 28): ext4, the usual Linux file system, writes out a new file's data blocks when
-    a rename replaces an existing file (its ``auto_da_alloc``), which :func:`atomic_write` does on
-    every overwrite; for the 6.4 MB of a 60 s synthesis, writing and renaming took 1.5 + 4-6 ms,
-    and 0.9 + 0.4 ms with the blocks given first.
-
-    >>> import tempfile, pathlib
-    >>> out = pathlib.Path(tempfile.mkdtemp()) / "x.bin"
-    >>> with open(out, "wb") as f, preallocated(f, 1000):
-    ...     _ = f.write(b"abc")
-    >>> out.read_bytes()
-    b'abc'
-    """
-    fn = _fallocate()
-    try:                                       # appends and pipes: as they are
-        fd = handle.fileno() if handle.seekable() and "a" not in getattr(handle, "mode", "") else -1
-    except (AttributeError, OSError, io.UnsupportedOperation):
-        fd = -1
-    given = fn is not None and fd >= 0 and nbytes > 0
-    if given:
-        handle.flush()
-        fn(fd, 0, handle.tell(), nbytes)       # a failure (no support, no space): as without it
-    yield handle
-    if given:                                  # the file may reach past what was written
-        handle.truncate()
-
-
 def write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
-    """``data`` written to ``path`` (:func:`preallocated`): the temporary file of
-    :func:`atomic_write`."""
-    with open(path, "wb") as handle, preallocated(handle, len(data)):
+    """``data`` written to ``path`` (the temporary file of :func:`atomic_write`)."""
+    with open(path, "wb") as handle:
         handle.write(data)
+
+
+def write_npz(handle: BinaryIO, arrays: Mapping[str, np.ndarray]) -> None:
+    """``arrays`` as an uncompressed ``.npz`` archive (``numpy.savez``) to the open binary file
+    ``handle``; an array of Python objects is refused (models and trajectories hold numbers and
+    text only: nothing is pickled, nothing is unpickled when they are read).
+
+    >>> import io
+    >>> import numpy as np
+    >>> out = io.BytesIO()
+    >>> write_npz(out, {"x": np.arange(3.0), "name": np.array("jaw")})
+    >>> sorted((k, v.tolist()) for k, v in np.load(io.BytesIO(out.getvalue())).items())
+    [('name', 'jaw'), ('x', [0.0, 1.0, 2.0])]
+    """
+    import numpy as np  # not for the command's start: only where arrays are
+
+    arrays = {name: np.asarray(value) for name, value in arrays.items()}
+    for name, arr in arrays.items():
+        if arr.dtype.hasobject:
+            raise ValueError(f"{name}: an array of Python objects is not saved (no pickle)")
+    np.savez(handle, **arrays)
 
 
 def write_json(path: str | os.PathLike[str], data: object, overwrite: bool = True) -> Path:

@@ -37,18 +37,15 @@ MAX_META_BYTES = 64 << 20
 _COMPRESSIONS = (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED)
 
 
-def read_members(path: Path, only: frozenset[str] | None = None
-                 ) -> tuple[dict, dict[str, np.ndarray]]:
-    """The metadata dict and the arrays of a model archive (``only``: the members of these names
-    alone), each header checked first; a stored member read once, straight into the buffer its
-    array keeps (checksum checked), a deflated one (older files) through ``zipfile``."""
+def read_members(path: Path) -> tuple[dict, dict[str, np.ndarray]]:
+    """The metadata dict and the arrays of a model archive, each header checked first; a stored
+    member read once, straight into the buffer its array keeps (checksum checked), a deflated one
+    (older files) through ``zipfile``."""
     try:
         with zipfile.ZipFile(path) as zf, open(path, "rb") as raw:
             arrays: dict[str, np.ndarray] = {}
             for info in zf.infolist():
                 name = info.filename.removesuffix(".npy")
-                if only is not None and name not in only:
-                    continue
                 if info.compress_type not in _COMPRESSIONS:
                     raise ModelFileError(path, f"entry {name!r} uses an unsupported compression "
                                                f"method ({info.compress_type})")
@@ -414,16 +411,6 @@ def read_model_file(path: str | os.PathLike[str], newest: int, fmt: str
     check_meta(path, meta, newest, fmt)
     check_config(path, meta["config"])
     return meta, check_arrays(path, meta, arrays)
-
-
-def read_model_meta(path: str | os.PathLike[str], newest: int, fmt: str) -> dict:
-    """The checked metadata of a model file, its arrays not read (:func:`read_model_file`
-    reads and checks them)."""
-    path = _archive(path)
-    meta, _ = read_members(path, only=frozenset({"meta"}))
-    check_meta(path, meta, newest, fmt)
-    check_config(path, meta["config"])
-    return meta
 
 
 def _archive(path: str | os.PathLike[str]) -> Path:

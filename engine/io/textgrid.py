@@ -3,9 +3,8 @@
 are skipped, so the long and the short text forms are one grammar. Anything else (``4.3O57``, a
 stray character, text after the last tier), and what the grammar does not allow (a missing
 number, a time that is not finite, too few intervals) is refused with the place it was found;
-nothing is guessed, sorted or repaired. (praatio writes them; reading through it took a new
-process its import, about 15 ms, and two parses of 4.6 ms each on a minute of phones, against
-2.9 ms here.)
+nothing is guessed, sorted or repaired. (praatio writes them; it reads them more leniently, and
+more slowly.)
 """
 
 from __future__ import annotations

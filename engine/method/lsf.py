@@ -10,7 +10,6 @@ from itertools import pairwise
 import numpy as np
 
 from ..threads import map_spans
-from .kernels import compiled
 
 #: white-noise correction added to r[0] (a -40 dB noise floor) so that LPC of near-silent or
 #: perfectly periodic frames stays well conditioned.
@@ -162,12 +161,6 @@ def root_grid(m: int, grid: int) -> tuple[np.ndarray, np.ndarray]:
     ``(m+1, grid+1)``."""
     w = np.linspace(0.0, np.pi, grid + 1)
     return _frozen(np.cos(w)), _frozen(np.cos(np.outer(np.arange(m + 1), w)))
-
-
-@lru_cache(maxsize=8)
-def hamming(n: int) -> np.ndarray:
-    """``np.hamming(n)``, made once per length (read-only: shared by every caller)."""
-    return _frozen(np.hamming(n))
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:
@@ -472,29 +465,13 @@ def frame_lsf(frames: np.ndarray, order: int) -> np.ndarray:
     return poly2lsf(lpc(frames, order))
 
 
-def compiled_frame_lsf(kernel, pad: np.ndarray, starts: np.ndarray, window: np.ndarray,
-                       order: int) -> np.ndarray:
-    """The compiled analysis (``kernel.lsf_frames``, ``engine.method.compiled_lsf``) of the frames
-    ``pad[s:s + n] * window`` with this module's root grid and tolerances; the frames it flags
-    (roots the grid cannot bracket) solved by :func:`poly2lsf` from their LPC polynomials."""
-    xg, basis = root_grid(order // 2, ROOT_GRID)
-    lsf, polys, ok = kernel.lsf_frames(pad, np.ascontiguousarray(starts, dtype=np.int64), window,
-                                       order, xg, np.ascontiguousarray(basis), 1e-9, 12)
-    if not ok.all():
-        bad = ~ok
-        lsf[bad] = poly2lsf(polys[bad])
-    return lsf
-
-
 def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
            window_s: float = 0.025, audio_rate: int = 16000,
            preemphasis: float = 0.97, threads: int | None = 1) -> np.ndarray:
     """LSF vectors ``(len(times), order)`` from 25 ms Hamming frames centred on ``times``.
 
     The audio is resampled to ``audio_rate`` first (the paper analyses 16 kHz speech). The frames
-    are analysed by the compiled kernel (``engine.method.compiled_lsf``, equal to this module's
-    functions to rounding) unless :mod:`engine.method.kernels` chooses numpy, in ``threads`` spans
-    at once (``None``: :func:`engine.threads.frame_threads`).
+    are analysed in ``threads`` spans at once (``None``: :func:`engine.threads.frame_threads`).
     The LSFs equal one thread's to rounding: BLAS's matrix products (autocorrelation lags, the
     root bracketing grid) may add a row's terms in another order for another number of rows.
 
@@ -513,13 +490,6 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
         x, exponent = np.ldexp(x, exponent), 0
     x = resample_audio(x, rate, audio_rate)
     times = np.asarray(times, dtype=np.float64)
-    kernel = compiled("compiled_lsf") if order % 2 == 0 and order >= 2 else None
-    if kernel is not None:                         # the same analysis compiled, frame by frame
-        pad, starts, n = padded_signal(x, audio_rate, times, window_s, preemphasis, exponent)
-        window = hamming(n)
-        return np.concatenate(map_spans(lambda a, b: compiled_frame_lsf(kernel, pad, starts[a:b],
-                                                                        window, order),
-                                        len(starts), threads))
     frames = analysis_frames(x, audio_rate, times, window_s, preemphasis, exponent)
     return np.concatenate(map_spans(lambda a, b: frame_lsf(frames[a:b], order), len(frames),
                                     threads))

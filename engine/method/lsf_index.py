@@ -17,7 +17,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .kernels import compiled
 from .synthesis import perceptual_weights
 
 log = logging.getLogger(__name__)
@@ -106,12 +105,6 @@ class LsfIndex:
         search a few frames at a time and pass it to :meth:`nearest` on every call."""
         return np.asarray(cb_lsf, dtype=np.float64)[self.order]
 
-    def prepare(self, cb_lsf: np.ndarray) -> None:
-        """Make now the search layout of ``cb_lsf`` that the first :meth:`nearest` on it would
-        make (1.5 MB for the default corpus's codebook): before worker processes fork, so that
-        they share it instead of each making its own on its first input."""
-        self._cell_lsf(cb_lsf, None)
-
     def _cell_lsf(self, cb_lsf: np.ndarray, grouped: np.ndarray | None) -> np.ndarray:
         """:meth:`grouped` transposed, ``(P, 5L)``, in float32 for the search, made once per
         codebook array: a cell's codewords are the columns ``offsets[c]:offsets[c + 1]``."""
@@ -123,8 +116,7 @@ class LsfIndex:
 
     def layout(self, cb_lsf: np.ndarray) -> np.ndarray:
         """The search layout of ``cb_lsf``: :meth:`grouped`, transposed to ``(P, 5L)``, float32;
-        made in two passes over the codebook (to float32, then taken in cell order), not three
-        (4.4 -> 2.9 ms on the default corpus's)."""
+        made in two passes over the codebook (to float32, then taken in cell order)."""
         return np.take(np.asarray(cb_lsf).T.astype(np.float32), self.order, axis=1)
 
     def nearest(self, w: np.ndarray, cb_lsf: np.ndarray, count: int, probe: int,
@@ -140,9 +132,7 @@ class LsfIndex:
         laid out ``(P, size)`` so that the innermost loops run along the cell's codewords, and in
         float32 (half the memory traffic of the search's largest arrays; the distances only rank
         the codewords: eqs 5-8 are computed again in float64 on the ``count`` found). ``grouped``
-        may pass :meth:`grouped` of ``cb_lsf``, computed once. The compiled kernel
-        (``engine.method.compiled_search``) runs this search frame by frame unless
-        :mod:`engine.method.kernels` chooses numpy.
+        may pass :meth:`grouped` of ``cb_lsf``, computed once.
 
         Examples
         --------
@@ -158,16 +148,11 @@ class LsfIndex:
         count = min(count, self.n_codewords)
         probe = min(max(probe, self.min_probe(count)), self.n_cells)
         cell_lsf = self._cell_lsf(cb_lsf, grouped)                        # (P, 5L) by cell
-        kernel = compiled("compiled_search")
-        if kernel is not None:                     # the same search compiled, frame by frame
-            return kernel.nearest_frames(np.ascontiguousarray(w, dtype=np.float64),
-                                         np.ascontiguousarray(self.centroids.T, dtype=np.float32),
-                                         cell_lsf, self.offsets, self.order, count, probe)
         return self._search(w, cell_lsf, count, probe, chunk)
 
     def _search(self, w: np.ndarray, cell_lsf: np.ndarray, count: int, probe: int,
                 chunk: int | None) -> np.ndarray:
-        """:meth:`nearest` in numpy (the reference of the compiled kernel), chunk by chunk."""
+        """:meth:`nearest`, chunk by chunk of frames."""
         n_frames, order = w.shape[0], w.shape[1]
         sizes = self.sizes
         width_max = int(np.sort(sizes)[-probe:].sum())

@@ -18,9 +18,8 @@ import numpy as np
 from .. import __version__
 from ..config import TrainConfig
 from ..errors import ModelFileError
-from ..io.files import atomic_write
-from ..io.model_file import read_model_file, read_model_meta
-from ..io.npz import write_npz
+from ..io.files import atomic_write, write_npz
+from ..io.model_file import read_model_file
 from .chain import join_scale
 from .closure import ClosureStats
 from .codebook import Codebook
@@ -152,12 +151,6 @@ class Model:
             self.index = build_index(self.codebook.lsf, self.config.index_cells)
         return self.index
 
-    def prepare_search(self) -> None:
-        """Build now what the first search of the codebook by LSF builds (the index when the file
-        has none, its search layout): before worker processes fork (``facetraj synth``'s batch),
-        so that they share it."""
-        self.lsf_index().prepare(self.codebook.lsf)
-
     @property
     def lsf_mean(self) -> np.ndarray:
         """The training speaker's mean LSF vector (mean over the codewords), ``(P,)``."""
@@ -183,8 +176,8 @@ class Model:
     def save(self, path: str | os.PathLike[str], overwrite: bool = True) -> Path:
         """Write the model as one ``.npz`` (arrays + a JSON ``meta`` entry); never pickle.
 
-        The members are stored, not deflated: compression saved 5 % of the size and inflating
-        cost 0.1 s of every start (issue #15). Compressed files (older versions) still load."""
+        The members are stored, not deflated: compression saves little of the size and inflating
+        slows every start (issue #15). Compressed files (older versions) still load."""
         path = Path(path)
         meta = {
             "format": MODEL_FORMAT,
@@ -228,13 +221,6 @@ class Model:
         with atomic_write(path, overwrite) as tmp, open(tmp, "wb") as handle:
             write_npz(handle, arrays)
         return path
-
-    @staticmethod
-    def read_settings(path: str | os.PathLike[str]) -> tuple[TrainConfig, float]:
-        """The training settings and the marker rate of a model file, its metadata checked, its
-        arrays not read (what analyses an input before they are: ``EarlyLsf``)."""
-        meta = read_model_meta(path, MODEL_VERSION, MODEL_FORMAT)
-        return TrainConfig.from_dict(meta["config"]), float(meta["marker_rate"])
 
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> Model:

@@ -1,7 +1,7 @@
-"""The synthesis pipeline (paper section 2.3): input LSFs, the candidate codewords of each frame
-(eq 4 in phonetic mode, the LSF index in acoustic-only mode, both in the robust mode), eqs 5-8
-(``engine.method.synthesis``; ``engine.method.selection`` for the robust mode), smoothing, and the PCs back to
-face points.
+"""The synthesis pipeline (paper section 2.3): input LSFs, the mode's search of each frame's
+candidate codewords and eqs 5-8 (:mod:`engine.method.modes`: eq 4 in the phonetic mode, the LSF
+index in the acoustic-only mode, both in the robust mode), smoothing, the closure step, and the
+PCs back to face points.
 
 Which mode the labels allow is :func:`engine.method.modes.choose_mode`, the one rule.
 """
@@ -11,7 +11,7 @@ from __future__ import annotations
 import functools
 import json
 import logging
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -21,30 +21,20 @@ from ..data import PhoneSegment, Provenance
 from ..errors import InputError
 from ..io.labelfiles import validate_phones
 from ..labels.phoneset import SILENCE, map_labels, normalise_label
-from ..threads import beside, frame_threads, map_spans
-from .chain import chain_pcs
+from ..threads import frame_threads
 from .closure import ClosurePlan, aperture_functional, apply_closure, closure_intervals, closure_strengths
-from .context import context_ids, segment_index
+from .context import segment_index
 from .model import Model
-from .selection import mean_normalise, robust_frames
-from .similarity import top_context_phones
+from .modes import mode_of
+from .search import SearchInput, SegmentChoice
+from .selection import mean_normalise
 from .smoothing import smooth
 from .speaker import choose_warp, warp_lsf
 from .speech import filtered_energy_db, pauses, speech_mask
-from .synthesis import FrameWeights, gamma_grid, nearest_codewords, weight_frames
-from .voice_match import label_weight_scale, trust_by_voice, voice_distance, voice_match
+from .synthesis import FrameWeights
+from .voice_match import voice_distance, voice_match
 
 log = logging.getLogger(__name__)
-
-
-@dataclass
-class SegmentChoice:
-    """The context-phones chosen for one input phone segment (eq 4)."""
-
-    segment: PhoneSegment
-    context: np.ndarray      # (2C+1,) phone ids of the input context-phone
-    chosen: np.ndarray       # (N,) codebook context-phone indices, best first
-    scores: np.ndarray       # (N,) their n_j
 
 
 @dataclass
@@ -137,38 +127,24 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     The input's speech energy (pauses, speech frames) is computed once for both.
     """
     config = config or SynthConfig()
+    mode = mode_of(config)
     times, w, warp = _input(model, audio, sample_rate, n_frames, lsf, config,
                             audio_source or source)
-    segs: list[PhoneSegment] | None = None
     energy = SpeechEnergy(audio, sample_rate)
-    voice_ratio = _voice_ratio_of(model, energy, times, w, config, provenance, voice)
-    segments: list[SegmentChoice] = []
-    frame_seg = None
-    if config.mode in ("phonetic", "robust"):
+    ratio = _voice_ratio(model, energy, times, w, config, provenance, voice)
+    job = SearchInput(model, w, times, config, voice_ratio=ratio)
+    if mode.needs_labels:
         if not phones:
             raise InputError(source, f"{config.mode} mode needs phone labels (or use acoustic mode)")
-        segs, unlabelled = _model_phones(model, phones, len(audio) / sample_rate, label_map,
-                                         source, config)
-        segments, frame_seg, candidates = _eq4(model, segs, times, config)
-        if config.mode == "robust":
-            conf = trust_by_voice(frame_confidence(list(phones), confidence, times),
-                                  voice_ratio(), config.label_weight_by_voice)
-            conf[unlabelled[frame_seg]] = 0.0
-            scale = label_weight_scale(voice_ratio(), config.label_weight_by_voice)
-            fw = robust_weights(model, w, candidates, conf, config, scale)
-            if config.chain_beta > 0:                 # the weights made consistent over time
-                fw.pcs = chain_pcs(fw.weights, fw.candidates, model.codebook.pcs, config.chain_beta,
-                                   model.join_scale)
-        else:
-            fw = _weighted(model, w, lambda a, b: candidates[a:b], config)
-    elif config.mode == "acoustic":
-        fw = _weighted(model, w, lambda a, b: acoustic_candidates(model, w[a:b], config), config)
-    else:
-        raise ValueError(f"unknown mode {config.mode!r} (phonetic, acoustic or robust)")
-    ratio = voice_ratio()
-    plan = plan_closure(model, audio, sample_rate, times, segs, provenance, voice_match(ratio, 1.0),
-                        config, energy.filtered if config.closure else None)
-    res = _finish(model, times, w, fw, config, segments, frame_seg, warp, plan)
+        job.segs, job.unlabelled = _model_phones(model, phones, len(audio) / sample_rate,
+                                                 label_map, source, mode.weighs_labels)
+        if mode.weighs_labels:
+            job.confidence = frame_confidence(list(phones), confidence, times)
+    found = mode.search(job)
+    plan = plan_closure(model, audio, sample_rate, times, job.segs, provenance,
+                        voice_match(ratio, 1.0), config, energy.filtered if config.closure else None)
+    res = _finish(model, times, w, found.frames, config, found.segments, found.frame_segment,
+                  warp, plan)
     res.voice_match = voice_match(ratio, 1.0)
     return res
 
@@ -191,72 +167,22 @@ def _input(model: Model, audio: np.ndarray, sample_rate: int, n_frames: int | No
     else:
         w = lsf
     w, warp = normalise_speaker(model, w, config)
-    if config.mode == "robust" and config.mean_normalise:
+    if mode_of(config).weighs_labels and config.mean_normalise:
         w = mean_normalise(w, model.lsf_mean)
     return times, w, warp
 
 
 def _model_phones(model: Model, phones: Sequence[PhoneSegment], duration: float,
-                  label_map: Mapping[str, str] | None, source: str | None, config: SynthConfig
+                  label_map: Mapping[str, str] | None, source: str | None, weighs_labels: bool
                   ) -> tuple[list[PhoneSegment], np.ndarray]:
     """The labels checked against the audio and mapped onto the model's phones, and which are
-    unlabelled: in the robust mode, which weighs labels by trust, a phone the model lacks."""
+    unlabelled: in a mode that weighs labels by trust, a phone the model lacks."""
     segs = validate_phones(list(phones), duration, source)
     raw = [normalise_label(s.label) for s in segs]
     segs = map_labels(segs, model.phones, label_map, source,
-                      unknown_as=SILENCE if config.mode == "robust" else None)
+                      unknown_as=SILENCE if weighs_labels else None)
     unlabelled = np.array([s.label == SILENCE and r != SILENCE for s, r in zip(segs, raw, strict=True)])
     return segs, unlabelled
-
-
-def _eq4(model: Model, segs: list[PhoneSegment], times: np.ndarray, config: SynthConfig
-         ) -> tuple[list[SegmentChoice], np.ndarray, np.ndarray]:
-    """Eq 4 per input phone: its chosen context-phones, each frame's phone, and each frame's
-    ``(T, 5N)`` candidate codewords."""
-    mc, cb = model.config, model.codebook
-    pid = {p: i for i, p in enumerate(model.phones)}
-    ctx = context_ids([pid[s.label] for s in segs], mc.context, pid[SILENCE])
-    top, scores = top_context_phones(ctx, cb.contexts, model.similarity(config.nu), config.xi,
-                                     min(config.context, mc.context), config.n_context_phones)
-    segments = [SegmentChoice(seg, ctx[i], top[i], scores[i]) for i, seg in enumerate(segs)]
-    frame_seg = segment_index(segs, times)
-    return segments, frame_seg, cb.codewords_of(top)[frame_seg]
-
-
-def robust_weights(model: Model, w: np.ndarray, candidates: np.ndarray, conf: np.ndarray,
-                   config: SynthConfig, scale: float = 1.0, w_ctx: np.ndarray | None = None
-                   ) -> FrameWeights:
-    """The robust mode's eqs 5-8 (``engine.method.selection``), its label weight times
-    ``scale`` (the voice's distance ratio: eq 5's distances grow with it); ``w_ctx``: the input
-    frames at :func:`context_offsets` when ``w`` is part of a longer input (a stream). The chain
-    over frames (``engine.method.chain``) is :func:`synthesize`'s, on the whole input."""
-    cb = model.codebook
-    near = model.lsf_index().nearest(w, cb.lsf, config.robust_candidates, config.acoustic_probe or 8)
-    return robust_frames(w, candidates, near, conf, cb.lsf, cb.pcs, _gammas(config),
-                         config.label_weight * scale, cb.lsf_context, context_offsets(model),
-                         config.context_weight, w_ctx=w_ctx)
-
-
-def context_offsets(model: Model) -> np.ndarray:
-    """The frame offsets of the robust mode's acoustic context (the codewords' stored LSFs)."""
-    k = model.config.lsf_context_frames
-    return np.array([-k, k])
-
-
-def _weighted(model: Model, w: np.ndarray, candidates: Callable[[int, int], np.ndarray],
-              config: SynthConfig) -> FrameWeights:
-    """Eqs 5-8 on each frame's candidates (``candidates(a, b)`` of frames ``a:b``), the frames
-    split between threads (they are independent)."""
-    cb = model.codebook
-
-    def span(a: int, b: int) -> FrameWeights:
-        return weight_frames(w[a:b], candidates(a, b), cb.lsf, cb.pcs, _gammas(config))
-
-    return FrameWeights.concatenate(map_spans(span, len(w), frame_threads()))
-
-
-def _gammas(config: SynthConfig) -> np.ndarray:
-    return gamma_grid(config.gamma_min, config.gamma_max, config.gamma_steps)
 
 
 def _finish(model: Model, times: np.ndarray, w: np.ndarray, fw: FrameWeights, config: SynthConfig,
@@ -312,27 +238,16 @@ class SpeechEnergy:
         return filtered_energy_db(self.audio, self.sample_rate)
 
 
-def _voice_ratio_of(model: Model, energy: SpeechEnergy, times: np.ndarray, w: np.ndarray,
-                    config: SynthConfig, provenance: Provenance | None, wanted: bool
-                    ) -> Callable[[], float]:
-    """What gives the input's voice distance ratio when the synthesis weighs by it (the robust
-    mode's label weight, the closure step's trust in recognized labels) or it is ``wanted``,
-    else NaN (not computed). In the phonetic mode eqs 4-8 do not use it: it is computed beside
-    them (:func:`engine.threads.beside`; its energy, index layout and search let go of the
-    interpreter lock), else here."""
+def _voice_ratio(model: Model, energy: SpeechEnergy, times: np.ndarray, w: np.ndarray,
+                 config: SynthConfig, provenance: Provenance | None, wanted: bool) -> float:
+    """The input's voice distance ratio when the synthesis weighs by it (a mode that weighs its
+    labels by the voice, the closure step's trust in recognized labels) or it is ``wanted``,
+    else NaN (not computed)."""
     recognized = provenance is not None and provenance.kind == "recognized"
-    if not (wanted or (config.mode == "robust" and config.label_weight_by_voice) or
+    if not (wanted or (mode_of(config).weighs_labels and config.label_weight_by_voice) or
             (config.closure and recognized)):
-        return lambda: float("nan")
-
-    def ratio() -> float:
-        return input_voice_ratio(model, energy.audio, energy.sample_rate, times, w,
-                                 energy.filtered)
-
-    if config.mode == "phonetic":
-        return beside(ratio, len(times))
-    value = ratio()
-    return lambda: value
+        return float("nan")
+    return input_voice_ratio(model, energy.audio, energy.sample_rate, times, w, energy.filtered)
 
 
 def input_voice_ratio(model: Model, audio: np.ndarray, sample_rate: int,
@@ -367,19 +282,6 @@ def normalise_speaker(model: Model, w: np.ndarray, config: SynthConfig) -> tuple
         alpha = choose_warp(w, model.codebook.lsf)
         log.info("speaker warp %.2f chosen", alpha)
     return (w, 1.0) if alpha == 1.0 else (warp_lsf(w, alpha), float(alpha))
-
-
-def acoustic_candidates(model: Model, w: np.ndarray, config: SynthConfig,
-                        grouped: np.ndarray | None = None) -> np.ndarray:
-    """Acoustic-only candidates ``(T, I)`` of frames ``w``: the ``config.acoustic_prefilter``
-    codewords nearest by eq 5 through the model's LSF index (``acoustic_probe`` cells), or exactly,
-    or every codeword (``acoustic_prefilter=None``, as the paper does). ``grouped``: the index's
-    :meth:`~engine.method.lsf_index.LsfIndex.grouped` codebook, when the caller keeps it."""
-    cb = model.codebook
-    if config.acoustic_prefilter is not None and config.acoustic_probe is not None:
-        return model.lsf_index().nearest(w, cb.lsf, config.acoustic_prefilter,
-                                         config.acoustic_probe, grouped=grouped)
-    return nearest_codewords(w, cb.lsf, config.acoustic_prefilter)   # every one, or exact K
 
 
 def frame_confidence(phones: Sequence[PhoneSegment], confidence: Sequence[float] | np.ndarray | None,

@@ -9,8 +9,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .kernels import compiled
-
 
 def phone_means(pcs: np.ndarray, phone_of: np.ndarray, n_phones: int) -> np.ndarray:
     """Eq 1: ``m_k = (1/T_k) sum_t P_kt``, the mean PC vector of each phone.
@@ -157,9 +155,7 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     :func:`context_similarity`'s order, so the scores are its scores to the bit; then the
     ``count``-th best score of each query (a partition) and a sort of the few scores reaching it.
     The result, including the lower-index-first tie order, is that of the full computation
-    (tested). The compiled kernel (``engine.method.compiled_search``) finds the same contexts
-    per centre phone and scores them with the same additions, query by query, keeping each
-    query's best ``count`` as it goes, unless :mod:`engine.method.kernels` chooses numpy.
+    (tested).
 
     Returns ``(top, scores)``, both ``(Q, count)``.
 
@@ -177,12 +173,6 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     count = min(count, n_cb)
     cols = np.arange(full - c, full + c + 1)
     tables = context_weights(c, xi)[:, None, None] * s                       # (2c+1) x n x n
-    kernel = compiled("compiled_search")
-    if kernel is not None and n_q > 0:             # the same scores compiled, query by query
-        return kernel.top_context_scores(np.ascontiguousarray(q, dtype=np.int64),
-                                         np.ascontiguousarray(codebook, dtype=np.int64),
-                                         np.ascontiguousarray(s, dtype=np.float64), tables, cols,
-                                         bound, count)
     # the contexts that can win, per distinct query centre u: cand_all[u_start[u]:][:u_size[u]]
     centres, inverse = np.unique(q[:, full], return_inverse=True)
     sim = s[centres][:, codebook[:, full]]                                  # (U, L)

@@ -7,8 +7,6 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from .kernels import compiled
-
 
 def perceptual_weights(w: np.ndarray) -> np.ndarray:
     """Eq 5 (first line): ``h_k = 1 / min(|w_k - w_(k-1)|, |w_k - w_(k+1)|)``, ``w_0 = 0``,
@@ -146,13 +144,6 @@ class FrameWeights:
         return cls(**joined, candidates=np.concatenate(cands))
 
 
-#: the most candidates per frame that :func:`weight_frames` gives its compiled kernel: on the
-#: phonetic mode's 15 it took 0.5-0.66 of numpy's time (60 and 600 frames), on the acoustic-only
-#: 128 1.25-1.3 (numba's ``exp`` is one value at a time, numpy's vectorised; eq 7's products
-#: are BLAS's)
-COMPILED_MAX_CANDIDATES = 32
-
-
 def weight_frames(w: np.ndarray, candidates: np.ndarray, cb_lsf: np.ndarray, cb_pcs: np.ndarray,
                   gammas: np.ndarray, chunk: int = 1024) -> FrameWeights:
     """Eqs 5-8 for every frame: distances to its candidate codewords, gamma searched on
@@ -163,25 +154,12 @@ def weight_frames(w: np.ndarray, candidates: np.ndarray, cb_lsf: np.ndarray, cb_
     Work is chunked over frames: about 300,000 values per array, which stay in cache, when each
     frame gathers its own candidates; about 4 million when every frame has the same candidates
     (acoustic-only full search), whose codebook is not gathered per frame and eqs 7-8 are plain
-    matrix products. Codewords are gathered with ``np.take`` (a third of the time of indexing).
-    A few candidates per frame (:data:`COMPILED_MAX_CANDIDATES`: the phonetic mode's 5N) on an
-    evenly spaced gamma grid go to the compiled kernel (``engine.method.compiled_weights``,
-    equal to this to rounding) unless :mod:`engine.method.kernels` chooses numpy.
+    matrix products. Codewords are gathered with ``np.take``.
     """
     n_frames = w.shape[0]
     n_cand = candidates.shape[1]
     shared = n_frames > 0 and candidates.strides[0] == 0          # a broadcast row: same for all
     gammas = np.asarray(gammas, dtype=np.float64)
-    steps = np.diff(gammas)
-    few = not shared and n_cand <= COMPILED_MAX_CANDIDATES and len(gammas) >= 3
-    kernel = compiled("compiled_weights") if few else None
-    if kernel is not None and np.all(np.abs(steps - steps[0]) <= 1e-12 * abs(steps[0])):
-        # the same equations compiled, frame by frame, on grid_weights' evenly spaced grid
-        pcs, best, weights, lsf_hat, err = kernel.weight_frames(
-            np.ascontiguousarray(w, dtype=np.float64), np.ascontiguousarray(candidates, dtype=np.int64),
-            np.ascontiguousarray(cb_lsf, dtype=np.float64), np.ascontiguousarray(cb_pcs, dtype=np.float64),
-            float(gammas[0]), float(steps[0]), len(gammas))
-        return FrameWeights(pcs, gammas[best], weights, np.asarray(candidates), lsf_hat, err)
     budget = 4e6 if shared else 3e5          # values per chunk array: gathered ones stay in cache
     chunk = max(1, min(chunk, int(budget // max(1, n_cand * max(w.shape[1], len(gammas))))))
     pcs = np.empty((n_frames, cb_pcs.shape[1]))

@@ -34,7 +34,6 @@ from ..config import SynthConfig
 from ..data import PhoneSegment, Provenance
 from ..labels.phoneset import SILENCE
 from ..labels.provenance import SCORE_SCALE, Labels
-from ..method.kernels import never_waiting
 from ..method.model import Model
 from ..method.modes import ModeChoice, choose_mode
 from .phones import PhoneSnapshot
@@ -167,7 +166,6 @@ class LiveStream:
     def received_s(self) -> float:
         return (self.phonetic or self.acoustic).received_s
 
-    @never_waiting
     def feed(self, block: np.ndarray) -> StreamFrames:
         """The face frames the next ``block`` completes."""
         block = np.nan_to_num(np.asarray(block, dtype=np.float64).ravel(), nan=0.0,
@@ -189,7 +187,6 @@ class LiveStream:
             self.recognize_s += time.perf_counter() - t0
         return self.phonetic.feed(step)
 
-    @never_waiting
     def flush(self) -> StreamFrames:
         """The last frames (the audio ended)."""
         if self.acoustic is not None:

@@ -10,8 +10,8 @@ Per frame t (at ``t / marker_rate``), in order:
    settled phone makes it a robust-mode frame (eq 4's codewords of that phone in its context --
    the phones settled so far, silence after them -- and the acoustically nearest ones, the label
    weighed by the phone's confidence and the running voice ratio,
-   :func:`engine.method.pipeline.robust_weights`); without one it is an acoustic-only frame, as
-   in ``facetraj live`` before (:func:`engine.method.pipeline.acoustic_candidates`);
+   :func:`engine.method.search.robust_weights`); without one it is an acoustic-only frame, as
+   in ``facetraj live`` before (:func:`engine.method.search.acoustic_candidates`);
 3. frames are analysed ``batch`` at a time, smoothed by the triangular window (3 frames later);
 4. the closure step (``engine.streaming.closure``): the lips close at the settled /p b m/ (trusted
    as far as the running voice match is low, :func:`engine.method.closure.closure_strengths`),
@@ -33,9 +33,9 @@ from ..config import SynthConfig
 from ..labels.phoneset import SILENCE, map_labels
 from ..method.closure import BILABIALS, ClosurePlan, closure_strengths
 from ..method.context import context_ids, segment_index
-from ..method.kernels import never_waiting
 from ..method.model import Model
-from ..method.pipeline import acoustic_candidates, context_offsets, frame_confidence, robust_weights
+from ..method.pipeline import frame_confidence
+from ..method.search import acoustic_candidates, context_offsets, robust_weights
 from ..method.similarity import top_context_phones
 from ..method.smoothing import TriangularStream
 from ..method.synthesis import gamma_grid, weight_frames
@@ -149,7 +149,6 @@ class PhoneticSynthesizer:
         return self.front.received_s
 
     # ------------------------------------------------------------------ blocks
-    @never_waiting
     def feed(self, block: np.ndarray) -> StreamFrames:
         """Face frames completed by the next ``block`` of audio samples (mono)."""
         complete = self.front.feed(block)
@@ -160,7 +159,6 @@ class PhoneticSynthesizer:
         raw = self._analyse(stop, None) if stop - self._next >= self.timing.batch else None
         return self._emit(self._smoother.feed(raw) if raw is not None else None, final=False)
 
-    @never_waiting
     def flush(self) -> StreamFrames:
         """The remaining frames, the audio ended (as many as offline synthesis makes)."""
         total = self.front.flush()

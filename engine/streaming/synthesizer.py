@@ -22,9 +22,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..config import SynthConfig
-from ..method.kernels import never_waiting
 from ..method.model import Model
-from ..method.pipeline import acoustic_candidates
+from ..method.search import acoustic_candidates
 from ..method.smoothing import TriangularStream
 from ..method.speaker import warp_lsf
 from ..method.synthesis import gamma_grid, weight_frames
@@ -59,8 +58,8 @@ class StreamConfig:
 
 
 #: the frame batch of live mode (``facetraj live`` and the Live window): 5 frames at 60 Hz add
-#: at most 67 ms to the lookahead (129.2 ms in all, under the 150 ms aim of issue 13) and make the
-#: 10 ms-block stream about 3 times faster (docs/benchmarks.md)
+#: at most 67 ms to the lookahead, for a stream of small blocks that keeps up with fewer, larger
+#: analyses (docs/benchmarks.md, "Live mode", has the latency and the speed)
 LIVE_BATCH_FRAMES = 5
 
 
@@ -130,7 +129,6 @@ class StreamingSynthesizer:
         k = self.model.codebook.pcs.shape[1]
         return np.concatenate(self._raw) if self._raw else np.zeros((0, k))
 
-    @never_waiting
     def feed(self, block: np.ndarray) -> StreamFrames:
         """Face frames completed by the next ``block`` of audio samples (mono)."""
         last = self.front.feed(block)           # frame t is complete once its window is in
@@ -138,7 +136,6 @@ class StreamingSynthesizer:
             last = self._next                           # not a whole batch yet: wait
         return self._emit(self._analyse(last), self._smoother.feed)
 
-    @never_waiting
     def flush(self) -> StreamFrames:
         """The remaining frames, the audio ended: as many frames in all as offline synthesis makes
         of the same audio (none if it is shorter than two frames)."""

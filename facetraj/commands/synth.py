@@ -17,7 +17,7 @@ log = logging.getLogger("facetraj")
 
 def _job(args: argparse.Namespace):
     from engine.method.modes import TUNED_FIELDS
-    from engine.method.recording import LabelRequest
+    from engine.workflow.recording import LabelRequest
 
     from ..batch import SynthJob
 
@@ -36,16 +36,12 @@ def cmd_synth(args: argparse.Namespace) -> int:
         return _cmd_batch(args)
     from engine.io.files import check_output_path
     from engine.method.model import Model
-    from engine.method.recording import EarlyLsf
 
-    from ..batch import choose_kernels, synthesize_file
+    from ..batch import synthesize_file
 
     check_output_path(args.output, args.overwrite)       # before the work, not after
-    source = Path(args.inputs[0])
-    job = choose_kernels(_job(args), [source])
-    early, samples = EarlyLsf.start(args.model, source, job.kernels)   # beside what follows
     model = Model.load(args.model)
-    res = synthesize_file(model, source, args.output, job, samples, early).synthesis
+    res = synthesize_file(model, Path(args.inputs[0]), args.output, _job(args)).synthesis
     log.info("%d frames (%.2f s) synthesized, %s smoothing", len(res.times), res.times[-1],
              res.config.smoothing)
     print(args.output)
@@ -106,6 +102,6 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="worker processes in a batch (default: the cores)")
     p.add_argument("--overwrite", action="store_true", help="replace existing outputs")
     p.add_argument("--compress", action="store_true",
-                   help=".npz: deflate it (17%% smaller, 40 times slower to write)")
+                   help=".npz: deflate it (a little smaller, much slower to write)")
     add_synth_options(p)
     p.set_defaults(func=cmd_synth)

@@ -1,0 +1,122 @@
+"""The candidate searches of the synthesis modes (paper section 2.3): eq 4's context-phones and
+their 5N codewords, the LSF index's acoustically nearest codewords, the robust mode's both
+together, and eqs 5-8 over each frame's candidates, split between frame threads. The modes
+(:mod:`engine.method.modes`) compose them."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..config import SynthConfig
+from ..data import PhoneSegment
+from ..labels.phoneset import SILENCE
+from ..threads import frame_threads, map_spans
+from .context import context_ids, segment_index
+from .model import Model
+from .selection import robust_frames
+from .similarity import top_context_phones
+from .synthesis import FrameWeights, gamma_grid, nearest_codewords, weight_frames
+
+
+@dataclass
+class SegmentChoice:
+    """The context-phones chosen for one input phone segment (eq 4)."""
+
+    segment: PhoneSegment
+    context: np.ndarray      # (2C+1,) phone ids of the input context-phone
+    chosen: np.ndarray       # (N,) codebook context-phone indices, best first
+    scores: np.ndarray       # (N,) their n_j
+
+
+@dataclass
+class SearchInput:
+    """What a mode's search is given: the model, the input frames' LSFs ``w`` ``(T, P)`` at
+    ``times``, the labels mapped onto the model's phones (``segs``; ``None`` without labels),
+    which of them the model lacks (``unlabelled``), each frame's label ``confidence`` in [0, 1],
+    the input's voice distance ratio, and the settings."""
+
+    model: Model
+    w: np.ndarray
+    times: np.ndarray
+    config: SynthConfig
+    segs: list[PhoneSegment] | None = None
+    unlabelled: np.ndarray | None = None
+    confidence: np.ndarray | None = None
+    voice_ratio: float = float("nan")
+
+
+@dataclass
+class SearchResult:
+    """A search's eqs 5-8 per frame, and (the modes that read labels) each input phone's chosen
+    context-phones (eq 4) and each frame's phone."""
+
+    frames: FrameWeights
+    segments: list[SegmentChoice] = field(default_factory=list)
+    frame_segment: np.ndarray | None = None
+
+
+def eq4(model: Model, segs: list[PhoneSegment], times: np.ndarray, config: SynthConfig
+        ) -> tuple[list[SegmentChoice], np.ndarray, np.ndarray]:
+    """Eq 4 per input phone: its chosen context-phones, each frame's phone, and each frame's
+    ``(T, 5N)`` candidate codewords."""
+    mc, cb = model.config, model.codebook
+    pid = {p: i for i, p in enumerate(model.phones)}
+    ctx = context_ids([pid[s.label] for s in segs], mc.context, pid[SILENCE])
+    top, scores = top_context_phones(ctx, cb.contexts, model.similarity(config.nu), config.xi,
+                                     min(config.context, mc.context), config.n_context_phones)
+    segments = [SegmentChoice(seg, ctx[i], top[i], scores[i]) for i, seg in enumerate(segs)]
+    frame_seg = segment_index(segs, times)
+    return segments, frame_seg, cb.codewords_of(top)[frame_seg]
+
+
+def robust_weights(model: Model, w: np.ndarray, candidates: np.ndarray, conf: np.ndarray,
+                   config: SynthConfig, scale: float = 1.0, w_ctx: np.ndarray | None = None
+                   ) -> FrameWeights:
+    """The robust mode's eqs 5-8 (``engine.method.selection``), its label weight times
+    ``scale`` (the voice's distance ratio: eq 5's distances grow with it); ``w_ctx``: the input
+    frames at :func:`context_offsets` when ``w`` is part of a longer input (a stream). The chain
+    over frames (``engine.method.chain``) is the search's, on the whole input."""
+    cb = model.codebook
+    near = model.lsf_index().nearest(w, cb.lsf, config.robust_candidates, config.acoustic_probe or 8)
+    return robust_frames(w, candidates, near, conf, cb.lsf, cb.pcs, gammas(config),
+                         config.label_weight * scale, cb.lsf_context, context_offsets(model),
+                         config.context_weight, w_ctx=w_ctx)
+
+
+def context_offsets(model: Model) -> np.ndarray:
+    """The frame offsets of the robust mode's acoustic context (the codewords' stored LSFs)."""
+    k = model.config.lsf_context_frames
+    return np.array([-k, k])
+
+
+def weighted(model: Model, w: np.ndarray, candidates: Callable[[int, int], np.ndarray],
+             config: SynthConfig) -> FrameWeights:
+    """Eqs 5-8 on each frame's candidates (``candidates(a, b)`` of frames ``a:b``), the frames
+    split between threads (they are independent)."""
+    cb = model.codebook
+
+    def span(a: int, b: int) -> FrameWeights:
+        return weight_frames(w[a:b], candidates(a, b), cb.lsf, cb.pcs, gammas(config))
+
+    return FrameWeights.concatenate(map_spans(span, len(w), frame_threads()))
+
+
+def gammas(config: SynthConfig) -> np.ndarray:
+    """The gamma grid of eqs 6-7 that ``config`` asks for."""
+    return gamma_grid(config.gamma_min, config.gamma_max, config.gamma_steps)
+
+
+def acoustic_candidates(model: Model, w: np.ndarray, config: SynthConfig,
+                        grouped: np.ndarray | None = None) -> np.ndarray:
+    """Acoustic-only candidates ``(T, I)`` of frames ``w``: the ``config.acoustic_prefilter``
+    codewords nearest by eq 5 through the model's LSF index (``acoustic_probe`` cells), or exactly,
+    or every codeword (``acoustic_prefilter=None``, as the paper does). ``grouped``: the index's
+    :meth:`~engine.method.lsf_index.LsfIndex.grouped` codebook, when the caller keeps it."""
+    cb = model.codebook
+    if config.acoustic_prefilter is not None and config.acoustic_probe is not None:
+        return model.lsf_index().nearest(w, cb.lsf, config.acoustic_prefilter,
+                                         config.acoustic_probe, grouped=grouped)
+    return nearest_codewords(w, cb.lsf, config.acoustic_prefilter)   # every one, or exact K
