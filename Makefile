@@ -4,19 +4,24 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 XVFB   := $(if $(DISPLAY),,xvfb-run -a -s "-screen 0 1600x1200x24")
 
-.PHONY: run test lint bench fuzz corpus report clean
+.PHONY: run test lint bench fuzz corpus report clean dist check-install
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
 
-$(VENV)/.installed-run: pyproject.toml | $(BIN)/python
-	$(BIN)/pip install -q -e .
+# both distributions from this checkout, editable: the engine (pyproject.toml) and the app
+# (packaging/app); the first install takes a minute or two (the libraries, PyQt6 and VTK among them)
+APP := packaging/app
+$(VENV)/.installed-run: pyproject.toml $(APP)/pyproject.toml $(APP)/setup.py | $(BIN)/python
+	@echo "facetraj: installing the engine and the app into $(VENV) (a minute or two the first time)"
+	$(BIN)/pip install -q -e . -e $(APP)
 	touch $@
 
 # the tests include the corpus generator's bit-for-bit reproduction check, hence the corpus extra
-$(VENV)/.installed-test: pyproject.toml | $(BIN)/python
-	$(BIN)/pip install -q -e ".[test,corpus]"
+$(VENV)/.installed-test: pyproject.toml $(APP)/pyproject.toml $(APP)/setup.py | $(BIN)/python
+	@echo "facetraj: installing the engine, the app and the test tools into $(VENV) (a few minutes the first time)"
+	$(BIN)/pip install -q -e ".[test,corpus]" -e $(APP)
 	touch $@ $(VENV)/.installed-run $(VENV)/.installed-corpus
 
 $(VENV)/.installed-corpus: pyproject.toml | $(BIN)/python
@@ -50,11 +55,21 @@ corpus: $(VENV)/.installed-corpus
 # every screenshot of the docs (docs/figures/), on a screen big enough for the 1920x1080 window;
 # the results figures come from `make report`
 figures: $(VENV)/.installed-test
-	$(if $(DISPLAY),,xvfb-run -a -s "-screen 0 2000x1400x24") $(BIN)/python -m app.gallery docs/figures
+	$(if $(DISPLAY),,xvfb-run -a -s "-screen 0 2000x1400x24") $(BIN)/python -m facetraj_app.gallery docs/figures
 	$(BIN)/python docs/figures/make_corpus_figures.py
 
 report: $(VENV)/.installed-test
 	$(BIN)/facetraj report data_samples -o docs
 
+# the two wheels and their sdists (docs/install.md): dist/facetraj_engine-*, dist/facetraj-*
+dist: $(VENV)/.installed-test
+	rm -rf dist
+	$(BIN)/python -m build -o dist .
+	$(BIN)/python -m build -o dist $(APP)
+
+# both wheels installed into fresh environments (only pip) and used outside the checkout
+check-install: $(VENV)/.installed-test
+	$(BIN)/python packaging/check_install.py
+
 clean:
-	rm -rf $(VENV) build *.egg-info .pytest_cache .ruff_cache
+	rm -rf $(VENV) build dist *.egg-info $(APP)/build $(APP)/*.egg-info .pytest_cache .ruff_cache

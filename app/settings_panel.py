@@ -23,8 +23,8 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from engine.config import SynthConfig
-from engine.method.modes import MODES, SEARCHES, TUNED_FIELDS
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.method.modes import MODES, SEARCHES, TUNED_FIELDS
 
 from .provenance import MODE_NOTES, mode_reason, search_key
 

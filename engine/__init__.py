@@ -20,21 +20,20 @@ shared          ``config`` (settings), ``data`` (an utterance), ``errors``, ``fa
 ``corpusgen``   building the default corpus (the ``corpus`` extra)
 ==============  ===========================================================================
 
-The entry points: :func:`engine.method.train`, :func:`engine.method.synthesize` and
-:func:`engine.evaluation.evaluate`. ``docs/architecture.md`` follows one request through them.
+The names a script needs are exported here (:data:`API`; ``docs/api.md`` shows them at work):
+``Model``, ``train``, ``read_audio``, ``read_labels``, ``synthesize``, ``synthesize_recording``,
+``evaluate``, ``write_trajectories`` and their settings. ``docs/architecture.md`` follows one
+request through the stages.
 """
 
 from __future__ import annotations
 
 import importlib
-import importlib.abc
-import importlib.machinery
 import sys
-import types
-import warnings
 from collections.abc import Callable
 
-__version__ = "0.1.0"
+#: facetraj's version, the one place it is written (both distributions read it at build time).
+__version__ = "0.2.0"
 
 #: The stages, lowest first: a module may import from its own stage and the ones before it.
 STAGES = ("labels", "io", "method", "workflow", "streaming", "evaluation",
@@ -42,7 +41,7 @@ STAGES = ("labels", "io", "method", "workflow", "streaming", "evaluation",
 
 
 def lazy_exports(package: str, table: dict[str, str]) -> tuple[Callable, Callable, list[str]]:
-    """``__getattr__``, ``__dir__`` and ``__all__`` of a stage package that exports the names in
+    """``__getattr__``, ``__dir__`` and ``__all__`` of a package that exports the names in
     ``table`` (``{"module": "name name ..."}``) and imports each module on first use, so that
     importing one module of a stage does not import the whole stage."""
     where = {name: module for module, names in table.items() for name in names.split()}
@@ -61,59 +60,24 @@ def lazy_exports(package: str, table: dict[str, str]) -> tuple[Callable, Callabl
     return __getattr__, __dir__, names
 
 
-# --------------------------------------------------------------------------- old module paths
-#: Module paths of version 0.1 before the stages, and where their names are now. Importing one
-#: still works, with a DeprecationWarning, until the next release.
-MOVED: dict[str, tuple[str, ...]] = {
-    "engine.formats": ("engine.io.files", "engine.io.audio", "engine.io.labelfiles",
-                       "engine.io.markerfiles"),
-    "engine.phones": ("engine.labels.phoneset", "engine.method.context"),
-    "engine.labelmap": ("engine.labels.labelmap", "engine.io.labelfiles"),
-    **{f"engine.{old}": (f"engine.{new}",) for old, new in {
-        "alignment": "labels.alignment", "c3d_check": "io.c3d_check", "corpus": "io.corpus",
-        "model_file": "io.model_file", "cachedir": "io.cachedir", "hash_memo": "io.hash_memo",
-        "labelling": "io.labelling", "export": "io.export", "lsf": "method.lsf",
-        "lsf_index": "method.lsf_index", "markers": "method.markers", "pca": "method.pca",
-        "codebook": "method.codebook", "similarity": "method.similarity",
-        "synthesis": "method.synthesis", "selection": "method.selection",
-        "smoothing": "method.smoothing", "speaker": "method.speaker",
-        "training": "method.training", "model": "method.model", "pipeline": "method.pipeline",
-        "baselines": "evaluation.baselines", "tuning": "evaluation.tuning",
-        "label_accuracy": "evaluation.label_accuracy", "label_eval": "evaluation.label_eval",
-        "voice_eval": "evaluation.voice_eval", "voice": "evaluation.second_voice",
-        "kinematics": "evaluation.kinematics", "paper": "evaluation.paper",
-    }.items()},
+#: The public Python API: what a script imports from ``facetraj_engine`` (docs/api.md).
+API = {
+    "config": "SynthConfig TrainConfig EvalConfig",
+    "errors": "FacetrajError InputError",
+    "io.audio": "read_audio write_audio",
+    "io.labelfiles": "read_labels read_label_file write_textgrid",
+    "io.markerfiles": "read_markers",
+    "io.corpus": "load_corpus init_corpus",
+    "io.export": "write_trajectories",
+    "method.model": "Model",
+    "method.training": "train",
+    "method.modes": "MODES choose_mode",
+    "method.pipeline": "synthesize resmooth Synthesis",
+    "workflow.recording": "synthesize_recording LabelRequest",
+    "labels.alignment": "align recognize",
+    "method.speech": "speech_mask",
+    "evaluation.scores": "evaluate",
 }
 
-
-class _MovedModules(importlib.abc.MetaPathFinder, importlib.abc.Loader):
-    """Imports an old module path (:data:`MOVED`) as a module that forwards every attribute to
-    the modules that now hold its names."""
-
-    def find_spec(self, fullname, path=None, target=None):
-        if fullname not in MOVED:
-            return None
-        return importlib.machinery.ModuleSpec(fullname, self)
-
-    def create_module(self, spec):
-        targets = MOVED[spec.name]
-        warnings.warn(f"{spec.name} is deprecated: its names are now in {', '.join(targets)}",
-                      DeprecationWarning, stacklevel=2)
-        modules = [importlib.import_module(t) for t in targets]
-        module = types.ModuleType(spec.name, f"Deprecated: see {', '.join(targets)}.")
-
-        def forward(name: str):
-            for m in modules:
-                if hasattr(m, name):
-                    return getattr(m, name)
-            raise AttributeError(f"module {spec.name!r} has no attribute {name!r}")
-
-        module.__getattr__ = forward
-        return module
-
-    def exec_module(self, module) -> None:
-        return None
-
-
-if not any(isinstance(f, _MovedModules) for f in sys.meta_path):
-    sys.meta_path.append(_MovedModules())
+__getattr__, __dir__, _api_names = lazy_exports(__name__, API)
+__all__ = ["STAGES", "__version__", *_api_names]

@@ -12,8 +12,8 @@ import logging
 import sys
 from collections.abc import Sequence
 
-from engine.errors import FacetrajError
-from engine.io.files import write_problem
+from facetraj_engine.errors import FacetrajError
+from facetraj_engine.io.files import write_problem
 
 from .commands import align, corpus, evaluate, gui, live, render, synth, train
 from .options import SECONDS
@@ -60,22 +60,21 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 class _Version(argparse.Action):
-    """``--version``: the installed package's version, looked up only when asked
-    (``importlib.metadata`` is slow to import)."""
+    """``--version``: facetraj's version (the engine's, written in one place), and whether the
+    app is installed."""
 
     def __call__(self, parser, namespace, values, option_string=None):
-        from importlib.metadata import PackageNotFoundError, version
+        from facetraj_engine import __version__
 
-        try:
-            text = version("facetraj")
-        except PackageNotFoundError:
-            text = "(not installed)"
-        parser.exit(message=f"facetraj {text}\n")
+        from .app_modules import APP_DISTRIBUTION, app_installed
+
+        app = "" if app_installed() else f" (engine only: pip install {APP_DISTRIBUTION} for the app)"
+        parser.exit(message=f"facetraj {__version__}{app}\n")
 
 
 #: The packages whose messages ``-v`` shows (facetraj's own); every other logger (matplotlib's font
 #: matching, PIL, ...) logs warnings and errors only, unless ``-vv`` is given.
-OWN_LOGGERS = ("facetraj", "engine", "app", "benchmarks")
+OWN_LOGGERS = ("facetraj", "facetraj_engine", "facetraj_app", "benchmarks")
 
 
 def configure_logging(verbose: int = 0, quiet: bool = False) -> None:
@@ -99,12 +98,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser().parse_args(argv)
     configure_logging(args.verbose, args.quiet)
-    if args.command is None:
-        args.corpus = default_corpus()
-        args.func = gui.cmd_gui
-    elif args.command in ("gui", "report") and args.corpus is None:
-        args.corpus = default_corpus()
+    if args.command is None:                    # the app on the default corpus
+        args.corpus, args.func = None, gui.cmd_gui
     try:
+        if args.command == "report" and args.corpus is None:
+            args.corpus = default_corpus()
         return args.func(args)
     except FacetrajError as exc:
         print(f"facetraj: error: {exc}", file=sys.stderr)

@@ -9,12 +9,17 @@ from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+#: the project's folders of source, and the import package each one is
+IMPORT_NAMES = {"engine": "facetraj_engine", "app": "facetraj_app", "facetraj": "facetraj",
+                "benchmarks": "benchmarks", "tests": "tests"}
 PACKAGES = ("engine", "app", "facetraj", "benchmarks")
 
 
 def module_name(path: Path) -> str:
-    """``engine/method/pipeline.py`` -> ``engine.method.pipeline`` (a package: its ``__init__``)."""
-    parts = path.relative_to(ROOT).with_suffix("").parts
+    """``engine/method/pipeline.py`` -> ``facetraj_engine.method.pipeline`` (a package: its
+    ``__init__``)."""
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    parts[0] = IMPORT_NAMES[parts[0]]
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
@@ -140,11 +145,11 @@ def box_of(module: str) -> str:
     """The box of the picture a module is drawn in: an engine stage, the engine's shared
     modules, or a top-level package."""
     parts = module.split(".")
-    if parts[0] != "engine":
+    if parts[0] != "facetraj_engine":
         return parts[0]
     if len(parts) == 1 or parts[1] in SHARED_NAMES:
-        return "engine.shared"
-    return f"engine.{parts[1]}"
+        return "facetraj_engine.shared"
+    return f"facetraj_engine.{parts[1]}"
 
 
 def mermaid(edges: list[Import] | None = None) -> str:
@@ -157,7 +162,7 @@ def mermaid(edges: list[Import] | None = None) -> str:
         box = box_of(module_name(path))
         files[box] = files.get(box, 0) + 1
     arrows = {(box_of(e.importer), box_of(e.target)) for e in edges}
-    arrows = {(a, b) for a, b in arrows if a != b and b != "engine.shared"}
+    arrows = {(a, b) for a, b in arrows if a != b and b != "facetraj_engine.shared"}
     ids = {box: box.replace(".", "_") for box in files}
     lines = ["```mermaid", "flowchart TD"]
     lines += [f'  {ids[box]}["{box}<br/>{files[box]} modules"]' for box in sorted(files, key=_box_order)]
@@ -168,9 +173,9 @@ def mermaid(edges: list[Import] | None = None) -> str:
 
 
 def _box_order(box: str) -> tuple[int, str]:
-    order = ["benchmarks", "facetraj", "app", "engine.corpusgen", "engine.report", "engine.analysis",
-             "engine.evaluation", "engine.streaming", "engine.method", "engine.io", "engine.labels",
-             "engine.shared"]
+    order = ["benchmarks", "facetraj", "facetraj_app", *(f"facetraj_engine.{s}" for s in (
+        "corpusgen", "report", "analysis", "evaluation", "streaming", "workflow", "method", "io",
+        "labels", "shared"))]
     return (order.index(box) if box in order else len(order), box)
 
 

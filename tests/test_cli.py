@@ -6,8 +6,8 @@ import os
 import numpy as np
 import pytest
 
-from engine.io.markerfiles import read_c3d, read_marker_table
 from facetraj.cli import main
+from facetraj_engine.io.markerfiles import read_c3d, read_marker_table
 
 
 @pytest.fixture(scope="module")
@@ -102,7 +102,7 @@ from matplotlib.figure import Figure
 fig = Figure()
 fig.text(0.5, 0.5, "a font is looked up")
 fig.savefig(sys.argv[2])
-logging.getLogger("engine.probe").debug("our own debug line")
+logging.getLogger("facetraj_engine.probe").debug("our own debug line")
 logging.getLogger("matplotlib.probe").warning("a library warning")
 """
 

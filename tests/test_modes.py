@@ -1,4 +1,4 @@
-"""``engine.method.modes``: every mode's one home. The command line, the rule, the synthesis, the
+"""``facetraj_engine.method.modes``: every mode's one home. The command line, the rule, the synthesis, the
 app's selector and the docs read the registry; a mode added there (a test's own, below) is
 synthesized, chosen and offered without a change anywhere else."""
 
@@ -11,11 +11,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engine.config import SynthConfig
-from engine.data import PhoneSegment, Provenance
-from engine.method import modes
-from engine.method.modes import MODES, SEARCHES, TUNED_FIELDS, Mode, choose_mode, mode_of, modes_table
-from engine.method.pipeline import synthesize
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.data import PhoneSegment, Provenance
+from facetraj_engine.method import modes
+from facetraj_engine.method.modes import (
+    MODES,
+    SEARCHES,
+    TUNED_FIELDS,
+    Mode,
+    choose_mode,
+    mode_of,
+    modes_table,
+)
+from facetraj_engine.method.pipeline import synthesize
 
 ROOT = Path(__file__).resolve().parent.parent
 FIELDS = {f.name for f in dataclasses.fields(SynthConfig)}
@@ -60,8 +68,8 @@ class Nearest(Mode):
     help = "each frame the nearest codeword"
 
     def search(self, job):
-        from engine.method.search import SearchResult, weighted
-        from engine.method.synthesis import nearest_codewords
+        from facetraj_engine.method.search import SearchResult, weighted
+        from facetraj_engine.method.synthesis import nearest_codewords
 
         model, w = job.model, job.w
         return SearchResult(weighted(model, w, lambda a, b: nearest_codewords(w[a:b], model.codebook.lsf, 1),

@@ -1,4 +1,4 @@
-"""Synthesis split between frame threads (engine.threads): the same result as one thread, to
+"""Synthesis split between frame threads (facetraj_engine.threads): the same result as one thread, to
 rounding (BLAS's matrix products may add a row's terms in another order for another number of
 rows), in every mode that splits its frames; the thread-count rule; the evaluation on one thread."""
 
@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from engine.config import SynthConfig
-from engine.method.pipeline import synthesize
-from engine.threads import (
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.method.pipeline import synthesize
+from facetraj_engine.threads import (
     THREADS_ENV,
     frame_spans,
     frame_threads,
@@ -31,7 +31,7 @@ SHORT = 120          # frames: 2 s
 @pytest.fixture
 def short_spans(monkeypatch):
     """Spans of 2 s, so that a few seconds of speech split between threads."""
-    from engine import threads
+    from facetraj_engine import threads
 
     monkeypatch.setattr(threads, "MIN_FRAMES_PER_THREAD", SHORT)
 
@@ -96,8 +96,8 @@ def test_an_error_in_a_span_reaches_the_caller(short_spans):
 def test_evaluation_synthesizes_on_one_frame_thread(default_model, default_corpus, monkeypatch):
     """evaluate() scores are independent of its worker processes to the bit: each utterance is
     synthesized on one frame thread, whatever the process would use."""
-    from engine.evaluation.scores import evaluate
-    from engine.method import search
+    from facetraj_engine.evaluation.scores import evaluate
+    from facetraj_engine.method import search
 
     seen = []
     real = search.frame_threads

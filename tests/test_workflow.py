@@ -7,9 +7,9 @@ from __future__ import annotations
 import logging
 import shutil
 
-from engine.io.labelfiles import recorded_provenance
-from engine.method.model import Model
 from facetraj.cli import main
+from facetraj_engine.io.labelfiles import recorded_provenance
+from facetraj_engine.method.model import Model
 
 
 def said(caplog, start: int = 0) -> list[str]:

@@ -21,7 +21,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from engine.corpusgen.face import (  # noqa: E402
+from facetraj_engine.corpusgen.face import (  # noqa: E402
     GROUPS,
     MARKER_NAMES,
     REST_FACE,

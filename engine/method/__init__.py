@@ -14,7 +14,7 @@ beyond the paper), then eqs 5-8 (``synthesis``)); ``smoothing``; PCs back to fac
 Equation modules are plain array functions, each naming its equation, with doctests; where a
 vectorised form replaces the formula (``synthesis.grid_weights``, ``lsf.chebyshev_real_roots``,
 ``similarity.top_context_phones``) it is tested against it. Imports shared modules,
-``engine.labels`` and ``engine.io``; never ``engine.evaluation`` or above.
+``facetraj_engine.labels`` and ``facetraj_engine.io``; never ``facetraj_engine.evaluation`` or above.
 """
 
 from .. import lazy_exports

@@ -471,7 +471,7 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     """LSF vectors ``(len(times), order)`` from 25 ms Hamming frames centred on ``times``.
 
     The audio is resampled to ``audio_rate`` first (the paper analyses 16 kHz speech). The frames
-    are analysed in ``threads`` spans at once (``None``: :func:`engine.threads.frame_threads`).
+    are analysed in ``threads`` spans at once (``None``: :func:`facetraj_engine.threads.frame_threads`).
     The LSFs equal one thread's to rounding: BLAS's matrix products (autocorrelation lags, the
     root bracketing grid) may add a row's terms in another order for another number of rows.
 

@@ -11,11 +11,11 @@ here, in :data:`MODES`, and its tests.
 
 The rule (:func:`choose_mode`). The paper's phonetic mode (eq 4) trusts its labels fully: right
 for hand-checked labels, wrong for labels from an aligner or a recognizer, whose errors it copies
-into the face. So the mode follows the labels' provenance (``engine.labels.provenance``):
+into the face. So the mode follows the labels' provenance (``facetraj_engine.labels.provenance``):
 
 - no labels: acoustic-only (the paper's "5N replaced with the whole codebook");
 - hand-checked labels: the paper's phonetic mode;
-- aligned or recognized labels: the robust mode (``engine.method.selection``), each phone's label
+- aligned or recognized labels: the robust mode (``facetraj_engine.method.selection``), each phone's label
   counting as much as its maker trusted it, with the settings cross-validated at training
   (:func:`tuned_config`, ``facetraj train``);
 - a mode the user chose explicitly is kept (acoustic-only when there are no labels at all).
@@ -100,7 +100,7 @@ class Phonetic(Mode):
 
 class Robust(Mode):
     """Eq 4's codewords and the acoustically nearest together, each label counting as much as its
-    maker trusted it (``engine.method.selection``), the weights chained over frames."""
+    maker trusted it (``facetraj_engine.method.selection``), the weights chained over frames."""
 
     name = "robust"
     title = "robust"

@@ -1,7 +1,7 @@
 """The candidate searches of the synthesis modes (paper section 2.3): eq 4's context-phones and
 their 5N codewords, the LSF index's acoustically nearest codewords, the robust mode's both
 together, and eqs 5-8 over each frame's candidates, split between frame threads. The modes
-(:mod:`engine.method.modes`) compose them."""
+(:mod:`facetraj_engine.method.modes`) compose them."""
 
 from __future__ import annotations
 
@@ -75,10 +75,10 @@ def eq4(model: Model, segs: list[PhoneSegment], times: np.ndarray, config: Synth
 def robust_weights(model: Model, w: np.ndarray, candidates: np.ndarray, conf: np.ndarray,
                    config: SynthConfig, scale: float = 1.0, w_ctx: np.ndarray | None = None
                    ) -> FrameWeights:
-    """The robust mode's eqs 5-8 (``engine.method.selection``), its label weight times
+    """The robust mode's eqs 5-8 (``facetraj_engine.method.selection``), its label weight times
     ``scale`` (the voice's distance ratio: eq 5's distances grow with it); ``w_ctx``: the input
     frames at :func:`context_offsets` when ``w`` is part of a longer input (a stream). The chain
-    over frames (``engine.method.chain``) is the search's, on the whole input."""
+    over frames (``facetraj_engine.method.chain``) is the search's, on the whole input."""
     cb = model.codebook
     near = model.lsf_index().nearest(w, cb.lsf, config.robust_candidates, config.acoustic_probe or 8)
     return robust_frames(w, candidates, near, conf, cb.lsf, cb.pcs, gammas(config),
@@ -114,7 +114,7 @@ def acoustic_candidates(model: Model, w: np.ndarray, config: SynthConfig,
     """Acoustic-only candidates ``(T, I)`` of frames ``w``: the ``config.acoustic_prefilter``
     codewords nearest by eq 5 through the model's LSF index (``acoustic_probe`` cells), or exactly,
     or every codeword (``acoustic_prefilter=None``, as the paper does). ``grouped``: the index's
-    :meth:`~engine.method.lsf_index.LsfIndex.grouped` codebook, when the caller keeps it."""
+    :meth:`~facetraj_engine.method.lsf_index.LsfIndex.grouped` codebook, when the caller keeps it."""
     cb = model.codebook
     if config.acoustic_prefilter is not None and config.acoustic_probe is not None:
         return model.lsf_index().nearest(w, cb.lsf, config.acoustic_prefilter,

@@ -5,22 +5,19 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from engine.errors import FacetrajError
-
+from ..app_modules import app_module
 from ..options import SECONDS
 from ..paths import default_corpus
 
 
 def cmd_gui(args: argparse.Namespace) -> int:
-    try:
-        from app.main import run_app
-        from app.recordings import recordings_in
-    except ImportError as exc:
-        raise FacetrajError(f"the app cannot start: {exc}") from exc
-    recordings = recordings_in(args.corpus) if args.corpus is not None else []
+    main = app_module("main", "facetraj gui")      # the app first: without it, nothing else matters
+    if args.corpus is None:
+        args.corpus = default_corpus()
+    recordings = app_module("recordings", "facetraj gui").recordings_in(args.corpus)
     corpus = default_corpus() if recordings else args.corpus
-    return run_app(corpus=corpus, screenshot=args.screenshot, utterance=args.utterance,
-                   time=args.time, model=getattr(args, "model", None), recordings=recordings)
+    return main.run_app(corpus=corpus, screenshot=args.screenshot, utterance=args.utterance,
+                        time=args.time, model=getattr(args, "model", None), recordings=recordings)
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -7,8 +7,9 @@ import argparse
 import logging
 from pathlib import Path
 
-from engine.errors import FacetrajError
+from facetraj_engine.errors import FacetrajError
 
+from ..app_modules import AppMissing, app_module
 from ..corpus_work import add_corpus_work_options, finish, jobs, skips
 from ..options import FPS, add_synth_options, integer, synth_config, video_size
 from ..paths import default_corpus, shared_path
@@ -18,19 +19,17 @@ log = logging.getLogger("facetraj")
 
 
 def cmd_video(args: argparse.Namespace) -> int:
-    from engine.method.model import Model
-    from engine.method.modes import choose_mode
-    from engine.method.pipeline import synthesize
+    from facetraj_engine.method.model import Model
+    from facetraj_engine.method.modes import choose_mode
+    from facetraj_engine.method.pipeline import synthesize
 
-    try:
-        from app.video import VideoSettings, render_video
-    except ImportError as exc:
-        raise FacetrajError(f"video export needs the app's packages: {exc}") from exc
+    video = app_module("video", "facetraj video")
+    VideoSettings, render_video = video.VideoSettings, video.render_video
     model = Model.load(args.model)
     original = None
     title = ""
     if args.corpus:
-        from engine.io.corpus import load_corpus
+        from facetraj_engine.io.corpus import load_corpus
 
         if not args.utterance:
             raise FacetrajError("give --utterance ID with --corpus")
@@ -40,8 +39,8 @@ def cmd_video(args: argparse.Namespace) -> int:
         original = model.normalise_markers(utt.markers) if utt.markers is not None else None
         title, source = utt.text or utt.name, utt.name
     elif args.audio:
-        from engine.io.audio import read_audio
-        from engine.io.labelfiles import read_label_file
+        from facetraj_engine.io.audio import read_audio
+        from facetraj_engine.io.labelfiles import read_label_file
 
         audio, rate = read_audio(args.audio)
         labels = read_label_file(args.labels, rate, len(audio) / rate) if args.labels else None
@@ -65,38 +64,40 @@ def cmd_video(args: argparse.Namespace) -> int:
 
 
 def cmd_report(args: argparse.Namespace) -> int:
-    from engine.method.model import Model
+    from facetraj_engine.method.model import Model
+    from facetraj_engine.report import write_report
 
     try:
-        from app.report_figures import make_report
-    except ImportError as exc:
-        raise FacetrajError(f"the report's figures need matplotlib: {exc}") from exc
+        figures = app_module("report_figures", "the report's figures").make_figures
+    except AppMissing as exc:
+        log.warning("%s; results.md is written without its figures", exc)
+        figures = None
     model = Model.load(args.model) if args.model else None
     if args.automatic_labels:
-        from engine.evaluation.label_eval import LABEL_EVAL_FILE, evaluate_labels, write_label_eval
-        from engine.io.corpus import load_corpus
+        from facetraj_engine.evaluation.label_eval import LABEL_EVAL_FILE, evaluate_labels, write_label_eval
+        from facetraj_engine.io.corpus import load_corpus
 
         args.output.mkdir(parents=True, exist_ok=True)
         result = evaluate_labels(load_corpus(args.corpus or default_corpus()),
                                  progress=TerminalProgress("automatic labels"))
         write_label_eval(args.output / LABEL_EVAL_FILE, result)
     if args.second_voice:
-        from engine.evaluation.voice_eval import VOICE_EVAL_FILE, evaluate_voices, write_voice_eval
-        from engine.io.corpus import load_corpus
+        from facetraj_engine.evaluation.voice_eval import VOICE_EVAL_FILE, evaluate_voices, write_voice_eval
+        from facetraj_engine.io.corpus import load_corpus
 
         args.output.mkdir(parents=True, exist_ok=True)
         voices = evaluate_voices(load_corpus(args.corpus or default_corpus()), model=model,
                                  progress=TerminalProgress("second voice"))
         write_voice_eval(args.output / VOICE_EVAL_FILE, voices)
     if args.closure:
-        from engine.evaluation.closure_eval import (
+        from facetraj_engine.evaluation.closure_eval import (
             ARCTIC_DIR,
             CLOSURE_EVAL_FILE,
             evaluate_closure,
             write_closure_eval,
         )
-        from engine.io.corpus import load_corpus
-        from engine.method.training import train
+        from facetraj_engine.io.corpus import load_corpus
+        from facetraj_engine.method.training import train
 
         corpus = load_corpus(args.corpus or default_corpus())
         args.output.mkdir(parents=True, exist_ok=True)
@@ -104,8 +105,8 @@ def cmd_report(args: argparse.Namespace) -> int:
                                   progress=TerminalProgress("closure"))
         write_closure_eval(args.output / CLOSURE_EVAL_FILE, result)
     skipped = skips(args)
-    out = make_report(args.corpus, args.output, model=model, progress=TerminalProgress("report"),
-                      ns=range(1, args.max_n + 1), workers=jobs(args), skip=skipped)
+    out = write_report(args.corpus, args.output, model=model, progress=TerminalProgress("report"),
+                       ns=range(1, args.max_n + 1), figures=figures, workers=jobs(args), skip=skipped)
     print(out)
     return finish(skipped)
 

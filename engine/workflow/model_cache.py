@@ -1,5 +1,6 @@
 """The trained-model cache: ``$FACETRAJ_CACHE_DIR`` or the user cache directory, one ``.npz`` per
-(corpus contents, training settings)."""
+(corpus contents, training settings): what the app and ``facetraj live`` use when no model file
+is given (the default corpus trained once, on first use)."""
 
 from __future__ import annotations
 
@@ -8,13 +9,13 @@ import json
 import logging
 from pathlib import Path
 
-from engine.config import TrainConfig
-from engine.errors import InputError, ModelFileError
-from engine.io.cachedir import cache_dir
-from engine.io.corpus import Corpus
-from engine.io.model_file import is_compressed
-from engine.method.model import Model
-from engine.progress import Progress
+from ..config import TrainConfig
+from ..errors import InputError, ModelFileError
+from ..io.cachedir import cache_dir
+from ..io.corpus import Corpus
+from ..io.model_file import is_compressed
+from ..method.model import Model
+from ..progress import Progress
 
 log = logging.getLogger(__name__)
 
@@ -62,7 +63,7 @@ def load_or_train(corpus: Corpus, config: TrainConfig | None = None,
             return model
         except ModelFileError as exc:
             log.warning("ignoring unreadable cached model: %s", exc)
-    from engine.method.training import train
+    from ..method.training import train
 
     log.info("training the model on %s (first run; cached in %s)", corpus.root, path.parent)
     model = train(corpus, config=config, progress=lambda f, m: progress(0.02 + 0.96 * f, f"training: {m}"))
