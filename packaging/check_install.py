@@ -116,7 +116,8 @@ def engine_alone(tmp: Path, wheel: Path, env: dict) -> None:
     first_test = json.loads((corpus / "corpus.json").read_text())["test"][0]
     facetraj = str(bin_ / "facetraj")
     py = str(bin_ / "python")
-    run([py, "-c", "import facetraj_engine, facetraj_engine.method.pipeline, facetraj.cli"], cwd=work, env=env)
+    run([py, "-c", "import facetraj_engine, facetraj_engine.method.pipeline, facetraj.cli"], cwd=work,
+        env=env)
     out = run([py, "-c", "import PyQt6"], cwd=work, env=env, expect=1)
     assert "No module named 'PyQt6'" in out, out
     assert "engine only" in run([facetraj, "--version"], cwd=work, env=env)
