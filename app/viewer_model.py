@@ -25,7 +25,8 @@ from engine.data import Utterance
 from engine.errors import FacetrajError
 from engine.evaluation.paper import FIGURE4_TEXT
 from engine.evaluation.scores import evaluate_utterance
-from engine.io.corpus import Corpus, label_path
+from engine.io.corpus import Corpus, held_transcript, label_source
+from engine.io.labelfiles import LABEL_SUFFIXES
 from engine.method.model import Model
 from engine.method.modes import choose_mode
 from engine.progress import Progress
@@ -151,9 +152,12 @@ class ViewerModel:
             raise FacetrajError(f"{utt_id}: no such utterance in {corpus.root}")
         split = "test" if utt_id in info.test else "train"
         try:
-            origin = LabelOrigin("file", file=label_path(corpus.data_root, utt_id).name)
+            source = label_source(corpus.data_root, utt_id)
         except FacetrajError:           # reading the utterance reports it
             origin = None
+        else:             # a label file, or a marker file's own (MVIEW's PHONES)
+            held = source.suffix.lower() not in LABEL_SUFFIXES
+            origin = LabelOrigin("file", file=f"{source.name}{' (PHONES)' if held else ''}")
         return self._new_request(lambda: corpus.utterance(utt_id), split, True, origin)
 
     def set_config(self, config: SynthConfig, explicit: bool = False) -> tuple[bool, SynthRequest | None]:
@@ -272,12 +276,17 @@ def view_summary(view: UtteranceView) -> str:
 
 
 def read_texts(corpus: Corpus) -> dict[str, str]:
-    """The orthographic text of each utterance that has a ``<id>.txt`` file."""
+    """The orthographic text of each utterance: its ``<id>.txt`` file, else the sentence its
+    marker file holds (MVIEW's SENTENCE)."""
     texts = {}
     for utt_id in corpus.info.ids:
         p = corpus.data_root / f"{utt_id}.txt"
         if p.exists():
             texts[utt_id] = p.read_text(encoding="utf-8", errors="replace").strip()
+        else:
+            held = held_transcript(corpus.data_root, utt_id)
+            if held:
+                texts[utt_id] = held
     return texts
 
 

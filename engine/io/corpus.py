@@ -21,13 +21,15 @@ from ..errors import InputError, warn_file
 from .audio import read_audio
 from .files import atomic_write, check_output_path
 from .hash_memo import folder_key, memoized_hash
-from .labelfiles import read_label_file, read_labels, read_textgrid, recorded_provenance, validate_phones
-from .markerfiles import MarkerRecording, read_markers
+from .labelfiles import held_labels, read_label_file, read_labels, read_textgrid, recorded_provenance
+from .markerfiles import read_markers
 from .markerformats import NAMES_FILE, check_names, format_for, marker_suffixes, read_names_file
 
 log = logging.getLogger(__name__)
 
 CORPUS_FORMAT = "facetraj-corpus"
+#: The share of a folder's recordings ``corpus init`` puts in the test split by default.
+DEFAULT_TEST_FRACTION = 1 / 3
 CORPUS_VERSION = 1
 MAX_DESCRIPTION_BYTES = 64 << 20
 
@@ -372,7 +374,8 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
         labels = read_label_file(lpath, rate, len(audio) / rate, info.label_provenance,
                                  detect_alphabet=not label_map)
     elif mdata.phones:
-        labels = recording_labels(mdata, mpath, len(audio) / rate, detect_alphabet=not label_map)
+        labels = held_labels(mdata.phones, mdata.words, len(audio) / rate, mpath,
+                             detect_alphabet=not label_map)
     else:
         raise no_labels
     phones = labels.phones
@@ -387,19 +390,6 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
                      marker_names=list(mdata.names), words=labels.words,
                      text=_transcript(root, utt_id) or mdata.transcript,
                      provenance=labels.provenance, confidence=labels.trust())
-
-
-def recording_labels(mdata: MarkerRecording, mpath: Path, duration: float,
-                     detect_alphabet: bool = True):
-    """The labels a marker file holds (MVIEW's PHONES and WORDS), checked against the audio's
-    ``duration``; forced-aligned by convention (HPRC's are), so their provenance is ``aligned``."""
-    from ..labels.alphabets import to_arpabet
-    from ..labels.provenance import labels_from_tiers
-
-    phones = validate_phones(mdata.phones, duration, mpath)
-    if detect_alphabet:
-        phones = to_arpabet(phones, f"{mpath} (PHONES)")
-    return labels_from_tiers(phones, mdata.words, {}, "aligned")
 
 
 def _fit_to_audio(mpath: Path, markers: np.ndarray, marker_rate: float, duration: float
@@ -420,6 +410,16 @@ def _fit_to_audio(mpath: Path, markers: np.ndarray, marker_rate: float, duration
                   f"only {100 * seen:.0f} % of the marker samples are seen; frames with gaps over "
                   f"100 ms are left out of training and evaluation")
     return markers
+
+
+def held_transcript(root: str | os.PathLike[str], utt_id: str) -> str:
+    """The sentence an utterance's marker file holds (MVIEW's SENTENCE), ``""`` when it holds none
+    or cannot be read (reading the utterance reports why)."""
+    try:
+        mpath = marker_path(root, utt_id)
+        return read_markers(mpath).transcript if format_for(mpath).carries_labels else ""
+    except InputError:
+        return ""
 
 
 def _transcript(root: Path, utt_id: str) -> str:
@@ -530,7 +530,7 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
                 fixed: list[str] | None = None, upper_lip: str = "", lower_lip: str = "",
                 lip_corners: list[str] | None = None, label_map: str = "",
                 marker_rate: float = 60.0, test: list[str] | None = None,
-                test_fraction: float = 1 / 3, name: str = "",
+                test_fraction: float | None = None, name: str = "",
                 overwrite: bool = True, label_provenance: str = "hand-checked",
                 channel_names: list[str] | None = None, head_corrected: bool = False
                 ) -> tuple[Path, CorpusInfo]:
@@ -540,7 +540,8 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
     marker roles (fixed references, lip centres) are given by name, the channels named by
     ``channel_names`` (or the folder's ``channel-names.txt``); data that its files say (or
     ``head_corrected`` says) is head-corrected needs no fixed markers. The test split is ``test``
-    or every ``round(1 / test_fraction)``-th utterance. ``output`` defaults to
+    or every ``round(1 / test_fraction)``-th utterance (by default a third, and at least one of
+    two or more utterances). ``output`` defaults to
     ``data_dir/corpus.json``; when it lies elsewhere (a read-only data folder), the description
     records ``data_dir`` relative to it. An existing description is replaced only with
     ``overwrite``. ``label_provenance`` says how label files without a record of their own were
@@ -560,10 +561,13 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
                              f"no marker named {role!r}; markers: {' '.join(names)}")
     corrected = _head_correction(scan, list(fixed or []), head_corrected)
     if test is None:
+        fraction = DEFAULT_TEST_FRACTION if test_fraction is None else test_fraction
         # a fraction of 1e-320 gave 1 / 0-ish = inf (found by make fuzz); any step past the
         # utterances' count means no test utterance, as 1e9 does
-        step = max(2, round(1 / max(test_fraction, 1e-9))) if test_fraction > 0 else 0
+        step = max(2, round(1 / max(fraction, 1e-9))) if fraction > 0 else 0
         test = [u for i, u in enumerate(ids) if step and i % step == step - 1]
+        if test_fraction is None and not test and len(ids) > 1:
+            test = ids[-1:]     # two recordings: one to train on, one to evaluate
     train_ids = [u for u in ids if u not in test]
     if not train_ids:
         train_ids, test = ids, [u for u in test if u in ids]

@@ -125,7 +125,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_label_provenance_option(i)
     i.add_argument("--rate", type=RATE, default=60.0, help="marker rate to resample to (60 Hz)")
     i.add_argument("--test", nargs="+", metavar="ID", help="test utterances")
-    i.add_argument("--test-fraction", type=FRACTION, default=1 / 3)
+    i.add_argument("--test-fraction", type=FRACTION,
+                   help="the share of the recordings in the test split (default: a third, and "
+                        "at least one of two or more)")
     i.add_argument("--name")
     i.add_argument("--overwrite", action="store_true", help="replace an existing description")
     i.set_defaults(func=cmd_corpus_init)
