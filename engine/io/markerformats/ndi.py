@@ -47,7 +47,7 @@ def sniff(head: bytes) -> bool:
     """Whether a file starts with a WaveFront header row (time, an id and position columns)."""
     first = head.split(b"\n", 1)[0].decode("latin-1")
     keys = {_key(k) for k in first.split("\t")}
-    return "\t" in first and any(_is_id(k) for k in keys) and {"tx", "ty", "tz"} <= keys
+    return "\t" in first and any(_is_id(k) for k in keys) and bool({"tx", "ty", "tz", "q0"} & keys)
 
 
 def _sensors(path: Path, header: list[str]) -> list[tuple[int, int | None, list[int]]]:
