@@ -6,79 +6,16 @@ from __future__ import annotations
 
 import json
 import logging
-import shutil
-from pathlib import Path
 
 import numpy as np
 import pytest
-from articulograph import (
-    PELLETS,
-    mview_entries,
-    write_ag500,
-    write_ag501,
-    write_est,
-    write_mview_v5,
-    write_mview_v73,
-    write_ndi,
-    write_txy,
-)
+from articulograph import PELLETS, write_folder
 from toycorpus import FIXED, NAMES
 
 from engine.io.corpus import load_corpus
-from engine.io.labelfiles import read_textgrid
 from facetraj.cli import main
 
 IDS = ["toy000", "toy001", "toy002", "toy003", "toy004", "toy005"]
-
-
-def at_rate(markers: np.ndarray, rate: float, target: float) -> np.ndarray:
-    """Trajectories at another rate (linear interpolation over the gaps: a file's samples)."""
-    t_in = np.arange(len(markers)) / rate
-    t_out = np.arange(int((len(markers) - 1) / rate * target) + 1) / target
-    flat = markers.reshape(len(markers), -1)
-    out = np.stack([np.interp(t_out, t_in[np.isfinite(c)], c[np.isfinite(c)]) for c in flat.T], axis=1)
-    return out.reshape(len(t_out), *markers.shape[1:])
-
-
-def _toy(toy_corpus_dir: Path, utt_id: str):
-    from engine.io.markerfiles import read_c3d
-
-    return read_c3d(toy_corpus_dir / f"{utt_id}.c3d").markers
-
-
-def write_folder(kind: str, toy: Path, out: Path, ids=IDS) -> Path:
-    """A folder of ``ids`` in format ``kind``: audio and TextGrid beside (MVIEW: inside)."""
-    out.mkdir(parents=True, exist_ok=True)
-    for utt in ids:
-        m = _toy(toy, utt)
-        if kind != "mview":
-            for ext in ("wav", "TextGrid"):
-                shutil.copy(toy / f"{utt}.{ext}", out / f"{utt}.{ext}")
-        if kind == "ag501":
-            write_ag501(out / f"{utt}.pos", at_rate(m, 60, 250), 250.0)
-        elif kind == "ag500":
-            padded = np.concatenate([m, np.zeros((len(m), 12 - m.shape[1], 3))], axis=1)
-            write_ag500(out / f"{utt}.pos", at_rate(padded, 60, 200))
-        elif kind == "ndi":
-            m100 = at_rate(m, 60, 100)
-            write_ndi(out / f"{utt}.tsv", m100, np.arange(len(m100)) / 100)
-        elif kind == "est":
-            m200 = at_rate(m, 60, 200)
-            names = [f"{n}_{a}" for n in NAMES for a in "xyz"]
-            write_est(out / f"{utt}.ema", names, m200.reshape(len(m200), -1), np.arange(len(m200)) / 200)
-        elif kind == "xrmb":
-            m = at_rate(m, 60, 145.6)[:, :8]
-            write_txy(out / f"{utt}.txy", np.stack([m[..., 2], m[..., 1]], axis=-1),
-                      np.arange(len(m)) * 1000 / 145.6)
-        elif kind == "mview":
-            import soundfile as sf
-
-            audio, rate = sf.read(toy / f"{utt}.wav")
-            phones = read_textgrid(toy / f"{utt}.TextGrid")
-            writer = write_mview_v5 if int(utt[-1]) % 2 else write_mview_v73
-            writer(out / f"{utt}.mat", mview_entries(NAMES, at_rate(m, 60, 100)[:, :, [2, 0, 1]], 100.0,
-                                                     audio, rate, phones, [], "toy sentence"))
-    return out
 
 
 def run(argv, capsys) -> tuple[int, str, str]:

@@ -13,7 +13,7 @@ pytest.importorskip("pytestqt")
 if not os.environ.get("DISPLAY"):
     pytest.skip("the app tests need an X display (run under xvfb-run)", allow_module_level=True)
 
-from test_articulograph_corpora import write_folder
+from articulograph import write_folder
 from toycorpus import FIXED, NAMES
 
 from app.main import build_window

@@ -78,8 +78,13 @@ def check_rate(path: Path, rate: float, where: str = "") -> float:
 
 def rate_of_times(path: Path, times: np.ndarray, unit: float = 1.0) -> float:
     """The frame rate of a time column in ``unit`` seconds: (frames - 1) / span, rounded to a whole
-    number when within 0.1 %; refused unless the span is finite and positive and the rate sane."""
+    number when within 0.1 %; refused unless the times increase and the rate is sane."""
     times = np.asarray(times, dtype=np.float64) * unit
+    steps = np.diff(times)
+    if len(steps) and not (steps > 0).all() and np.isfinite(times).all():
+        raise InputError(path, f"its times do not increase (frame {int(np.argmax(~(steps > 0))) + 2}: "
+                               f"{times[np.argmax(~(steps > 0)) + 1]:g} s after "
+                               f"{times[np.argmax(~(steps > 0))]:g} s)")
     span = float(times[-1] - times[0]) if len(times) > 1 else np.nan
     rate = (len(times) - 1) / span if np.isfinite(span) and span > 0 else np.nan
     if not MIN_RATE <= rate <= MAX_RATE:

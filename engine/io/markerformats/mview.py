@@ -34,7 +34,7 @@ AUDIO_RATES = (8000, 384000)
 def read_mview(path: Path) -> MarkerRecording:
     """Read an MVIEW ``.mat`` file (see the module's description)."""
     raw = read_binary(path, "MATLAB file")
-    if raw[512:520] == HDF5_AT_512 or raw.startswith(HDF5_AT_512):
+    if raw[512:520] == HDF5_AT_512 or raw.startswith((HDF5_AT_512, b"MATLAB 7.3")):
         from .mview_h5 import variables_v73
 
         entries = pick_struct(path, variables_v73(path))

@@ -17,6 +17,9 @@ from ...errors import InputError
 
 #: Deeper than this, a file is refused (MVIEW nests two levels: channels, then PHONES).
 MAX_DEPTH = 6
+#: The largest value read (a damaged file may claim any size; MATLAB compresses, so the file's
+#: own size is no bound): 512 MiB, 35 minutes of 16 sensors x 3 at 1250 Hz.
+MAX_VALUE_BYTES = 512 << 20
 
 
 def _class(obj) -> str:
@@ -34,6 +37,8 @@ def _value(h5, obj, depth: int = 0):
         return _struct(h5, obj, depth + 1)
     if obj.attrs.get("MATLAB_empty", 0):
         return np.zeros(0)
+    if obj.size * obj.dtype.itemsize > MAX_VALUE_BYTES:
+        raise ValueError(f"{obj.name} claims {obj.size * obj.dtype.itemsize} bytes")
     data = obj[()]
     if obj.dtype == h5py.ref_dtype:
         items = [_value(h5, h5[ref], depth + 1) for ref in np.asarray(data).T.ravel()]
