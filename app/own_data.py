@@ -123,15 +123,7 @@ class ImportDialog(QDialog):
         self.summary = QLabel("")
         self.summary.setWordWrap(True)
         form.addRow("", self.summary)
-        self.channel_names = QLineEdit()
-        self.channel_names.setPlaceholderText("the files' own names (e.g. Ch1=UL Ch2=LL, or one "
-                                              "name per channel)")
-        self.channel_names.editingFinished.connect(
-            lambda: self.set_folder(Path(self.folder_edit.text())))
-        form.addRow("Channel names", self.channel_names)
-        self.head_corrected = QCheckBox("already corrected for head motion (no fixed markers "
-                                        "needed)")
-        form.addRow("", self.head_corrected)
+        self._channel_rows(form)
         self.fixed_list = QListWidget()
         self.fixed_list.setSelectionMode(QAbstractItemView.SelectionMode.NoSelection)
         self.fixed_list.setMaximumHeight(130)
@@ -180,6 +172,18 @@ class ImportDialog(QDialog):
         self.folder_edit.editingFinished.connect(lambda: self.set_folder(Path(self.folder_edit.text())))
         if folder is not None:
             self.set_folder(folder)
+
+    def _channel_rows(self, form: QFormLayout) -> None:
+        """The channels' names (the folder scanned again with them) and the head-correction box."""
+        self.channel_names = QLineEdit()
+        self.channel_names.setPlaceholderText("the files' own names (e.g. Ch1=UL Ch2=LL, or one "
+                                              "name per channel)")
+        self.channel_names.editingFinished.connect(
+            lambda: self.set_folder(Path(self.folder_edit.text())))
+        form.addRow("Channel names", self.channel_names)
+        self.head_corrected = QCheckBox("already corrected for head motion (no fixed markers "
+                                        "needed)")
+        form.addRow("", self.head_corrected)
 
     # ------------------------------------------------------------------ folder
     def _browse(self) -> None:
