@@ -20,6 +20,8 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+import numpy as np
+
 from engine.config import SynthConfig
 from engine.data import Utterance
 from engine.errors import FacetrajError
@@ -262,7 +264,8 @@ def view_title(view: UtteranceView) -> str:
     origin = view.label_origin
     text = f" — “{utt.text}”" if utt.text and origin.source != "recognized" else ""
     n = f", N={cfg.n_context_phones}" if cfg.mode in ("phonetic", "robust") else ""
-    return (f"{utt.name} ({view.split}){text}    ·    3-D: {SMOOTHING_NAMES[cfg.smoothing]} synthesis, "
+    dims = "2-D" if np.nanmax(np.abs(view.shown[..., 0]), initial=0.0) < 1e-9 else "3-D"  # midsagittal
+    return (f"{utt.name} ({view.split}){text}    ·    {dims}: {SMOOTHING_NAMES[cfg.smoothing]} synthesis, "
             f"{search_title(cfg)}{n};  labels: {origin.text()}")
 
 

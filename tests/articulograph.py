@@ -228,6 +228,9 @@ def _toy(toy_corpus_dir: Path, utt_id: str):
     return read_c3d(toy_corpus_dir / f"{utt_id}.c3d").markers
 
 
+#: the toy markers written as XRMB's pellets UL LL T1 T2 T3 T4 MNI MNM (the toy face has no
+#: tongue: nose and cheek markers stand in for T1-T4)
+XRMB_FROM_TOY = ("UL_C", "LL_C", "NB", "NT", "LC_R", "CHK_R", "CHIN", "JAW_R")
 #: a toy corpus's first utterances
 IDS = ["toy000", "toy001", "toy002", "toy003", "toy004", "toy005"]
 #: what write_folder writes, and each kind's marker file suffix
@@ -238,7 +241,7 @@ FOLDER_KINDS = {"ag501": ".pos", "ag500": ".pos", "ndi": ".tsv", "est": ".ema", 
 def write_folder(kind: str, toy: Path, out: Path, ids=IDS) -> Path:
     """A folder of the toy corpus's ``ids`` (tests/toycorpus.py: 12 markers at 60 Hz) in format
     ``kind``, at each format's usual rate: audio and TextGrid beside (MVIEW: inside, v5 and v7.3
-    in turn; XRMB: the first 8 markers' z, y as pellets' x, y)."""
+    in turn; XRMB: the z, y of the markers of :data:`XRMB_FROM_TOY` as the pellets' x, y)."""
     import shutil
 
     from toycorpus import NAMES
@@ -264,7 +267,7 @@ def write_folder(kind: str, toy: Path, out: Path, ids=IDS) -> Path:
             names = [f"{n}_{a}" for n in NAMES for a in "xyz"]
             write_est(out / f"{utt}.ema", names, m200.reshape(len(m200), -1), np.arange(len(m200)) / 200)
         elif kind == "xrmb":
-            m = at_rate(m, 60, 145.6)[:, :8]
+            m = at_rate(m, 60, 145.6)[:, [NAMES.index(n) for n in XRMB_FROM_TOY]]
             write_txy(out / f"{utt}.txy", np.stack([m[..., 2], m[..., 1]], axis=-1),
                       np.arange(len(m)) * 1000 / 145.6)
         elif kind == "mview":

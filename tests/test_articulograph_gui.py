@@ -78,4 +78,5 @@ def test_two_d_xrmb_corpus_in_the_window(qtbot, toy_corpus_dir, tmp_path, monkey
     assert win.dimensions_label.isVisible() and not win.view_bar.surface.isEnabled()
     assert win.marker_panels[0].marker == "MNI"                    # XRMB's jaw beside the lips
     assert np.nanmax(np.abs(win.view.shown[..., 0])) < 1e-9       # no third axis invented
+    assert "2-D: triangular synthesis" in win.title.text()
     win.close()
