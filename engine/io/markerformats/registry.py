@@ -3,8 +3,9 @@
 Every format is a :class:`MarkerFormat` in a module of this package (its ``FORMATS`` tuple); the
 registry finds them there, so adding a format is adding one module (and its tests). A file is
 read by the first format whose content test (``sniff``, on the file's first bytes) says it is
-one of its files; when none does, by its suffix. Every error about an unknown format lists what
-:func:`accepted` says, made from the same list.
+one of its files; when none does, by its suffix (a suffix two formats share goes to the one
+without a content test: a ``.pos`` without the AG50x header is an AG500 file). Every error about
+an unknown format lists what :func:`accepted` says, made from the same list.
 """
 
 from __future__ import annotations
