@@ -14,9 +14,9 @@ if not os.environ.get("DISPLAY"):
     pytest.skip("the app tests need an X display (run under xvfb-run)", allow_module_level=True)
 
 from articulograph import write_folder
+from conftest import shown_corpus_window
 from toycorpus import FIXED, NAMES
 
-from app.main import build_window
 from app.own_data import ImportDialog
 from engine.io.corpus import load_corpus
 
@@ -60,20 +60,11 @@ def test_import_dialog_names_carstens_channels(qtbot, toy_corpus_dir, tmp_path):
 
 
 def test_two_d_xrmb_corpus_in_the_window(qtbot, toy_corpus_dir, tmp_path, monkeypatch):
-    from PyQt6.QtWidgets import QMessageBox
-
     from engine.io.corpus import init_corpus
 
     folder = write_folder("xrmb", toy_corpus_dir, tmp_path / "xrmb")
     path, _ = init_corpus(folder, upper_lip="UL", lower_lip="LL")
-    errors: list[str] = []
-    monkeypatch.setattr(QMessageBox, "critical", lambda *a, **k: errors.append(a[2]))
-    win = build_window(path, use_audio=False)
-    qtbot.addWidget(win)
-    win.resize(1400, 900)
-    win.show()
-    qtbot.waitUntil(lambda: errors or (win.view is not None and not win.busy), timeout=WAIT_MS)
-    assert not errors, errors
+    win = shown_corpus_window(qtbot, path, monkeypatch, WAIT_MS)
     assert win.model.is_planar and win.face.preset == "profile"
     assert win.dimensions_label.isVisible() and not win.view_bar.surface.isEnabled()
     assert win.marker_panels[0].marker == "MNI"                    # XRMB's jaw beside the lips
