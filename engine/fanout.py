@@ -6,7 +6,7 @@ that the model and the corpus are inherited, not pickled). Either way a bad file
 outcome:
 
 - by default, the first item in order whose file is bad stops the work with its own
-  :class:`~engine.errors.FacetrajError` (``file: problem``; its ``item`` attribute names the
+  :class:`~facetraj_engine.errors.FacetrajError` (``file: problem``; its ``item`` attribute names the
   item), as the serial run does; the items still waiting are cancelled;
 - with a :class:`Skips` (the commands' ``--skip-bad``), the item is left out, its message kept,
   and the work goes on; the command ends with :meth:`Skips.summary` ("1 of 3 utterances skipped:
@@ -17,7 +17,7 @@ does not is replaced by a plain copy before it leaves the worker); a worker that
 out of memory, a crash in a file reader) is an error naming the item it was working on (with a
 :class:`Skips`, that item is skipped), never a traceback. :func:`forked_map` is the worker
 processes under both this and ``facetraj synth``'s batch. The warnings about files a worker
-logs (``engine.errors.warn_file``) are sent to the parent, which logs each once.
+logs (``facetraj_engine.errors.warn_file``) are sent to the parent, which logs each once.
 """
 
 from __future__ import annotations
@@ -101,7 +101,7 @@ def portable(exc: BaseException) -> BaseException:
 
 
 #: called in the parent before worker processes fork: what every worker would otherwise load
-#: for itself (``engine.method.kernels`` loads the compiled kernels here), loaded once
+#: for itself (``facetraj_engine.method.kernels`` loads the compiled kernels here), loaded once
 _BEFORE_FORK: list[Callable[[], None]] = []
 
 
@@ -290,7 +290,7 @@ def forked_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int,
 
 
 def _worker_setup() -> None:
-    """A corpus command's worker process: the processes share the cores (``engine.threads``),
+    """A corpus command's worker process: the processes share the cores (``facetraj_engine.threads``),
     and the parent logs the file warnings."""
     one_blas_thread()
     FILE_WARNINGS.quiet = True
@@ -313,7 +313,7 @@ def fan_out(fn: Callable[[I], R], items: Sequence[I], workers: int = 1, *,
             skip: Skips | None = None, progress: Progress | None = None,
             describe: Callable[[I], str] = str) -> list[tuple[I, R]]:
     """``(item, fn(item))`` for every item, in order, computed in ``workers`` processes (forked;
-    serially for 1, or where fork is unavailable). A :class:`~engine.errors.FacetrajError` of an
+    serially for 1, or where fork is unavailable). A :class:`~facetraj_engine.errors.FacetrajError` of an
     item stops the work (raised as it is), or with ``skip`` leaves the item out (recorded there).
     ``progress(fraction, describe(item))`` as the items are taken in order."""
     items = list(items)

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from engine.data import PhoneSegment
+from facetraj_engine.data import PhoneSegment
 
 rng = np.random.default_rng(37)
 
@@ -171,7 +171,7 @@ MAT73_HEADER = (b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: Mon May  6
 
 
 def write_mview_v73(path: Path, entries: list[dict]) -> Path:
-    """The struct array as MATLAB v7.3 lays it out in HDF5 (see engine.io.markerformats.mview_h5)."""
+    """The struct array as MATLAB v7.3 lays it out in HDF5 (see facetraj_engine.io.markerformats.mview_h5)."""
     import h5py
 
     count = itertools.count()
@@ -223,7 +223,7 @@ def at_rate(markers: np.ndarray, rate: float, target: float) -> np.ndarray:
 
 
 def _toy(toy_corpus_dir: Path, utt_id: str):
-    from engine.io.markerfiles import read_c3d
+    from facetraj_engine.io.markerfiles import read_c3d
 
     return read_c3d(toy_corpus_dir / f"{utt_id}.c3d").markers
 
@@ -246,7 +246,7 @@ def write_folder(kind: str, toy: Path, out: Path, ids=IDS) -> Path:
 
     from toycorpus import NAMES
 
-    from engine.io.labelfiles import read_textgrid
+    from facetraj_engine.io.labelfiles import read_textgrid
 
     out.mkdir(parents=True, exist_ok=True)
     for utt in ids:

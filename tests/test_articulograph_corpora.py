@@ -12,7 +12,7 @@ import pytest
 from articulograph import PELLETS, write_folder
 from toycorpus import FIXED, NAMES
 
-from engine.io.corpus import load_corpus
+from facetraj_engine.io.corpus import load_corpus
 from facetraj.cli import main
 
 IDS = ["toy000", "toy001", "toy002", "toy003", "toy004", "toy005"]
@@ -83,7 +83,7 @@ def test_unnamed_channels_need_names_and_fixed_markers(toy_corpus_dir, tmp_path,
 
 def test_two_d_data_runs_the_whole_method(toy_corpus_dir, tmp_path, capsys):
     """XRMB pellets (x, y): trained, evaluated and synthesized in the midsagittal plane."""
-    from engine.method.model import Model
+    from facetraj_engine.method.model import Model
 
     folder = write_folder("xrmb", toy_corpus_dir, tmp_path / "xrmb")
     assert run(["corpus", "init", folder, "--upper-lip", "UL", "--lower-lip", "LL"], capsys)[0] == 0

@@ -17,8 +17,8 @@ from articulograph import write_folder
 from conftest import shown_corpus_window
 from toycorpus import FIXED, NAMES
 
-from app.own_data import ImportDialog
-from engine.io.corpus import load_corpus
+from facetraj_app.own_data import ImportDialog
+from facetraj_engine.io.corpus import load_corpus
 
 pytestmark = pytest.mark.gui
 WAIT_MS = 240_000   # a hang guard (a loaded machine is slow), not a speed limit
@@ -60,7 +60,7 @@ def test_import_dialog_names_carstens_channels(qtbot, toy_corpus_dir, tmp_path):
 
 
 def test_two_d_xrmb_corpus_in_the_window(qtbot, toy_corpus_dir, tmp_path, monkeypatch):
-    from engine.io.corpus import init_corpus
+    from facetraj_engine.io.corpus import init_corpus
 
     folder = write_folder("xrmb", toy_corpus_dir, tmp_path / "xrmb")
     path, _ = init_corpus(folder, upper_lip="UL", lower_lip="LL")

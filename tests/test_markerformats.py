@@ -26,10 +26,10 @@ from articulograph import (
     write_txy,
 )
 
-from engine.data import PhoneSegment
-from engine.errors import InputError
-from engine.io.markerfiles import read_markers
-from engine.io.markerformats import accepted, format_for, formats, marker_suffixes, read_recording
+from facetraj_engine.data import PhoneSegment
+from facetraj_engine.errors import InputError
+from facetraj_engine.io.markerfiles import read_markers
+from facetraj_engine.io.markerformats import accepted, format_for, formats, marker_suffixes, read_recording
 
 pytestmark = pytest.mark.filterwarnings("ignore::RuntimeWarning")
 

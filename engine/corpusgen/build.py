@@ -253,7 +253,7 @@ def build_corpus(out_dir: str | os.PathLike[str], n_sentences: int = DEFAULT_SEN
         fixed_markers=list(FIXED_MARKERS), upper_lip=UPPER_LIP, lower_lip=LOWER_LIP,
         train=train, test=test, lip_corners=list(LIP_CORNERS),
         name="facetraj synthetic (VocalTractLab JD3)",
-        description=(f"Synthetic audio-visual corpus built by engine.corpusgen (seed {seed}, "
+        description=(f"Synthetic audio-visual corpus built by facetraj_engine.corpusgen (seed {seed}, "
                      f"{n_sentences} sentences): speech from the VocalTractLab articulatory "
                      f"synthesizer (speaker JD3), 54 face markers driven by its jaw and lip "
                      f"articulators, with head motion, marker noise and {n_drops} short marker "

@@ -52,7 +52,7 @@ class CorpusInfo:
         description) mapping the labels onto ARPAbet when utterances are loaded.
     label_provenance : how label files without a record of their own (any file facetraj did not
         write) were made: ``hand-checked`` (the default), ``aligned`` or ``recognized``
-        (``engine.labels.provenance``).
+        (``facetraj_engine.labels.provenance``).
     data_dir : where the utterance files are, relative to the description's folder (``""``: the
         same folder). Lets a description point at a read-only folder of someone else's data.
     dimensions : 3, or 2 for midsagittal data (x = 0 for every marker).
@@ -60,7 +60,7 @@ class CorpusInfo:
         any given are still used).
     channel_names : how the marker files' channels map onto the names used here: ``OLD=NEW``
         renames (``NEW`` = ``-`` leaves a channel out), a plain list names every channel in file
-        order (:mod:`engine.io.markerformats.channels`); ``[]``: the files' own names.
+        order (:mod:`facetraj_engine.io.markerformats.channels`); ``[]``: the files' own names.
     name, description : free text.
     """
 
@@ -241,7 +241,7 @@ def label_path(root: str | os.PathLike[str], utt_id: str) -> Path:
 
 
 def marker_path(root: str | os.PathLike[str], utt_id: str) -> Path:
-    """The marker file of an utterance (any format of :mod:`engine.io.markerformats`)."""
+    """The marker file of an utterance (any format of :mod:`facetraj_engine.io.markerformats`)."""
     return _find(Path(root), utt_id, marker_suffixes(), "marker")
 
 
@@ -312,7 +312,7 @@ class Corpus:
     def fingerprint(self) -> str:
         """A hash of the description and every data file (names and contents), for caching
         models; computed once per corpus object, and known from the files' stamps alone when
-        they are unchanged since an earlier computation (:mod:`engine.io.hash_memo`)."""
+        they are unchanged since an earlier computation (:mod:`facetraj_engine.io.hash_memo`)."""
         if "fingerprint" not in self._memo:
             description = json.dumps(self.info.to_json(), sort_keys=True)
             files = [p for p in sorted(self.data_root.iterdir())
@@ -348,12 +348,12 @@ def load_corpus(root: str | os.PathLike[str]) -> Corpus:
 def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
                    label_map: dict[str, str] | None = None) -> Utterance:
     """Load ``<id>`` audio, labels (``phones`` and ``words`` tiers of a TextGrid, or a .lab /
-    .phn file) and markers (any format of :mod:`engine.io.markerformats`, its channels named by
+    .phn file) and markers (any format of :mod:`facetraj_engine.io.markerformats`, its channels named by
     the description's ``channel_names``, resampled to the corpus rate). A marker file that holds
     the speech and its labels (MVIEW) provides them when no audio or label file is beside it.
 
     Labels are mapped onto ARPAbet with ``label_map``, or without one from the alphabet they are
-    in (:func:`engine.labels.alphabets.to_arpabet`: labels in none is an error naming them).
+    in (:func:`facetraj_engine.labels.alphabets.to_arpabet`: labels in none is an error naming them).
     Markers shorter than the audio are padded with NaN (a warning); longer ones are cut at the
     audio's end.
     """

@@ -157,9 +157,9 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     :func:`context_similarity`'s order, so the scores are its scores to the bit; then the
     ``count``-th best score of each query (a partition) and a sort of the few scores reaching it.
     The result, including the lower-index-first tie order, is that of the full computation
-    (tested). The compiled kernel (``engine.method.compiled_search``) finds the same contexts
+    (tested). The compiled kernel (``facetraj_engine.method.compiled_search``) finds the same contexts
     per centre phone and scores them with the same additions, query by query, keeping each
-    query's best ``count`` as it goes, unless :mod:`engine.method.kernels` chooses numpy.
+    query's best ``count`` as it goes, unless :mod:`facetraj_engine.method.kernels` chooses numpy.
 
     Returns ``(top, scores)``, both ``(Q, count)``.
 

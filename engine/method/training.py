@@ -68,7 +68,7 @@ def load_training_set(utterances: Iterable[Utterance] | Corpus, setup: MarkerSet
                       progress: Progress, workers: int = 1, skip: Skips | None = None
                       ) -> tuple[list[Utterance], MarkerSetup, str]:
     """The training utterances, their marker roles and the corpus fingerprint ("" outside a
-    corpus). A :class:`~engine.io.corpus.Corpus` gives its ``train`` split (read in ``workers``
+    corpus). A :class:`~facetraj_engine.io.corpus.Corpus` gives its ``train`` split (read in ``workers``
     processes) and its ``corpus.json`` roles. An utterance with a bad file stops training with its
     error, or with ``skip`` is left out (recorded there)."""
     fingerprint = ""
@@ -178,7 +178,7 @@ def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = 
           skip: Skips | None = None) -> Model:
     """Train a model (paper sections 2.1-2.2) on utterances with markers and phone labels.
 
-    Given a :class:`~engine.io.corpus.Corpus`, its ``train`` split is used and the marker roles come
+    Given a :class:`~facetraj_engine.io.corpus.Corpus`, its ``train`` split is used and the marker roles come
     from ``corpus.json``; otherwise pass ``setup``.
 
     Steps: gap filling; head-motion removal against a Procrustes-mean neutral pose of the fixed
@@ -186,7 +186,7 @@ def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = 
     means and distances; the coarse LSF index of acoustic-only synthesis.
 
     The utterances are read, and their codewords computed, in ``workers`` processes
-    (:func:`engine.fanout.fan_out`; the model equals the serial run's). A bad file stops training
+    (:func:`facetraj_engine.fanout.fan_out`; the model equals the serial run's). A bad file stops training
     with its error, or with ``skip`` its utterance is left out (``--skip-bad``).
     """
     config = config or TrainConfig()
@@ -231,7 +231,7 @@ def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = 
 
 def closure_part(model: Model, loaded: Sequence[Utterance], normed: Sequence[np.ndarray]
                  ) -> ClosureStats:
-    """The closure step's statistics (:mod:`engine.method.closure`) of the training talker."""
+    """The closure step's statistics (:mod:`facetraj_engine.method.closure`) of the training talker."""
     a0, g = aperture_functional(model.pca, model.upper_lip, model.lower_lip)
     pcs = [model.to_pcs(n) for n in normed]
     return closure_stats(pcs, [u.phones for u in loaded], model.marker_rate, a0, g)
@@ -239,7 +239,7 @@ def closure_part(model: Model, loaded: Sequence[Utterance], normed: Sequence[np.
 
 def voice_part(model: Model, loaded: Sequence[Utterance], utterances: int = 40,
                frames: int = 60) -> float:
-    """``D0`` of :mod:`engine.method.voice_match` on (up to ``utterances`` evenly spaced)
+    """``D0`` of :mod:`facetraj_engine.method.voice_match` on (up to ``utterances`` evenly spaced)
     training utterances, ``frames`` speech frames each."""
     pick = np.unique(np.linspace(0, len(loaded) - 1, min(len(loaded), utterances)).astype(int))
     position = np.full(len(loaded), -1)

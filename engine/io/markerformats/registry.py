@@ -38,7 +38,7 @@ class MarkerFormat:
     name : what the format is called in messages and docs.
     suffixes : the file suffixes (lower case) read as this format when no content test matches.
     read : the reader: a path to a :class:`MarkerRecording` (mm, facetraj's axes, NaN missing),
-        or an :class:`~engine.errors.InputError` naming the file and the problem.
+        or an :class:`~facetraj_engine.errors.InputError` naming the file and the problem.
     sniff : a test on the file's first :data:`SNIFF_BYTES` bytes: whether the content says it is
         this format (``None``: known by suffix alone).
     signature : what the content test looks for, for messages.
