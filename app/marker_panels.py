@@ -14,7 +14,7 @@ from facetraj_engine.method.model import Model
 from .style import ORIGINAL_COLOR, SPLINE_COLOR, TRIANGULAR_COLOR, fit_ylabel
 from .timeline import Timeline
 
-JAW_NAMES = ("LI", "JAW", "JAW_C", "CN_C", "CHIN", "CN")
+JAW_NAMES = ("LI", "MNI", "JAW", "JAW_C", "CN_C", "CHIN", "CN")
 
 
 class MarkerPanel:

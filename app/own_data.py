@@ -1,8 +1,9 @@
 """Bringing one's own data in and getting results out (File menu).
 
-In: a dialog that describes a folder of recordings (audio + labels + markers) as a corpus: which
-markers are the fixed head references and which are the lip centres, and an editable table that
-maps the folder's labels onto ARPAbet (a MOCHA-TIMIT preset is provided). The description is
+In: a dialog that describes a folder of recordings (audio + labels + markers in any format of
+:mod:`facetraj_engine.io.markerformats`) as a corpus: the channels' names, which markers are the fixed head
+references (none for head-corrected data) and which are the lip centres, and an editable table
+that maps the folder's labels onto ARPAbet (a MOCHA-TIMIT preset is provided). The description is
 written by the engine (:func:`facetraj_engine.io.corpus.init_corpus`) and opened like any corpus.
 
 Out: the current synthesized or original trajectories (C3D, TSV, NPZ), the time-aligned panels as
@@ -21,6 +22,7 @@ from PyQt6.QtCore import Qt
 from PyQt6.QtGui import QAction
 from PyQt6.QtWidgets import (
     QAbstractItemView,
+    QCheckBox,
     QComboBox,
     QDialog,
     QDialogButtonBox,
@@ -47,6 +49,7 @@ from facetraj_engine.io.corpus import FolderScan, init_corpus, scan_folder
 from facetraj_engine.io.export import write_trajectories
 from facetraj_engine.io.files import atomic_write
 from facetraj_engine.io.labelfiles import write_label_map
+from facetraj_engine.io.markerformats import formats
 from facetraj_engine.labels.labelmap import MOCHA_TO_ARPABET, read_label_map
 from facetraj_engine.labels.phoneset import ARPABET, SILENCE, SILENCE_LABELS, normalise_label
 
@@ -104,8 +107,9 @@ class ImportDialog(QDialog):
         self.result_path: Path | None = None
         lay = QVBoxLayout(self)
         intro = QLabel("A folder with one audio file (WAV/FLAC), one label file (TextGrid, .lab, "
-                       ".phn) and one marker file (C3D, TSV/CSV, MOCHA .ema) per utterance, sharing "
-                       "the file name.")
+                       ".phn) and one marker file per utterance, sharing the file name (an MVIEW "
+                       "file may hold the audio and labels itself). Marker files: "
+                       + ", ".join(f"{f.name} ({', '.join(f.suffixes)})" for f in formats()) + ".")
         intro.setWordWrap(True)
         lay.addWidget(intro)
         form = QFormLayout()
@@ -117,7 +121,9 @@ class ImportDialog(QDialog):
         row.addWidget(browse)
         form.addRow("Folder", row)
         self.summary = QLabel("")
+        self.summary.setWordWrap(True)
         form.addRow("", self.summary)
+        self._channel_rows(form)
         self.fixed_list = QListWidget()
         self.fixed_list.setSelectionMode(QAbstractItemView.SelectionMode.NoSelection)
         self.fixed_list.setMaximumHeight(130)
@@ -167,6 +173,18 @@ class ImportDialog(QDialog):
         if folder is not None:
             self.set_folder(folder)
 
+    def _channel_rows(self, form: QFormLayout) -> None:
+        """The channels' names (the folder scanned again with them) and the head-correction box."""
+        self.channel_names = QLineEdit()
+        self.channel_names.setPlaceholderText("the files' own names (e.g. Ch1=UL Ch2=LL, or one "
+                                              "name per channel)")
+        self.channel_names.editingFinished.connect(
+            lambda: self.set_folder(Path(self.folder_edit.text())))
+        form.addRow("Channel names", self.channel_names)
+        self.head_corrected = QCheckBox("already corrected for head motion (no fixed markers "
+                                        "needed)")
+        form.addRow("", self.head_corrected)
+
     # ------------------------------------------------------------------ folder
     def _browse(self) -> None:
         path = QFileDialog.getExistingDirectory(self, "A folder of recordings")
@@ -177,7 +195,7 @@ class ImportDialog(QDialog):
         """Scan ``folder`` and fill the marker roles and the label map."""
         self.folder_edit.setText(str(folder))
         try:
-            scan = scan_folder(folder)
+            scan = scan_folder(folder, channel_names=self.channel_names.text().split() or None)
         except FacetrajError as exc:
             self.scan = None
             self.summary.setText(str(exc))
@@ -188,7 +206,12 @@ class ImportDialog(QDialog):
         self.summary.setText(f"{len(scan.ids)} utterances, {len(scan.marker_names)} {dims} markers at "
                              f"{scan.marker_rate:g} Hz, {len(scan.labels)} distinct labels"
                              + (f"; {len(scan.left_out)} files without labels or markers left out"
-                                if scan.left_out else ""))
+                                if scan.left_out else "")
+                             + (f"; {scan.format} files: head-corrected" if scan.head_corrected
+                                else ""))
+        if not self.channel_names.text() and scan.channel_names:
+            self.channel_names.setText(" ".join(scan.channel_names))
+        self.head_corrected.setChecked(bool(scan.head_corrected))
         fixed, upper, lower = guess_roles(scan.marker_names)
         self.fixed_list.clear()
         for name in scan.marker_names:
@@ -283,7 +306,8 @@ class ImportDialog(QDialog):
         path, _ = init_corpus(folder, out, self.fixed_markers(), self.upper.currentText(),
                               self.lower.currentText(), label_map=label_map,
                               marker_rate=self.rate.value(), test_fraction=self.test_fraction.value(),
-                              name=folder.name)
+                              name=folder.name, channel_names=self.channel_names.text().split() or None,
+                              head_corrected=self.head_corrected.isChecked())
         return path
 
     def _accept(self) -> None:

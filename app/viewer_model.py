@@ -20,12 +20,15 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+import numpy as np
+
 from facetraj_engine.config import SynthConfig
 from facetraj_engine.data import Utterance
 from facetraj_engine.errors import FacetrajError
 from facetraj_engine.evaluation.paper import FIGURE4_TEXT
 from facetraj_engine.evaluation.scores import evaluate_utterance
-from facetraj_engine.io.corpus import Corpus, label_path
+from facetraj_engine.io.corpus import Corpus, held_transcript, label_source
+from facetraj_engine.io.labelfiles import LABEL_SUFFIXES
 from facetraj_engine.method.model import Model
 from facetraj_engine.method.modes import MODES, choose_mode
 from facetraj_engine.progress import Progress
@@ -151,9 +154,12 @@ class ViewerModel:
             raise FacetrajError(f"{utt_id}: no such utterance in {corpus.root}")
         split = "test" if utt_id in info.test else "train"
         try:
-            origin = LabelOrigin("file", file=label_path(corpus.data_root, utt_id).name)
+            source = label_source(corpus.data_root, utt_id)
         except FacetrajError:           # reading the utterance reports it
             origin = None
+        else:             # a label file, or a marker file's own (MVIEW's PHONES)
+            held = source.suffix.lower() not in LABEL_SUFFIXES
+            origin = LabelOrigin("file", file=f"{source.name}{' (PHONES)' if held else ''}")
         return self._new_request(lambda: corpus.utterance(utt_id), split, True, origin)
 
     def set_config(self, config: SynthConfig, explicit: bool = False) -> tuple[bool, SynthRequest | None]:
@@ -258,8 +264,9 @@ def view_title(view: UtteranceView) -> str:
     origin = view.label_origin
     text = f" — “{utt.text}”" if utt.text and origin.source != "recognized" else ""
     n = f", N={cfg.n_context_phones}" if MODES[cfg.mode].needs_labels else ""
-    return (f"{utt.name} ({view.split}){text}    ·    3-D: {SMOOTHING_NAMES[cfg.smoothing]} synthesis, "
-            f"{search_title(cfg)}{n};  labels: {origin.text()}")
+    dims = "2-D" if np.nanmax(np.abs(view.shown[..., 0]), initial=0.0) < 1e-9 else "3-D"  # midsagittal
+    return (f"{utt.name} ({view.split}){text}    ·    {dims}: {SMOOTHING_NAMES[cfg.smoothing]} "
+            f"synthesis, {search_title(cfg)}{n};  labels: {origin.text()}")
 
 
 def view_summary(view: UtteranceView) -> str:
@@ -272,12 +279,17 @@ def view_summary(view: UtteranceView) -> str:
 
 
 def read_texts(corpus: Corpus) -> dict[str, str]:
-    """The orthographic text of each utterance that has a ``<id>.txt`` file."""
+    """The orthographic text of each utterance: its ``<id>.txt`` file, else the sentence its
+    marker file holds (MVIEW's SENTENCE)."""
     texts = {}
     for utt_id in corpus.info.ids:
         p = corpus.data_root / f"{utt_id}.txt"
         if p.exists():
             texts[utt_id] = p.read_text(encoding="utf-8", errors="replace").strip()
+        else:
+            held = held_transcript(corpus.data_root, utt_id)
+            if held:
+                texts[utt_id] = held
     return texts
 
 

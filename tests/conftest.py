@@ -88,3 +88,22 @@ def default_model(default_corpus):
 def trained_cache(default_model) -> Path:
     """The session cache, holding the default model (trained once for every test that needs it)."""
     return Path(os.environ["FACETRAJ_CACHE_DIR"])
+
+
+def shown_corpus_window(qtbot, path: Path, monkeypatch, timeout_ms: int = 240_000):
+    """The app's window on the corpus at ``path`` with its first utterance shown, no error dialog
+    on the way (the wait is a hang guard, not a speed limit)."""
+    from PyQt6.QtWidgets import QMessageBox
+
+    from facetraj_app.main import build_window
+
+    errors: list[str] = []
+    monkeypatch.setattr(QMessageBox, "critical", lambda *a, **k: errors.append(a[2]))
+    win = build_window(path, use_audio=False)
+    qtbot.addWidget(win)
+    win.resize(1400, 900)
+    win.show()
+    qtbot.waitUntil(lambda: errors or (win.view is not None and not win.busy), timeout=timeout_ms)
+    assert not errors, errors
+    monkeypatch.undo()
+    return win

@@ -45,8 +45,8 @@ PARSE_ONLY = {"gui", "report", "video", "build", None}
 BAD_NUMBERS = ["0", "-1", "-20", "nan", "inf", "-inf", "1e309", "1e-320", "abc", "", "3.5",
                "99999999999999999999", "0x10", "1e6", "-0", "1e-9", "2"]
 
-CATEGORIES = ("audio", "labels", "model", "corpus", "c3d", "markers", "options", "output",
-              "fanout", "alphabet", "app")
+CATEGORIES = ("audio", "labels", "model", "corpus", "c3d", "markers", "articulograph", "options",
+              "output", "fanout", "alphabet", "app")
 #: Exit status of a corpus-wide command that left bad files out (--skip-bad): allowed only there.
 EXIT_INCOMPLETE = 3
 
@@ -673,6 +673,74 @@ def marker_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
         yield Case("markers", f"{kind} {how}", argv, _protect(ws.model), out)
 
 
+# --------------------------------------------------------------------------- articulographs
+#: binary formats get byte damage, text formats text damage (and byte damage now and then)
+_TEXT_KINDS = {"ndi", "xrmb"}
+
+
+def _articulograph_base(ws: Workspace, kind: str) -> Path:
+    """The workspace's corpus with its markers in format ``kind`` (tests/articulograph.py),
+    described: channels named where the files do not name them; XRMB as its 8 pellets (2-D)."""
+    from articulograph import PELLETS, write_folder
+
+    from facetraj_engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
+
+    base = ws.root / "articulograph" / kind
+    if (base / "corpus.json").is_file():
+        return base
+    info = load_corpus(ws.corpus).info
+    write_folder(kind, ws.corpus, base, info.ids)
+    if kind == "xrmb":
+        info = CorpusInfo(**{**info.__dict__, "marker_names": list(PELLETS), "fixed_markers": [],
+                             "upper_lip": "UL", "lower_lip": "LL", "lip_corners": [],
+                             "dimensions": 2, "head_corrected": True})
+    elif kind in ("ag501", "ag500", "ndi"):
+        info = CorpusInfo(**{**info.__dict__, "channel_names": list(info.marker_names)})
+    save_corpus_info(base, info)
+    return base
+
+
+def _init_argv(kind: str, corpus: Path, out: Path) -> list[str]:
+    from toycorpus import FIXED, NAMES
+
+    lips = ["--upper-lip", "UL", "--lower-lip", "LL"] if kind == "xrmb" else \
+        ["--upper-lip", "UL_C", "--lower-lip", "LL_C"]
+    named = ["--channel-names", *NAMES] if kind in ("ag501", "ag500", "ndi") else []
+    fixed = [] if kind in ("xrmb", "mview") else ["--fixed", *FIXED]
+    return ["corpus", "init", str(corpus), "-o", str(out), *lips, *named, *fixed, "-q"]
+
+
+def articulograph_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
+    """Carstens, NDI Wave, MVIEW (v5, v7.3), XRMB and EST files in place of the C3D, damaged."""
+    from articulograph import FOLDER_KINDS
+
+    while True:
+        kind = rng.choice(sorted(FOLDER_KINDS))
+        d = ws.fresh("articulograph")
+        corpus = d / "corpus"
+        shutil.copytree(_articulograph_base(ws, kind), corpus)
+        r = rng.random()
+        utt = "toy000" if r >= 0.8 else "toy030"       # corpus init reads the first file
+        target = corpus / f"{utt}{FOLDER_KINDS[kind]}"
+        if kind in _TEXT_KINDS and rng.random() < 0.7:
+            text, how = _mutate_text(rng, target.read_text())
+            target.write_text(text)
+        else:
+            data, how = mutate_bytes(rng, target.read_bytes(), 0, rng.choice([120, 600, None]))
+            target.write_bytes(data)
+        out = d / "model.npz"
+        if r < 0.45:
+            argv, out = ["corpus", "show", str(corpus), "-q"], None
+        elif r < 0.65 and kind != "xrmb":                   # the model's 12 markers
+            argv, out = ["eval", str(ws.model), str(corpus), "--split", "test", "-q"], None
+        elif r < 0.8:
+            argv = ["train", str(corpus), "-o", str(out), "--no-tune", "-q"]
+        else:
+            out = d / "described.json"
+            argv = _init_argv(kind, corpus, out)
+        yield Case("articulograph", f"{kind} {how}", argv, _protect(ws.model), out)
+
+
 # --------------------------------------------------------------------------- options
 def _positional_value(ws: Workspace, dest: str, d: Path) -> str:
     return {"model": str(ws.model), "audio": str(ws.wav), "inputs": str(ws.wav),
@@ -1048,7 +1116,8 @@ def app_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
 
 GENERATORS: dict[str, Callable[[Workspace, random.Random], Iterator[Case]]] = {
     "audio": audio_cases, "labels": label_cases, "model": model_cases, "corpus": corpus_cases,
-    "c3d": c3d_cases, "markers": marker_cases, "options": option_cases, "output": output_cases,
+    "c3d": c3d_cases, "markers": marker_cases, "articulograph": articulograph_cases,
+    "options": option_cases, "output": output_cases,
     "fanout": fanout_cases, "alphabet": alphabet_cases, "app": app_cases,
 }
 

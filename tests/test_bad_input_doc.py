@@ -200,7 +200,57 @@ def file_format_cases(f: BadInputs) -> dict[str, Callable[[], object]]:
     "markers whose names differ from the corpus (same count)": lambda: f.corpus_with(
         f.toy_markers, [n + "_X" if i == 3 else n for i, n in enumerate(f.names)]),
     "marker table or EMA times that give no sane rate": lambda: read_markers(f.write(
+        "t.tsv", "time\ta_x\ta_y\ta_z\n0\t1\t2\t3\n1e-6\t1\t2\t3\n")),
+    "marker times that do not increase": lambda: read_markers(f.write(
         "t.tsv", "time\ta_x\ta_y\ta_z\n0\t1\t2\t3\n0\t1\t2\t3\n")),
+    }
+
+
+def articulograph_cases(f: BadInputs) -> dict[str, Callable[[], object]]:
+    """Articulograph files (tests/articulograph.py writes them to their published layouts)."""
+    from articulograph import sensors, write_ag501, write_est, write_mview_v5, write_txy
+    from scipy.io import savemat
+
+    from facetraj_engine.io.corpus import init_corpus
+
+    def ag501(name: str = "s.pos", xyz=None):
+        return write_ag501(f.tmp / name, sensors(10, 4) if xyz is None else xyz)
+
+    def dead_channel():
+        xyz = sensors(10, 4)
+        xyz[:, 1] = np.nan
+        return ag501("d.pos", xyz)
+
+    def pos_folder():
+        for ext in ("wav", "TextGrid"):
+            (f.tmp / f"u.{ext}").write_bytes((f.toy_dir / f"toy030.{ext}").read_bytes())
+        ag501("u.pos", sensors(400, 4))
+        return init_corpus(f.tmp, upper_lip="Ch1", lower_lip="Ch2")
+
+    return {
+    "a Carstens .pos file cut short, or with another channel count than its header says":
+        lambda: read_markers(f.write("c.pos", ag501().read_bytes()[:-6])),
+    "a Carstens AG50x header that is damaged": lambda: read_markers(f.write(
+        "h.pos", ag501().read_bytes().replace(b"NumberOfChannels", b"NumberOfSensors"))),
+    "a sensor without a single valid sample": lambda: read_markers(dead_channel()),
+    "missing samples (NaN, XRMB's 1000000, a status not OK, an rms over 30)": lambda: read_markers(
+        write_txy(f.tmp / "m.txy", sensors(9, 8)[..., :2], np.arange(9) * 7.0,
+                  np.eye(9, 8, dtype=bool))),
+    "channel names that do not fit the file": lambda: read_markers(ag501(), channel_names=["UL"]),
+    "no fixed markers for data not known to be head-corrected": pos_folder,
+    "an EST track whose channels have no sensor names": lambda: read_markers(write_est(
+        f.tmp / "e.ema", ["a", "b", "c"], np.zeros((4, 3)), np.arange(4) / 100)),
+    "an EST track without names of exactly MOCHA's 20 channels": lambda: read_markers(write_est(
+        f.tmp / "m.ema", [], np.zeros((4, 20)), np.arange(4) / 500, named=False)),
+    "an EST track cut short": lambda: read_markers(f.write("t.ema", write_est(
+        f.tmp / "t0.ema", ["a_x", "a_y"], np.zeros((4, 2)), np.arange(4) / 100).read_bytes()[:-4])),
+    "an MVIEW file that is not a readable MATLAB file": lambda: read_markers(f.write(
+        "x.mat", b"MATLAB 5.0 MAT-file" + b"\0" * 200)),
+    "a MATLAB file without an MVIEW struct": lambda: (savemat(f.tmp / "o.mat", {"x": np.zeros(3)}),
+                                                      read_markers(f.tmp / "o.mat")),
+    "an MVIEW file without a sensor channel": lambda: read_markers(write_mview_v5(
+        f.tmp / "a.mat", [{"NAME": "AUDIO", "SRATE": 16000.0, "SIGNAL": np.zeros((800, 1))}])),
+    "an XRMB file with another column count": lambda: read_markers(f.write("x.txy", "0 1 2\n7 1 2\n")),
     }
 
 
@@ -304,7 +354,7 @@ def corpus_command_cases(f: BadInputs) -> dict[str, Callable[[], object]]:
 
 CASE_GROUPS = (audio_and_label_cases, marker_and_training_cases, model_and_corpus_cases,
                file_format_cases, model_detail_cases, output_cases, model_value_cases,
-               corpus_command_cases)
+               corpus_command_cases, articulograph_cases)
 
 #: the toy phones in SAMPA
 _SAMPA = {"aa": "A:", "iy": "i:", "uw": "u:"}

@@ -7,7 +7,7 @@ import os
 
 import numpy as np
 import pytest
-from conftest import MOCHA
+from conftest import MOCHA, shown_corpus_window
 
 pytest.importorskip("pytestqt")
 if not os.environ.get("DISPLAY"):
@@ -17,7 +17,6 @@ if not (MOCHA / "fsew0_001.ema").exists():
 
 from PyQt6.QtWidgets import QMessageBox
 
-from facetraj_app.main import build_window
 from facetraj_app.own_data import (
     ImportDialog,
     default_label_map,
@@ -71,16 +70,7 @@ def mocha_window(qtbot, tmp_path, monkeypatch):
     dlg = ImportDialog(folder=MOCHA)
     qtbot.addWidget(dlg)
     dlg.output_edit.setText(str(tmp_path / "mocha.json"))
-    path = dlg.write_description()
-    errors: list[str] = []
-    monkeypatch.setattr(QMessageBox, "critical", lambda *a, **k: errors.append(a[2]))
-    win = build_window(path, use_audio=False)
-    qtbot.addWidget(win)
-    win.resize(1400, 900)
-    win.show()
-    qtbot.waitUntil(lambda: errors or (win.view is not None and not win.busy), timeout=WAIT_MS)
-    assert not errors, errors
-    monkeypatch.undo()
+    win = shown_corpus_window(qtbot, dlg.write_description(), monkeypatch, WAIT_MS)
     yield win
     win.close()
 

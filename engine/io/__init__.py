@@ -2,7 +2,8 @@
 
 - ``files``: atomic writes (never a half-written file), output path checks, small JSON files;
 - ``audio``, ``labelfiles`` (with ``textgrid``, Praat's TextGrid grammar), ``markerfiles`` (with
-  ``c3d_check``, ``c3d_layout``): the file formats;
+  ``c3d_check``, ``c3d_layout``): the file formats; ``markerformats``: the one registry of marker
+  file formats, a module per format (C3D, tables, MOCHA, EST, Carstens, NDI Wave, MVIEW, XRMB);
 - ``corpus``: a corpus folder (``corpus.json`` and its recordings), ``hash_memo`` its content
   hashes, ``cachedir`` where recomputable things are kept;
 - ``model_file``: a model file's arrays and metadata checked before use (no pickle);

@@ -31,8 +31,25 @@ _INTEGER_SUBTYPES = {"PCM_S8", "PCM_U8", "PCM_16", "PCM_24", "PCM_32", "ULAW", "
 _BLOCK_SAMPLES = 1 << 20
 
 
+def _held_audio(path: Path) -> tuple[np.ndarray, int] | None:
+    """The speech a marker file holds (an MVIEW ``.mat``), ``None`` for a file of no such format."""
+    from .markerformats import format_for, read_recording
+
+    try:
+        fmt = format_for(path)
+    except InputError:
+        return None
+    if not fmt.carries_audio:
+        return None
+    rec = read_recording(path)
+    if rec.audio is None:
+        raise InputError(path, f"the {fmt.name} file holds no audio channel")
+    return rec.audio, rec.audio_rate
+
+
 def read_audio(path: str | os.PathLike[str]) -> tuple[np.ndarray, int]:
-    """Read a WAV or FLAC file as mono float64 samples and its rate.
+    """Read a WAV or FLAC file as mono float64 samples and its rate (or the speech a marker file
+    holds: an MVIEW ``.mat``).
 
     Stereo and multi-channel files are mixed down (a note is logged), block by block, so that
     only the mono samples are held. The header's sample count is checked against the file's
@@ -44,6 +61,10 @@ def read_audio(path: str | os.PathLike[str]) -> tuple[np.ndarray, int]:
     path = Path(path)
     if not path.exists():
         raise InputError(path, "no such audio file")
+    if path.suffix.lower() not in AUDIO_SUFFIXES and not path.is_dir():
+        held = _held_audio(path)
+        if held is not None:
+            return held
     if path.stat().st_size == 0:
         raise InputError(path, "the audio file is empty (0 bytes)")
     try:

@@ -21,12 +21,15 @@ from ..errors import InputError, warn_file
 from .audio import read_audio
 from .files import atomic_write, check_output_path
 from .hash_memo import folder_key, memoized_hash
-from .labelfiles import read_label_file, read_labels, read_textgrid, recorded_provenance
-from .markerfiles import MARKER_SUFFIXES, read_markers
+from .labelfiles import held_labels, read_label_file, read_labels, read_textgrid, recorded_provenance
+from .markerfiles import read_markers
+from .markerformats import NAMES_FILE, check_names, format_for, marker_suffixes, read_names_file
 
 log = logging.getLogger(__name__)
 
 CORPUS_FORMAT = "facetraj-corpus"
+#: The share of a folder's recordings ``corpus init`` puts in the test split by default.
+DEFAULT_TEST_FRACTION = 1 / 3
 CORPUS_VERSION = 1
 MAX_DESCRIPTION_BYTES = 64 << 20
 
@@ -53,6 +56,11 @@ class CorpusInfo:
     data_dir : where the utterance files are, relative to the description's folder (``""``: the
         same folder). Lets a description point at a read-only folder of someone else's data.
     dimensions : 3, or 2 for midsagittal data (x = 0 for every marker).
+    head_corrected : the data is already corrected for head motion (no fixed markers needed;
+        any given are still used).
+    channel_names : how the marker files' channels map onto the names used here: ``OLD=NEW``
+        renames (``NEW`` = ``-`` leaves a channel out), a plain list names every channel in file
+        order (:mod:`facetraj_engine.io.markerformats.channels`); ``[]``: the files' own names.
     name, description : free text.
     """
 
@@ -72,6 +80,8 @@ class CorpusInfo:
     label_provenance: str = "hand-checked"
     data_dir: str = ""
     dimensions: int = 3
+    head_corrected: bool = False
+    channel_names: list[str] = field(default_factory=list)
     name: str = ""
     description: str = ""
 
@@ -125,9 +135,12 @@ class CorpusInfo:
             if m not in info.marker_names:
                 raise InputError(path, f"marker {m!r} is not among marker_names")
         need = 2 if info.dimensions == 2 else 3
-        if len(info.fixed_markers) < need:
+        if len(info.fixed_markers) < need and not (info.head_corrected and not info.fixed_markers):
             raise InputError(path, f"at least {need} fixed markers are needed to remove head motion "
-                                   f"from {info.dimensions}-D data")
+                                   f"from {info.dimensions}-D data"
+                                   + ("" if info.head_corrected else
+                                      " (none for data already head-corrected: head_corrected)"))
+        check_names(info.channel_names, path)
         return info
 
 
@@ -167,6 +180,8 @@ SCHEMA: dict[str, tuple] = {
     "label_provenance": (lambda v: v in LABEL_KINDS, " or ".join(f'"{k}"' for k in LABEL_KINDS)),
     "data_dir": (_text, "text (a folder relative to the description)"),
     "dimensions": (lambda v: v in (2, 3) and not isinstance(v, bool), "2 or 3"),
+    "head_corrected": (lambda v: isinstance(v, bool), "true or false"),
+    "channel_names": (_names, "a list of channel names (OLD=NEW, or one per channel)"),
     "name": (_text, "text"),
     "description": (_text, "text"),
 }
@@ -226,8 +241,27 @@ def label_path(root: str | os.PathLike[str], utt_id: str) -> Path:
 
 
 def marker_path(root: str | os.PathLike[str], utt_id: str) -> Path:
-    """The marker file of an utterance (C3D, TSV/CSV or MOCHA .ema)."""
-    return _find(Path(root), utt_id, MARKER_SUFFIXES, "marker")
+    """The marker file of an utterance (any format of :mod:`facetraj_engine.io.markerformats`)."""
+    return _find(Path(root), utt_id, marker_suffixes(), "marker")
+
+
+def _beside(find, root: Path, utt_id: str) -> tuple[Path | None, InputError | None]:
+    """``find(root, utt_id)``, or ``None`` and why not."""
+    try:
+        return find(root, utt_id), None
+    except InputError as exc:
+        return None, exc
+
+
+def label_source(root: str | os.PathLike[str], utt_id: str) -> Path:
+    """Where an utterance's labels are: its label file, else its marker file (MVIEW's PHONES)."""
+    found, missing = _beside(label_path, Path(root), utt_id)
+    if found is not None:
+        return found
+    mpath = marker_path(root, utt_id)
+    if not format_for(mpath).carries_labels:
+        raise missing
+    return mpath
 
 
 @dataclass
@@ -314,7 +348,9 @@ def load_corpus(root: str | os.PathLike[str]) -> Corpus:
 def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
                    label_map: dict[str, str] | None = None) -> Utterance:
     """Load ``<id>`` audio, labels (``phones`` and ``words`` tiers of a TextGrid, or a .lab /
-    .phn file) and markers (C3D, TSV/CSV or MOCHA EMA, resampled to the corpus rate).
+    .phn file) and markers (any format of :mod:`facetraj_engine.io.markerformats`, its channels named by
+    the description's ``channel_names``, resampled to the corpus rate). A marker file that holds
+    the speech and its labels (MVIEW) provides them when no audio or label file is beside it.
 
     Labels are mapped onto ARPAbet with ``label_map``, or without one from the alphabet they are
     in (:func:`facetraj_engine.labels.alphabets.to_arpabet`: labels in none is an error naming them).
@@ -324,25 +360,46 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
     from ..labels.phoneset import apply_label_map
 
     root = Path(root)
-    apath = audio_path(root, utt_id)
-    audio, rate = read_audio(apath)
-    lpath = label_path(root, utt_id)
-    labels = read_label_file(lpath, rate, len(audio) / rate, info.label_provenance,
+    apath, no_audio = _beside(audio_path, root, utt_id)
+    lpath, no_labels = _beside(label_path, root, utt_id)
+    if apath is not None:
+        audio, rate = read_audio(apath)
+    mpath = marker_path(root, utt_id)
+    mdata = read_markers(mpath, info.marker_rate, info.channel_names or None)
+    if apath is None:
+        if mdata.audio is None:
+            raise no_audio
+        audio, rate = mdata.audio, mdata.audio_rate
+    if lpath is not None:
+        labels = read_label_file(lpath, rate, len(audio) / rate, info.label_provenance,
+                                 detect_alphabet=not label_map)
+    elif mdata.phones:
+        labels = held_labels(mdata.phones, mdata.words, len(audio) / rate, mpath,
                              detect_alphabet=not label_map)
+    else:
+        raise no_labels
     phones = labels.phones
     if label_map:
         phones = [PhoneSegment(s.start, s.end, apply_label_map(s.label, label_map)) for s in phones]
-    mpath = marker_path(root, utt_id)
-    mdata = read_markers(mpath, info.marker_rate)
     if mdata.names != info.marker_names:
         raise InputError(mpath, f"marker set differs from the corpus description "
                                 f"({marker_set_difference(mdata.names, info.marker_names)})")
-    markers = mdata.markers
-    n_audio = int(np.floor(len(audio) / rate * info.marker_rate + 1e-9)) + 1
+    markers = _fit_to_audio(mpath, mdata.markers, info.marker_rate, len(audio) / rate)
+    return Utterance(name=utt_id, audio=audio, sample_rate=rate, phones=phones,
+                     markers=markers, marker_rate=info.marker_rate,
+                     marker_names=list(mdata.names), words=labels.words,
+                     text=_transcript(root, utt_id) or mdata.transcript,
+                     provenance=labels.provenance, confidence=labels.trust())
+
+
+def _fit_to_audio(mpath: Path, markers: np.ndarray, marker_rate: float, duration: float
+                  ) -> np.ndarray:
+    """Markers of the audio's length: padded with NaN (a warning) or cut."""
+    n_audio = int(np.floor(duration * marker_rate + 1e-9)) + 1
     if markers.shape[0] < n_audio - 1:
         warn_file(log, mpath, "markers shorter than the audio (later frames are treated as unseen)",
-                  f"markers end at {(markers.shape[0] - 1) / info.marker_rate:.2f} s but the audio "
-                  f"at {len(audio) / rate:.2f} s; later frames are treated as unseen")
+                  f"markers end at {(markers.shape[0] - 1) / marker_rate:.2f} s but the audio "
+                  f"at {duration:.2f} s; later frames are treated as unseen")
     if markers.shape[0] < n_audio:
         pad = np.full((n_audio - markers.shape[0], *markers.shape[1:]), np.nan)
         markers = np.concatenate([markers, pad])
@@ -352,22 +409,33 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
         warn_file(log, mpath, "markers mostly missing (frames with gaps are left out)",
                   f"only {100 * seen:.0f} % of the marker samples are seen; frames with gaps over "
                   f"100 ms are left out of training and evaluation")
-    text = ""
+    return markers
+
+
+def held_transcript(root: str | os.PathLike[str], utt_id: str) -> str:
+    """The sentence an utterance's marker file holds (MVIEW's SENTENCE), ``""`` when it holds none
+    or cannot be read (reading the utterance reports why)."""
+    try:
+        mpath = marker_path(root, utt_id)
+        return read_markers(mpath).transcript if format_for(mpath).carries_labels else ""
+    except InputError:
+        return ""
+
+
+def _transcript(root: Path, utt_id: str) -> str:
     txt = root / f"{utt_id}.txt"
-    if txt.is_file():
-        try:
-            text = txt.read_text(encoding="utf-8").strip()
-        except UnicodeDecodeError:
-            raise InputError(txt, "the transcript is not UTF-8 text") from None
-    return Utterance(name=utt_id, audio=audio, sample_rate=rate, phones=phones,
-                     markers=markers, marker_rate=info.marker_rate,
-                     marker_names=list(mdata.names), words=labels.words, text=text,
-                     provenance=labels.provenance, confidence=labels.trust())
+    if not txt.is_file():
+        return ""
+    try:
+        return txt.read_text(encoding="utf-8").strip()
+    except UnicodeDecodeError:
+        raise InputError(txt, "the transcript is not UTF-8 text") from None
 
 
 @dataclass
 class FolderScan:
-    """What a folder of recordings holds: usable utterances, the marker set, the labels used."""
+    """What a folder of recordings holds: usable utterances, the marker set, the labels used,
+    and what the first marker file says (its format, whether its data is head-corrected)."""
 
     ids: list[str]
     marker_names: list[str]
@@ -376,70 +444,130 @@ class FolderScan:
     labels: list[str]
     first_marker_file: Path
     left_out: list[str] = field(default_factory=list)
+    format: str = ""
+    head_corrected: bool | None = None
+    channel_names: list[str] = field(default_factory=list)
 
 
-def scan_folder(data_dir: str | os.PathLike[str], read_labels_of: int = 50) -> FolderScan:
-    """List the utterances (stems with audio, labels and markers) of a folder, its marker set
-    (from the first marker file) and the distinct labels of the first ``read_labels_of`` label
-    files (for building a label map)."""
+def _complete(data_dir: Path, stem: str) -> bool:
+    """Whether ``stem`` has markers, and audio and labels (in files, or in its marker file)."""
+    mpath, _ = _beside(marker_path, data_dir, stem)
+    if mpath is None:
+        return False
+    fmt = None
+    for find, carried in ((audio_path, "carries_audio"), (label_path, "carries_labels")):
+        if _beside(find, data_dir, stem)[0] is None:
+            try:
+                fmt = fmt or format_for(mpath)
+            except InputError:
+                return False
+            if not getattr(fmt, carried):
+                return False
+    return True
+
+
+def _label_set(data_dir: Path, ids: list[str], names: list[str]) -> set[str]:
+    """The distinct labels of these utterances' label files (or marker files' PHONES)."""
+    labels: set[str] = set()
+    for utt_id in ids:
+        lpath = label_source(data_dir, utt_id)
+        if lpath.suffix.lower() == ".textgrid":
+            segs = read_textgrid(lpath)
+        elif lpath.suffix.lower() in (".lab", ".phn"):
+            segs = read_labels(lpath)
+        else:
+            segs = read_markers(lpath, channel_names=names or None).phones
+        labels.update(s.label for s in segs)
+    return labels
+
+
+def scan_folder(data_dir: str | os.PathLike[str], read_labels_of: int = 50,
+                channel_names: list[str] | None = None) -> FolderScan:
+    """List the utterances (stems with markers, audio and labels, in files of their own or in the
+    marker file) of a folder, its marker set (from the first marker file, its channels named by
+    ``channel_names``, else by a ``channel-names.txt`` in the folder) and the distinct labels of
+    the first ``read_labels_of`` utterances (for building a label map)."""
     data_dir = Path(data_dir)
     if not data_dir.is_dir():
         raise InputError(data_dir, "not a folder")
-    stems = sorted({p.stem for p in data_dir.iterdir() if p.suffix.lower() in (".wav", ".flac")})
-    ids, left_out = [], []
-    for stem in stems:
-        try:
-            label_path(data_dir, stem)
-            marker_path(data_dir, stem)
-        except InputError:
-            left_out.append(stem)
-            continue
-        ids.append(stem)
+    names = list(channel_names or [])
+    if not names and (data_dir / NAMES_FILE).is_file():
+        names = read_names_file(data_dir / NAMES_FILE)
+    suffixes = {".wav", ".flac", *marker_suffixes()}
+    stems = sorted({p.stem for p in data_dir.iterdir() if p.suffix.lower() in suffixes
+                    and not p.name.startswith(".")})
+    ids = [s for s in stems if _complete(data_dir, s)]
+    left_out = [s for s in stems if s not in ids]
     if not ids:
         raise InputError(data_dir, "no utterance with audio, labels and markers")
     mfile = marker_path(data_dir, ids[0])
-    first = read_markers(mfile)
-    labels: set[str] = set()
-    for utt_id in ids[:read_labels_of]:
-        lpath = label_path(data_dir, utt_id)
-        segs = read_textgrid(lpath) if lpath.suffix.lower() == ".textgrid" else read_labels(lpath)
-        labels.update(s.label for s in segs)
-    planar = not np.any(first.markers[..., 0][np.isfinite(first.markers[..., 0])])
-    return FolderScan(ids, first.names, first.rate, 2 if planar else 3, sorted(labels), mfile,
-                      left_out)
+    first = read_markers(mfile, channel_names=names or None)
+    labels = _label_set(data_dir, ids[:read_labels_of], names)
+    return FolderScan(ids, first.names, first.rate, first.dimensions, sorted(labels), mfile,
+                      left_out, first.format, first.head_corrected, names)
+
+
+def _head_correction(scan: FolderScan, fixed: list[str], head_corrected: bool) -> bool:
+    """Whether the data is head-corrected, said in the log; no fixed markers for data that is not
+    (by its files' word or the user's) is an error naming what to give."""
+    corrected = bool(scan.head_corrected) or head_corrected
+    why = (f"its {scan.format} files say so" if scan.head_corrected else "as declared")
+    if fixed and corrected:
+        log.info("data head-corrected (%s); the fixed markers given are used as well", why)
+    elif corrected:
+        log.info("data already head-corrected (%s): no fixed markers needed", why)
+    elif not fixed:
+        need = 2 if scan.dimensions == 2 else 3
+        raise InputError(scan.first_marker_file,
+                         f"no fixed markers: name {need} or more sensors that move only with the "
+                         f"head (--fixed, among {' '.join(scan.marker_names)}), or pass "
+                         f"--head-corrected if the data is already corrected ({scan.format} files "
+                         f"do not say)")
+    return corrected
 
 
 def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str] | None = None,
                 fixed: list[str] | None = None, upper_lip: str = "", lower_lip: str = "",
                 lip_corners: list[str] | None = None, label_map: str = "",
                 marker_rate: float = 60.0, test: list[str] | None = None,
-                test_fraction: float = 1 / 3, name: str = "",
-                overwrite: bool = True, label_provenance: str = "hand-checked"
+                test_fraction: float | None = None, name: str = "",
+                overwrite: bool = True, label_provenance: str = "hand-checked",
+                channel_names: list[str] | None = None, head_corrected: bool = False
                 ) -> tuple[Path, CorpusInfo]:
     """Describe a folder of someone's own recordings as a corpus and write the description.
 
-    Utterances are the file stems that have audio, labels and markers. The marker roles (fixed
-    references, lip centres) are given by name; the test split is ``test`` or every
-    ``round(1 / test_fraction)``-th utterance. ``output`` defaults to ``data_dir/corpus.json``;
-    when it lies elsewhere (a read-only data folder), the description records ``data_dir``
-    relative to it. An existing description is replaced only with ``overwrite``.
-    ``label_provenance`` says how label files without a record of their own were made.
+    Utterances are the file stems that have markers, audio and labels (:func:`scan_folder`). The
+    marker roles (fixed references, lip centres) are given by name, the channels named by
+    ``channel_names`` (or the folder's ``channel-names.txt``); data that its files say (or
+    ``head_corrected`` says) is head-corrected needs no fixed markers. The test split is ``test``
+    or every ``round(1 / test_fraction)``-th utterance (by default a third, and at least one of
+    two or more utterances). ``output`` defaults to
+    ``data_dir/corpus.json``; when it lies elsewhere (a read-only data folder), the description
+    records ``data_dir`` relative to it. An existing description is replaced only with
+    ``overwrite``. ``label_provenance`` says how label files without a record of their own were
+    made.
     """
     data_dir = Path(data_dir).resolve()
     out = Path(output) if output else data_dir / "corpus.json"
     out = out if out.suffix.lower() == ".json" else out / "corpus.json"
     check_output_path(out, overwrite)
-    scan = scan_folder(data_dir)
-    ids, names, planar = scan.ids, scan.marker_names, scan.dimensions == 2
+    if channel_names:
+        check_names(channel_names, "--channel-names")
+    scan = scan_folder(data_dir, channel_names=channel_names)
+    ids, names = scan.ids, scan.marker_names
     for role in [*(fixed or []), upper_lip, lower_lip, *(lip_corners or [])]:
         if role not in names:
             raise InputError(scan.first_marker_file,
                              f"no marker named {role!r}; markers: {' '.join(names)}")
+    corrected = _head_correction(scan, list(fixed or []), head_corrected)
     if test is None:
+        fraction = DEFAULT_TEST_FRACTION if test_fraction is None else test_fraction
         # a fraction of 1e-320 gave 1 / 0-ish = inf (found by make fuzz); any step past the
         # utterances' count means no test utterance, as 1e9 does
-        step = max(2, round(1 / max(test_fraction, 1e-9))) if test_fraction > 0 else 0
+        step = max(2, round(1 / max(fraction, 1e-9))) if fraction > 0 else 0
         test = [u for i, u in enumerate(ids) if step and i % step == step - 1]
+        if test_fraction is None and not test and len(ids) > 1:
+            test = ids[-1:]     # two recordings: one to train on, one to evaluate
     train_ids = [u for u in ids if u not in test]
     if not train_ids:
         train_ids, test = ids, [u for u in test if u in ids]
@@ -447,8 +575,9 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
     info = CorpusInfo(marker_names=names, marker_rate=float(marker_rate), fixed_markers=list(fixed or []),
                       upper_lip=upper_lip, lower_lip=lower_lip, train=train_ids, test=list(test),
                       lip_corners=list(lip_corners or []), label_map=label_map, data_dir=rel,
-                      dimensions=2 if planar else 3, name=name or data_dir.name,
-                      label_provenance=label_provenance)
+                      dimensions=scan.dimensions, name=name or data_dir.name,
+                      label_provenance=label_provenance, head_corrected=corrected,
+                      channel_names=scan.channel_names)
     CorpusInfo.from_json(info.to_json(), out)  # the same checks as on loading
     save_corpus_info(out, info, overwrite)
     return out, info
@@ -456,11 +585,16 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
 
 def label_kinds(corpus: Corpus) -> dict[str, int]:
     """How the labels of a corpus were made: utterances per kind (the record of each label file,
-    else the corpus's ``label_provenance``), read from the label files alone."""
+    else the corpus's ``label_provenance``; labels inside marker files are aligned), read from
+    the label files alone."""
     counts: dict[str, int] = {}
     for utt_id in corpus.info.ids:
-        found = recorded_provenance(label_path(corpus.data_root, utt_id))
-        kind = found.kind if found else corpus.info.label_provenance
+        source = label_source(corpus.data_root, utt_id)
+        if source.suffix.lower() in (".textgrid", ".lab", ".phn"):
+            found = recorded_provenance(source)
+            kind = found.kind if found else corpus.info.label_provenance
+        else:
+            kind = "aligned"
         counts[kind] = counts.get(kind, 0) + 1
     return counts
 

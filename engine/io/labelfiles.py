@@ -201,6 +201,17 @@ def read_label_file(path: str | os.PathLike[str], rate: int, duration: float,
     return labels_from_tiers(phones, words, tiers, declared)
 
 
+def held_labels(phones: Sequence[PhoneSegment], words: Sequence[PhoneSegment], duration: float,
+                path: str | os.PathLike[str], detect_alphabet: bool = True) -> Labels:
+    """The labels a marker file holds (MVIEW's PHONES and WORDS), checked against the audio's
+    ``duration`` and mapped onto ARPAbet like a label file's; forced-aligned by convention (HPRC's
+    are), so their provenance is ``aligned``."""
+    checked = validate_phones(list(phones), duration, path)
+    if detect_alphabet:
+        checked = to_arpabet(checked, f"{path} (PHONES)")
+    return labels_from_tiers(checked, list(words), {}, "aligned")
+
+
 def recorded_provenance(path: str | os.PathLike[str]) -> Provenance | None:
     """The provenance a label file records (a TextGrid facetraj wrote), ``None`` when it records
     none; a missing or unreadable file records none either (reading it for synthesis says why)."""

@@ -37,7 +37,7 @@ from ..progress import Progress
 from .cachedir import cache_dir
 from .corpus import Corpus
 from .files import atomic_write
-from .labelfiles import LABEL_SUFFIXES, read_label_file
+from .labelfiles import LABEL_SUFFIXES, held_labels, read_label_file
 
 log = logging.getLogger(__name__)
 
@@ -126,7 +126,8 @@ def labels_for_audio(audio_path: str | os.PathLike[str], audio: np.ndarray, rate
     1. ``labels`` (a label file) -> ``source="file"``;
     2. ``text``, or the sentence of ``transcript`` -> aligned;
     3. ``recognize`` -> recognized;
-    4. a label file beside the audio (same stem) -> file;
+    4. a label file beside the audio (same stem) -> file; else the labels the audio's own file
+       holds (an MVIEW file's PHONES) -> aligned;
     5. a ``.txt`` beside the audio -> aligned;
     6. otherwise, with ``fallback``, recognized (synthesis: on every voice measured the robust mode
        with recognized labels beats acoustic-only, and only labels can close the lips), when
@@ -159,6 +160,10 @@ def labels_for_audio(audio_path: str | os.PathLike[str], audio: np.ndarray, rate
     if label_file is not None:
         log.info("phone labels from %s (beside the audio)", label_file)
         return read_label_file(label_file, rate, duration, declared, detect_alphabet)
+    held = _held_by(audio_path)
+    if held is not None:
+        log.info("phone labels from %s's PHONES (aligned)", Path(audio_path).name)
+        return held_labels(held.phones, held.words, duration, audio_path, detect_alphabet)
     if txt is not None:
         sentence = read_transcript(txt)
         log.info("phone labels aligned from %s: %r", txt.name, sentence)
@@ -174,6 +179,23 @@ def labels_for_audio(audio_path: str | os.PathLike[str], audio: np.ndarray, rate
             return None
     log.info("no labels, no sentence and no .txt beside %s", audio_path)
     return None
+
+
+def _held_by(audio_path: str | os.PathLike[str]):
+    """The recording of a marker file that holds the speech and its phones (MVIEW), else ``None``."""
+    from .audio import AUDIO_SUFFIXES
+    from .markerformats import format_for, read_recording
+
+    path = Path(audio_path)
+    if path.suffix.lower() in AUDIO_SUFFIXES or not path.is_file():
+        return None
+    try:
+        if not format_for(path).carries_labels:
+            return None
+    except InputError:
+        return None
+    rec = read_recording(path)
+    return rec if rec.phones else None
 
 
 def _made_from(labels: Labels, origin: str) -> Labels:

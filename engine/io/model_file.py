@@ -380,9 +380,10 @@ def check_arrays(path: Path, meta: dict, a: dict[str, np.ndarray]) -> dict[str, 
         if name in a:
             out[name] = _checked_array(path, name, a[name], kind, shape)
     k, n_ctx, n_fixed = len(out["pca_components"]), len(out["cb_contexts"]), len(out["fixed"])
-    if k < 1 or n_ctx < 1 or n_fixed < 2:
-        raise ModelFileError(path, f"the model is empty ({k} PCs, {n_ctx} context-phones, "
-                                   f"{n_fixed} fixed markers)")
+    if k < 1 or n_ctx < 1:
+        raise ModelFileError(path, f"the model is empty ({k} PCs, {n_ctx} context-phones)")
+    if n_fixed == 1:  # none: trained on head-corrected data
+        raise ModelFileError(path, "the model has 1 fixed marker (head motion needs 2 or more)")
     _check_indices(path, meta, out)
     _check_values(path, meta, out)
     _check_index(path, out)

@@ -99,8 +99,11 @@ def remove_head_motion(markers: np.ndarray, fixed: np.ndarray, reference: np.nda
 
     ``markers`` is ``(T, M, 3)``, ``fixed`` the indices of the fixed markers, ``reference`` their
     ``(len(fixed), 3)`` neutral positions. Frames whose fixed markers are not all finite become NaN.
+    No fixed markers (data already head-corrected): the markers as they are.
     """
     markers = np.asarray(markers, dtype=np.float64)
+    if len(fixed) == 0:
+        return markers.copy()
     src = markers[:, fixed, :]
     ok = np.isfinite(src).all(axis=(1, 2))
     out = np.full_like(markers, np.nan)
@@ -113,8 +116,11 @@ def remove_head_motion(markers: np.ndarray, fixed: np.ndarray, reference: np.nda
 def reference_pose(frames: np.ndarray, fixed: np.ndarray, iterations: int = 3) -> np.ndarray:
     """Neutral pose of the fixed markers: a generalised Procrustes mean of ``frames`` ``(T, M, 3)``.
 
-    Starts from the first complete frame and re-fits every frame to the running mean.
+    Starts from the first complete frame and re-fits every frame to the running mean. No fixed
+    markers (data already head-corrected): an empty pose.
     """
+    if len(fixed) == 0:
+        return np.zeros((0, 3))
     src = np.asarray(frames, dtype=np.float64)[:, fixed, :]
     src = src[np.isfinite(src).all(axis=(1, 2))]
     if len(src) == 0:

@@ -45,7 +45,8 @@ class Model:
     config : the training configuration.
     phones : the phone set (ids index this list).
     marker_names, marker_rate : the marker set and frame rate of the training data.
-    fixed : indices of the fixed (head) markers; ``reference`` their neutral pose ``(F, 3)``.
+    fixed : indices of the fixed (head) markers; ``reference`` their neutral pose ``(F, 3)``;
+        none for data already head-corrected.
     upper_lip, lower_lip : indices of the lip centre markers; ``lip_corners`` right and left.
     pca : the PCA of the head-normalised marker vectors.
     codebook : the audio-visual codebook.
@@ -90,6 +91,11 @@ class Model:
     trained_labels: dict = field(default_factory=dict)
     closure: ClosureStats | None = None
     voice_distance: float = float("nan")
+
+    def __post_init__(self) -> None:
+        # no fixed markers (head-corrected data) is an empty index array, not numpy's float []
+        self.fixed = np.asarray(self.fixed, dtype=np.intp)
+        self.reference = np.asarray(self.reference, dtype=np.float64).reshape(len(self.fixed), 3)
 
     # ------------------------------------------------------------------ derived quantities
     @cached_property

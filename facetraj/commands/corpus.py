@@ -40,9 +40,10 @@ def cmd_corpus_init(args: argparse.Namespace) -> int:
                             args.lower_lip, args.lip_corners, args.label_map or "", args.rate,
                             args.test, args.test_fraction, args.name or "",
                             overwrite=args.overwrite,
-                            label_provenance=args.label_provenance or "hand-checked")
-    log.info("%d train and %d test utterances, %d markers (%d-D)", len(info.train),
-             len(info.test), len(info.marker_names), info.dimensions)
+                            label_provenance=args.label_provenance or "hand-checked",
+                            channel_names=args.channel_names, head_corrected=args.head_corrected)
+    log.info("%d train and %d test utterances, %d markers (%d-D): %s", len(info.train),
+             len(info.test), len(info.marker_names), info.dimensions, " ".join(info.marker_names))
     kinds = label_kinds(load_corpus(out))
     log.info("labels: %s%s", ", ".join(f"{n} {k}" for k, n in sorted(kinds.items())),
              "" if set(kinds) <= {"hand-checked"} else
@@ -58,7 +59,9 @@ def cmd_corpus_show(args: argparse.Namespace) -> int:
     info = corpus.info
     print(f"{info.name or corpus.root.name}: {len(info.train)} train, {len(info.test)} test, "
           f"{len(info.marker_names)} markers at {info.marker_rate:g} Hz ({info.dimensions}-D)")
-    print(f"fixed: {' '.join(info.fixed_markers)}; lips: {info.upper_lip} / {info.lower_lip}")
+    fixed = " ".join(info.fixed_markers) or "none"
+    print(f"fixed: {fixed}{' (head-corrected data)' if info.head_corrected else ''}; "
+          f"lips: {info.upper_lip} / {info.lower_lip}")
     from facetraj_engine.fanout import fan_out
 
     skipped = skips(args)
@@ -99,11 +102,22 @@ def register(sub: argparse._SubParsersAction) -> None:
     b.add_argument("--seed", type=int, help="random seed")
     b.set_defaults(func=cmd_corpus_build)
     i = csub.add_parser("init", help="describe a folder of your own recordings as a corpus")
-    i.add_argument("data_dir", type=Path, help="folder with <id>.wav|flac, labels, markers")
+    i.add_argument("data_dir", type=Path,
+                   help="folder with <id>.wav|flac, labels and markers (any format facetraj reads: "
+                        "C3D, TSV/CSV, MOCHA, EST, Carstens .pos, NDI Wave TSV, MVIEW .mat, XRMB "
+                        ".txy; an MVIEW file may hold the audio and labels itself)")
     i.add_argument("-o", "--output", type=Path,
                    help="the description (default DATA_DIR/corpus.json; elsewhere for read-only data)")
-    i.add_argument("--fixed", nargs="+", required=True, metavar="MARKER",
-                   help="markers that move only with the head (3, or 2 for midsagittal data)")
+    i.add_argument("--fixed", nargs="+", metavar="MARKER",
+                   help="markers that move only with the head (3, or 2 for midsagittal data); "
+                        "not needed for data already head-corrected")
+    i.add_argument("--head-corrected", action="store_true",
+                   help="the data is already corrected for head motion (MVIEW, XRMB and AG501 "
+                        "files with a head normalisation say so themselves)")
+    i.add_argument("--channel-names", nargs="+", metavar="NAME",
+                   help="name the files' channels: OLD=NEW pairs (NEW '-' leaves a channel out), "
+                        "or one name per channel in file order (default: channel-names.txt in "
+                        "the folder, else the files' own names, Ch1, Ch2, ... where they have none)")
     i.add_argument("--upper-lip", required=True, metavar="MARKER")
     i.add_argument("--lower-lip", required=True, metavar="MARKER")
     i.add_argument("--lip-corners", nargs=2, metavar=("RIGHT", "LEFT"))
@@ -111,7 +125,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_label_provenance_option(i)
     i.add_argument("--rate", type=RATE, default=60.0, help="marker rate to resample to (60 Hz)")
     i.add_argument("--test", nargs="+", metavar="ID", help="test utterances")
-    i.add_argument("--test-fraction", type=FRACTION, default=1 / 3)
+    i.add_argument("--test-fraction", type=FRACTION,
+                   help="the share of the recordings in the test split (default: a third, and "
+                        "at least one of two or more)")
     i.add_argument("--name")
     i.add_argument("--overwrite", action="store_true", help="replace an existing description")
     i.set_defaults(func=cmd_corpus_init)

@@ -23,7 +23,7 @@ def cmd_train(args: argparse.Namespace) -> int:
     skipped = skips(args)
     model = train(corpus, config=train_config(args), progress=TerminalProgress("train"),
                   workers=jobs(args, 1), skip=skipped)
-    folds = tune_folds(args, model.trained_labels)
+    folds = tune_folds(args, model.trained_labels, len(model.train_utterances))
     if folds:
         from facetraj_engine.evaluation.tuning import cross_validate
 
@@ -42,17 +42,22 @@ def cmd_train(args: argparse.Namespace) -> int:
     return finish(skipped)
 
 
-def tune_folds(args: argparse.Namespace, trained_labels: dict[str, int]) -> int:
+def tune_folds(args: argparse.Namespace, trained_labels: dict[str, int], n_train: int = 2) -> int:
     """How many folds the robust mode's settings are cross-validated on: ``--tune FOLDS``;
     ``--no-tune`` none; by default 2 when the training labels are not all hand-checked (the
     robust mode will synthesize from such labels, and its untuned settings lose to acoustic-only
-    on real talkers), else none."""
+    on real talkers) and there are two training utterances to fold, else none."""
     kinds = ", ".join(f"{n} {k}" for k, n in sorted(trained_labels.items()))
     if args.tune is not None:
         return args.tune
     if set(trained_labels) <= {"hand-checked"}:
         log.info("training labels: %s; the robust mode is not tuned (--tune to tune it)",
                  kinds or "hand-checked")
+        return 0
+    if n_train < 2:
+        log.info("training labels: %s, not all hand-checked, but %d training utterance is too few "
+                 "to cross-validate the robust mode's settings: its defaults are used", kinds,
+                 n_train)
         return 0
     log.info("training labels: %s, not all hand-checked: cross-validating the robust mode's "
              "settings on the training split (--no-tune to skip)", kinds)
