@@ -37,8 +37,9 @@ _GLOB_CHARS = frozenset("*?[")
 @dataclass(frozen=True)
 class SynthJob:
     """What every input of a run shares: the synthesis settings and how outputs are written
-    (``request``: :class:`~facetraj_engine.workflow.recording.LabelRequest`; ``explicit``, ``keep``: as
-    :func:`~facetraj_engine.workflow.recording.synthesize_recording` takes them)."""
+    (``request``: :class:`~facetraj_engine.workflow.recording.LabelRequest`; ``explicit``, ``keep``,
+    ``allow_damaged``: as :func:`~facetraj_engine.workflow.recording.synthesize_recording` takes
+    them)."""
 
     config: Any
     request: Any
@@ -46,6 +47,7 @@ class SynthJob:
     keep: tuple[str, ...] = ()
     overwrite: bool = False
     compress: bool = False
+    allow_damaged: bool = False
 
 
 @dataclass
@@ -137,7 +139,7 @@ def synthesize_file(model: Any, audio: Path, output: Path, job: SynthJob) -> Any
     from facetraj_engine.workflow.recording import synthesize_recording
 
     done = synthesize_recording(model, audio, job.config, job.request, explicit=job.explicit,
-                                keep=list(job.keep))
+                                keep=list(job.keep), allow_damaged=job.allow_damaged)
     log.info("%s", done.describe())
     res = done.synthesis
     write_trajectories(output, res.markers, model.marker_rate, model.marker_names, res.arrays(),

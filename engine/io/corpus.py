@@ -21,7 +21,7 @@ from ..errors import InputError, warn_file
 from .audio import read_audio
 from .files import atomic_write, check_output_path
 from .hash_memo import folder_key, memoized_hash
-from .labelfiles import read_label_file, read_labels, read_textgrid, recorded_provenance
+from .labelfiles import label_file_provenance, read_labels, read_textgrid
 from .markerfiles import MARKER_SUFFIXES, read_markers
 
 log = logging.getLogger(__name__)
@@ -48,8 +48,9 @@ class CorpusInfo:
     label_map : ``""`` (labels are ARPAbet), ``"mocha"`` or a label map file (relative to the
         description) mapping the labels onto ARPAbet when utterances are loaded.
     label_provenance : how label files without a record of their own (any file facetraj did not
-        write) were made: ``hand-checked`` (the default), ``aligned`` or ``recognized``
-        (``facetraj_engine.labels.provenance``).
+        write) were made: ``hand-checked``, ``aligned`` or ``recognized``
+        (``facetraj_engine.labels.provenance``); ``""`` (the default): not said, so an aligner's
+        conventions make them aligned, and anything else hand-checked.
     data_dir : where the utterance files are, relative to the description's folder (``""``: the
         same folder). Lets a description point at a read-only folder of someone else's data.
     dimensions : 3, or 2 for midsagittal data (x = 0 for every marker).
@@ -69,7 +70,7 @@ class CorpusInfo:
         default_factory=lambda: {"x": "right", "y": "up", "z": "forward"})
     label_set: str = "arpabet"
     label_map: str = ""
-    label_provenance: str = "hand-checked"
+    label_provenance: str = ""
     data_dir: str = ""
     dimensions: int = 3
     name: str = ""
@@ -164,7 +165,8 @@ SCHEMA: dict[str, tuple] = {
              "an object of axis names"),
     "label_set": (_text, "text"),
     "label_map": (_text, "text (\"\", \"mocha\" or a label map file)"),
-    "label_provenance": (lambda v: v in LABEL_KINDS, " or ".join(f'"{k}"' for k in LABEL_KINDS)),
+    "label_provenance": (lambda v: v in ("", *LABEL_KINDS),
+                         " or ".join(f'"{k}"' for k in ("", *LABEL_KINDS))),
     "data_dir": (_text, "text (a folder relative to the description)"),
     "dimensions": (lambda v: v in (2, 3) and not isinstance(v, bool), "2 or 3"),
     "name": (_text, "text"),
@@ -314,7 +316,9 @@ def load_corpus(root: str | os.PathLike[str]) -> Corpus:
 def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
                    label_map: dict[str, str] | None = None) -> Utterance:
     """Load ``<id>`` audio, labels (``phones`` and ``words`` tiers of a TextGrid, or a .lab /
-    .phn file) and markers (C3D, TSV/CSV or MOCHA EMA, resampled to the corpus rate).
+    .phn file: the label file beside the audio, by the one rule,
+    :func:`facetraj_engine.io.label_rule.resolve_labels`) and markers (C3D, TSV/CSV or MOCHA EMA,
+    resampled to the corpus rate).
 
     Labels are mapped onto ARPAbet with ``label_map``, or without one from the alphabet they are
     in (:func:`facetraj_engine.labels.alphabets.to_arpabet`: labels in none is an error naming them).
@@ -322,13 +326,15 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
     audio's end.
     """
     from ..labels.phoneset import apply_label_map
+    from .label_rule import LabelRequest, resolve_labels
 
     root = Path(root)
     apath = audio_path(root, utt_id)
     audio, rate = read_audio(apath)
     lpath = label_path(root, utt_id)
-    labels = read_label_file(lpath, rate, len(audio) / rate, info.label_provenance,
-                             detect_alphabet=not label_map)
+    labels = resolve_labels(apath, audio, rate, LabelRequest(
+        labels=lpath, declared=info.label_provenance or None,
+        label_map="corpus" if label_map else None), quiet=True).labels
     phones = labels.phones
     if label_map:
         phones = [PhoneSegment(s.start, s.end, apply_label_map(s.label, label_map)) for s in phones]
@@ -414,7 +420,7 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
                 lip_corners: list[str] | None = None, label_map: str = "",
                 marker_rate: float = 60.0, test: list[str] | None = None,
                 test_fraction: float = 1 / 3, name: str = "",
-                overwrite: bool = True, label_provenance: str = "hand-checked"
+                overwrite: bool = True, label_provenance: str = ""
                 ) -> tuple[Path, CorpusInfo]:
     """Describe a folder of someone's own recordings as a corpus and write the description.
 
@@ -456,11 +462,12 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
 
 def label_kinds(corpus: Corpus) -> dict[str, int]:
     """How the labels of a corpus were made: utterances per kind (the record of each label file,
-    else the corpus's ``label_provenance``), read from the label files alone."""
+    else the corpus's ``label_provenance``, else its conventions: as the labels are read,
+    :func:`facetraj_engine.io.labelfiles.label_file_provenance`), read from the label files alone."""
     counts: dict[str, int] = {}
     for utt_id in corpus.info.ids:
-        found = recorded_provenance(label_path(corpus.data_root, utt_id))
-        kind = found.kind if found else corpus.info.label_provenance
+        kind = label_file_provenance(label_path(corpus.data_root, utt_id),
+                                     corpus.info.label_provenance or None).kind
         counts[kind] = counts.get(kind, 0) + 1
     return counts
 

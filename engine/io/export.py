@@ -12,6 +12,9 @@ from ..errors import InputError
 from .files import atomic_write, write_npz
 from .markerfiles import write_c3d, write_marker_tsv
 
+#: The suffixes a trajectory file may have (:func:`write_trajectories`; ``.txt`` is a TSV).
+TRAJECTORY_SUFFIXES = (".c3d", ".tsv", ".csv", ".npz", ".txt")
+
 
 def write_trajectories(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
                        names: Sequence[str], arrays: Mapping[str, np.ndarray] | None = None,

@@ -31,6 +31,7 @@ import numpy as np
 
 from ..data import PhoneSegment, Provenance
 from ..errors import FacetrajError, InputError
+from ..level import peak
 from .phoneset import ARPABET, SILENCE
 from .provenance import Labels
 
@@ -137,9 +138,31 @@ def _pcm16k(audio: np.ndarray, rate: int, source: str | os.PathLike[str] | None)
     if rate != ALIGN_RATE:
         g = gcd(int(rate), ALIGN_RATE)
         audio = resample_poly(audio, ALIGN_RATE // g, int(rate) // g)
-    if not np.any(np.abs(audio) * 32767 >= 1.0):
+    pcm = pcm16(audio)
+    if not pcm.any():
         raise UnalignableError(source, "the audio is silent: there is no speech to label")
-    return (np.clip(audio, -1.0, 1.0) * 32767).astype("<i2").tobytes()
+    return pcm.tobytes()
+
+
+#: The peak, as a share of full scale, of the 16-bit samples PocketSphinx is given.
+PCM_PEAK = 0.9
+
+
+def pcm16(audio: np.ndarray) -> np.ndarray:
+    """``audio`` as 16-bit samples whose peak is :data:`PCM_PEAK` of full scale, whatever the
+    recording's gain (issue 38): PocketSphinx's labels move with the level (measured on CMU
+    ARCTIC: 2 boundaries at 1.2 times the gain, 7 at 0.05 times), and samples beyond full scale
+    would be clipped. The same recording at any gain gives the same samples (but where rounding
+    puts a sample on the other side of a step: about one in 10^11).
+
+    >>> pcm16(np.array([0.0, 0.5, -0.25])).tolist(), pcm16(np.array([0.0, 5e199, -2.5e199])).tolist()
+    ([0, 29490, -14745], [0, 29490, -14745])
+    """
+    audio = np.asarray(audio, dtype=np.float64)
+    top = peak(audio)
+    if not 0.0 < top < np.inf:
+        return np.zeros(len(audio), dtype="<i2")
+    return np.rint(audio * (PCM_PEAK * 32767 / top)).astype("<i2")
 
 
 def _decoder(**settings):
