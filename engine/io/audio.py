@@ -60,15 +60,18 @@ def read_audio(path: str | os.PathLike[str], allow_damaged: bool = False) -> tup
             rate, channels, frames = int(f.samplerate), int(f.channels), int(f.frames)
             whole = f.subtype in _INTEGER_SUBTYPES
             bound = _check_header(path, f.format, f.subtype, rate, channels, frames, allow_damaged)
-            samples, done = _samples(f, bound, channels)
+            samples, done, stopped = _samples(f, bound, channels)
     except InputError:
         raise
     except Exception as exc:  # soundfile raises several types for corrupt data
         raise InputError(path, f"cannot read audio ({exc})") from exc
+    if stopped and not done:
+        raise InputError(path, f"cannot read audio ({stopped})")
     if done == 0:
         raise InputError(path, "the audio file holds no samples")
     if done < frames and damage is None:
-        damage = cut_short(frames, done, rate)
+        damage = cut_short(frames, done, rate) + (f" (decoding stopped: {stopped})" if stopped
+                                                  else "")
         if not allow_damaged:
             raise DamagedAudioError(path, damage)
     if damage is not None:
@@ -94,19 +97,22 @@ class DamagedAudioError(InputError):
 DAMAGED_HINT = "read what it holds anyway with --read-damaged-audio"
 
 
-def _samples(f, frames: int, channels: int) -> tuple[np.ndarray, int]:
-    """The mono samples of an open :class:`soundfile.SoundFile` (its first ``frames`` at most)
-    and how many it held."""
+def _samples(f, frames: int, channels: int) -> tuple[np.ndarray, int, str]:
+    """The mono samples of an open :class:`soundfile.SoundFile` (its first ``frames`` at most),
+    how many it held, and why decoding stopped before them (``""``: it did not; a compressed
+    file cut short loses its decoder's sync)."""
     samples = np.empty(frames)
     done = 0
-    if channels == 1:                           # straight into place, one call
-        done = len(f.read(frames, dtype="float64", out=samples))
-    else:
-        for block in f.blocks(max(1, _BLOCK_SAMPLES // channels), dtype="float64",
-                              always_2d=True, frames=frames):
-            samples[done:done + len(block)] = block.mean(axis=1)
+    if channels == 1 and f.format not in _COMPRESSED:      # straight into place, one call
+        return samples, len(f.read(frames, dtype="float64", out=samples)), ""
+    step = max(1, _BLOCK_SAMPLES // channels) if f.format not in _COMPRESSED else 1 << 14
+    try:
+        for block in f.blocks(step, dtype="float64", always_2d=True, frames=frames):
+            samples[done:done + len(block)] = block.mean(axis=1) if channels > 1 else block[:, 0]
             done += len(block)
-    return samples, done
+    except Exception as exc:  # soundfile raises several types for corrupt data
+        return samples, done, " ".join(str(exc).split()) or type(exc).__name__
+    return samples, done, ""
 
 
 def cut_short(declared: int, held: int, rate: int) -> str:
@@ -176,6 +182,8 @@ def check_wav_header(path: Path) -> str | None:
             handle.seek(pos)
             name, length = struct.unpack("<4sI", handle.read(8))
             if not all(32 <= c < 127 for c in name):
+                if fmt is None:             # not a WAV header we can judge: the reader says
+                    return None
                 return (f"the audio file's header does not match its data: the bytes at offset "
                         f"{pos} are not a chunk ({name!r}; damaged header?)")
             if name == b"fmt ":
@@ -185,12 +193,22 @@ def check_wav_header(path: Path) -> str | None:
                 problem = _data_chunk(fmt, pos, length, size)
                 if problem is not None or length in _UNKNOWN_SIZES:
                     return problem
+                if pos + 8 + length > end + 1:
+                    return (f"the audio file's header does not match its data: its 'data' chunk "
+                            f"ends at byte {pos + 8 + length}, after the {end} bytes its RIFF "
+                            "header says the file has (damaged header?)")
             elif pos + 8 + length > size:
-                return (f"the audio file is cut short: its {name.decode()!r} chunk at offset {pos} "
-                        f"needs {length} bytes, the file ends {size - pos - 8} bytes after it")
+                if fmt is None:             # not a WAV header we can judge: the reader says
+                    return None
+                return (f"the audio file is cut short{' after its samples' if data else ''}: its "
+                        f"{name.decode()!r} chunk at offset {pos} needs {length} bytes, the file "
+                        f"ends {size - pos - 8} bytes after it")
             pos += 8 + length + (length & 1)
     if not data:
         return "the audio file's header does not match its data: no 'data' chunk in its RIFF size"
+    if min(end, size) - pos > 1:           # more than a pad byte left, too little for a chunk
+        return (f"the audio file's header does not match its data: {min(end, size) - pos} bytes "
+                f"after its last chunk (damaged header?)")
     if end > size + 1:                     # a missing pad byte at the end is common, no more
         return (f"the audio file is cut short: its RIFF header says {end} bytes, the file has "
                 f"{size}")
@@ -206,8 +224,15 @@ def _data_chunk(fmt: bytes | None, pos: int, length: int, size: int) -> str | No
         return "the audio file's header does not match its data: no 'fmt ' chunk before 'data'"
     tag, channels, rate, byte_rate, block, bits = struct.unpack("<HHIIHH", fmt)
     held = size - pos - 8
-    if tag not in _BLOCK_FORMATS or channels == 0 or bits == 0:
-        return None                         # compressed or odd: the reader decides
+    if tag not in _BLOCK_FORMATS:
+        return (f"the audio file's header names WAV format {tag} (not PCM, float, A-law or "
+                "mu-law): damaged, or an encoding facetraj does not read (convert it to PCM)")
+    if channels == 0 or bits == 0:
+        return (f"the audio file's header does not match its data: its 'fmt ' chunk says "
+                f"{channels} channel(s) of {bits} bits")
+    if tag in (6, 7) and bits != 8:
+        return (f"the audio file's header does not match its data: its 'fmt ' chunk says "
+                f"{_BLOCK_FORMATS[tag]} of {bits} bits (A-law and mu-law are 8-bit)")
     width = channels * ((bits + 7) // 8)
     if block != width or byte_rate != rate * block:
         return (f"the audio file's header does not match its data: its 'fmt ' chunk says "

@@ -93,7 +93,7 @@ def place_problem(folder: Path, exc: OSError) -> str:
     if exc.errno in (errno.EACCES, errno.EPERM):
         return f"no permission to write in {folder}"
     if exc.errno == errno.EROFS:
-        return f"{folder} is on a read-only file system"
+        return f"the file system is read-only ({folder})"
     if exc.errno in (errno.ENOSPC, errno.EDQUOT):
         return f"{write_problem(exc)} in {folder}"
     return f"{write_problem(exc)} ({folder})"

@@ -27,6 +27,7 @@ import numpy as np
 from ..errors import InputError
 from ..labels.alignment import align, pcm16, pocketsphinx_version, recognize
 from ..labels.provenance import Labels
+from ..progress import Progress
 from .cachedir import cache_dir
 from .files import atomic_write
 from .labelfiles import LABEL_SUFFIXES, read_label_file
@@ -60,9 +61,11 @@ def label_cache_path(key: str) -> Path:
 
 def label_audio(audio: np.ndarray, rate: int, method: str, text: str = "",
                 extra_dict: Mapping[str, Sequence[str]] | None = None,
-                source: str | os.PathLike[str] | None = None, use_cache: bool = True) -> Labels:
+                source: str | os.PathLike[str] | None = None, use_cache: bool = True,
+                progress: Progress | None = None) -> Labels:
     """Labels of one recording by ``method`` (``"aligned"`` needs ``text``), from the cache when
-    the same audio was labelled the same way before. Errors are not cached."""
+    the same audio was labelled the same way before (``progress``: told as each decoding pass
+    starts). Errors are not cached."""
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     path = label_cache_path(label_cache_key(audio, rate, method, text, extra_dict)) \
@@ -73,9 +76,9 @@ def label_audio(audio: np.ndarray, rate: int, method: str, text: str = "",
         except (ValueError, KeyError, TypeError) as exc:
             log.warning("ignoring unreadable cached labels %s: %s", path, exc)
     if method == "aligned":
-        labels = align(audio, rate, text, extra_dict, source)
+        labels = align(audio, rate, text, extra_dict, source, progress=progress)
     else:
-        labels = recognize(audio, rate, source)
+        labels = recognize(audio, rate, source, progress)
     if path is not None:
         try:
             with atomic_write(path) as tmp:
@@ -146,7 +149,7 @@ NOTHING_BESIDE = "no label file, sentence or .txt beside the audio"
 
 def resolve_labels(audio_path: str | os.PathLike[str], audio: np.ndarray, rate: int,
                    request: LabelRequest | None = None, *, use_cache: bool = True,
-                   quiet: bool = False) -> FoundLabels:
+                   quiet: bool = False, progress: Progress | None = None) -> FoundLabels:
     """THE rule for the phone labels of a recording (every command that takes audio: ``synth``
     and its batch, ``video``, ``gui`` and the app's Open audio, ``live --from-file``, ``align``,
     and the corpus commands through :func:`facetraj_engine.io.corpus.load_utterance`); the first
@@ -169,20 +172,23 @@ def resolve_labels(audio_path: str | os.PathLike[str], audio: np.ndarray, rate: 
     later: :func:`facetraj_engine.io.labelfiles.read_label_file`).
 
     Alignment and recognition are logged as they start (``quiet``: at debug level, for a
-    corpus's every utterance); the caller says where the labels came from
+    corpus's every utterance), and tell ``progress`` as each decoding pass starts (on 300 s of
+    speech, recognition takes half a minute); the caller says where the labels came from
     (:meth:`FoundLabels.describe`). Errors of alignment (missing words, text that does not fit)
     propagate.
     """
     request = request or LabelRequest()
     say = functools.partial(log.log, logging.DEBUG if quiet else logging.INFO)
-    found = _resolve(Path(audio_path), audio, rate, request, use_cache, say)
+    label = functools.partial(label_audio, use_cache=use_cache, progress=progress)
+    found = _resolve(Path(audio_path), audio, rate, request, label, say)
     log.debug("%s: phone labels %s", Path(audio_path).name, found.describe())
     return found
 
 
 def _resolve(audio_path: Path, audio: np.ndarray, rate: int, request: LabelRequest,
-             use_cache: bool, say) -> FoundLabels:
-    """:func:`resolve_labels`'s steps."""
+             label, say) -> FoundLabels:
+    """:func:`resolve_labels`'s steps (``label``: :func:`label_audio` with the caller's cache and
+    progress settings)."""
     duration = len(audio) / float(rate)
     detect = not request.label_map
     if request.labels is not None:
@@ -194,14 +200,12 @@ def _resolve(audio_path: Path, audio: np.ndarray, rate: int, request: LabelReque
     if text is not None:
         origin = Path(transcript).name if transcript else "the sentence given"
         say("aligning the phones of %s to %r", audio_path.name, text)
-        return FoundLabels(made_from(label_audio(audio, rate, "aligned", text, request.extra_dict,
-                                                  transcript or audio_path, use_cache), origin),
-                           f"{origin}, given" if transcript else origin)
+        labels = label(audio, rate, "aligned", text, request.extra_dict, transcript or audio_path)
+        return FoundLabels(made_from(labels, origin), f"{origin}, given" if transcript else origin)
     if request.recognize:
         say("recognizing the phones of %s (no text)", audio_path.name)
-        return FoundLabels(made_from(label_audio(audio, rate, "recognized", source=audio_path,
-                                                  use_cache=use_cache), audio_path.name),
-                           "recognition, as asked")
+        labels = label(audio, rate, "recognized", source=audio_path)
+        return FoundLabels(made_from(labels, audio_path.name), "recognition, as asked")
     label_file, txt = beside(audio_path)
     if label_file is not None:
         return FoundLabels(read_label_file(label_file, rate, duration, request.declared, detect),
@@ -209,19 +213,17 @@ def _resolve(audio_path: Path, audio: np.ndarray, rate: int, request: LabelReque
     if txt is not None:
         sentence = read_transcript(txt)
         say("aligning the phones of %s to %r (%s beside it)", audio_path.name, sentence, txt.name)
-        return FoundLabels(made_from(label_audio(audio, rate, "aligned", sentence,
-                                                  request.extra_dict, txt, use_cache), txt.name),
-                           f"{txt.name} beside the audio")
+        labels = label(audio, rate, "aligned", sentence, request.extra_dict, txt)
+        return FoundLabels(made_from(labels, txt.name), f"{txt.name} beside the audio")
     if not request.fallback:
         return FoundLabels(None, NOTHING_BESIDE)
     say("%s: %s: recognizing its phones", audio_path.name, NOTHING_BESIDE)
     try:
-        return FoundLabels(made_from(label_audio(audio, rate, "recognized", source=audio_path,
-                                                  use_cache=use_cache), audio_path.name),
-                           f"recognition: {NOTHING_BESIDE}")
+        labels = label(audio, rate, "recognized", source=audio_path)
     except InputError as exc:
         log.warning("%s; acoustic-only synthesis", exc)
         return FoundLabels(None, f"recognition failed: {NOTHING_BESIDE}")
+    return FoundLabels(made_from(labels, audio_path.name), f"recognition: {NOTHING_BESIDE}")
 
 
 def made_from(labels: Labels, origin: str) -> Labels:

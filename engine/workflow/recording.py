@@ -23,6 +23,7 @@ from ..method.model import Model
 from ..method.modes import ModeChoice, choose_mode, mode_of
 from ..method.pipeline import Synthesis, check_length, synthesize
 from ..method.voice_match import explain_match
+from ..progress import Progress
 
 __all__ = ["LabelRequest", "RecordingSynthesis", "synthesize_recording"]
 
@@ -60,13 +61,15 @@ def synthesize_recording(model: Model, audio_path: str | os.PathLike[str],
                          config: SynthConfig | None = None, request: LabelRequest | None = None,
                          explicit: bool = False, keep: Sequence[str] = (),
                          audio: tuple[np.ndarray, int] | None = None,
-                         allow_damaged: bool = False) -> RecordingSynthesis:
+                         allow_damaged: bool = False, progress: Progress | None = None
+                         ) -> RecordingSynthesis:
     """Synthesize the recording at ``audio_path`` (``audio``: its samples and rate, when already
     read; ``allow_damaged``: read an audio file whose header does not match its data, as
     :func:`facetraj_engine.io.audio.read_audio`) as every command does: its labels by the label rule
     (none when the mode is acoustic and ``explicit``), the mode by the mode rule (``explicit``:
     the user chose ``config.mode``; ``keep``: the settings the user set, which the model's tuned
-    ones must not replace)."""
+    ones must not replace; ``progress``: told as labelling and synthesis go, which on a long
+    recording take seconds each)."""
     config = config or SynthConfig()
     request = request or LabelRequest()
     audio_path = Path(audio_path)
@@ -74,15 +77,19 @@ def synthesize_recording(model: Model, audio_path: str | os.PathLike[str],
     check_length(model, len(samples), rate, str(audio_path))  # before the labels are checked
     found = FoundLabels(None, f"--mode {config.mode}: none asked for")
     if not (explicit and not mode_of(config).needs_labels):
-        found = resolve_labels(audio_path, samples, rate, request)
+        found = resolve_labels(audio_path, samples, rate, request, progress=progress)
     labels = found.labels
     choice = choose_mode(config, labels.phones if labels else None,
                          labels.provenance if labels else None, explicit=explicit,
                          tuned=model.tuned, keep=keep)
     label_map = read_label_map(request.label_map) if request.label_map and labels and \
         labels.source == "file" else None
+    if progress is not None:
+        progress(0.0, f"synthesizing {audio_path.name} ({choice.mode} mode)")
     res = synthesize(model, samples, rate, labels.phones if labels else None, choice.config,
                      label_map=label_map, source=str(found.file or audio_path),
                      audio_source=str(audio_path), confidence=labels.trust() if labels else None,
                      provenance=labels.provenance if labels else None, voice=True)
+    if progress is not None:
+        progress(1.0, f"{len(res.times)} frames synthesized")
     return RecordingSynthesis(res, found, choice, res.voice_match, audio_path)

@@ -74,7 +74,8 @@ def write_take(args: argparse.Namespace, model, audio: np.ndarray, rate: int, cf
     if len(take.frames) == 0:
         raise FacetrajError(f"{args.from_file}: the audio is too short to synthesize")
     out = write_trajectories(args.output, take.frames.markers, model.marker_rate,
-                             model.marker_names, overwrite=args.overwrite)
+                             model.marker_names, overwrite=args.overwrite,
+                             audio=None if args.no_audio else (audio, rate))
     if take.labels is not None:                         # the phones the take was made with
         write_labels(textgrid, take.labels, len(audio) / rate, overwrite=args.overwrite)
     stream = take.stream
@@ -125,6 +126,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", type=Path,
                    help="with --from-file: no window; write the take (.c3d, .tsv, .csv or .npz)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing output file")
+    p.add_argument("--no-audio", action="store_true",
+                   help="-o .c3d: leave the speech out (by default the C3D's analog channel)")
     g = p.add_argument_group("labels of --from-file -o (as synth finds them; without any, the "
                              "phones are recognized as they are spoken)")
     add_label_options(g)

@@ -23,7 +23,7 @@ def _job(args: argparse.Namespace):
     return SynthJob(synth_config(args), label_request(args), explicit=args.mode is not None,
                     keep=tuple(f for f in TUNED_FIELDS if getattr(args, f, None) is not None),
                     overwrite=args.overwrite, compress=args.compress,
-                    allow_damaged=args.read_damaged_audio)
+                    allow_damaged=args.read_damaged_audio, c3d_audio=not args.no_audio)
 
 
 def cmd_synth(args: argparse.Namespace) -> int:
@@ -36,10 +36,12 @@ def cmd_synth(args: argparse.Namespace) -> int:
     from facetraj_engine.method.model import Model
 
     from ..batch import synthesize_file
+    from ..progress import TerminalProgress
 
     check_output_path(args.output, args.overwrite, TRAJECTORY_SUFFIXES, probe=True)  # before work
     model = Model.load(args.model)
-    res = synthesize_file(model, Path(args.inputs[0]), args.output, _job(args)).synthesis
+    res = synthesize_file(model, Path(args.inputs[0]), args.output, _job(args),
+                          progress=TerminalProgress("synth")).synthesis
     log.info("%d frames (%.2f s) synthesized, %s smoothing", len(res.times), res.times[-1],
              res.config.smoothing)
     print(args.output)
@@ -93,5 +95,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--overwrite", action="store_true", help="replace existing outputs")
     p.add_argument("--compress", action="store_true",
                    help=".npz: deflate it (a little smaller, much slower to write)")
+    p.add_argument("--no-audio", action="store_true",
+                   help=".c3d: leave the speech out (by default it is the C3D's analog channel "
+                        "SPEECH, where motion-capture software keeps and plays a recording's "
+                        "sound in sync with its points; about as many bytes as the points)")
     add_synth_options(p)
     p.set_defaults(func=cmd_synth)
