@@ -1,12 +1,19 @@
 """A signal's level, kept out of what facetraj computes (issue 38): the same recording at any
 gain that floating point can represent gives the same energy decisions, LSFs, labels and face.
 
-Scaling by a power of two is exact in floating point (short of underflow), so a signal brought to
-a peak in [0.5, 1) that way (:func:`unit_exponent`, :func:`to_unit_peak`) is the signal itself
-for every number that is computed from it relative to its own level -- LPC, whose equations are
-scale-free, and energies in dB measured from the signal's own peak -- and nothing squares a sample
-of 1e200 into an overflow. What is left between two gains is rounding (the gains' ratio is not a
-power of two), well under what any output file stores.
+- LPC's equations are scale-free: :func:`facetraj_engine.method.lsf.lsf_at` brings the signal to a
+  peak in [0.5, 1) by a power of two (:func:`unit_exponent`: exact, and no sample squared
+  overflows);
+- short-time energy is measured relative to the peak (:func:`peak_scaling`: the power of two
+  first, then the mantissa), so that its floor and the speech/silence threshold see the same
+  values at any gain;
+- PocketSphinx hears 16-bit samples at a fixed share of full scale
+  (:func:`facetraj_engine.labels.alignment.pcm16`); a streamed file is scaled to a peak of 1
+  (:func:`to_full_scale`).
+
+What is left between two gains is rounding (their ratio's mantissa), far under what any output
+file stores: a float WAV scaled by 1e200 gives the same output file as the same audio unscaled
+(tests/test_level.py).
 """
 
 from __future__ import annotations
@@ -40,8 +47,7 @@ def unit_exponent(x: np.ndarray | float) -> int:
 def peak_scaling(x: np.ndarray) -> tuple[int, float]:
     """``(k, f)`` such that ``ldexp(x, k) * f`` has a peak of exactly 1 (``(0, 1.0)`` for silence
     or a peak that is not finite): the power of two first, so that no factor overflows however
-    small the peak. The same recording at two gains comes out equal to rounding (where a power of
-    two leaves their ratio in the mantissa).
+    small the peak. The same recording at two gains comes out equal to rounding.
 
     >>> peak_scaling(np.array([0.25, -0.5])), peak_scaling(np.array([3.0]))
     ((0, 2.0), (-2, 1.3333333333333333))
@@ -61,15 +67,3 @@ def to_full_scale(x: np.ndarray) -> np.ndarray:
     """
     k, f = peak_scaling(x)
     return np.ldexp(np.asarray(x, dtype=np.float64), k) * f
-
-
-def to_unit_peak(x: np.ndarray) -> np.ndarray:
-    """``x`` scaled by a power of two to a peak in [0.5, 1) (exact); ``x`` itself (as float64, no
-    copy) when its peak is there already, or it is silent.
-
-    >>> to_unit_peak(np.array([3.0, -1.5])).tolist(), to_unit_peak(np.array([2.0 ** -900])).tolist()
-    ([0.75, -0.375], [0.5])
-    """
-    x = np.asarray(x, dtype=np.float64)
-    k = unit_exponent(x)
-    return np.ldexp(x, k) if k else x

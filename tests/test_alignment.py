@@ -163,9 +163,9 @@ def test_label_cache(tmp_path, monkeypatch, clip):
     monkeypatch.setenv("FACETRAJ_CACHE_DIR", str(tmp_path))
     first = label_audio(audio, rate, "aligned", text)
     assert len(list((tmp_path / "labels").glob("labels-*.json"))) == 1
-    import facetraj_engine.io.label_rule as label_rule
+    import facetraj_engine.labels.alignment as alignment
 
-    monkeypatch.setattr(label_rule, "align", lambda *a, **k: pytest.fail("not cached"))
+    monkeypatch.setattr(alignment, "align", lambda *a, **k: pytest.fail("not cached"))
     again = label_audio(audio, rate, "aligned", text)
     assert again.phones == first.phones and np.allclose(again.scores, first.scores)
     assert again.words == first.words and again.source == "aligned"

@@ -186,6 +186,8 @@ def check_wav_header(path: Path) -> str | None:
                     return None
                 return (f"the audio file's header does not match its data: the bytes at offset "
                         f"{pos} are not a chunk ({name!r}; damaged header?)")
+            if not data and pos + 8 + length > size and name != b"data":
+                return None                 # a header in pieces: the reader says what it is
             if name == b"fmt ":
                 fmt = handle.read(min(length, 16))
             if name == b"data" and not data:
@@ -198,11 +200,9 @@ def check_wav_header(path: Path) -> str | None:
                             f"ends at byte {pos + 8 + length}, after the {end} bytes its RIFF "
                             "header says the file has (damaged header?)")
             elif pos + 8 + length > size:
-                if fmt is None:             # not a WAV header we can judge: the reader says
-                    return None
-                return (f"the audio file is cut short{' after its samples' if data else ''}: its "
-                        f"{name.decode()!r} chunk at offset {pos} needs {length} bytes, the file "
-                        f"ends {size - pos - 8} bytes after it")
+                return (f"the audio file is cut short after its samples: its {name.decode()!r} "
+                        f"chunk at offset {pos} needs {length} bytes, the file ends "
+                        f"{size - pos - 8} bytes after it")
             pos += 8 + length + (length & 1)
     if not data:
         return "the audio file's header does not match its data: no 'data' chunk in its RIFF size"

@@ -25,7 +25,6 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..labels.alignment import align, pcm16, pocketsphinx_version, recognize
 from ..labels.provenance import Labels
 from ..progress import Progress
 from .cachedir import cache_dir
@@ -45,6 +44,8 @@ def label_cache_key(audio: np.ndarray, rate: int, method: str, text: str = "",
                     extra_dict: Mapping[str, Sequence[str]] | None = None) -> str:
     """A hash of the audio samples (as 16-bit PCM at the labeller's level), the rate, the method,
     the text, extra pronunciations, the PocketSphinx version and :data:`LABELLER_VERSION`."""
+    from ..labels.alignment import pcm16, pocketsphinx_version
+
     h = hashlib.sha256()
     h.update(pcm16(audio).tobytes())            # what the labeller hears: the same at any gain
     meta = {"rate": int(rate), "method": method, "text": text if method == "aligned" else "",
@@ -75,10 +76,13 @@ def label_audio(audio: np.ndarray, rate: int, method: str, text: str = "",
             return Labels.from_json(json.loads(path.read_text(encoding="utf-8")))
         except (ValueError, KeyError, TypeError) as exc:
             log.warning("ignoring unreadable cached labels %s: %s", path, exc)
+    # PocketSphinx's side, imported when labels are made (reading label files does not need it)
+    from ..labels import alignment
+
     if method == "aligned":
-        labels = align(audio, rate, text, extra_dict, source, progress=progress)
+        labels = alignment.align(audio, rate, text, extra_dict, source, progress=progress)
     else:
-        labels = recognize(audio, rate, source, progress)
+        labels = alignment.recognize(audio, rate, source, progress)
     if path is not None:
         try:
             with atomic_write(path) as tmp:

@@ -36,8 +36,9 @@ def mode_rule(args: argparse.Namespace, model, corpus, splits) -> EvalConfig:
     if utt is not None:
         choice = choose_mode(synth_config(args), utt.phones, utt.provenance, explicit=explicit,
                              tuned=model.tuned, keep=keep)
-        log.info("%s (%s%s)", choice.describe(), first,
-                 "" if explicit else "; each utterance's mode follows its labels")
+        log.info("%s: labels %s [its label file, by the one rule]; %s%s", first,
+                 utt.provenance.describe(), choice.describe(),
+                 "" if explicit else " (each utterance's mode follows its labels)")
     return EvalConfig(by_labels=not explicit, keep=keep)
 
 
