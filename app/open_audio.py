@@ -336,7 +336,8 @@ class AudioOpener(QObject):
                 return opened, "none"
             progress(0.1, f"labelling {audio_path.name}")
             found = resolve_labels(audio_path, audio, rate, LabelRequest(
-                labels=labels_path, text=text, recognize=recognize, extra_dict=opened.extra_dict))
+                labels=labels_path, text=text, recognize=recognize, extra_dict=opened.extra_dict),
+                progress=lambda f, m: progress(0.1 + 0.8 * f, m))     # each decoding pass
             log.info("%s: labels %s", audio_path.name, found.describe())
             labels = found.labels
             source = labels.source if labels else "none"
