@@ -838,7 +838,8 @@ def output_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
         elif kind == "deep":
             out = d / "a" / "b" / "c" / "out.tsv"
         elif kind == "suffix":
-            out = d / rng.choice(["out.xyz", "out", "out.C3D", "out.csv", "out.npz", ".tsv"])
+            out = d / rng.choice(["out.xyz", "out", "out.C3D", "out.csv", "out.npz", ".tsv", "out.bvh",
+                                   "out.glb"])
         elif kind == "init-exists":
             corpus = d / "corpus"
             shutil.copytree(ws.corpus, corpus)
@@ -1007,8 +1008,15 @@ def alphabet_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
         name = rng.choice(list(SPELLINGS))
         table = SPELLINGS[name]
         out_segs = [PhoneSegment(s.start, s.end, rng.choice(table[s.label])) for s in segs]
-        damage = rng.choice(["none", "none", "none", "alien", "mixed", "case", "stress"])
-        if damage == "alien":
+        damage = rng.choice(["none", "none", "none", "alien", "mixed", "case", "stress", "aligner"])
+        if damage == "aligner":        # an aligner's TextGrid (MFA): aligned by its conventions
+            name, vowels = "ARPAbet", {"aa", "ae", "ah", "ao", "aw", "ay", "eh", "er", "ey", "ih",
+                                       "iy", "ow", "oy", "uh", "uw"}
+            out_segs = [PhoneSegment(s.start, s.end, "" if s.label == "sil" else s.label.upper()
+                                     + (rng.choice("012") if s.label in vowels else ""))
+                        for s in segs]
+            out_segs[-1] = PhoneSegment(out_segs[-1].start, out_segs[-1].end, "spn")
+        elif damage == "alien":
             k = rng.randrange(1, len(out_segs) - 1)
             out_segs[k] = PhoneSegment(out_segs[k].start, out_segs[k].end, rng.choice(ALIEN_LABELS))
         elif damage == "mixed":
@@ -1036,7 +1044,7 @@ def alphabet_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
         yield Case("alphabet", f"{name} {suffix}{' beside' if beside else ''}, {damage}"
                                f"{', ' + extra[-1] if len(extra) > 2 else ''}", argv,
                    _protect(ws.model, ws.wav), out,
-                   expect_ok=damage == "none" and len(extra) == 2)
+                   expect_ok=damage in ("none", "aligner") and len(extra) == 2)
 
 
 # --------------------------------------------------------------------------- the app

@@ -66,7 +66,9 @@ def read_audio(path: str | os.PathLike[str], allow_damaged: bool = False) -> tup
     except Exception as exc:  # soundfile raises several types for corrupt data
         raise InputError(path, f"cannot read audio ({exc})") from exc
     if stopped and not done:
-        raise InputError(path, f"cannot read audio ({stopped})")
+        raise InputError(path, f"the audio file is cut short or damaged: its header says "
+                               f"{frames / rate:.3f} s ({frames} samples), none could be decoded "
+                               f"({stopped})" if frames else f"cannot read audio ({stopped})")
     if done == 0:
         raise InputError(path, "the audio file holds no samples")
     if done < frames and damage is None:
@@ -230,6 +232,10 @@ def _data_chunk(fmt: bytes | None, pos: int, length: int, size: int) -> str | No
     if channels == 0 or bits == 0:
         return (f"the audio file's header does not match its data: its 'fmt ' chunk says "
                 f"{channels} channel(s) of {bits} bits")
+    if tag in (1, 3) and bits % 8:
+        # plain PCM and float name whole bytes; fewer valid bits need WAVE_FORMAT_EXTENSIBLE
+        return (f"the audio file's header does not match its data: its 'fmt ' chunk says "
+                f"{_BLOCK_FORMATS[tag]} of {bits} bits, which WAV stores in whole bytes")
     if tag in (6, 7) and bits != 8:
         return (f"the audio file's header does not match its data: its 'fmt ' chunk says "
                 f"{_BLOCK_FORMATS[tag]} of {bits} bits (A-law and mu-law are 8-bit)")
