@@ -152,7 +152,8 @@ def explain_match(ratio: float, config: SynthConfig, kind: str | None) -> str:
     """
     m = voice_match(ratio, 1.0)
     if not np.isfinite(m):
-        return "voice match unknown (the model file has no reference distance D0)"
+        return ("voice match unknown (no speech measured, or a model file without the training "
+                "voice's distance D0): nothing weighed by it")
     changed = []
     if config.mode == "robust" and config.label_weight_by_voice:
         raised = "raised to 1 (by 1 - match)" if m == 0 else \

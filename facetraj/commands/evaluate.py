@@ -36,8 +36,11 @@ def mode_rule(args: argparse.Namespace, model, corpus, splits) -> EvalConfig:
     if utt is not None:
         choice = choose_mode(synth_config(args), utt.phones, utt.provenance, explicit=explicit,
                              tuned=model.tuned, keep=keep)
-        log.info("%s: labels %s [its label file, by the one rule]; %s%s", first,
-                 utt.provenance.describe(), choice.describe(),
+        from facetraj_engine.io.corpus import label_path
+
+        where = label_path(corpus.data_root, first).name
+        log.info("%s: labels %s [%s beside the audio]; %s%s", first, utt.provenance.describe(),
+                 where, choice.describe(),
                  "" if explicit else " (each utterance's mode follows its labels)")
     return EvalConfig(by_labels=not explicit, keep=keep)
 
