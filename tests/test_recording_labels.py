@@ -137,3 +137,19 @@ def test_an_aligners_textgrid_counts_as_aligned_saying_why(default_corpus, model
     assert said["mode"] == "phonetic"
     # the corpus's own labels (lower case, no stress digits) stay hand-checked
     assert utt.provenance.kind == "hand-checked" and not utt.provenance.why
+
+
+def test_labelling_tells_its_progress_pass_by_pass(tmp_path):
+    """Recognition of long audio took half a minute in silence (issue 38): each PocketSphinx pass
+    is announced as it starts (a pass cannot report its own progress without changing its
+    result), to the progress bar of synth and the app's status bar."""
+    rec = tmp_path / "rec.flac"
+    shutil.copy(ROOT / "data_samples" / "s002.flac", rec)
+    audio, rate = read_audio(rec)
+    seen: list[tuple[float, str]] = []
+    resolve_labels(rec, audio, rate, LabelRequest(recognize=True), use_cache=False,
+                   progress=lambda f, m: seen.append((round(f, 2), m)))
+    assert seen == [(0.0, "recognizing rec.flac 1/3: phone loop"),
+                    (0.33, "recognizing rec.flac 2/3: alignment"),
+                    (0.67, "recognizing rec.flac 3/3: phone boundaries"),
+                    (1.0, "recognizing rec.flac: done")]

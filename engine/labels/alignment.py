@@ -248,9 +248,9 @@ class Passes:
     its cepstral mean is the whole utterance's) is announced as it starts, ``done`` of ``total``.
 
     >>> seen = []
-    >>> steps = Passes(lambda f, m: seen.append((round(f, 2), m)), 2, "aligning")
+    >>> steps = Passes(lambda f, m: seen.append((round(f, 2), m)), 2, "aligning a.wav")
     >>> steps.next("words"); steps.next("phones"); steps.end(); seen
-    [(0.0, 'aligning: words (pass 1 of 2)'), (0.5, 'aligning: phones (pass 2 of 2)'), (1.0, 'aligning: done')]
+    [(0.0, 'aligning a.wav 1/2: words'), (0.5, 'aligning a.wav 2/2: phones'), (1.0, 'aligning a.wav: done')]
     """
 
     def __init__(self, progress: Progress | None, total: int, what: str):
@@ -259,7 +259,7 @@ class Passes:
     def next(self, message: str) -> None:
         if self.progress is not None:
             self.progress(self.done / self.total,
-                          f"{self.what}: {message} (pass {self.done + 1} of {self.total})")
+                          f"{self.what} {self.done + 1}/{self.total}: {message}")
         self.done += 1
 
     def end(self) -> None:
@@ -272,12 +272,12 @@ def _phone_alignment(decoder, pcm: bytes, text: str, steps: Passes | None = None
     steps = steps or Passes(None, 2, "")
     try:
         decoder.set_align_text(text)
-        steps.next("the words")
+        steps.next("alignment")
         _decode(decoder, pcm)
         if decoder.hyp() is None:
             return None
         decoder.set_alignment()
-        steps.next("the phones")
+        steps.next("phone boundaries")
         _decode(decoder, pcm)
     except RuntimeError:
         return None
@@ -374,7 +374,7 @@ def _recognize_segments(pcm: bytes, steps: Passes | None = None
     """All-phone search, then the phones found re-aligned as a phone sequence (scores)."""
     steps = steps or Passes(None, 3, "")
     dec = allphone_decoder()
-    steps.next("the phone loop")
+    steps.next("phone loop")
     _decode(dec, pcm)
     n_frames = dec.n_frames()
     found = [(s.word, s.start_frame, s.end_frame - s.start_frame + 1) for s in dec.seg()]
