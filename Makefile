@@ -11,21 +11,23 @@ $(BIN)/python:
 	$(BIN)/pip install -q --upgrade pip
 
 # both distributions from this checkout, editable: the engine (pyproject.toml) and the app
-# (packaging/app); the first install takes a minute or two (the libraries, PyQt6 and VTK among them)
+# (packaging/app); the first install takes a minute or two (the libraries, PyQt6 and VTK among them),
+# so pip is not quietened: its lines and download bars are the install's progress (issue 38)
 APP := packaging/app
 $(VENV)/.installed-run: pyproject.toml $(APP)/pyproject.toml $(APP)/setup.py | $(BIN)/python
-	@echo "facetraj: installing the engine and the app into $(VENV) (a minute or two the first time)"
-	$(BIN)/pip install -q -e . -e $(APP)
+	@echo "facetraj: installing the engine and the app into $(VENV) (a minute or two the first time; pip shows each package)"
+	$(BIN)/pip install --progress-bar on -e . -e $(APP)
 	touch $@
 
 # the tests include the corpus generator's bit-for-bit reproduction check, hence the corpus extra
 $(VENV)/.installed-test: pyproject.toml $(APP)/pyproject.toml $(APP)/setup.py | $(BIN)/python
-	@echo "facetraj: installing the engine, the app and the test tools into $(VENV) (a few minutes the first time)"
-	$(BIN)/pip install -q -e ".[test,corpus]" -e $(APP)
+	@echo "facetraj: installing the engine, the app and the test tools into $(VENV) (a few minutes the first time; pip shows each package)"
+	$(BIN)/pip install --progress-bar on -e ".[test,corpus]" -e $(APP)
 	touch $@ $(VENV)/.installed-run $(VENV)/.installed-corpus
 
 $(VENV)/.installed-corpus: pyproject.toml | $(BIN)/python
-	$(BIN)/pip install -q -e ".[test,corpus]"
+	@echo "facetraj: installing the corpus generator's libraries into $(VENV)"
+	$(BIN)/pip install --progress-bar on -e ".[test,corpus]"
 	touch $@
 
 run: $(VENV)/.installed-run

@@ -99,7 +99,15 @@ from .status import StatusArea
 from .timeline import LipPanel, PhoneTierPanel, SpectrogramPanel, Timeline, WaveformPanel
 from .transport import PlaybackClock
 from .view3d import FaceView
-from .viewer_model import DEFAULT_SENTENCE, SynthRequest, ViewerModel, load_model, view_summary, view_title
+from .viewer_model import (
+    DEFAULT_SENTENCE,
+    SynthRequest,
+    ViewerModel,
+    load_model,
+    view_summary,
+    view_title,
+    voice_match_tip,
+)
 from .window_frame import WindowDocks, WindowMenus
 from .workers import Progress, Task, TaskRunner
 
@@ -400,6 +408,7 @@ class MainWindow(QMainWindow):
         self.browser.set_current(view.utterance.name)
         self.scores.score(view, self.model)
         self.status_label.setText(view_summary(view))
+        self.status_label.setToolTip(voice_match_tip(view))     # the voice match in words
 
     # ================================================================== playback
     def toggle_play(self) -> None:

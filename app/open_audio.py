@@ -1,7 +1,7 @@
 """Opening a recording for synthesis, with phone labels from wherever they can come from.
 
 "Open audio…" uses a label file or a ``.txt`` transcript beside the audio (the one rule,
-``facetraj_engine.io.labelling.labels_for_audio``), otherwise asks for the sentence (:class:`SentenceDialog`:
+``facetraj_engine.io.label_rule.resolve_labels``), otherwise asks for the sentence (:class:`SentenceDialog`:
 empty = recognize the phones; or no labels, acoustic-only). Alignment runs in a worker with the
 window's busy indicator; words missing from the dictionary are asked for
 (:class:`MissingWordsDialog`) and the alignment retried. The :class:`LabelSourceBox` in the settings
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
@@ -154,26 +154,25 @@ class OpenedAudio:
     labels: dict[str, Labels | None] = field(default_factory=dict)
 
     def labels_for(self, source: str) -> Labels | None:
-        """Labels of ``source`` (computed on the first call: run in a worker)."""
-        from facetraj_engine.io.labelfiles import read_label_file
-        from facetraj_engine.io.labelling import label_audio
+        """Labels of ``source`` (computed on the first call: run in a worker), by the one rule
+        (``facetraj_engine.io.label_rule.resolve_labels``) asked for that source."""
+        from facetraj_engine.io.label_rule import LabelRequest, resolve_labels
 
         if source not in self.labels:
             if source == "none":
                 self.labels[source] = None
-            elif source == "file":
-                if self.label_file is None:
-                    raise InputError(self.path, "no label file beside the audio")
-                self.labels[source] = read_label_file(self.label_file, self.rate,
-                                                  len(self.audio) / self.rate)
-            elif source == "aligned":
-                if not self.text:
-                    raise InputError(self.path, "no sentence to align: give one with Open audio…")
-                self.labels[source] = label_audio(self.audio, self.rate, "aligned", self.text,
-                                                  self.extra_dict, self.path)
-            else:
-                self.labels[source] = label_audio(self.audio, self.rate, "recognized",
-                                                  source=self.path)
+                return None
+            if source == "file" and self.label_file is None:
+                raise InputError(self.path, "no label file beside the audio")
+            if source == "aligned" and not self.text:
+                raise InputError(self.path, "no sentence to align: give one with Open audio…")
+            request = {"file": LabelRequest(labels=self.label_file),
+                       "aligned": LabelRequest(text=self.text, extra_dict=self.extra_dict)
+                       }.get(source, LabelRequest(recognize=True))
+            found = resolve_labels(self.path, self.audio, self.rate, request)
+            if source == "aligned" and found.labels is not None and self.text_from:
+                found.labels.provenance = replace(found.labels.provenance, origin=self.text_from)
+            self.labels[source] = found.labels
         return self.labels[source]
 
     def origin(self, source: str) -> LabelOrigin:
@@ -261,7 +260,7 @@ class AudioOpener(QObject):
                                               "Audio (*.wav *.flac);;All files (*)")
         if not path:
             return
-        from facetraj_engine.io.labelling import beside
+        from facetraj_engine.io.label_rule import beside
 
         path = Path(path)
         read = self._read(path)  # a corrupt file is reported before the sentence is asked for
@@ -298,7 +297,7 @@ class AudioOpener(QObject):
     def open(self, audio_path: Path, labels_path: Path | None = None, text: str | None = None,
              recognize: bool = False, acoustic_only: bool = False,
              extra_dict: dict[str, list[str]] | None = None) -> bool:
-        """Open ``audio_path`` for synthesis; labels by ``facetraj_engine.io.labelling.labels_for_audio``
+        """Open ``audio_path`` for synthesis; labels by ``facetraj_engine.io.label_rule.resolve_labels``
         (alignment or recognition in a worker), none with ``acoustic_only``. False when the
         audio cannot be read (the error is shown)."""
         read = self._read(audio_path)
@@ -310,7 +309,7 @@ class AudioOpener(QObject):
               labels_path: Path | None = None, text: str | None = None, recognize: bool = False,
               acoustic_only: bool = False,
               extra_dict: dict[str, list[str]] | None = None) -> None:
-        from facetraj_engine.io.labelling import beside, labels_for_audio, read_transcript
+        from facetraj_engine.io.label_rule import LabelRequest, beside, read_transcript, resolve_labels
         from facetraj_engine.labels.alignment import MissingWordsError
 
         win = self.window
@@ -336,9 +335,11 @@ class AudioOpener(QObject):
             if acoustic_only:
                 return opened, "none"
             progress(0.1, f"labelling {audio_path.name}")
-            labels = labels_for_audio(audio_path, audio, rate, labels=labels_path, text=text,
-                                      recognize=recognize, extra_dict=opened.extra_dict,
-                                      fallback=True)
+            found = resolve_labels(audio_path, audio, rate, LabelRequest(
+                labels=labels_path, text=text, recognize=recognize, extra_dict=opened.extra_dict),
+                progress=lambda f, m: progress(0.1 + 0.8 * f, m))     # each decoding pass
+            log.info("%s: labels %s", audio_path.name, found.describe())
+            labels = found.labels
             source = labels.source if labels else "none"
             opened.labels[source] = labels
             return opened, source

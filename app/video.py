@@ -310,12 +310,14 @@ def render_video(model: Model, synthesis: Synthesis, audio: np.ndarray, sample_r
     try:
         with tempfile.TemporaryDirectory() as tmpdir:
             wav = Path(tmpdir) / "speech.wav"
-            write_audio(wav, audio, sample_rate)
+            write_audio(wav, *sound_for_frames(audio, sample_rate, n_video, settings.fps))
             with atomic_write(path, overwrite=True) as tmp:
+                # the sound exactly as long as the frames, and both cut there: every frame kept
+                # (``-shortest`` dropped the last, the AAC stream ending a few ms early)
                 writer = imageio_ffmpeg.write_frames(
                     str(tmp), frames.size, fps=settings.fps, codec="libx264",
                     audio_path=str(wav), audio_codec="aac", macro_block_size=8,
-                    output_params=["-shortest"])
+                    ffmpeg_log_level="error", output_params=["-t", f"{n_video / settings.fps:.6f}"])
                 writer.send(None)
                 try:
                     for k in range(n_video):
@@ -329,6 +331,30 @@ def render_video(model: Model, synthesis: Synthesis, audio: np.ndarray, sample_r
     progress(1.0, "done")
     log.info("wrote %s (%d frames at %g fps)", path, n_video, settings.fps)
     return path
+
+
+#: the sound's rate in the video: AAC's frames of 1024 samples are 21 ms, under a video frame
+VIDEO_AUDIO_RATE = 48000
+
+
+def sound_for_frames(audio: np.ndarray, sample_rate: int, n_frames: int, fps: float
+                     ) -> tuple[np.ndarray, int]:
+    """The speech as long as ``n_frames`` video frames at ``fps`` (cut, or silence after it), at
+    :data:`VIDEO_AUDIO_RATE`, peak-limited to full scale, and its rate.
+
+    >>> x, rate = sound_for_frames(np.ones(16000), 16000, 30, 30.0)
+    >>> len(x), rate
+    (48000, 48000)
+    """
+    from facetraj_engine.level import peak
+    from facetraj_engine.method.lsf import resample_audio
+
+    x = resample_audio(audio, sample_rate, VIDEO_AUDIO_RATE)
+    top = peak(x)
+    if top > 1.0:                                   # over full scale: lowered, not clipped
+        x = x / top
+    n = int(round(n_frames / fps * VIDEO_AUDIO_RATE))
+    return np.concatenate([x[:n], np.zeros(max(0, n - len(x)))]), VIDEO_AUDIO_RATE
 
 
 def video_for_utterance(model: Model, utt: Utterance, synthesis: Synthesis,

@@ -278,6 +278,19 @@ def view_summary(view: UtteranceView) -> str:
     return f"{text}; voice match {view.voice_match:.2f}" if math.isfinite(view.voice_match) else text
 
 
+def voice_match_tip(view: UtteranceView) -> str:
+    """The status line's tooltip: what the voice match means and what it changed in this
+    synthesis (:func:`facetraj_engine.method.voice_match.explain_match`), empty without one."""
+    from facetraj_engine.method.voice_match import explain_match
+
+    res = view.synthesis
+    if not math.isfinite(res.voice_ratio):
+        return ""
+    kind = view.utterance.provenance.kind if view.utterance.phones else None
+    return explain_match(res.voice_ratio, res.config, kind).replace("; here: ", ".\nIn this "
+                                                                    "synthesis: ", 1)
+
+
 def read_texts(corpus: Corpus) -> dict[str, str]:
     """The orthographic text of each utterance: its ``<id>.txt`` file, else the sentence its
     marker file holds (MVIEW's SENTENCE)."""

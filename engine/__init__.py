@@ -5,7 +5,8 @@ each imports only the stages listed before it (``tests/test_layering.py`` checks
 
 ==============  ===========================================================================
 shared          ``config`` (settings), ``data`` (an utterance), ``errors``, ``fanout`` (work
-                over processes), ``progress``, ``threads``: small modules every stage uses
+                over processes), ``level`` (a signal's gain kept out), ``progress``,
+                ``threads``: small modules every stage uses
 ``labels``      the phone set, other alphabets, PocketSphinx alignment and recognition
 ``io``          files in and out: audio, label and marker files, corpus folders, model files,
                 exports, caches, and which labels an input gets

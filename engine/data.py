@@ -38,12 +38,15 @@ class Provenance:
     tool : what made them (``PocketSphinx 5.1.1``), if known.
     origin : what they were made from (a transcript file, ``--text``), if known.
     corrected : phones corrected by hand after they were made (0: none).
+    why : how the kind was told, when the labels do not record it (a label file in an aligner's
+        conventions, :func:`facetraj_engine.labels.provenance.aligner_conventions`), else ``""``.
     """
 
     kind: str = "hand-checked"
     tool: str = ""
     origin: str = ""
     corrected: int = 0
+    why: str = ""
 
     def __post_init__(self) -> None:
         if self.kind not in LABEL_KINDS:
@@ -70,6 +73,8 @@ class Provenance:
             text += f" ({self.tool})"
         if self.corrected:
             text += f", {self.corrected} phone{'s' if self.corrected != 1 else ''} corrected by hand"
+        if self.why:
+            text += f" ({self.why})"
         return text
 
 

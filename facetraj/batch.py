@@ -37,8 +37,9 @@ _GLOB_CHARS = frozenset("*?[")
 @dataclass(frozen=True)
 class SynthJob:
     """What every input of a run shares: the synthesis settings and how outputs are written
-    (``request``: :class:`~facetraj_engine.workflow.recording.LabelRequest`; ``explicit``, ``keep``: as
-    :func:`~facetraj_engine.workflow.recording.synthesize_recording` takes them)."""
+    (``request``: :class:`~facetraj_engine.workflow.recording.LabelRequest`; ``explicit``, ``keep``,
+    ``allow_damaged``: as :func:`~facetraj_engine.workflow.recording.synthesize_recording` takes
+    them; ``c3d_audio``: a C3D output carries the speech as its analog channel)."""
 
     config: Any
     request: Any
@@ -46,6 +47,8 @@ class SynthJob:
     keep: tuple[str, ...] = ()
     overwrite: bool = False
     compress: bool = False
+    allow_damaged: bool = False
+    c3d_audio: bool = True
 
 
 @dataclass
@@ -130,19 +133,36 @@ def output_paths(inputs: Sequence[Path], outdir: Path, fmt: str) -> list[Path]:
 
 
 # --------------------------------------------------------------------------- one input
-def synthesize_file(model: Any, audio: Path, output: Path, job: SynthJob) -> Any:
+def synthesize_file(model: Any, audio: Path, output: Path, job: SynthJob, say: bool = True,
+                    progress: Callable[[float, str], None] | None = None) -> Any:
     """One recording to one trajectory file, as ``facetraj synth`` does for every input;
-    returns the :class:`~facetraj_engine.workflow.recording.RecordingSynthesis` (logged)."""
+    returns the :class:`~facetraj_engine.workflow.recording.RecordingSynthesis` (logged unless
+    ``say`` is off: a batch's parent logs each input's lines above its progress bar)."""
+    from facetraj_engine.io.audio import read_audio
     from facetraj_engine.io.export import write_trajectories
     from facetraj_engine.workflow.recording import synthesize_recording
 
+    sound = read_audio(audio, job.allow_damaged)
     done = synthesize_recording(model, audio, job.config, job.request, explicit=job.explicit,
-                                keep=list(job.keep))
-    log.info("%s", done.describe())
+                                keep=list(job.keep), audio=sound, progress=progress)
+    if say:
+        log.info("%s", done.describe())
     res = done.synthesis
     write_trajectories(output, res.markers, model.marker_rate, model.marker_names, res.arrays(),
-                       job.overwrite, compress=job.compress)
+                       job.overwrite, compress=job.compress,
+                       audio=sound if job.c3d_audio else None)
+    if output.suffix.lower() == ".c3d" and say:
+        log.info("%s: %s", output.name, c3d_contents(job.c3d_audio))
     return done
+
+
+def c3d_contents(audio: bool) -> str:
+    """What a C3D output holds beside its points, and why (for the log)."""
+    axes = "axes declared (POINT:X_SCREEN +X, Y_SCREEN +Y: upright in a viewer that honours them)"
+    if not audio:
+        return f"{axes}; no speech (--no-audio)"
+    return (f"{axes}; the speech as analog channel SPEECH (by default: where motion-capture "
+            "software keeps a recording's sound in sync with its points; --no-audio leaves it out)")
 
 
 #: a worker's model and job (set before the pool forks, else by :func:`_worker_init`)
@@ -171,7 +191,7 @@ def _worker_run(pair: tuple[Path, Path]) -> Outcome:
     src, out = pair
     t0 = time.perf_counter()
     try:
-        done = synthesize_file(_WORKER["model"], src, out, _WORKER["job"])
+        done = synthesize_file(_WORKER["model"], src, out, _WORKER["job"], say=False)
     except FacetrajError as exc:
         return Outcome(str(src), str(out), "failed", str(exc), time.perf_counter() - t0)
     except OSError as exc:
@@ -186,8 +206,8 @@ def _worker_run(pair: tuple[Path, Path]) -> Outcome:
                        f"{src}: unexpected error ({type(exc).__name__}: {exc})",
                        time.perf_counter() - t0)
     res = done.synthesis
-    details = {"labels": done.labels.provenance.describe() if done.labels else "none",
-               "mode": done.choice.config.mode, "why": done.choice.describe(),
+    details = {"labels": done.found.describe(), "mode": done.choice.config.mode,
+               "why": done.choice.describe(), "line": done.describe(),
                "voice_match": done.voice_match if math.isfinite(done.voice_match) else None,
                "frames": len(res.times)}
     return Outcome(str(src), str(out), "done", "", time.perf_counter() - t0,
@@ -265,6 +285,8 @@ def run_batch(model_path: Path, specs: Sequence[str], outdir: Path, fmt: str, jo
         outcomes[Path(outcome.input)] = outcome
         if outcome.status == "failed":
             log.info("%s", outcome.reason)          # and in the summary at the end
+        elif "line" in outcome.details:             # here, above the bar: not from a worker
+            log.info("%s", outcome.details["line"])
         if progress:
             progress(k / len(todo), Path(outcome.input).name)
     log.info("%d inputs in %.1f s", len(todo), time.perf_counter() - t0)

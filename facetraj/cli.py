@@ -87,9 +87,13 @@ def configure_logging(verbose: int = 0, quiet: bool = False) -> None:
     """
     if logging.getLogger().handlers:
         return          # configured already (an embedding program, a test run): as basicConfig
+    from .progress import LogAboveBar
+
     own = logging.DEBUG if verbose else logging.ERROR if quiet else logging.INFO
     libraries = logging.DEBUG if verbose >= 2 else max(own, logging.WARNING)
-    logging.basicConfig(level=libraries, format="%(levelname)s: %(message)s")
+    handler = LogAboveBar()                 # lines above a progress bar, not through it
+    handler.setFormatter(logging.Formatter("%(levelname)s: %(message)s"))
+    logging.basicConfig(level=libraries, handlers=[handler])
     for name in OWN_LOGGERS:
         logging.getLogger(name).setLevel(own)
 

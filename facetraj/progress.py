@@ -1,13 +1,19 @@
-"""A one-line progress bar on stderr for the engine's ``progress(fraction, message)`` callbacks."""
+"""A one-line progress bar on stderr for the engine's ``progress(fraction, message)`` callbacks,
+and the log handler that prints log lines above it, not through it (issue 38)."""
 
 from __future__ import annotations
 
+import logging
 import sys
 import time
 
 
 class TerminalProgress:
-    """A one-line progress bar on stderr when it is a terminal (silent otherwise)."""
+    """A one-line progress bar on stderr when it is a terminal (silent otherwise). While it is
+    drawn, a log line (:class:`LogAboveBar`) clears it, prints, and draws it again."""
+
+    #: the bar drawn now, if any (one at a time: the command's)
+    active: TerminalProgress | None = None
 
     def __init__(self, label: str, stream=None):
         self.label = label
@@ -15,6 +21,7 @@ class TerminalProgress:
         self.live = bool(getattr(self.stream, "isatty", lambda: False)())
         self._last = -1
         self._start = time.monotonic()
+        self._line = ""
 
     def __call__(self, fraction: float, message: str) -> None:
         pct = int(100 * fraction)
@@ -22,11 +29,39 @@ class TerminalProgress:
             return
         self._last = pct
         bar = "#" * (pct // 4)
-        self.stream.write(f"\r{self.label} [{bar:<25}] {pct:3d}% {message[:40]:<40}"
-                          f"{remaining(time.monotonic() - self._start, fraction):>12}")
+        self._line = (f"{self.label} [{bar:<25}] {pct:3d}% {message[:40]:<40}"
+                      f"{remaining(time.monotonic() - self._start, fraction):>12}")
+        self.stream.write("\r" + self._line)
         if fraction >= 1.0:
             self.stream.write("\n")
+            self._line = ""
+        TerminalProgress.active = self if self._line else None
         self.stream.flush()
+
+    def clear(self) -> None:
+        """Take the bar off its line (a log line is about to be printed there)."""
+        if self._line:
+            self.stream.write("\r" + " " * len(self._line) + "\r")
+
+    def redraw(self) -> None:
+        """Draw the bar again, under what was printed."""
+        if self._line:
+            self.stream.write(self._line)
+            self.stream.flush()
+
+
+class LogAboveBar(logging.StreamHandler):
+    """A stderr log handler that prints each line above the progress bar being drawn (the bar is
+    cleared, the line printed, the bar drawn again under it), not into it."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        bar = TerminalProgress.active
+        if bar is None or bar.stream is not self.stream:
+            super().emit(record)
+            return
+        bar.clear()
+        super().emit(record)
+        bar.redraw()
 
 
 def remaining(elapsed: float, fraction: float) -> str:

@@ -45,8 +45,8 @@ PARSE_ONLY = {"gui", "report", "video", "build", None}
 BAD_NUMBERS = ["0", "-1", "-20", "nan", "inf", "-inf", "1e309", "1e-320", "abc", "", "3.5",
                "99999999999999999999", "0x10", "1e6", "-0", "1e-9", "2"]
 
-CATEGORIES = ("audio", "labels", "model", "corpus", "c3d", "markers", "articulograph", "options",
-              "output", "fanout", "alphabet", "app")
+CATEGORIES = ("audio", "damaged", "labels", "model", "corpus", "c3d", "markers", "articulograph",
+              "options", "output", "fanout", "alphabet", "app")
 #: Exit status of a corpus-wide command that left bad files out (--skip-bad): allowed only there.
 EXIT_INCOMPLETE = 3
 
@@ -67,6 +67,8 @@ class Case:
     expect_ok: bool = False        # valid input (a label file in another alphabet): must exit 0
     serial_argv: list[str] | None = None   # the same with -j 1: must end the same way
     app: list[str] | None = None   # an app case: what the window opens (tests/fuzz_app.py)
+    blame: list[Path] = field(default_factory=list)   # damaged inputs: refused, each named
+    summary: Path | None = None    # a batch's synth-summary.json: the blamed inputs failed there
 
 
 @dataclass
@@ -250,6 +252,65 @@ def audio_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
         out = d / "out.tsv"
         yield Case("audio", name, _synth_argv(ws, ws.model, path, out, labels),
                    _protect(ws.model, ws.textgrid), out)
+
+
+# --------------------------------------------------------------------------- damaged audio
+def damaged_wav(rng: random.Random, wav: bytes) -> tuple[bytes, str]:
+    """``wav`` (16-bit PCM, the 44-byte header) cut short or with a header that no longer matches
+    its data: every one a file facetraj must refuse, naming it (issue 38)."""
+    kind = rng.choice(["cut", "cut", "data size", "riff size", "fmt field", "chunk id"])
+    if kind == "cut":
+        n = rng.randrange(1, len(wav) - 45)
+        return wav[:len(wav) - n], f"cut short by {n} bytes"
+    m = bytearray(wav)
+    if kind == "data size":
+        size = struct.unpack("<I", wav[40:44])[0]
+        new = size + rng.choice([-1, 1]) * 2 * rng.randrange(4, 1000)
+        m[40:44] = struct.pack("<I", max(0, min(new, 0xFFFFFFFE)) or 2)
+        return bytes(m), f"data size {size} -> {struct.unpack('<I', m[40:44])[0]}"
+    if kind == "riff size":
+        size = struct.unpack("<I", wav[4:8])[0]
+        m[4:8] = struct.pack("<I", max(1, size + rng.choice([-1, 1]) * rng.randrange(2, 5000)))
+        return bytes(m), f"RIFF size {size} -> {struct.unpack('<I', m[4:8])[0]}"
+    if kind == "fmt field":
+        at, what, values = rng.choice([(22, "channels", [0, 2, 3, 255]), (24, "rate", [8000, 44100, 7]),
+                                       (28, "byte rate", [1, 32001, 64000]),
+                                       (32, "block align", [1, 3, 4]), (34, "bits", [8, 24, 32, 5])])
+        width = 4 if what in ("rate", "byte rate") else 2
+        m[at:at + width] = struct.pack("<I" if width == 4 else "<H", rng.choice(values))
+        return bytes(m), f"{what} -> {struct.unpack('<I' if width == 4 else '<H', m[at:at + width])[0]}"
+    m[36:40] = bytes(rng.randrange(256) for _ in range(4))
+    return bytes(m), f"data chunk id {bytes(m[36:40])!r}"
+
+
+def damaged_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
+    """Truncated and header-damaged WAVs, each with its labels beside it (which must not be
+    blamed), through ``synth`` one at a time or as a batch beside an undamaged one (which is
+    done, and no damaged one counted as done)."""
+    wav = ws.wav.read_bytes()
+    while True:
+        d = ws.fresh("damaged")
+        folder = d / "in"
+        folder.mkdir()
+        blame, hows = [], []
+        for k in range(rng.choice([1, 1, 2, 3])):
+            data, how = damaged_wav(rng, wav)
+            (folder / f"r{k}.wav").write_bytes(data)
+            shutil.copy(ws.textgrid, folder / f"r{k}.TextGrid")
+            blame.append(folder / f"r{k}.wav")
+            hows.append(how)
+        if rng.random() < 0.5:
+            out = d / "out.tsv"
+            yield Case("damaged", f"one: {hows[0]}", _synth_argv(ws, ws.model, blame[0], out),
+                       _protect(ws.model, *blame), out, blame=blame[:1])
+            continue
+        shutil.copy(ws.wav, folder / "good.wav")
+        shutil.copy(ws.textgrid, folder / "good.TextGrid")
+        out = d / "out"
+        argv = ["synth", str(ws.model), str(folder), "-o", str(out), "--format", "tsv", "-q",
+                "-j", rng.choice(["1", "2"])]
+        yield Case("damaged", f"batch of {len(blame) + 1}: {'; '.join(hows)}"[:80], argv,
+                   _protect(ws.model, *blame), blame=blame, summary=out / "synth-summary.json")
 
 
 # --------------------------------------------------------------------------- labels
@@ -845,7 +906,8 @@ def output_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
         elif kind == "deep":
             out = d / "a" / "b" / "c" / "out.tsv"
         elif kind == "suffix":
-            out = d / rng.choice(["out.xyz", "out", "out.C3D", "out.csv", "out.npz", ".tsv"])
+            out = d / rng.choice(["out.xyz", "out", "out.C3D", "out.csv", "out.npz", ".tsv", "out.bvh",
+                                   "out.glb"])
         elif kind == "init-exists":
             corpus = d / "corpus"
             shutil.copytree(ws.corpus, corpus)
@@ -1014,8 +1076,15 @@ def alphabet_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
         name = rng.choice(list(SPELLINGS))
         table = SPELLINGS[name]
         out_segs = [PhoneSegment(s.start, s.end, rng.choice(table[s.label])) for s in segs]
-        damage = rng.choice(["none", "none", "none", "alien", "mixed", "case", "stress"])
-        if damage == "alien":
+        damage = rng.choice(["none", "none", "none", "alien", "mixed", "case", "stress", "aligner"])
+        if damage == "aligner":        # an aligner's TextGrid (MFA): aligned by its conventions
+            name, vowels = "ARPAbet", {"aa", "ae", "ah", "ao", "aw", "ay", "eh", "er", "ey", "ih",
+                                       "iy", "ow", "oy", "uh", "uw"}
+            out_segs = [PhoneSegment(s.start, s.end, "" if s.label == "sil" else s.label.upper()
+                                     + (rng.choice("012") if s.label in vowels else ""))
+                        for s in segs]
+            out_segs[-1] = PhoneSegment(out_segs[-1].start, out_segs[-1].end, "spn")
+        elif damage == "alien":
             k = rng.randrange(1, len(out_segs) - 1)
             out_segs[k] = PhoneSegment(out_segs[k].start, out_segs[k].end, rng.choice(ALIEN_LABELS))
         elif damage == "mixed":
@@ -1043,7 +1112,7 @@ def alphabet_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
         yield Case("alphabet", f"{name} {suffix}{' beside' if beside else ''}, {damage}"
                                f"{', ' + extra[-1] if len(extra) > 2 else ''}", argv,
                    _protect(ws.model, ws.wav), out,
-                   expect_ok=damage == "none" and len(extra) == 2)
+                   expect_ok=damage in ("none", "aligner") and len(extra) == 2)
 
 
 # --------------------------------------------------------------------------- the app
@@ -1115,9 +1184,9 @@ def app_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
 
 
 GENERATORS: dict[str, Callable[[Workspace, random.Random], Iterator[Case]]] = {
-    "audio": audio_cases, "labels": label_cases, "model": model_cases, "corpus": corpus_cases,
-    "c3d": c3d_cases, "markers": marker_cases, "articulograph": articulograph_cases,
-    "options": option_cases, "output": output_cases,
+    "audio": audio_cases, "damaged": damaged_cases, "labels": label_cases, "model": model_cases,
+    "corpus": corpus_cases, "c3d": c3d_cases, "markers": marker_cases,
+    "articulograph": articulograph_cases, "options": option_cases, "output": output_cases,
     "fanout": fanout_cases, "alphabet": alphabet_cases, "app": app_cases,
 }
 
@@ -1162,12 +1231,36 @@ def _judge(case: Case, code: int, err: str, status: str | None = None) -> Outcom
         return Outcome(case, "unclear message", code, err[-300:])
     if case.expect_ok and code != 0:
         return Outcome(case, "refused valid input", code, err[-300:])
+    blamed = _blame_problem(case, code, errors, failed)
+    if blamed is not None:
+        return Outcome(case, blamed[0], code, blamed[1])
     bad = _files_problem(case, code)
     if bad is not None:
         return Outcome(case, bad[0], code, bad[1])
     return Outcome(case, {0: "ok", 2: "refused"}.get(code, "skipped bad files"), code,
                    lines[-1][:200] if lines else "",
                    error_line=(errors or summary or failed or [""])[0])
+
+
+def _blame_problem(case: Case, code: int, errors: list[str], failed: list[str]
+                   ) -> tuple[str, str] | None:
+    """A damaged input (issue 38) that was not refused, not named as the file at fault, or
+    counted as done in a batch: (status, detail), else None."""
+    if not case.blame:
+        return None
+    if code != 2:
+        return "accepted damaged audio", f"exit {code}"
+    for path in case.blame:
+        named = [ln for ln in errors + failed
+                 if ln.startswith((f"facetraj: error: {path}: ", f"facetraj: failed: {path}: "))]
+        if not named:
+            return "blamed the wrong file", f"{path} not named first in {errors + failed}"[:300]
+    if case.summary is not None:
+        inputs = json.loads(case.summary.read_text())["inputs"]
+        done = [o["input"] for o in inputs if o["status"] == "done" and Path(o["input"]) in case.blame]
+        if done:
+            return "damaged audio counted as done", ", ".join(done)[:300]
+    return None
 
 
 def _files_problem(case: Case, code: int) -> tuple[str, str] | None:

@@ -15,8 +15,9 @@ from facetraj.cli import main
 from facetraj_engine.data import PhoneSegment
 from facetraj_engine.evaluation.label_accuracy import boundary_errors, merged, phone_error_rate, summarise
 from facetraj_engine.io.audio import read_audio
+from facetraj_engine.io.label_rule import FoundLabels, LabelRequest, label_audio, resolve_labels
 from facetraj_engine.io.labelfiles import read_lab, read_textgrid, read_textgrid_tiers, recorded_provenance
-from facetraj_engine.io.labelling import label_audio, label_corpus, labels_for_audio, relabelled
+from facetraj_engine.io.labelling import label_corpus, relabelled
 from facetraj_engine.labels.alignment import MissingWordsError, UnalignableError, align, recognize
 from facetraj_engine.labels.labelmap import read_label_map
 
@@ -136,14 +137,25 @@ def test_label_source_rule(tmp_path, clip):
     audio, rate, truth, text = clip
     wav = tmp_path / "u.flac"
     shutil.copy(CLIP, wav)
-    assert labels_for_audio(wav, audio, rate) is None                       # -> acoustic-only
+
+    def found(**request) -> FoundLabels:
+        return resolve_labels(wav, audio, rate, LabelRequest(**{"fallback": False, **request}))
+
+    assert found().labels is None                                            # -> acoustic-only
+    assert found().where == "no label file, sentence or .txt beside the audio"
+    assert found(fallback=True).where.startswith("recognition: no label file")
     (tmp_path / "u.txt").write_text(text)
-    assert labels_for_audio(wav, audio, rate).source == "aligned"            # .txt beside
+    aligned = found()                                                        # .txt beside
+    assert aligned.labels.source == "aligned" and aligned.where == "u.txt beside the audio"
+    assert aligned.describe().startswith("aligned from u.txt (PocketSphinx ")
     shutil.copy(CLIP.with_suffix(".TextGrid"), tmp_path / "u.TextGrid")
-    beside = labels_for_audio(wav, audio, rate)                              # label file beside
-    assert beside.source == "file" and [p.label for p in beside.phones] == [p.label for p in truth]
-    assert labels_for_audio(wav, audio, rate, recognize=True).source == "recognized"
-    assert labels_for_audio(wav, audio, rate, text="the boy enjoyed the noisy toy").source == "aligned"
+    beside = found()                                                         # label file beside
+    assert beside.labels.source == "file" and beside.file == tmp_path / "u.TextGrid"
+    assert [p.label for p in beside.labels.phones] == [p.label for p in truth]
+    assert beside.describe() == "hand-checked [u.TextGrid beside the audio]"
+    assert found(recognize=True).labels.source == "recognized"
+    given = found(text="the boy enjoyed the noisy toy")
+    assert given.labels.source == "aligned" and given.where == "the sentence given"
 
 
 def test_label_cache(tmp_path, monkeypatch, clip):
@@ -151,9 +163,9 @@ def test_label_cache(tmp_path, monkeypatch, clip):
     monkeypatch.setenv("FACETRAJ_CACHE_DIR", str(tmp_path))
     first = label_audio(audio, rate, "aligned", text)
     assert len(list((tmp_path / "labels").glob("labels-*.json"))) == 1
-    import facetraj_engine.io.labelling as labelling
+    import facetraj_engine.labels.alignment as alignment
 
-    monkeypatch.setattr(labelling, "align", lambda *a, **k: pytest.fail("not cached"))
+    monkeypatch.setattr(alignment, "align", lambda *a, **k: pytest.fail("not cached"))
     again = label_audio(audio, rate, "aligned", text)
     assert again.phones == first.phones and np.allclose(again.scores, first.scores)
     assert again.words == first.words and again.source == "aligned"
@@ -257,7 +269,8 @@ def test_synth_with_text_aligns_then_synthesizes_robustly(tmp_path, default_mode
     with caplog.at_level(logging.INFO, logger="facetraj"):
         assert main(["synth", str(model), str(wav), "--mode", "acoustic",
                      "-o", str(tmp_path / "b.c3d")]) == 0
-    assert "labels none; acoustic-only (indexed) mode: chosen" in caplog.text
+    assert "labels none [--mode acoustic: none asked for]; acoustic-only (indexed) mode: chosen" \
+        in caplog.text
     caplog.clear()
     with caplog.at_level(logging.INFO, logger="facetraj"):
         assert main(["synth", str(model), str(wav), "--text", text,

@@ -25,7 +25,8 @@ from facetraj_engine.errors import FILE_WARNINGS, FacetrajError
 from facetraj_engine.fanout import fan_out
 from facetraj_engine.io.audio import read_audio
 from facetraj_engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
-from facetraj_engine.io.files import atomic_write
+from facetraj_engine.io.export import TRAJECTORY_SUFFIXES
+from facetraj_engine.io.files import atomic_write, check_output_path
 from facetraj_engine.io.labelfiles import (
     read_lab,
     read_label_file,
@@ -133,7 +134,25 @@ def audio_and_label_cases(f: BadInputs) -> dict[str, Callable[[], object]]:
     "a phone the model does not know": lambda: (synthesize(f.model, f.audio, f.rate, f.with_phone("ux")),
                                                 synthesize(f.model, f.audio, f.rate, f.with_phone("zz"))),
     "label text that is not UTF-8": lambda: read_lab(f.write("b.lab", b"0 1 \xe9\xff\xfe\xfa")),
+    "an ARPAbet phone the model has never seen (a model trained on a few sentences)": lambda:
+        synthesize(f.model, f.audio, f.rate, f.with_phone("zh"), source="u.lab"),
+    "an audio file cut short (a WAV or FLAC holding fewer samples than its header says)": lambda:
+        read_audio(f.write("t.wav", f.wav.read_bytes()[:3000])),
+    "a WAV header that does not match its data (block size or byte rate against channels, bits "
+    "and rate; a 'data' chunk of part of a sample frame; bytes after the 'fmt ' chunk that are not "
+    "a chunk)": lambda: read_audio(f.write("h.wav", _block_size_damaged(f.wav.read_bytes()))),
+    "audio read with `--read-damaged-audio`": lambda:
+        read_audio(f.write("r.wav", f.wav.read_bytes()[:3000]), allow_damaged=True),
+    "an output format facetraj does not write (`face.bvh`, `face.glb`)": lambda:
+        check_output_path(f.tmp / "face.bvh", formats=TRAJECTORY_SUFFIXES, probe=True),
+    "an output in a place that takes no new files (`/proc/x.tsv`)": lambda:
+        check_output_path("/proc/x.tsv", formats=TRAJECTORY_SUFFIXES, probe=True),
     }
+
+
+def _block_size_damaged(wav: bytes) -> bytes:
+    """``wav`` with its fmt chunk's block size (bytes 32-33) made wrong."""
+    return wav[:32] + struct.pack("<H", struct.unpack("<H", wav[32:34])[0] + 1) + wav[34:]
 
 
 def marker_and_training_cases(f: BadInputs) -> dict[str, Callable[[], object]]:

@@ -48,12 +48,14 @@ def test_a_folder_with_a_corrupt_file_finishes_the_others_and_names_it(model_pat
                                                      SUMMARY_NAME]
     assert "3 done, 0 skipped (output exists), 1 failed" in captured.out
     err = [ln for ln in captured.err.splitlines() if "broken.flac" in ln]
-    assert len(err) == 1 and "cannot read audio" in err[0] and "Traceback" not in captured.err
+    assert len(err) == 1 and "Traceback" not in captured.err
+    assert err[0].startswith("facetraj: failed: ") and "broken.flac: the audio file is cut short " \
+        "or damaged: its header says" in err[0]
     summary = _summary(out)
     assert (summary["done"], summary["skipped"], summary["failed"]) == (3, 0, 1)
     by_name = {r["input"].rsplit("/", 1)[-1]: r for r in summary["inputs"]}
     assert by_name["broken.flac"]["status"] == "failed"
-    assert "broken.flac: cannot read audio" in by_name["broken.flac"]["reason"]
+    assert "broken.flac: the audio file is cut short or damaged" in by_name["broken.flac"]["reason"]
     # every input's labels by the rule for one file: beside it, else recognized
     assert by_name["s001.flac"]["details"]["labels"].startswith("hand-checked")
     assert by_name["s001.flac"]["details"]["mode"] == "phonetic"

@@ -291,7 +291,7 @@ def test_unwritable_and_read_only(tmp_path, monkeypatch):
     def refuse(*a, **k):
         raise OSError(errno.EROFS, "Read-only file system")
     monkeypatch.setattr(tempfile, "mkstemp", refuse)
-    with pytest.raises(InputError, match="o.tsv: cannot be written \\(the file system is read-only\\)"):
+    with pytest.raises(InputError, match="o.tsv: cannot be written: the file system is read-only"):
         with atomic_write(tmp_path / "o.tsv"):
             pass
     monkeypatch.setattr(os, "access", lambda *a: False)
@@ -458,8 +458,8 @@ def _flac_claiming(src: Path, dst: Path, total: int) -> Path:
 
 def test_audio_header_claiming_too_much_is_refused_before_allocating(workspace, tmp_path):
     """A FLAC whose header claims 2^36 samples (550 GB as float64): refused with the count, the
-    forked run staying far below the memory limit; a WAV whose data size field is damaged reads
-    the samples the file holds."""
+    forked run staying far below the memory limit; a WAV whose data size field is damaged is
+    refused as cut short (issue 38), and reads the samples the file holds when asked."""
     from fuzzing import Case
 
     from facetraj_engine.io.audio import read_audio
@@ -478,7 +478,11 @@ def test_audio_header_claiming_too_much_is_refused_before_allocating(workspace, 
     i = data.find(b"data")
     data[i + 4:i + 8] = struct.pack("<I", 0xFFFFFFF0)
     (tmp_path / "size.wav").write_bytes(bytes(data))
-    np.testing.assert_array_equal(read_audio(tmp_path / "size.wav")[0], read_audio(workspace.wav)[0])
+    with pytest.raises(InputError, match="size.wav: the audio file is cut short: its header says "
+                                         "134217.728 s"):
+        read_audio(tmp_path / "size.wav")
+    np.testing.assert_array_equal(read_audio(tmp_path / "size.wav", allow_damaged=True)[0],
+                                  read_audio(workspace.wav)[0])
 
 
 def test_multichannel_audio_is_mixed_down_block_by_block(tmp_path, monkeypatch):

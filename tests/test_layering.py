@@ -15,8 +15,8 @@ import facetraj_engine
 ROOT = Path(__file__).resolve().parent.parent
 
 #: The engine's top-level modules outside every stage: small things every stage uses.
-SHARED = {f"facetraj_engine.{name}" for name in ("config", "data", "errors", "fanout", "progress",
-                                                  "threads")}
+SHARED = {f"facetraj_engine.{name}" for name in ("config", "data", "errors", "fanout", "level",
+                                                  "progress", "threads")}
 
 # Run in a fresh interpreter in which every GUI package and the upper layers cannot be imported.
 PROBE = """

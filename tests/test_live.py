@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import shutil
+
 import numpy as np
 import pytest
 
@@ -40,7 +42,8 @@ def test_live_from_file_with_phones_writes_them_beside_the_take(model_file, defa
     from facetraj_engine.io.labelfiles import read_label_file
     from facetraj_engine.streaming.live import stream_file
 
-    wav = default_corpus.root / f"{default_corpus.info.test[1]}.flac"
+    wav = tmp_path / "u.flac"                # nothing beside it: phones recognized as spoken
+    shutil.copy(default_corpus.root / f"{default_corpus.info.test[1]}.flac", wav)
     out = tmp_path / "take.tsv"
     assert main(["-q", "live", "--model", str(model_file), "--from-file", str(wav),
                  "--as-fast-as-possible", "--block-ms", "100", "-o", str(out)]) == 0
@@ -55,7 +58,7 @@ def test_live_from_file_with_phones_writes_them_beside_the_take(model_file, defa
     out.unlink()
     assert main(["-q", "live", "--model", str(model_file), "--from-file", str(wav),
                  "--as-fast-as-possible", "-o", str(out)]) == 2
-    assert "take.TextGrid exists" in capsys.readouterr().err
+    assert "take.TextGrid: already exists" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("args, message", [

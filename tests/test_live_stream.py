@@ -13,6 +13,7 @@ import pytest
 from facetraj_engine.config import SynthConfig
 from facetraj_engine.data import PhoneSegment
 from facetraj_engine.labels.provenance import Labels
+from facetraj_engine.level import to_full_scale
 from facetraj_engine.method.closure import ClosurePlan, aperture_functional, close_lips, rest_in_pauses
 from facetraj_engine.method.pipeline import synthesize
 from facetraj_engine.method.speech import filtered_energy_db, pauses, speech_mask
@@ -253,6 +254,7 @@ def test_pauses_of_a_stream():
 # --------------------------------------------------------------------------- speech, voice
 def test_speech_stream_filters_the_energy_as_offline(utterance):
     audio, rate, _ = utterance
+    audio = to_full_scale(audio)        # a file is streamed at this level (offline: any level)
     times = np.arange(int(np.floor(len(audio) / rate * 60)) + 1) / 60
     offline = filtered_energy_db(audio, rate)
     for block in (160, 997, rate):

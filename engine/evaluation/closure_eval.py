@@ -27,7 +27,8 @@ from ..data import PhoneSegment
 from ..io.audio import read_audio
 from ..io.corpus import Corpus
 from ..io.files import read_json, write_json
-from ..io.labelling import label_audio, read_transcript, relabelled
+from ..io.label_rule import label_audio, read_transcript
+from ..io.labelling import relabelled
 from ..method.model import Model
 from ..method.modes import choose_mode
 from ..method.pipeline import Synthesis, synthesize

@@ -7,7 +7,8 @@
 - ``corpus``: a corpus folder (``corpus.json`` and its recordings), ``hash_memo`` its content
   hashes, ``cachedir`` where recomputable things are kept;
 - ``model_file``: a model file's arrays and metadata checked before use (no pickle);
-- ``labelling``: which labels an input gets (a file, an aligned transcript, recognition), cached;
+- ``label_rule``: which labels a recording gets (the one rule: a file, an aligned transcript,
+  recognition), automatic labels cached; ``labelling``: automatic labels of corpora and folders;
 - ``export``: trajectories out as C3D, TSV/CSV or NPZ.
 
 Imports the shared modules and ``facetraj_engine.labels``; never ``facetraj_engine.method`` or above.
@@ -23,7 +24,8 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "markerfiles": "MARKER_SUFFIXES MarkerData read_markers read_c3d write_c3d write_marker_tsv",
     "corpus": "Corpus CorpusInfo load_corpus init_corpus",
     "model_file": "read_model_file",
-    "labelling": "labels_for_audio label_corpus relabelled label_folder",
+    "label_rule": "resolve_labels LabelRequest FoundLabels label_audio",
+    "labelling": "label_corpus relabelled label_folder",
     "export": "write_trajectories",
     "cachedir": "cache_dir",
 })

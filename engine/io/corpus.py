@@ -21,7 +21,7 @@ from ..errors import InputError, warn_file
 from .audio import read_audio
 from .files import atomic_write, check_output_path
 from .hash_memo import folder_key, memoized_hash
-from .labelfiles import held_labels, read_label_file, read_labels, read_textgrid, recorded_provenance
+from .labelfiles import held_labels, label_file_provenance, read_labels, read_textgrid
 from .markerfiles import read_markers
 from .markerformats import NAMES_FILE, check_names, format_for, marker_suffixes, read_names_file
 
@@ -51,8 +51,9 @@ class CorpusInfo:
     label_map : ``""`` (labels are ARPAbet), ``"mocha"`` or a label map file (relative to the
         description) mapping the labels onto ARPAbet when utterances are loaded.
     label_provenance : how label files without a record of their own (any file facetraj did not
-        write) were made: ``hand-checked`` (the default), ``aligned`` or ``recognized``
-        (``facetraj_engine.labels.provenance``).
+        write) were made: ``hand-checked``, ``aligned`` or ``recognized``
+        (``facetraj_engine.labels.provenance``); ``""`` (the default): not said, so an aligner's
+        conventions make them aligned, and anything else hand-checked.
     data_dir : where the utterance files are, relative to the description's folder (``""``: the
         same folder). Lets a description point at a read-only folder of someone else's data.
     dimensions : 3, or 2 for midsagittal data (x = 0 for every marker).
@@ -77,7 +78,7 @@ class CorpusInfo:
         default_factory=lambda: {"x": "right", "y": "up", "z": "forward"})
     label_set: str = "arpabet"
     label_map: str = ""
-    label_provenance: str = "hand-checked"
+    label_provenance: str = ""
     data_dir: str = ""
     dimensions: int = 3
     head_corrected: bool = False
@@ -177,7 +178,8 @@ SCHEMA: dict[str, tuple] = {
              "an object of axis names"),
     "label_set": (_text, "text"),
     "label_map": (_text, "text (\"\", \"mocha\" or a label map file)"),
-    "label_provenance": (lambda v: v in LABEL_KINDS, " or ".join(f'"{k}"' for k in LABEL_KINDS)),
+    "label_provenance": (lambda v: v in ("", *LABEL_KINDS),
+                         " or ".join(f'"{k}"' for k in ("", *LABEL_KINDS))),
     "data_dir": (_text, "text (a folder relative to the description)"),
     "dimensions": (lambda v: v in (2, 3) and not isinstance(v, bool), "2 or 3"),
     "head_corrected": (lambda v: isinstance(v, bool), "true or false"),
@@ -348,7 +350,9 @@ def load_corpus(root: str | os.PathLike[str]) -> Corpus:
 def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
                    label_map: dict[str, str] | None = None) -> Utterance:
     """Load ``<id>`` audio, labels (``phones`` and ``words`` tiers of a TextGrid, or a .lab /
-    .phn file) and markers (any format of :mod:`facetraj_engine.io.markerformats`, its channels named by
+    .phn file, read by the one rule, :func:`facetraj_engine.io.label_rule.resolve_labels`) and
+    markers (any format of
+    :mod:`facetraj_engine.io.markerformats`, its channels named by
     the description's ``channel_names``, resampled to the corpus rate). A marker file that holds
     the speech and its labels (MVIEW) provides them when no audio or label file is beside it.
 
@@ -358,6 +362,7 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
     audio's end.
     """
     from ..labels.phoneset import apply_label_map
+    from .label_rule import LabelRequest, resolve_labels
 
     root = Path(root)
     apath, no_audio = _beside(audio_path, root, utt_id)
@@ -371,8 +376,9 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
             raise no_audio
         audio, rate = mdata.audio, mdata.audio_rate
     if lpath is not None:
-        labels = read_label_file(lpath, rate, len(audio) / rate, info.label_provenance,
-                                 detect_alphabet=not label_map)
+        labels = resolve_labels(apath or mpath, audio, rate, LabelRequest(
+            labels=lpath, declared=info.label_provenance or None,
+            label_map="corpus" if label_map else None), quiet=True).labels
     elif mdata.phones:
         labels = held_labels(mdata.phones, mdata.words, len(audio) / rate, mpath,
                              detect_alphabet=not label_map)
@@ -531,7 +537,7 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
                 lip_corners: list[str] | None = None, label_map: str = "",
                 marker_rate: float = 60.0, test: list[str] | None = None,
                 test_fraction: float | None = None, name: str = "",
-                overwrite: bool = True, label_provenance: str = "hand-checked",
+                overwrite: bool = True, label_provenance: str = "",
                 channel_names: list[str] | None = None, head_corrected: bool = False
                 ) -> tuple[Path, CorpusInfo]:
     """Describe a folder of someone's own recordings as a corpus and write the description.
@@ -585,14 +591,14 @@ def init_corpus(data_dir: str | os.PathLike[str], output: str | os.PathLike[str]
 
 def label_kinds(corpus: Corpus) -> dict[str, int]:
     """How the labels of a corpus were made: utterances per kind (the record of each label file,
-    else the corpus's ``label_provenance``; labels inside marker files are aligned), read from
-    the label files alone."""
+    else the corpus's ``label_provenance``, else its conventions, as the labels are read:
+    :func:`facetraj_engine.io.labelfiles.label_file_provenance`), read from the label files alone
+    (labels inside marker files are aligned)."""
     counts: dict[str, int] = {}
     for utt_id in corpus.info.ids:
         source = label_source(corpus.data_root, utt_id)
         if source.suffix.lower() in (".textgrid", ".lab", ".phn"):
-            found = recorded_provenance(source)
-            kind = found.kind if found else corpus.info.label_provenance
+            kind = label_file_provenance(source, corpus.info.label_provenance or None).kind
         else:
             kind = "aligned"
         counts[kind] = counts.get(kind, 0) + 1

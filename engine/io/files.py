@@ -14,7 +14,7 @@ import signal
 import stat
 import tempfile
 import threading
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, BinaryIO
 
@@ -41,12 +41,22 @@ def write_problem(exc: OSError) -> str:
     return _WRITE_PROBLEMS.get(exc.errno, exc.strerror or type(exc).__name__)
 
 
-def check_output_path(path: str | os.PathLike[str], overwrite: bool = True) -> Path:
-    """Refuse an output path that cannot be written, before any work is done: an existing file
-    without ``overwrite`` (:class:`~facetraj_engine.errors.OutputExistsError`), a folder at the path, a
-    parent that is a regular file, a name too long, a folder we may not write in.
-    Raises :class:`InputError` naming the path; returns it as a :class:`Path`."""
+def check_output_path(path: str | os.PathLike[str], overwrite: bool = True,
+                      formats: Sequence[str] | None = None, probe: bool = False) -> Path:
+    """Refuse an output path that cannot be written, before any work is done: a suffix not among
+    ``formats`` (lower case, with the dot; ``None``: any), an existing file without ``overwrite``
+    (:class:`~facetraj_engine.errors.OutputExistsError`), a folder at the path, a parent that is a
+    regular file, a name too long, a folder we may not write in; with ``probe``, a file is made
+    and removed in the nearest folder that exists, so that a place that takes no new files (a
+    read-only or special file system such as ``/proc``, a full disk) is named for what it is
+    (issue 38), not found out after the work. Raises :class:`InputError` naming the path;
+    returns it as a :class:`Path`."""
     path = Path(path)
+    if formats is not None and path.suffix.lower() not in formats:
+        names = [f for f in formats if f != ".txt"]
+        listed = ", ".join(names[:-1]) + f" or {names[-1]}" if len(names) > 1 else names[0]
+        raise OutputError(path, f"facetraj does not write {path.suffix or 'files without a suffix'}"
+                                f"{' files' if path.suffix else ''} here: give a {listed} name")
     if len(os.fsencode(path.name)) > _NAME_MAX:
         raise OutputError(path, f"the file name is too long ({len(os.fsencode(path.name))} bytes; "
                                f"at most {_NAME_MAX})")
@@ -62,7 +72,31 @@ def check_output_path(path: str | os.PathLike[str], overwrite: bool = True) -> P
         raise OutputError(path, f"cannot be written: {folder} is a file, not a folder")
     if folder.is_dir() and not os.access(folder, os.W_OK | os.X_OK):
         raise OutputError(path, f"cannot be written: no permission to write in {folder}")
+    if probe and folder.is_dir():
+        try:
+            fd, tmp = tempfile.mkstemp(prefix=".facetraj-probe-", dir=folder)
+            os.close(fd)
+            os.unlink(tmp)
+        except OSError as exc:
+            raise OutputError(path, f"cannot be written: {place_problem(folder, exc)}") from exc
     return path
+
+
+def place_problem(folder: Path, exc: OSError) -> str:
+    """Why no file can be made in ``folder``, which exists, in words (the error of making one).
+
+    >>> place_problem(Path("/proc"), FileNotFoundError(errno.ENOENT, "No such file"))
+    '/proc takes no new files (a special file system, such as /proc or /sys)'
+    """
+    if exc.errno in (errno.ENOENT, errno.EEXIST, errno.ENOTDIR) and folder.is_dir():
+        return f"{folder} takes no new files (a special file system, such as /proc or /sys)"
+    if exc.errno in (errno.EACCES, errno.EPERM):
+        return f"no permission to write in {folder}"
+    if exc.errno == errno.EROFS:
+        return f"the file system is read-only ({folder})"
+    if exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        return f"{write_problem(exc)} in {folder}"
+    return f"{write_problem(exc)} ({folder})"
 
 
 def _umask() -> int:
@@ -121,7 +155,9 @@ def atomic_write(path: str | os.PathLike[str], overwrite: bool = True) -> Iterat
                                    dir=path.parent)
         os.close(fd)
     except OSError as exc:
-        raise OutputError(path, f"cannot be written ({write_problem(exc)})") from exc
+        where = path.parent if path.parent.is_dir() else None
+        raise OutputError(path, f"cannot be written: {place_problem(where, exc)}" if where
+                          else f"cannot be written ({write_problem(exc)})") from exc
     tmp_path = Path(tmp)
     try:
         with _TermToExit():

@@ -178,16 +178,18 @@ def read_label_file(path: str | os.PathLike[str], rate: int, duration: float,
                     declared: str | None = None, detect_alphabet: bool = True) -> Labels:
     """The labels of a label file, checked against the audio's ``duration``: its phones, a
     TextGrid's ``words`` tier, and where they came from (the record a TextGrid written by
-    facetraj holds, :func:`facetraj_engine.labels.provenance.labels_from_tiers`; else ``declared``,
-    hand-checked by default). The phones are mapped onto ARPAbet from the alphabet they are in
-    (:func:`facetraj_engine.labels.alphabets.to_arpabet`) unless ``detect_alphabet`` is off (a label map
-    given by the user maps them later)."""
+    facetraj holds, :func:`facetraj_engine.labels.provenance.labels_from_tiers`; else ``declared``;
+    else aligned when the labels follow an aligner's conventions, saying why; else hand-checked).
+    The phones are mapped onto ARPAbet from the alphabet they are in
+    (:func:`facetraj_engine.labels.alphabets.to_arpabet`) unless ``detect_alphabet`` is off (a label
+    map given by the user maps them later)."""
     path = Path(path)
     if path.suffix.lower() != ".textgrid":
-        phones = validate_phones(read_labels(path, rate), duration, path)
+        read = read_labels(path, rate)
+        phones = validate_phones(read, duration, path)
         if detect_alphabet:
             phones = to_arpabet(phones, str(path))
-        return labels_from_tiers(phones, [], {}, declared)
+        return labels_from_tiers(phones, [], {}, declared, [s.label for s in read])
     tiers = read_textgrid_tiers(path)                     # read once: phones, words, record
     if "phones" not in tiers:
         raise InputError(path, f"no interval tier named 'phones' (tiers: {sorted(tiers)})")
@@ -198,7 +200,24 @@ def read_label_file(path: str | os.PathLike[str], rate: int, duration: float,
     if detect_alphabet:
         phones = to_arpabet(phones, str(path))
     words = [w for w in tiers.get("words", []) if w.label]
-    return labels_from_tiers(phones, words, tiers, declared)
+    return labels_from_tiers(phones, words, tiers, declared, [s.label for s in tiers["phones"]])
+
+
+def label_file_provenance(path: str | os.PathLike[str], declared: str | None = None) -> Provenance:
+    """How a label file's labels were made, as :func:`read_label_file` tells it (the record a
+    TextGrid facetraj wrote holds; else ``declared``; else an aligner's conventions; else
+    hand-checked), from the file alone; a missing or unreadable file counts as ``declared`` or
+    hand-checked (reading it for synthesis says why)."""
+    path = Path(path)
+    try:
+        if path.suffix.lower() == ".textgrid":
+            tiers = read_textgrid_tiers(path)
+            raw = [s.label for s in tiers.get("phones", [])]
+        else:
+            tiers, raw = {}, [s.label for s in read_labels(path)]
+    except InputError:
+        return Provenance(declared or "hand-checked")
+    return labels_from_tiers([], [], tiers, declared, raw).provenance
 
 
 def held_labels(phones: Sequence[PhoneSegment], words: Sequence[PhoneSegment], duration: float,

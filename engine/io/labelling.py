@@ -1,19 +1,13 @@
-"""Which phone labels an input gets, and automatic labels for whole corpora (cached).
+"""Automatic labels for whole corpora (cached) and folders.
 
-- :func:`labels_for_audio` is THE rule for where the labels of an audio file come from, used by
-  the command line and the app: a label file given, else a sentence given (aligned), else
-  recognition asked for, else a label file beside the audio (same stem), else a ``.txt``
-  transcript beside it (aligned), else none -- and then :func:`facetraj_engine.method.modes.choose_mode`
-  switches
-  to acoustic-only synthesis.
-- :func:`label_audio` labels one recording by ``"aligned"`` (from its text) or ``"recognized"``,
-  through a cache outside the repository (``facetraj_engine.io.cachedir``), keyed by the audio's content, the
-  method, the text, extra pronunciations and the PocketSphinx version.
 - :func:`label_corpus` labels every utterance of a :class:`~facetraj_engine.io.corpus.Corpus`;
   :func:`relabelled` gives a corpus whose utterances carry those labels, which
   :func:`facetraj_engine.method.training.train` and :func:`facetraj_engine.evaluation.scores.evaluate` take as
-  they are (the
-  paper trained and tested on aligner labels, section 3).
+  they are (the paper trained and tested on aligner labels, section 3).
+- :func:`label_folder` writes a TextGrid beside every recording of a folder.
+
+One recording's labels, and THE rule for where they come from, are
+:mod:`facetraj_engine.io.label_rule`'s.
 """
 
 from __future__ import annotations
@@ -26,182 +20,15 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-import numpy as np
-
 from ..data import Utterance
 from ..errors import InputError
 from ..fanout import Skips, fan_out
-from ..labels.alignment import align, pocketsphinx_version, recognize
 from ..labels.provenance import Labels
 from ..progress import Progress
-from .cachedir import cache_dir
 from .corpus import Corpus
-from .files import atomic_write
-from .labelfiles import LABEL_SUFFIXES, held_labels, read_label_file
+from .label_rule import METHODS, label_audio, made_from, read_transcript
 
 log = logging.getLogger(__name__)
-
-#: Automatic labelling methods (the :attr:`Labels.source` they produce).
-METHODS = ("aligned", "recognized")
-#: Bumped when this module's output for the same input changes (part of the cache key).
-LABELLER_VERSION = 2     # 2: the all-phone search's lw 4 (issue 25)
-
-
-# --------------------------------------------------------------------------- one recording
-def label_cache_key(audio: np.ndarray, rate: int, method: str, text: str = "",
-                    extra_dict: Mapping[str, Sequence[str]] | None = None) -> str:
-    """A hash of the audio samples (as 16-bit PCM), the rate, the method, the text, extra
-    pronunciations, the PocketSphinx version and :data:`LABELLER_VERSION`."""
-    h = hashlib.sha256()
-    h.update((np.clip(np.asarray(audio, float), -1, 1) * 32767).astype("<i2").tobytes())
-    meta = {"rate": int(rate), "method": method, "text": text if method == "aligned" else "",
-            "dict": {k: list(v) for k, v in sorted((extra_dict or {}).items())},
-            "pocketsphinx": pocketsphinx_version(), "labeller": LABELLER_VERSION}
-    h.update(json.dumps(meta, sort_keys=True).encode())
-    return h.hexdigest()[:24]
-
-
-def label_cache_path(key: str) -> Path:
-    """The cache file of a label key."""
-    return cache_dir() / "labels" / f"labels-{key}.json"
-
-
-def label_audio(audio: np.ndarray, rate: int, method: str, text: str = "",
-                extra_dict: Mapping[str, Sequence[str]] | None = None,
-                source: str | os.PathLike[str] | None = None, use_cache: bool = True) -> Labels:
-    """Labels of one recording by ``method`` (``"aligned"`` needs ``text``), from the cache when
-    the same audio was labelled the same way before. Errors are not cached."""
-    if method not in METHODS:
-        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-    path = label_cache_path(label_cache_key(audio, rate, method, text, extra_dict)) \
-        if use_cache else None
-    if path is not None and path.exists():
-        try:
-            return Labels.from_json(json.loads(path.read_text(encoding="utf-8")))
-        except (ValueError, KeyError, TypeError) as exc:
-            log.warning("ignoring unreadable cached labels %s: %s", path, exc)
-    if method == "aligned":
-        labels = align(audio, rate, text, extra_dict, source)
-    else:
-        labels = recognize(audio, rate, source)
-    if path is not None:
-        try:
-            with atomic_write(path) as tmp:
-                tmp.write_text(json.dumps(labels.to_json()), encoding="utf-8")
-        except OSError as exc:
-            log.warning("could not cache labels in %s: %s", path, exc)
-    return labels
-
-
-# --------------------------------------------------------------------------- the label source rule
-def beside(audio_path: str | os.PathLike[str]) -> tuple[Path | None, Path | None]:
-    """The label file (``.TextGrid``, ``.lab``, ``.phn``) and the ``.txt`` transcript beside an
-    audio file (same stem), each ``None`` when absent."""
-    audio_path = Path(audio_path)
-    label = next((p for suf in LABEL_SUFFIXES for p in audio_path.parent.glob(f"{audio_path.stem}.*")
-                  if p.suffix.lower() == suf and p.is_file()), None)
-    txt = audio_path.with_suffix(".txt")
-    return label, (txt if txt.is_file() else None)
-
-
-def read_transcript(path: str | os.PathLike[str]) -> str:
-    """The sentence of a ``.txt`` transcript (UTF-8)."""
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(path, "no such transcript file")
-    try:
-        return path.read_text(encoding="utf-8-sig").strip()
-    except UnicodeDecodeError:
-        raise InputError(path, "the transcript is not UTF-8 text") from None
-
-
-def labels_for_audio(audio_path: str | os.PathLike[str], audio: np.ndarray, rate: int, *,
-                     labels: str | os.PathLike[str] | None = None, text: str | None = None,
-                     transcript: str | os.PathLike[str] | None = None, recognize: bool = False,
-                     extra_dict: Mapping[str, Sequence[str]] | None = None,
-                     use_cache: bool = True, declared: str | None = None,
-                     fallback: bool = False, detect_alphabet: bool = True) -> Labels | None:
-    """The phone labels of ``audio`` by THE rule (first that applies):
-
-    1. ``labels`` (a label file) -> ``source="file"``;
-    2. ``text``, or the sentence of ``transcript`` -> aligned;
-    3. ``recognize`` -> recognized;
-    4. a label file beside the audio (same stem) -> file; else the labels the audio's own file
-       holds (an MVIEW file's PHONES) -> aligned;
-    5. a ``.txt`` beside the audio -> aligned;
-    6. otherwise, with ``fallback``, recognized (synthesis: on every voice measured the robust mode
-       with recognized labels beats acoustic-only, and only labels can close the lips), when
-       recognition fails or without ``fallback`` ``None``: :func:`facetraj_engine.method.modes.choose_mode`
-       then synthesizes acoustic-only.
-
-    A label file's provenance is the record it holds (a TextGrid facetraj wrote), else
-    ``declared`` (``--label-provenance``), else hand-checked.
-
-    The choice is logged. Errors of alignment (missing words, text that does not fit) propagate.
-    A label file's alphabet is recognised and mapped onto ARPAbet unless ``detect_alphabet`` is
-    off (:func:`facetraj_engine.io.labelfiles.read_label_file`).
-    """
-    duration = len(audio) / float(rate)
-    if labels is not None:
-        log.info("phone labels from %s", labels)
-        return read_label_file(labels, rate, duration, declared, detect_alphabet)
-    if text is None and transcript is not None:
-        text = read_transcript(transcript)
-    if text is not None:
-        log.info("phone labels aligned from the sentence %r", text)
-        return _made_from(label_audio(audio, rate, "aligned", text, extra_dict,
-                                      transcript or audio_path, use_cache),
-                          Path(transcript).name if transcript else "the sentence given")
-    if recognize:
-        log.info("phone labels by phone recognition (no text)")
-        return _made_from(label_audio(audio, rate, "recognized", source=audio_path,
-                                      use_cache=use_cache), Path(audio_path).name)
-    label_file, txt = beside(audio_path)
-    if label_file is not None:
-        log.info("phone labels from %s (beside the audio)", label_file)
-        return read_label_file(label_file, rate, duration, declared, detect_alphabet)
-    held = _held_by(audio_path)
-    if held is not None:
-        log.info("phone labels from %s's PHONES (aligned)", Path(audio_path).name)
-        return held_labels(held.phones, held.words, duration, audio_path, detect_alphabet)
-    if txt is not None:
-        sentence = read_transcript(txt)
-        log.info("phone labels aligned from %s: %r", txt.name, sentence)
-        return _made_from(label_audio(audio, rate, "aligned", sentence, extra_dict, txt, use_cache),
-                          txt.name)
-    if fallback:
-        log.info("no labels, no sentence and no .txt beside %s: phone recognition", audio_path)
-        try:
-            return _made_from(label_audio(audio, rate, "recognized", source=audio_path,
-                                          use_cache=use_cache), Path(audio_path).name)
-        except InputError as exc:
-            log.warning("%s; acoustic-only synthesis", exc)
-            return None
-    log.info("no labels, no sentence and no .txt beside %s", audio_path)
-    return None
-
-
-def _held_by(audio_path: str | os.PathLike[str]):
-    """The recording of a marker file that holds the speech and its phones (MVIEW), else ``None``."""
-    from .audio import AUDIO_SUFFIXES
-    from .markerformats import format_for, read_recording
-
-    path = Path(audio_path)
-    if path.suffix.lower() in AUDIO_SUFFIXES or not path.is_file():
-        return None
-    try:
-        if not format_for(path).carries_labels:
-            return None
-    except InputError:
-        return None
-    rec = read_recording(path)
-    return rec if rec.phones else None
-
-
-def _made_from(labels: Labels, origin: str) -> Labels:
-    """``labels`` with what they were made from in their provenance."""
-    labels.provenance = replace(labels.provenance, origin=origin)
-    return labels
 
 
 # --------------------------------------------------------------------------- corpora
@@ -394,7 +221,7 @@ def _label_file(apath: Path, method: str, extra_dict: Mapping[str, Sequence[str]
             if method == "aligned" and apath.with_suffix(".txt").is_file() else ""
         labels, error = label_utterance(Utterance(apath.stem, audio, rate, text=text), method,
                                         extra_dict, use_cache)
-        labels = _made_from(labels, apath.with_suffix(".txt").name if labels.source == "aligned"
+        labels = made_from(labels, apath.with_suffix(".txt").name if labels.source == "aligned"
                             else apath.name)
         write_labels(apath.with_suffix(".TextGrid"), labels, len(audio) / rate, overwrite)
     except InputError:

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import InputError, warn_file
 from .c3d_layout import MAX_POINTS as MAX_C3D_POINTS
-from .c3d_layout import c3d_bytes
+from .c3d_layout import C3dExtras, c3d_bytes
 from .files import atomic_write, write_bytes
 from .markerformats import MarkerRecording, apply_names, marker_suffixes, read_recording
 from .markerformats.c3d import read_c3d
@@ -35,13 +35,15 @@ C3D_INT_SCALE = 0.01  # mm per integer step in integer C3D files
 
 
 def write_c3d(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
-              names: Sequence[str], overwrite: bool = True, integer: bool | None = None) -> None:
+              names: Sequence[str], overwrite: bool = True, integer: bool | None = None,
+              extras: C3dExtras | None = None) -> None:
     """Write ``(frames, markers, 3)`` mm trajectories as C3D; NaN points are written as unseen.
 
     By default the compact integer form (int16, 0.01 mm steps, half the size of the float form) is
     used when every coordinate fits in +-327 mm, else the float form. The bytes are those the
-    ``c3d`` package writes (:mod:`.c3d_layout`). Read back with :func:`read_c3d` (ezc3d), which
-    reads both.
+    ``c3d`` package writes (:mod:`.c3d_layout`), and with ``extras`` the screen axes and an analog
+    channel beside (:class:`~.c3d_layout.C3dExtras`). Read back with :func:`read_c3d` (ezc3d),
+    which reads both.
     """
     markers = np.asarray(markers, dtype=np.float64)
     if markers.ndim != 3 or markers.shape[2] != 3 or markers.shape[1] != len(names):
@@ -62,7 +64,7 @@ def write_c3d(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
         raw[..., :3] = np.where(finite[..., None], markers / (C3D_INT_SCALE if integer else 1.0),
                                 0.0)
     raw[..., 3] = np.where(finite, 0, -1)     # residual 0 and no camera bits; -1: unseen
-    data = c3d_bytes(raw, float(rate), scale, list(names))
+    data = c3d_bytes(raw, float(rate), scale, list(names), extras=extras)
     with atomic_write(path, overwrite) as tmp:
         write_bytes(tmp, data)
 

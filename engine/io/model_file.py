@@ -304,7 +304,7 @@ def _checked_array(path: Path, name: str, arr: np.ndarray, kind: str,
         if arr.dtype.kind == "u" and arr.size and arr.max() > np.iinfo(np.int64).max:
             raise ModelFileError(path, f"array {name!r} holds indices outside 0..2^63")
         return arr.astype(np.int64, copy=False)        # the file's own copy: no second one
-    with np.errstate(over="ignore"):
+    with np.errstate(over="ignore", invalid="ignore"):       # inf - inf: NaN, no warning
         out = arr.astype(np.float64, copy=False)
         finite = np.isfinite(out.sum())    # NaN and inf reach the sum: one pass, nothing made
     if not finite and not np.all(np.isfinite(out)):   # (a sum that overflows: each value)

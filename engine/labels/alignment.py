@@ -31,6 +31,8 @@ import numpy as np
 
 from ..data import PhoneSegment, Provenance
 from ..errors import FacetrajError, InputError
+from ..level import peak
+from ..progress import Progress
 from .phoneset import ARPABET, SILENCE
 from .provenance import Labels
 
@@ -137,9 +139,31 @@ def _pcm16k(audio: np.ndarray, rate: int, source: str | os.PathLike[str] | None)
     if rate != ALIGN_RATE:
         g = gcd(int(rate), ALIGN_RATE)
         audio = resample_poly(audio, ALIGN_RATE // g, int(rate) // g)
-    if not np.any(np.abs(audio) * 32767 >= 1.0):
+    pcm = pcm16(audio)
+    if not pcm.any():
         raise UnalignableError(source, "the audio is silent: there is no speech to label")
-    return (np.clip(audio, -1.0, 1.0) * 32767).astype("<i2").tobytes()
+    return pcm.tobytes()
+
+
+#: The peak, as a share of full scale, of the 16-bit samples PocketSphinx is given.
+PCM_PEAK = 0.9
+
+
+def pcm16(audio: np.ndarray) -> np.ndarray:
+    """``audio`` as 16-bit samples whose peak is :data:`PCM_PEAK` of full scale, whatever the
+    recording's gain (issue 38): PocketSphinx's labels move with the level (measured on CMU
+    ARCTIC: 2 boundaries at 1.2 times the gain, 7 at 0.05 times), and samples beyond full scale
+    would be clipped. The same recording at any gain gives the same samples (but where rounding
+    puts a sample on the other side of a step: about one in 10^11).
+
+    >>> pcm16(np.array([0.0, 0.5, -0.25])).tolist(), pcm16(np.array([0.0, 5e199, -2.5e199])).tolist()
+    ([0, 29490, -14745], [0, 29490, -14745])
+    """
+    audio = np.asarray(audio, dtype=np.float64)
+    top = peak(audio)
+    if not 0.0 < top < np.inf:
+        return np.zeros(len(audio), dtype="<i2")
+    return np.rint(audio * (PCM_PEAK * 32767 / top)).astype("<i2")
 
 
 def _decoder(**settings):
@@ -218,24 +242,52 @@ def _segments(entries: Iterable[tuple[str, int, int, float]], duration: float
     return phones, per_frame
 
 
-def _phone_alignment(decoder, pcm: bytes, text: str):
+class Passes:
+    """The decoding passes of one labelling, for its progress line: each pass (a PocketSphinx
+    decode of the whole audio, which cannot report its own progress without changing its result:
+    its cepstral mean is the whole utterance's) is announced as it starts, ``done`` of ``total``.
+
+    >>> seen = []
+    >>> steps = Passes(lambda f, m: seen.append((round(f, 2), m)), 2, "aligning a.wav")
+    >>> steps.next("words"); steps.next("phones"); steps.end(); seen
+    [(0.0, 'aligning a.wav 1/2: words'), (0.5, 'aligning a.wav 2/2: phones'), (1.0, 'aligning a.wav: done')]
+    """
+
+    def __init__(self, progress: Progress | None, total: int, what: str):
+        self.progress, self.total, self.what, self.done = progress, total, what, 0
+
+    def next(self, message: str) -> None:
+        if self.progress is not None:
+            self.progress(self.done / self.total,
+                          f"{self.what} {self.done + 1}/{self.total}: {message}")
+        self.done += 1
+
+    def end(self) -> None:
+        if self.progress is not None:
+            self.progress(1.0, f"{self.what}: done")
+
+
+def _phone_alignment(decoder, pcm: bytes, text: str, steps: Passes | None = None):
     """The two-pass alignment of ``text`` (already in the decoder's dictionary); None on failure."""
+    steps = steps or Passes(None, 2, "")
     try:
         decoder.set_align_text(text)
+        steps.next("alignment")
         _decode(decoder, pcm)
         if decoder.hyp() is None:
             return None
         decoder.set_alignment()
+        steps.next("phone boundaries")
         _decode(decoder, pcm)
     except RuntimeError:
         return None
     return decoder.get_alignment()
 
 
-def _free_loop_score(pcm: bytes) -> float:
+def _free_loop_score(pcm: bytes, steps: Passes | None = None) -> float:
     """Mean per-frame score of the phone sequence the free phone loop finds, re-aligned (the
     best any sentence could do on this audio, near enough)."""
-    phones, scores, _ = _recognize_segments(pcm)
+    phones, scores, _ = _recognize_segments(pcm, steps)
     ok = np.isfinite(scores)
     if not ok.any():
         return np.nan
@@ -245,8 +297,9 @@ def _free_loop_score(pcm: bytes) -> float:
 
 def align(audio: np.ndarray, rate: int, text: str, extra_dict: Mapping[str, Sequence[str]] |
           None = None, source: str | os.PathLike[str] | None = None,
-          check_fit: bool = True) -> Labels:
-    """Forced alignment of ``text`` to ``audio`` (any rate; resampled to 16 kHz): phones and words.
+          check_fit: bool = True, progress: Progress | None = None) -> Labels:
+    """Forced alignment of ``text`` to ``audio`` (any rate; resampled to 16 kHz): phones and words
+    (``progress``: told as each decoding pass starts, :class:`Passes`).
 
     ``extra_dict`` adds pronunciations (word -> ARPAbet phones), e.g. from
     :func:`read_dictionary`. ``source`` names the input in error messages. With ``check_fit``,
@@ -274,7 +327,8 @@ def align(audio: np.ndarray, rate: int, text: str, extra_dict: Mapping[str, Sequ
         raise UnalignableError(source, f"the text ({n_phones} phones) is too long for "
                                        f"{duration:.2f} s of audio")
     sentence = " ".join(words)
-    alignment = _phone_alignment(decoder, pcm, sentence)
+    steps = Passes(progress, 5 if check_fit else 2, f"aligning {Path(source).name if source else 'the text'}")
+    alignment = _phone_alignment(decoder, pcm, sentence, steps)
     if alignment is None:
         raise UnalignableError(source, f"the text {sentence!r} does not match the audio: no "
                                        "alignment found (wrong sentence, silence or noise?)")
@@ -289,7 +343,7 @@ def align(audio: np.ndarray, rate: int, text: str, extra_dict: Mapping[str, Sequ
                     Provenance("aligned", f"PocketSphinx {pocketsphinx_version()}"))
     if check_fit:
         fit = _mean_score(labels)
-        free = _free_loop_score(pcm)
+        free = _free_loop_score(pcm, steps)
         log.debug("alignment fit %.1f per frame, free phone loop %.1f", fit, free)
         if np.isfinite(free) and free - fit > UNALIGNABLE_MARGIN:
             raise UnalignableError(source, f"the text {sentence!r} does not match the audio (it "
@@ -297,6 +351,7 @@ def align(audio: np.ndarray, rate: int, text: str, extra_dict: Mapping[str, Sequ
                                            "free phone recognition): wrong sentence or noise?")
     log.info("aligned %d words, %d phones to %.2f s of audio", len(word_segs),
              sum(p.label != SILENCE for p in phones), duration)
+    steps.end()
     return labels
 
 
@@ -314,9 +369,12 @@ def allphone_decoder():
     return _decoder(allphone=lm, **ALLPHONE_SETTINGS)
 
 
-def _recognize_segments(pcm: bytes) -> tuple[list[PhoneSegment], np.ndarray, int]:
+def _recognize_segments(pcm: bytes, steps: Passes | None = None
+                        ) -> tuple[list[PhoneSegment], np.ndarray, int]:
     """All-phone search, then the phones found re-aligned as a phone sequence (scores)."""
+    steps = steps or Passes(None, 3, "")
     dec = allphone_decoder()
+    steps.next("phone loop")
     _decode(dec, pcm)
     n_frames = dec.n_frames()
     found = [(s.word, s.start_frame, s.end_frame - s.start_frame + 1) for s in dec.seg()]
@@ -329,7 +387,7 @@ def _recognize_segments(pcm: bytes) -> tuple[list[PhoneSegment], np.ndarray, int
     aligner = _decoder(bestpath=False)
     for ph in set(speech):
         aligner.add_word(f"_{ph}_", ph.upper(), False)
-    alignment = _phone_alignment(aligner, pcm, " ".join(f"_{p}_" for p in speech))
+    alignment = _phone_alignment(aligner, pcm, " ".join(f"_{p}_" for p in speech), steps)
     if alignment is None:
         log.debug("recognized phones could not be re-aligned: boundaries of the phone loop kept")
         return phones, np.full(len(phones), np.nan), n_frames
@@ -338,9 +396,10 @@ def _recognize_segments(pcm: bytes) -> tuple[list[PhoneSegment], np.ndarray, int
     return aligned, scores, n_frames
 
 
-def recognize(audio: np.ndarray, rate: int, source: str | os.PathLike[str] | None = None
-              ) -> Labels:
-    """Phone recognition without text (any rate; resampled to 16 kHz): the phones tier.
+def recognize(audio: np.ndarray, rate: int, source: str | os.PathLike[str] | None = None,
+              progress: Progress | None = None) -> Labels:
+    """Phone recognition without text (any rate; resampled to 16 kHz): the phones tier
+    (``progress``: told as each decoding pass starts, :class:`Passes`).
 
     The all-phone search of PocketSphinx (phone loop with a phone trigram model) finds the phone
     sequence; it is then re-aligned to the audio as a phone sequence, which gives boundaries and
@@ -348,7 +407,9 @@ def recognize(audio: np.ndarray, rate: int, source: str | os.PathLike[str] | Non
     short and :class:`UnalignableError` for silent audio.
     """
     pcm = _pcm16k(audio, rate, source)
-    phones, scores, _ = _recognize_segments(pcm)
+    steps = Passes(progress, 3, f"recognizing {Path(source).name if source else 'the phones'}")
+    phones, scores, _ = _recognize_segments(pcm, steps)
+    steps.end()
     duration = len(audio) / float(rate)
     if phones and abs(phones[-1].end - duration) > 1e-9:
         phones[-1] = PhoneSegment(phones[-1].start, max(duration, phones[-1].start + 1e-3),

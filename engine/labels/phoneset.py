@@ -62,13 +62,16 @@ def apply_label_map(label: str, table: Mapping[str, str] | None = None) -> str:
 
 def map_labels(phones: Sequence[PhoneSegment], known: Sequence[str],
                table: Mapping[str, str] | None = None, path: str | None = None,
-               strict: bool = False, unknown_as: str | None = None) -> list[PhoneSegment]:
+               strict: bool = False, unknown_as: str | None = None,
+               warn_unknown: bool = True) -> list[PhoneSegment]:
     """Normalise labels and map those the model does not know.
 
     ``table`` (a user's label map, e.g. MOCHA -> ARPAbet) is applied first, then
     :data:`FALLBACK`. A label still unknown raises :class:`InputError` listing the known phones,
-    or with ``unknown_as`` becomes that label (a warning per label: labels from a recognizer
-    may hold a phone the training labels never had). With ``strict`` a fallback is an error too.
+    or, when it is an ARPAbet phone, with ``unknown_as`` becomes that label (the model never saw
+    it; a warning per label unless ``warn_unknown`` is off,
+    the caller saying it once: labels from a recognizer, or a small model, may meet a phone the
+    training labels never had). With ``strict`` a fallback is an error too.
     Each fallback is logged as a warning.
 
     >>> [s.label for s in map_labels([PhoneSegment(0, 1, "zh"), PhoneSegment(1, 2, "AA1")],
@@ -80,10 +83,12 @@ def map_labels(phones: Sequence[PhoneSegment], known: Sequence[str],
     for seg in phones:
         raw = seg.label
         lab = apply_label_map(raw, table)
-        if lab not in known_set and unknown_as is not None and FALLBACK.get(lab) not in known_set:
-            warn_file(log, path or "labels", "phones not in the model, synthesized as unlabelled",
-                      f"phone {lab!r} is not in the model; its frames are synthesized as "
-                      f"unlabelled")
+        if lab not in known_set and unknown_as is not None and FALLBACK.get(lab) not in known_set \
+                and lab in ARPABET:
+            if warn_unknown:
+                warn_file(log, path or "labels", "phones not in the model, synthesized as unlabelled",
+                          f"phone {lab!r} is not in the model; its frames are synthesized as "
+                          f"unlabelled")
             lab = unknown_as
         if lab not in known_set:
             alt = FALLBACK.get(lab)

@@ -145,7 +145,7 @@ def parse_provenance(text: str) -> Provenance | None:
     source: the file then counts as hand-checked).
 
     >>> parse_provenance("source=aligned; tool=PocketSphinx 5.1.1; from=a.txt")
-    Provenance(kind='aligned', tool='PocketSphinx 5.1.1', origin='a.txt', corrected=0)
+    Provenance(kind='aligned', tool='PocketSphinx 5.1.1', origin='a.txt', corrected=0, why='')
     >>> parse_provenance("made by hand") is None
     True
     """
@@ -204,12 +204,52 @@ def phone_confidence(phones: Sequence[PhoneSegment], recorded: Sequence[PhoneSeg
     return conf, kept
 
 
+#: ARPAbet's vowels: the phones an aligner's dictionary marks with stress digits (0, 1, 2)
+ARPABET_VOWELS = frozenset("aa ae ah ao aw ay eh er ey ih iy ow oy uh uw".split())
+#: the labels aligners give silence and what they could not align: empty intervals (the
+#: Montreal Forced Aligner), ``sil``/``sp`` (HTK-style aligners, PocketSphinx), ``spn`` (spoken
+#: noise: MFA's unknown words)
+ALIGNER_SILENCES = frozenset({"", "sil", "sp", "spn"})
+
+
+def aligner_conventions(labels: Sequence[str]) -> str | None:
+    """Why the raw phone labels of a file that records no provenance look like an automatic
+    aligner's, or ``None``: ARPAbet vowels with stress digits (``AH0``, ``IY1``: a pronouncing
+    dictionary's, which a person labelling by ear does not write) on at least half the vowels,
+    with the aligners' silences (empty, ``sil``, ``sp``, ``spn``). Upper-case phones with empty
+    silences are the Montreal Forced Aligner's own conventions.
+
+    >>> print(aligner_conventions(["", "DH", "AH0", "B", "OY1", "spn", ""]))  # doctest: +NORMALIZE_WHITESPACE
+    the Montreal Forced Aligner's conventions: upper-case phones with stress digits (2 of 2
+    vowels), empty silences, 'spn'
+    >>> aligner_conventions(["sil", "dh", "ah0", "b", "oy1", "sp"])
+    "an aligner's conventions: phones with stress digits (2 of 2 vowels), 'sil', 'sp'"
+    >>> aligner_conventions(["sil", "dh", "ah", "b", "oy", "sil"]) is None      # by ear
+    True
+    """
+    raw = [str(x).strip() for x in labels]
+    vowels = [x for x in raw if x.lower().rstrip("012") in ARPABET_VOWELS]
+    stressed = [x for x in vowels if x[-1:] in ("0", "1", "2")]
+    silences = sorted({x.lower() for x in raw} & ALIGNER_SILENCES)
+    if not stressed or 2 * len(stressed) < len(vowels) or not silences:
+        return None
+    upper = all(x == x.upper() for x in raw if x.lower() not in ALIGNER_SILENCES)
+    marks = [("empty silences" if s == "" else repr(s)) for s in silences]
+    mfa = upper and "" in silences
+    who = "the Montreal Forced Aligner's" if mfa else "an aligner's"
+    case = "upper-case phones" if upper else "phones"
+    return (f"{who} conventions: {case} with stress digits ({len(stressed)} of {len(vowels)} "
+            f"vowels), {', '.join(marks)}")
+
+
 def labels_from_tiers(phones: Sequence[PhoneSegment], words: Sequence[PhoneSegment],
-                      tiers: Mapping[str, Sequence[PhoneSegment]], declared: str | None = None
-                      ) -> Labels:
+                      tiers: Mapping[str, Sequence[PhoneSegment]], declared: str | None = None,
+                      raw: Sequence[str] | None = None) -> Labels:
     """The :class:`Labels` of a label file: its ``phones`` and ``words``, and the record in its
     ``tiers`` when it has one; otherwise its provenance is ``declared`` (what the user says of
-    files from elsewhere), hand-checked by default.
+    files from elsewhere), else ``aligned`` when its ``raw`` labels (as written in the file, empty
+    ones too) follow an aligner's conventions (:func:`aligner_conventions`, saying why), else
+    hand-checked.
 
     >>> phones = [PhoneSegment(0, .1, "sil"), PhoneSegment(.1, .2, "b")]
     >>> rec = {"provenance": [PhoneSegment(0, .2, "source=recognized; tool=PocketSphinx 5.1.1")],
@@ -223,8 +263,9 @@ def labels_from_tiers(phones: Sequence[PhoneSegment], words: Sequence[PhoneSegme
     recorded = tiers.get(PROVENANCE_TIER)
     found = parse_provenance(recorded[0].label) if recorded else None
     if found is None:
-        kind = declared or "hand-checked"
-        return Labels(list(phones), list(words), "file", provenance=Provenance(kind))
+        why = aligner_conventions(raw) if raw is not None and not declared else None
+        provenance = Provenance("aligned", why=why) if why else Provenance(declared or "hand-checked")
+        return Labels(list(phones), list(words), "file", provenance=provenance)
     conf, kept = phone_confidence(phones, tiers.get(CONFIDENCE_TIER, []))
     provenance = Provenance(found.kind, found.tool, found.origin, int((~kept).sum()))
     with np.errstate(divide="ignore"):

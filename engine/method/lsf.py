@@ -9,6 +9,7 @@ from itertools import pairwise
 
 import numpy as np
 
+from ..level import unit_exponent
 from ..threads import map_spans
 
 #: white-noise correction added to r[0] (a -40 dB noise floor) so that LPC of near-silent or
@@ -482,10 +483,10 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     (1, 10)
     """
     x = np.asarray(audio, dtype=np.float64)
-    peak = max(float(x.max()), -float(x.min())) if x.size else 0.0     # max |x|, no copy
-    # to a peak in [0.5, 1) by a power of 2: exact, and LPC is scale-free, so huge samples cannot
-    # overflow to inf; up after the pre-emphasis (padded_signal), down or to resample before
-    exponent = -int(np.frexp(peak)[1]) if 0 < peak < np.inf else 0
+    # to a peak in [0.5, 1) by a power of 2 (facetraj_engine.level): exact, and LPC is scale-free,
+    # so huge samples cannot overflow to inf; up after the pre-emphasis (padded_signal), down or
+    # to resample before
+    exponent = unit_exponent(x)
     if exponent < 0 or (exponent and rate != audio_rate):
         x, exponent = np.ldexp(x, exponent), 0
     x = resample_audio(x, rate, audio_rate)

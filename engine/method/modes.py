@@ -79,7 +79,8 @@ class Mode:
 
 class Phonetic(Mode):
     """The paper's mode (eq 4): the labels pick each phone's N context-phones, eqs 5-8 weigh their
-    5N codewords."""
+    5N codewords; the frames of a phone the model has never seen are filled by the acoustic-only
+    search (issue 38: a small model no longer refuses a whole file for one phone)."""
 
     name = "phonetic"
     title = "phonetic (the paper)"
@@ -91,10 +92,22 @@ class Phonetic(Mode):
                        "(eq 4); best with hand-checked labels."),)
 
     def search(self, job: SearchInput) -> SearchResult:
-        from .search import SearchResult, eq4, weighted
+        from .search import SearchResult, acoustic_candidates, eq4, weighted
+        from .synthesis import FrameWeights
 
-        segments, frame_seg, candidates = eq4(job.model, job.segs, job.times, job.config)
-        fw = weighted(job.model, job.w, lambda a, b: candidates[a:b], job.config)
+        model, config = job.model, job.config
+        segments, frame_seg, candidates = eq4(model, job.segs, job.times, config)
+        unseen = job.unlabelled[frame_seg] if job.unlabelled is not None else None
+        if unseen is None or not unseen.any():
+            return SearchResult(weighted(model, job.w, lambda a, b: candidates[a:b], config),
+                                segments, frame_seg)
+        # a phone the model has never seen: its frames filled by the acoustic-only search
+        seen_w, unseen_w, kept = job.w[~unseen], job.w[unseen], candidates[~unseen]
+        fw = FrameWeights.merged(
+            unseen,
+            weighted(model, unseen_w, lambda a, b: acoustic_candidates(model, unseen_w[a:b], config),
+                     config),
+            weighted(model, seen_w, lambda a, b: kept[a:b], config))
         return SearchResult(fw, segments, frame_seg)
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import functools
 import json
 import logging
+from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -18,7 +19,7 @@ import numpy as np
 
 from ..config import SynthConfig
 from ..data import PhoneSegment, Provenance
-from ..errors import InputError
+from ..errors import InputError, warn_file
 from ..io.labelfiles import validate_phones
 from ..labels.phoneset import SILENCE, map_labels, normalise_label
 from ..threads import frame_threads
@@ -53,7 +54,8 @@ class Synthesis:
     warp : the speaker warp factor applied to the input LSFs (``config.speaker_warp``).
     closure : where the closure step acted (:mod:`facetraj_engine.method.closure`), ``None`` when off.
     voice_match : the input's voice match (:func:`input_voice_match`) when the synthesis needed
-        it (the robust mode, recognized labels), else NaN.
+        it (the robust mode, recognized labels), else NaN; ``voice_ratio`` the distance ratio
+        ``D / D0`` it is made from.
     """
 
     times: np.ndarray
@@ -68,6 +70,7 @@ class Synthesis:
     warp: float = 1.0
     closure: ClosurePlan | None = None
     voice_match: float = float("nan")
+    voice_ratio: float = float("nan")
 
     def arrays(self) -> dict[str, np.ndarray]:
         """What an ``.npz`` output keeps of the synthesis beside its markers
@@ -137,7 +140,7 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         if not phones:
             raise InputError(source, f"{config.mode} mode needs phone labels (or use acoustic mode)")
         job.segs, job.unlabelled = _model_phones(model, phones, len(audio) / sample_rate,
-                                                 label_map, source, mode.weighs_labels)
+                                                 label_map, source, times)
         if mode.weighs_labels:
             job.confidence = frame_confidence(list(phones), confidence, times)
     found = mode.search(job)
@@ -145,7 +148,7 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                         voice_match(ratio, 1.0), config, energy.filtered if config.closure else None)
     res = _finish(model, times, w, found.frames, config, found.segments, found.frame_segment,
                   warp, plan)
-    res.voice_match = voice_match(ratio, 1.0)
+    res.voice_match, res.voice_ratio = voice_match(ratio, 1.0), ratio
     return res
 
 
@@ -173,15 +176,23 @@ def _input(model: Model, audio: np.ndarray, sample_rate: int, n_frames: int | No
 
 
 def _model_phones(model: Model, phones: Sequence[PhoneSegment], duration: float,
-                  label_map: Mapping[str, str] | None, source: str | None, weighs_labels: bool
+                  label_map: Mapping[str, str] | None, source: str | None, times: np.ndarray
                   ) -> tuple[list[PhoneSegment], np.ndarray]:
     """The labels checked against the audio and mapped onto the model's phones, and which are
-    unlabelled: in a mode that weighs labels by trust, a phone the model lacks."""
+    unlabelled: a phone the model has never seen (silence for its neighbours' context; its
+    frames are the acoustic search's in every mode), with one warning naming each such phone and
+    its frames."""
     segs = validate_phones(list(phones), duration, source)
     raw = [normalise_label(s.label) for s in segs]
-    segs = map_labels(segs, model.phones, label_map, source,
-                      unknown_as=SILENCE if weighs_labels else None)
+    segs = map_labels(segs, model.phones, label_map, source, unknown_as=SILENCE, warn_unknown=False)
     unlabelled = np.array([s.label == SILENCE and r != SILENCE for s, r in zip(segs, raw, strict=True)])
+    if unlabelled.any():
+        frames = Counter(raw[i] for i in segment_index(segs, times) if unlabelled[i])
+        unseen = ", ".join(f"{lab!r} ({n} frame{'s' * (n != 1)})" for lab, n in frames.items()) \
+            or ", ".join(sorted({repr(r) for r, u in zip(raw, unlabelled, strict=True) if u}))
+        warn_file(log, source, "phones not in the model, filled by the acoustic search",
+                  f"phones the model has never seen, their frames filled by the acoustic search: "
+                  f"{unseen}")
     return segs, unlabelled
 
 

@@ -9,6 +9,7 @@ import functools
 import numpy as np
 
 from ..config import EvalConfig
+from ..level import peak_scaling
 
 
 @functools.lru_cache(maxsize=8)
@@ -30,18 +31,27 @@ def short_time_energy_db(audio: np.ndarray, rate: int, window_s: float = 0.02,
     Hamming-windowed samples from ``i * hop`` of the signal preceded by half a window of zeros,
     its energy the mean of their squares.
 
+    Whatever the signal's gain (issue 38): the squares are those of the signal scaled to a peak
+    of 1 (:func:`facetraj_engine.level.peak_scaling`: a sample of 1e200 squared does not overflow),
+    so the dB are relative to the peak, with a floor of -120 dB under a silent frame: the same
+    recording at any gain has the same energies (to rounding), and the median filter's zero
+    padding and the speech/silence threshold see the same values.
+
     Computed without a copy per frame: the squared signal cut into blocks of one hop, each block
     times the squared window's matching part (a matrix product, :data:`ENERGY_CHUNK_HOPS` blocks
     at a time), and a frame's energy the sum of its window's blocks (the sum of the frames'
     squares to rounding, tested).
 
-    >>> e, t = short_time_energy_db(np.ones(16), 1000, window_s=0.004, hop_s=0.002)
+    >>> e, t = short_time_energy_db(np.full(16, 0.5), 1000, window_s=0.004, hop_s=0.002)
     >>> e.round(2).tolist()
     [-8.24, -5.23, -5.23, -5.23, -5.23, -5.23, -5.23, -5.23, -8.24]
+    >>> bool(np.array_equal(short_time_energy_db(np.full(16, 1e200), 1000, 0.004, 0.002)[0], e))
+    True
     >>> (t * 1000).round(6).tolist()
     [0.0, 2.0, 4.0, 6.0, 8.0, 10.0, 12.0, 14.0, 16.0]
     """
     x = np.asarray(audio, dtype=np.float64)
+    exponent, factor = peak_scaling(x)          # squared after scaling, in the chunks below
     n = max(1, int(round(window_s * rate)))
     hop = max(1, int(round(hop_s * rate)))
     count = len(x) // hop + 1
@@ -59,7 +69,10 @@ def short_time_energy_db(audio: np.ndarray, rate: int, window_s: float = 0.02,
         hi = max(lo, min(b, n // 2 + len(x)))
         sq = chunk[:b - a]
         sq[:lo - a] = 0.0
-        np.square(x[lo - n // 2:hi - n // 2], out=sq[lo - a:hi - a])
+        part = sq[lo - a:hi - a]
+        np.ldexp(x[lo - n // 2:hi - n // 2], exponent, out=part)
+        part *= factor
+        np.square(part, out=part)
         sq[hi - a:] = 0.0
         np.matmul(sq.reshape(-1, hop), w2t, out=parts[r0:r1])
     energy = parts[:count, 0].copy()

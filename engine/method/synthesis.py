@@ -144,6 +144,34 @@ class FrameWeights:
         return cls(**joined, candidates=np.concatenate(cands))
 
 
+    @classmethod
+    def merged(cls, mask: np.ndarray, inside: FrameWeights, outside: FrameWeights) -> FrameWeights:
+        """The frames of ``inside`` where ``mask`` is true and of ``outside`` elsewhere, in frame
+        order (two searches of one input's frames); the narrower candidate rows are padded with
+        their first candidate at weight 0.
+
+        >>> def frames(n, i, v):
+        ...     return FrameWeights(np.full((n, 2), v), np.full(n, v), np.full((n, i), v),
+        ...                         np.full((n, i), int(v)), np.full((n, 3), v), np.full(n, v))
+        >>> both = FrameWeights.merged(np.array([False, True, False]), frames(1, 2, 1.0),
+        ...                            frames(2, 3, 0.5))
+        >>> both.weights.tolist(), both.candidates[1].tolist()
+        ([[0.5, 0.5, 0.5], [1.0, 1.0, 0.0], [0.5, 0.5, 0.5]], [1, 1, 1])
+        """
+        mask = np.asarray(mask, bool)
+        width = max(inside.candidates.shape[1], outside.candidates.shape[1])
+        out = {}
+        for f in fields(cls):
+            a, b = getattr(inside, f.name), getattr(outside, f.name)
+            if f.name in ("weights", "candidates"):
+                a, b = (np.pad(x, ((0, 0), (0, width - x.shape[1])),
+                               mode="constant" if f.name == "weights" else "edge") for x in (a, b))
+            joined = np.empty((len(mask), *a.shape[1:]), dtype=np.result_type(a, b))
+            joined[mask], joined[~mask] = a, b
+            out[f.name] = joined
+        return cls(**out)
+
+
 def weight_frames(w: np.ndarray, candidates: np.ndarray, cb_lsf: np.ndarray, cb_pcs: np.ndarray,
                   gammas: np.ndarray, chunk: int = 1024) -> FrameWeights:
     """Eqs 5-8 for every frame: distances to its candidate codewords, gamma searched on

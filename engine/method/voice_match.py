@@ -18,6 +18,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..config import SynthConfig
 from .lsf_index import LsfIndex
 from .synthesis import lsf_distances, perceptual_weights
 
@@ -128,3 +129,45 @@ def trust_by_voice(confidence: np.ndarray, ratio: float, by_voice: bool = True) 
     if not by_voice or not np.isfinite(ratio):
         return c.copy()
     return 1.0 - (1.0 - c) * voice_match(ratio, 1.0)
+
+
+#: What the voice match means, for the log and the app's tooltip.
+MATCH_RANGE = (f"1 = the training voice's (D/D0 up to {MATCH_FULL:g}), 0 = a voice the codebook "
+               f"does not know (D/D0 {MATCH_NONE:g} or more)")
+
+
+def explain_match(ratio: float, config: SynthConfig, kind: str | None) -> str:
+    """The voice match of a synthesis at distance ratio ``ratio`` (``D / D0``) in words: what its
+    range means, and what it changed in this run (``config``: its settings; ``kind``: how its
+    labels were made, ``None`` without labels) -- the robust mode's label confidences and label
+    weight (:func:`trust_by_voice`, :func:`label_weight_scale`), the closure step's trust in
+    recognized /p b m/ (:func:`facetraj_engine.method.closure.closure_strengths`).
+
+    >>> explain_match(4.2, SynthConfig(mode="robust"), "aligned")  # doctest: +NORMALIZE_WHITESPACE
+    "voice match 0.00 (D/D0 4.20; 1 = the training voice's (D/D0 up to 1.5), 0 = a voice the
+    codebook does not know (D/D0 3 or more)); here: label confidences raised to 1 (by 1 - match),
+    the label weight x4.20, so the labels count over acoustics the codebook does not know"
+    >>> print(explain_match(1.0, SynthConfig(), "hand-checked").split("; here: ")[1])
+    changed nothing (the phonetic mode trusts its labels; the lips close at every labelled /p b m/)
+    """
+    m = voice_match(ratio, 1.0)
+    if not np.isfinite(m):
+        return ("voice match unknown (no speech measured, or a model file without the training "
+                "voice's distance D0): nothing weighed by it")
+    changed = []
+    if config.mode == "robust" and config.label_weight_by_voice:
+        raised = "raised to 1 (by 1 - match)" if m == 0 else \
+            f"raised towards 1 (by 1 - match = {1 - m:.2f})" if m < 1 else "as their maker gave them"
+        changed.append(f"label confidences {raised}, the label weight "
+                       f"x{label_weight_scale(ratio):.2f}")
+        if m < 1:
+            changed[-1] += ", so the labels count over acoustics the codebook does not know"
+    if config.closure and kind == "recognized":
+        changed.append(f"recognized /p b m/ closed with strength {1 - m:.2f} (1 - match)")
+    if not changed:
+        why = {"phonetic": "the phonetic mode trusts its labels",
+               "acoustic": "no labels to weigh"}.get(config.mode, "weighing by voice is off")
+        closing = ("the lips close at every labelled /p b m/" if config.closure and kind
+                   else "no closure step" if not config.closure else "no /p b m/ labels")
+        changed.append(f"changed nothing ({why}; {closing})")
+    return f"voice match {m:.2f} (D/D0 {ratio:.2f}; {MATCH_RANGE}); here: " + "; ".join(changed)

@@ -18,8 +18,9 @@ def accuracy_rows(corpus, mocha_dir=None, progress=None) -> list[dict]:
     """The accuracy table: alignment and recognition against the MOCHA sample's hand labels (when
     ``mocha_dir`` holds it) and against the exact labels of ``corpus``'s test split."""
     from ..io.audio import read_audio
+    from ..io.label_rule import label_audio
     from ..io.labelfiles import read_lab
-    from ..io.labelling import label_audio, label_utterance
+    from ..io.labelling import label_utterance
     from ..labels.labelmap import read_label_map
 
     progress = progress or (lambda f, m: None)

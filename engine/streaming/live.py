@@ -34,9 +34,10 @@ from ..config import SynthConfig
 from ..data import PhoneSegment, Provenance
 from ..labels.phoneset import SILENCE
 from ..labels.provenance import SCORE_SCALE, Labels
+from ..level import to_full_scale
 from ..method.model import Model
 from ..method.modes import ModeChoice, choose_mode
-from .phones import PhoneSnapshot
+from .phones import KnownPhones, PhoneSnapshot
 from .phonetic import PhoneticSynthesizer, PhoneticTiming
 from .recognizer import RecognizerConfig, RunningCmn, StreamingRecognizer
 from .synthesizer import LIVE_BATCH_FRAMES, StreamConfig, StreamFrames, StreamingSynthesizer
@@ -62,14 +63,25 @@ class LiveConfig:
     timing: PhoneticTiming = field(default_factory=lambda: LIVE_TIMING)
 
 
-def live_mode(config: SynthConfig, model: Model, phones: bool = True) -> ModeChoice:
+def live_mode(config: SynthConfig, model: Model, phones: bool = True,
+              labels: Labels | None = None) -> ModeChoice:
     """The synthesis settings of a take: with phones, those the mode rule
     (:func:`facetraj_engine.method.modes.choose_mode`) gives recognized labels -- the robust mode with the
     model's cross-validated settings, and the closure step, but not the chain over frames
     (``facetraj_engine.method.chain``: its forward-backward needs the whole input); acoustic-only, the
-    paper's search without it (as ``facetraj live`` was)."""
+    paper's search without it (as ``facetraj live`` was). With ``labels`` known before the audio
+    (a file's, by the one rule) the rule decides by them, as ``synth`` does: aligned or recognized
+    labels, the robust mode; hand-checked ones, the stream's robust search with every label
+    trusted fully (a stream has no phonetic search of its own)."""
     if not phones:
         return ModeChoice(config.with_(mode="acoustic", closure=False), "acoustic-only, chosen")
+    if labels is not None:
+        rule = choose_mode(config.with_(mode="phonetic"), labels.phones, labels.provenance,
+                           tuned=model.tuned)
+        if rule.mode != "robust":
+            return ModeChoice(config.with_(mode="robust", chain_beta=0.0),
+                              f"{rule.reason}: the stream's robust search, every label trusted")
+        return ModeChoice(rule.config.with_(chain_beta=0.0), rule.reason)
     streamed = [PhoneSegment(0.0, 1.0, SILENCE)]       # phones to come: the rule needs to know
     rule = choose_mode(config.with_(mode="phonetic"), streamed, Provenance("recognized"),
                        tuned=model.tuned)
@@ -133,10 +145,11 @@ class LiveStream:
 
     def __init__(self, model: Model, sample_rate: int, synth: SynthConfig | None = None,
                  config: LiveConfig | None = None, threaded: bool = False,
-                 cmn: RunningCmn | None = None):
+                 cmn: RunningCmn | None = None, labels: Labels | None = None):
         self.model = model
         self.config = config or LiveConfig()
-        self.choice = live_mode(synth or SynthConfig(), model, self.config.phones)
+        self.known = labels if self.config.phones else None
+        self.choice = live_mode(synth or SynthConfig(), model, self.config.phones, self.known)
         self.sample_rate = int(sample_rate)
         self.recognizer: StreamingRecognizer | None = None
         self._threaded: _ThreadedPhones | None = None
@@ -145,7 +158,13 @@ class LiveStream:
         self.recognize_s = 0.0                         # seconds spent recognizing (this thread)
         self._step = max(1, int(round(STEP_S * sample_rate)))
         self._pending = np.zeros(0)
-        if self.config.phones:
+        if self.known is not None:                      # phones known: nothing to recognize
+            trust = self.known.trust()
+            source = KnownPhones(self.known.phones, np.ones(len(self.known.phones))
+                                 if trust is None else trust)
+            self.phonetic = PhoneticSynthesizer(model, sample_rate, self.choice.config, source,
+                                                self.config.timing, self.known.provenance.kind)
+        elif self.config.phones:
             self.recognizer = StreamingRecognizer(sample_rate, self.config.recognizer, cmn)
             source = self.recognizer.track
             if threaded:
@@ -181,7 +200,7 @@ class LiveStream:
     def _feed_step(self, step: np.ndarray) -> StreamFrames:
         if self._threaded is not None:
             self._threaded.feed(step)
-        else:
+        elif self.recognizer is not None:
             t0 = time.perf_counter()
             self.recognizer.feed(step)
             self.recognize_s += time.perf_counter() - t0
@@ -195,7 +214,7 @@ class LiveStream:
         self._pending = np.zeros(0)
         if self._threaded is not None:
             self._threaded.finish()
-        else:
+        elif self.recognizer is not None:
             self.recognizer.flush()
         return _joined([p for p in (last, self.phonetic.flush()) if p is not None],
                        self.model.codebook.pcs.shape[1], self.model.n_markers)
@@ -249,6 +268,8 @@ class LiveStream:
         """The take's recognized phones as :class:`Labels` covering ``[0, duration]``, their
         confidence the stability of each (``facetraj_engine.streaming.phones``), their provenance
         ``recognized`` by the streamed search; ``None`` acoustic-only."""
+        if self.known is not None:
+            return self.known
         if self.recognizer is None:
             return None
         snap = self.phonetic.phones.snapshot(0.0)
@@ -304,11 +325,16 @@ class FileTake:
 def stream_file(model: Model, audio: np.ndarray, rate: int, block_s: float,
                 synth: SynthConfig | None = None, config: LiveConfig | None = None,
                 real_time: bool = False, sleep: Callable[[float], None] = time.sleep,
-                cmn: RunningCmn | None = None) -> FileTake:
+                cmn: RunningCmn | None = None, labels: Labels | None = None) -> FileTake:
     """``audio`` through a :class:`LiveStream` in blocks of ``block_s`` seconds (the recognizer in
     this thread), paced to the audio clock when ``real_time``: ``facetraj live --from-file``
-    (``cmn``: the running cepstral mean of earlier takes, as the Live window keeps it)."""
-    stream = LiveStream(model, rate, synth, config, cmn=cmn)
+    (``cmn``: the running cepstral mean of earlier takes, as the Live window keeps it; ``labels``:
+    the file's phones when the one rule found them, streamed instead of recognized). The file
+    is scaled to a peak of 1 first (:func:`facetraj_engine.level.to_full_scale`: its gain changes
+    nothing, samples beyond full scale are not clipped for the recognizer, and the stream's
+    energies are those of offline synthesis, relative to the peak)."""
+    audio = to_full_scale(audio)
+    stream = LiveStream(model, rate, synth, config, cmn=cmn, labels=labels)
     block = max(1, int(round(block_s * rate)))
     parts, times = [], []
     t0 = time.perf_counter()

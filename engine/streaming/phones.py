@@ -151,3 +151,26 @@ def first_phone_after(phones: Sequence[FrozenPhone], frame: float) -> int:
         else:
             hi = mid
     return lo
+
+
+class KnownPhones:
+    """Phones known before the audio comes (labels found by the one rule for a file streamed,
+    :func:`facetraj_engine.io.labelling.resolve_labels`): every one settled from the start, each
+    with its confidence (1 for hand-checked labels) -- a :class:`PhoneTrack`'s place in a stream.
+
+    >>> known = KnownPhones([PhoneSegment(0, .2, "sil"), PhoneSegment(.2, .3, "b")], np.ones(2))
+    >>> [s.label for s in known.snapshot(0.25).segments], known.snapshot(0.25, 1).confidence.tolist()
+    (['b'], [1.0, 1.0])
+    """
+
+    def __init__(self, phones: Sequence[PhoneSegment], confidence: np.ndarray):
+        self.phones = list(phones)
+        self.confidence = np.asarray(confidence, dtype=np.float64)
+        #: settled to beyond the end (a second after the last phone, which reaches it)
+        self.settled_s = (self.phones[-1].end if self.phones else 0.0) + 1.0
+        self._ends = np.array([p.end for p in self.phones])
+
+    def snapshot(self, since_s: float = 0.0, before: int = 0) -> PhoneSnapshot:
+        """The phones from the one holding ``since_s`` on, and ``before`` more before it."""
+        first = max(0, int(np.searchsorted(self._ends, since_s, side="right")) - before)
+        return PhoneSnapshot(self.phones[first:], self.confidence[first:], self.settled_s)

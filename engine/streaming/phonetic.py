@@ -104,15 +104,16 @@ class ContextCodewords:
 
 class PhoneticSynthesizer:
     """Feed audio blocks with :meth:`feed`, end with :meth:`flush`; ``phones`` gives the settled
-    phones (fed the same audio by the caller, before each block here)."""
+    phones (fed the same audio by the caller, before each block here), made as ``kind`` says
+    (``recognized``; a file's labels known before: how they were made)."""
 
     def __init__(self, model: Model, sample_rate: int, synth: SynthConfig, phones: PhoneSource,
-                 timing: PhoneticTiming | None = None):
+                 timing: PhoneticTiming | None = None, kind: str = "recognized"):
         if synth.smoothing not in ("triangular", "none") or synth.mean_normalise or \
                 synth.speaker_warp != 1.0:
             raise ValueError("a stream with phones smooths with the triangle or not at all, and "
                              "neither warps nor normalises the speaker's LSFs")
-        self.model, self.synth, self.phones = model, synth, phones
+        self.model, self.synth, self.phones, self.kind = model, synth, phones, kind
         self.timing = timing or PhoneticTiming()
         self.rate = model.marker_rate
         self.front = LsfFront(model, sample_rate)
@@ -278,7 +279,7 @@ class PhoneticSynthesizer:
         snap = self.phones.snapshot(max(0.0, since))
         bil = [s for s in snap.segments if s.label in BILABIALS]
         intervals = np.array([(s.start, min(s.end, snap.settled_s)) for s in bil]).reshape(-1, 2)
-        strengths = closure_strengths(len(bil), "recognized", self.voice.match)
+        strengths = closure_strengths(len(bil), self.kind, self.voice.match)
         first = max(0, self._emitted - int(PAUSE_LOOKBACK_S * self.rate))
         dec = np.asarray(self.speech.decisions[first:])
         times = np.arange(first, first + len(dec)) / self.rate

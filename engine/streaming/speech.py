@@ -4,8 +4,9 @@ a
 whole recording, computed as the audio arrives.
 
 The same short-time energy (20 ms Hamming window, 4 ms hop) and 112 ms median filter (its values
-equal :func:`facetraj_engine.method.speech.filtered_energy_db`'s, tested); a marker frame's value is known
-66 ms after its time (half the filter and half the window). What a stream cannot know is the
+equal :func:`facetraj_engine.method.speech.filtered_energy_db`'s for a signal whose peak is 1, as
+a file is streamed, :func:`facetraj_engine.streaming.live.stream_file`; tested); a marker frame's
+value is known 66 ms after its time (half the filter and half the window). What a stream cannot know is the
 recording's floor and peak (its 5th and 99th energy percentiles): the threshold uses those of the
 filtered energy so far (at most the last ``HISTORY_S``), and until the energy has spanned
 ``min_range_db`` a frame is *unranged*: neither speech nor pause (nothing rests, as offline in a

@@ -40,7 +40,7 @@ def cmd_corpus_init(args: argparse.Namespace) -> int:
                             args.lower_lip, args.lip_corners, args.label_map or "", args.rate,
                             args.test, args.test_fraction, args.name or "",
                             overwrite=args.overwrite,
-                            label_provenance=args.label_provenance or "hand-checked",
+                            label_provenance=args.label_provenance or "",
                             channel_names=args.channel_names, head_corrected=args.head_corrected)
     log.info("%d train and %d test utterances, %d markers (%d-D): %s", len(info.train),
              len(info.test), len(info.marker_names), info.dimensions, " ".join(info.marker_names))

@@ -36,8 +36,13 @@ def mode_rule(args: argparse.Namespace, model, corpus, splits) -> EvalConfig:
     if utt is not None:
         choice = choose_mode(synth_config(args), utt.phones, utt.provenance, explicit=explicit,
                              tuned=model.tuned, keep=keep)
-        log.info("%s (%s%s)", choice.describe(), first,
-                 "" if explicit else "; each utterance's mode follows its labels")
+        from facetraj_engine.io.corpus import label_source
+
+        where = label_source(corpus.data_root, first).name
+        log.info("%s: labels %s [%s]; %s%s", first, utt.provenance.describe(),
+                 f"{where} beside the audio" if where.endswith((".TextGrid", ".lab", ".phn"))
+                 else f"{where}'s PHONES", choice.describe(),
+                 "" if explicit else " (each utterance's mode follows its labels)")
     return EvalConfig(by_labels=not explicit, keep=keep)
 
 

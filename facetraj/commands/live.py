@@ -24,6 +24,7 @@ from facetraj_engine.errors import FacetrajError
 from ..app_modules import app_module
 from ..options import count_or_all, real, synth_config
 from ..paths import default_corpus
+from .align import add_label_options, label_request
 
 log = logging.getLogger("facetraj")
 
@@ -53,45 +54,60 @@ def live_config(args: argparse.Namespace):
 
 
 def write_take(args: argparse.Namespace, model, audio: np.ndarray, rate: int, cfg) -> Path:
-    """Stream ``--from-file`` and write the take to ``-o`` (its phones to a TextGrid beside it)."""
+    """Stream ``--from-file`` and write the take to ``-o`` (its phones to a TextGrid beside it).
+    Its labels come by the one rule, as ``synth``'s (``--labels``, ``--text``, a label file or
+    ``.txt`` beside it); without any, its phones are recognized as they are spoken."""
     from facetraj_engine.io.export import write_trajectories
+    from facetraj_engine.io.label_rule import FoundLabels, resolve_labels
     from facetraj_engine.io.labelling import write_labels
     from facetraj_engine.streaming.live import LiveConfig, stream_file
     from facetraj_engine.threads import one_blas_thread
 
     textgrid = args.output.with_suffix(".TextGrid")
-    if not args.acoustic_only and textgrid.exists() and not args.overwrite:
-        raise FileExistsError(f"{textgrid} exists (use --overwrite to replace it)")
+    found = FoundLabels(None, "--acoustic-only: none asked for")
+    if not args.acoustic_only:
+        found = resolve_labels(args.from_file, audio, rate, label_request(args, fallback=False))
     with one_blas_thread():                             # small products: threads only cost
         take = stream_file(model, audio, rate, args.block_ms / 1000.0, cfg,
                            LiveConfig(phones=not args.acoustic_only),
-                           real_time=not args.as_fast_as_possible)
+                           real_time=not args.as_fast_as_possible, labels=found.labels)
     if len(take.frames) == 0:
         raise FacetrajError(f"{args.from_file}: the audio is too short to synthesize")
     out = write_trajectories(args.output, take.frames.markers, model.marker_rate,
-                             model.marker_names, overwrite=args.overwrite)
-    if take.labels is not None:
+                             model.marker_names, overwrite=args.overwrite,
+                             audio=None if args.no_audio else (audio, rate))
+    if take.labels is not None:                         # the phones the take was made with
         write_labels(textgrid, take.labels, len(audio) / rate, overwrite=args.overwrite)
     stream = take.stream
-    log.info("%d frames streamed in %.2f s (%.1f x real time); %s", len(take.frames), take.wall_s,
-             len(audio) / rate / max(take.wall_s, 1e-9), stream.choice.describe())
+    where = found.describe() if found.labels is not None or args.acoustic_only else \
+        f"recognized as they are spoken [{found.where}]"
+    log.info("%s: labels %s; %s", args.from_file.name, where, stream.choice.describe())
+    log.info("%d frames streamed in %.2f s (%.1f x real time)", len(take.frames), take.wall_s,
+             len(audio) / rate / max(take.wall_s, 1e-9))
     if stream.recognizer is not None:
-        log.info("phones settled in time for %.0f %% of the frames; voice match %.2f (D/D0 %.2f)",
-                 100 * stream.labelled_share, stream.voice_match, stream.voice_ratio)
+        log.info("phones settled in time for %.0f %% of the frames", 100 * stream.labelled_share)
+    if stream.phonetic is not None:
+        from facetraj_engine.method.voice_match import explain_match
+
+        kind = found.labels.provenance.kind if found.labels is not None else "recognized"
+        log.info("%s", explain_match(stream.voice_ratio, stream.choice.config, kind))
     return out
 
 
 def cmd_live(args: argparse.Namespace) -> int:
     from facetraj_engine.io.audio import read_audio
+    from facetraj_engine.io.export import TRAJECTORY_SUFFIXES
+    from facetraj_engine.io.files import check_output_path
 
     cfg = live_config(args)
     if args.output is not None:
         if args.from_file is None:
             raise FacetrajError("-o writes a take played from a file: add --from-file FILE "
                                 "(a microphone take is saved from the Live window)")
-        if args.output.exists() and not args.overwrite:
-            raise FileExistsError(f"{args.output} exists (use --overwrite to replace it)")
-        audio, rate = read_audio(args.from_file)
+        check_output_path(args.output, args.overwrite, TRAJECTORY_SUFFIXES, probe=True)
+        if not args.acoustic_only:                       # the take's phones' TextGrid
+            check_output_path(args.output.with_suffix(".TextGrid"), args.overwrite)
+        audio, rate = read_audio(args.from_file, args.read_damaged_audio)
         print(write_take(args, load_model(args), audio, rate, cfg))
         return 0
     run_live = app_module("live", "the Live window (facetraj live without -o)").run_live
@@ -110,6 +126,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", type=Path,
                    help="with --from-file: no window; write the take (.c3d, .tsv, .csv or .npz)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing output file")
+    p.add_argument("--no-audio", action="store_true",
+                   help="-o .c3d: leave the speech out (by default the C3D's analog channel)")
+    g = p.add_argument_group("labels of --from-file -o (as synth finds them; without any, the "
+                             "phones are recognized as they are spoken)")
+    add_label_options(g)
     p.add_argument("--model", type=Path, help="a trained model (default: the default corpus's)")
     p.add_argument("--corpus", type=Path, help="train on this corpus when no --model is given")
     p.add_argument("--device", help="input device (part of its name; default: the system's)")

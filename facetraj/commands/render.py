@@ -14,53 +14,65 @@ from ..corpus_work import add_corpus_work_options, finish, jobs, skips
 from ..options import FPS, add_synth_options, integer, synth_config, video_size
 from ..paths import default_corpus, shared_path
 from ..progress import TerminalProgress
+from .align import add_label_options, label_request
 
 log = logging.getLogger("facetraj")
 
 
 def cmd_video(args: argparse.Namespace) -> int:
+    from facetraj_engine.io.files import check_output_path
     from facetraj_engine.method.model import Model
+
+    video = app_module("video", "facetraj video")
+    check_output_path(args.output, args.overwrite, (".mp4",), probe=True)   # before the work
+    if not args.corpus and not args.audio:
+        raise FacetrajError("give an AUDIO file, or --corpus and --utterance")
+    model = Model.load(args.model)
+    if args.corpus:
+        res, audio, rate, phones, original, title = _corpus_synthesis(args, model)
+    else:
+        res, audio, rate, phones, original, title = _recording_synthesis(args, model)
+    w, h = args.size
+    video.render_video(model, res, audio, rate, args.output, original=original,
+                       settings=video.VideoSettings(w, h, args.fps), overwrite=args.overwrite,
+                       progress=TerminalProgress("video"), title=title, phones=phones)
+    print(args.output)
+    return 0
+
+
+def _recording_synthesis(args: argparse.Namespace, model):
+    """A recording's synthesis as ``synth`` makes it: its labels by the one rule (the options,
+    else what lies beside it, else recognition), its mode by the mode rule."""
+    from facetraj_engine.io.audio import read_audio
+    from facetraj_engine.method.modes import TUNED_FIELDS
+    from facetraj_engine.workflow.recording import synthesize_recording
+
+    audio, rate = read_audio(args.audio, args.read_damaged_audio)
+    done = synthesize_recording(model, args.audio, synth_config(args), label_request(args),
+                                explicit=args.mode is not None, audio=(audio, rate),
+                                keep=tuple(f for f in TUNED_FIELDS if getattr(args, f, None) is not None))
+    log.info("%s", done.describe())
+    phones = done.labels.phones if done.labels else None
+    return done.synthesis, audio, rate, phones, None, args.audio.name
+
+
+def _corpus_synthesis(args: argparse.Namespace, model):
+    """A corpus utterance's synthesis (its labels those of the corpus), with its original."""
+    from facetraj_engine.io.corpus import load_corpus
     from facetraj_engine.method.modes import choose_mode
     from facetraj_engine.method.pipeline import synthesize
 
-    video = app_module("video", "facetraj video")
-    VideoSettings, render_video = video.VideoSettings, video.render_video
-    model = Model.load(args.model)
-    original = None
-    title = ""
-    if args.corpus:
-        from facetraj_engine.io.corpus import load_corpus
-
-        if not args.utterance:
-            raise FacetrajError("give --utterance ID with --corpus")
-        utt = load_corpus(args.corpus).utterance(args.utterance)
-        audio, rate, phones, n_frames = utt.audio, utt.sample_rate, utt.phones, utt.n_frames
-        provenance, confidence = utt.provenance, utt.confidence
-        original = model.normalise_markers(utt.markers) if utt.markers is not None else None
-        title, source = utt.text or utt.name, utt.name
-    elif args.audio:
-        from facetraj_engine.io.audio import read_audio
-        from facetraj_engine.io.labelfiles import read_label_file
-
-        audio, rate = read_audio(args.audio)
-        labels = read_label_file(args.labels, rate, len(audio) / rate) if args.labels else None
-        phones = labels.phones if labels else None
-        provenance, confidence = (labels.provenance, labels.trust()) if labels else (None, None)
-        n_frames, source, title = None, str(args.labels or args.audio), args.audio.name
-    else:
-        raise FacetrajError("give an AUDIO file, or --corpus and --utterance")
-    choice = choose_mode(synth_config(args), phones, provenance, explicit=args.mode is not None,
-                         tuned=model.tuned)
-    log.info("%s", choice.describe())
-    res = synthesize(model, audio, rate, phones, choice.config, n_frames=n_frames, source=source,
-                     audio_source=str(args.audio or source), confidence=confidence,
-                     provenance=provenance)
-    w, h = args.size
-    render_video(model, res, audio, rate, args.output, original=original,
-                 settings=VideoSettings(w, h, args.fps), overwrite=args.overwrite,
-                 progress=TerminalProgress("video"), title=title, phones=phones)
-    print(args.output)
-    return 0
+    if not args.utterance:
+        raise FacetrajError("give --utterance ID with --corpus")
+    utt = load_corpus(args.corpus).utterance(args.utterance)
+    choice = choose_mode(synth_config(args), utt.phones, utt.provenance,
+                         explicit=args.mode is not None, tuned=model.tuned)
+    log.info("%s: labels %s; %s", utt.name, utt.provenance.describe(), choice.describe())
+    res = synthesize(model, utt.audio, utt.sample_rate, utt.phones, choice.config,
+                     n_frames=utt.n_frames, source=utt.name, confidence=utt.confidence,
+                     provenance=utt.provenance)
+    original = model.normalise_markers(utt.markers) if utt.markers is not None else None
+    return res, utt.audio, utt.sample_rate, utt.phones, original, utt.text or utt.name
 
 
 def cmd_report(args: argparse.Namespace) -> int:
@@ -136,8 +148,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     p = sub.add_parser("video", help="an MP4 of the face points and lip panels with the sound")
     p.add_argument("model", type=Path)
-    p.add_argument("audio", type=Path, nargs="?", help="WAV or FLAC (or use --corpus)")
-    p.add_argument("--labels", type=Path, help="phone labels for AUDIO")
+    p.add_argument("audio", type=Path, nargs="?", help="WAV or FLAC (or use --corpus); its labels "
+                   "as synth finds them")
+    add_label_options(p)
     p.add_argument("--corpus", type=Path, help="take the utterance (and its original) from a corpus")
     p.add_argument("--utterance", help="utterance id in --corpus")
     p.add_argument("-o", "--output", type=Path, required=True, help="an .mp4 file")

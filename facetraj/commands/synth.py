@@ -10,23 +10,20 @@ import time
 from pathlib import Path
 
 from ..options import add_synth_options, integer, synth_config
-from .align import add_label_provenance_option, add_label_source_options, extra_dictionary
+from .align import add_label_options, label_request
 
 log = logging.getLogger("facetraj")
 
 
 def _job(args: argparse.Namespace):
     from facetraj_engine.method.modes import TUNED_FIELDS
-    from facetraj_engine.workflow.recording import LabelRequest
 
     from ..batch import SynthJob
 
-    request = LabelRequest(labels=args.labels, text=args.text, transcript=args.transcript,
-                           recognize=args.recognize, declared=args.label_provenance,
-                           label_map=args.label_map, extra_dict=extra_dictionary(args))
-    return SynthJob(synth_config(args), request, explicit=args.mode is not None,
+    return SynthJob(synth_config(args), label_request(args), explicit=args.mode is not None,
                     keep=tuple(f for f in TUNED_FIELDS if getattr(args, f, None) is not None),
-                    overwrite=args.overwrite, compress=args.compress)
+                    overwrite=args.overwrite, compress=args.compress,
+                    allow_damaged=args.read_damaged_audio, c3d_audio=not args.no_audio)
 
 
 def cmd_synth(args: argparse.Namespace) -> int:
@@ -34,14 +31,17 @@ def cmd_synth(args: argparse.Namespace) -> int:
 
     if is_batch(args.inputs, args.output):
         return _cmd_batch(args)
+    from facetraj_engine.io.export import TRAJECTORY_SUFFIXES
     from facetraj_engine.io.files import check_output_path
     from facetraj_engine.method.model import Model
 
     from ..batch import synthesize_file
+    from ..progress import TerminalProgress
 
-    check_output_path(args.output, args.overwrite)       # before the work, not after
+    check_output_path(args.output, args.overwrite, TRAJECTORY_SUFFIXES, probe=True)  # before work
     model = Model.load(args.model)
-    res = synthesize_file(model, Path(args.inputs[0]), args.output, _job(args)).synthesis
+    res = synthesize_file(model, Path(args.inputs[0]), args.output, _job(args),
+                          progress=TerminalProgress("synth")).synthesis
     log.info("%d frames (%.2f s) synthesized, %s smoothing", len(res.times), res.times[-1],
              res.config.smoothing)
     print(args.output)
@@ -85,15 +85,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("model", type=Path)
     p.add_argument("inputs", nargs="+", metavar="INPUT",
                    help="WAV or FLAC files, folders of them, globs, or list files")
-    p.add_argument("--labels", type=Path, help="phone labels: .TextGrid, .lab or .phn (default: "
-                   "one beside the audio, else the sentence of a .txt beside it, aligned, else "
-                   "the phones recognized; --mode acoustic: none)")
-    add_label_source_options(p)
-    p.add_argument("--label-map", metavar="FILE|ALPHABET",
-                   help="map the labels onto ARPAbet with this label map (TSV: label<TAB>arpabet) "
-                        "or alphabet (mocha, timit, sampa, x-sampa, ipa); without it a label "
-                        "file's alphabet is recognised (docs/labels.md)")
-    add_label_provenance_option(p)
+    add_label_options(p)
     p.add_argument("-o", "--output", type=Path, required=True,
                    help="one input: .c3d, .tsv, .csv or .npz; several: the output folder")
     p.add_argument("--format", choices=["c3d", "tsv", "csv", "npz"],
@@ -103,5 +95,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--overwrite", action="store_true", help="replace existing outputs")
     p.add_argument("--compress", action="store_true",
                    help=".npz: deflate it (a little smaller, much slower to write)")
+    p.add_argument("--no-audio", action="store_true",
+                   help=".c3d: leave the speech out (by default it is the C3D's analog channel "
+                        "SPEECH, where motion-capture software keeps and plays a recording's "
+                        "sound in sync with its points; about as many bytes as the points)")
     add_synth_options(p)
     p.set_defaults(func=cmd_synth)

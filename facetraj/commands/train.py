@@ -18,7 +18,7 @@ def cmd_train(args: argparse.Namespace) -> int:
     from facetraj_engine.io.files import check_output_path
     from facetraj_engine.method.training import train
 
-    check_output_path(args.output, args.overwrite)  # before training, not after
+    check_output_path(args.output, args.overwrite, probe=True)  # before training, not after
     corpus = load_corpus(args.corpus)
     skipped = skips(args)
     model = train(corpus, config=train_config(args), progress=TerminalProgress("train"),
