@@ -25,14 +25,15 @@ from pathlib import Path
 
 import numpy as np
 
-from facetraj_engine.data import PhoneSegment
-
 log = logging.getLogger(__name__)
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_CORPUS = ROOT / "data_samples"
-MOCHA = ROOT.parent / "shared" / "data" / "mocha_fsew0_001"
+#: the reference material beside the repository (``$FACETRAJ_SHARED``, else ``../shared``)
+SHARED = Path(os.environ.get("FACETRAJ_SHARED") or ROOT.parent / "shared")
+MOCHA = SHARED / "data" / "mocha_fsew0_001"
 SIZES = {"1280x800": (1280, 800), "1920x1080": (1920, 1080)}
+LAPTOP = (1366, 768)
 LONG_FILE_UTTERANCES = 4
 
 
@@ -269,13 +270,14 @@ def live_figure(out: Path) -> list[Path]:
     from facetraj_engine.workflow.model_cache import load_or_train
 
     from .analysis.figures import wait_until
-    from .live import LiveWindow
+    from .live import LIVE_SIZE, LiveWindow
+    from .window_frame import fit_to_screen
 
     corpus = load_corpus(DEFAULT_CORPUS)
     model = load_or_train(corpus)
     audio = read_audio(audio_path(corpus.root, "s002"))
     window = LiveWindow(model, None, audio, block_s=0.05, fast=True)
-    window.resize(1400, 800)
+    fit_to_screen(window, LIVE_SIZE)
     window.show()
     done = []
     window.takeFinished.connect(lambda: done.append(1))
@@ -289,36 +291,118 @@ def live_figure(out: Path) -> list[Path]:
 
 def video_figures(out: Path) -> list[Path]:
     """Frames of ``facetraj video`` at its default size and a small one, and acoustic-only."""
+    from dataclasses import replace
+
     import imageio.v3 as iio
 
     from facetraj_engine.config import SynthConfig
     from facetraj_engine.io.corpus import load_corpus
     from facetraj_engine.method.modes import choose_mode
-    from facetraj_engine.method.pipeline import synthesize
     from facetraj_engine.workflow.model_cache import load_or_train
 
+    from .screen_export import caption_text
+    from .state import build_view
     from .video import VideoFrames, VideoSettings
 
     corpus = load_corpus(DEFAULT_CORPUS)
     model = load_or_train(corpus)
     utt = corpus.utterance(corpus.info.test[0])
-    original = model.normalise_markers(utt.markers)
     written = []
-    cases: list[tuple[str, tuple[int, int], list[PhoneSegment]]] = [
-        ("video_frame.png", (1280, 544), utt.phones),
-        ("video_frame_640x320.png", (640, 320), utt.phones),
-        ("video_frame_acoustic.png", (1280, 544), [])]
-    for name, size, phones in cases:
-        res = synthesize(model, utt.audio, utt.sample_rate, phones or None,
-                         choose_mode(SynthConfig(), phones).config, n_frames=utt.n_frames)
-        frames = VideoFrames(model, res, original, phones, VideoSettings(*size),
-                             title=utt.text or utt.name)
+    cases: list[tuple[str, tuple[int, int], bool]] = [
+        ("video_frame.png", (1280, 544), True),
+        ("video_frame_640x320.png", (640, 320), True),
+        ("video_frame_acoustic.png", (1280, 544), False)]
+    for name, size, labelled in cases:
+        shown = utt if labelled else replace(utt, phones=[], words=[], label_source="none")
+        view = build_view(model, shown, "test", choose_mode(SynthConfig(), shown.phones).config)
+        frames = VideoFrames(model, view.synthesis, view.original, shown.phones,
+                             VideoSettings(*size), view=view, caption=caption_text(view))
         try:
             iio.imwrite(out / name, frames.frame(2.38 if utt.duration > 2.38 else 0.0))
         finally:
             frames.close()
         written.append(out / name)
         log.info("wrote %s", out / name)
+    return written
+
+
+def _ready(win) -> bool:
+    return win.view is not None and not win.busy and not win.timeline.building
+
+
+def laptop_figures(out: Path) -> list[Path]:
+    """The window on a 1366 x 768 laptop screen (the size ``place_on_screen`` gives it there)
+    with Kinematics and Errors docked: the lip panels keep their height, the legend is in its
+    row above them, the waveform and spectrogram give way (``app_1366x768_docks.png``)."""
+    from .analysis.figures import wait_until
+
+    win = _window(DEFAULT_CORPUS, LAPTOP)
+    views = win.extension("analysis")
+    for key in ("kinematics", "errors"):
+        views.view_actions[key].trigger()
+        wait_until(lambda k=key: k in views.widgets and _ready(win))
+    errors = views.widgets["errors"]
+    errors.per_split.setValue(4)
+    errors.start()
+    wait_until(lambda: errors.report is not None and _ready(win), 600)
+    path = _shoot(win, out / "app_1366x768_docks.png", 2.38)
+    views.close()
+    win.close()
+    return [path]
+
+
+def measure_figures(out: Path) -> list[Path]:
+    """The walk-through of docs/app.md: s002.flac opened (its labels and its markers beside it),
+    its labels aligned from s002.txt and pinned, then recognized, the cursor at the /b/ of "boy"
+    and the Measure table filtered to /b/ (``measure_boy.png``); the two faces side by side
+    there (``side_by_side.png``); the panels exported as a figure (``export_figure.png``) and a
+    video frame of the same (``video_frame_compare.png``)."""
+    import imageio.v3 as iio
+
+    from .analysis.figures import settle, wait_until
+    from .main import WINDOW_SIZE
+    from .own_data import export_figure
+    from .plotter_widget import grab_with_3d
+    from .screen_export import caption_text
+    from .video import VideoFrames, VideoSettings
+
+    win = _window(DEFAULT_CORPUS, WINDOW_SIZE, "s002")
+
+    def labels(change) -> None:
+        done = []
+        win.synthesisChanged.connect(lambda: done.append(1))
+        change()
+        wait_until(lambda: bool(done) and _ready(win), 600)
+
+    labels(lambda: win.open_audio(DEFAULT_CORPUS / "s002.flac"))
+    labels(lambda: win.audio_opener.switch("aligned"))
+    win.extension("compare").pin()
+    labels(lambda: win.audio_opener.switch("recognized"))
+    pin = win.pins.pins[0]
+    b = next(p for p in pin.view.utterance.phones if p.label == "b")
+    table = win.extension("measure").open_table()
+    table.filter.setText("b")
+    written = [_shoot(win, out / "measure_boy.png", 0.5 * (b.start + b.end))]
+    win.view_bar.side_by_side.setChecked(True)
+    win.view_bar.set_camera("front")
+    settle(500)
+    win.face.rerender()
+    grab_with_3d(win.face).save(str(out / "side_by_side.png"))
+    written.append(out / "side_by_side.png")
+    win.view_bar.side_by_side.setChecked(False)
+    written.append(export_figure(win, out / "export_figure.png"))
+    view = win.view
+    frames = VideoFrames(win.model, view.synthesis, view.original, view.utterance.phones,
+                         VideoSettings(1280, 544), view=view, pins=win.pins,
+                         caption=caption_text(view, win.pins.shown(view)))
+    try:
+        iio.imwrite(out / "video_frame_compare.png", frames.frame(0.5 * (b.start + b.end)))
+    finally:
+        frames.close()
+    written.append(out / "video_frame_compare.png")
+    for path in written:
+        log.info("wrote %s", path)
+    win.close()
     return written
 
 
@@ -332,6 +416,8 @@ def make_gallery(out: Path, analysis: bool = True) -> list[Path]:
         written += mouth_figure(out)
         written += live_figure(out)
         written += app_figures(out, Path(tmp))
+        written += laptop_figures(out)
+        written += measure_figures(out)
         written += dialog_figures(out, Path(tmp))
     if analysis:
         written += make_figures(DEFAULT_CORPUS, out)
@@ -346,6 +432,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--no-analysis", action="store_true", help="leave out the analysis views")
     p.add_argument("--only-dialogs", action="store_true",
                    help="just the dialogs and the settings panel (a quick look)")
+    p.add_argument("--only", choices=["video", "mouth", "live", "app", "laptop", "measure"],
+                   action="append", help="just these pictures (a quick look)")
     args = p.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     app = QApplication.instance() or QApplication(sys.argv[:1])
@@ -353,6 +441,13 @@ def main(argv: list[str] | None = None) -> int:
         args.out.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryDirectory(prefix="facetraj-gallery-") as tmp:
             paths = dialog_figures(args.out, Path(tmp))
+    elif args.only:
+        args.out.mkdir(parents=True, exist_ok=True)
+        makers = {"video": video_figures, "mouth": mouth_figure, "live": live_figure,
+                  "laptop": laptop_figures, "measure": measure_figures}
+        with tempfile.TemporaryDirectory(prefix="facetraj-gallery-") as tmp:
+            paths = [p for name in args.only for p in
+                     (app_figures(args.out, Path(tmp)) if name == "app" else makers[name](args.out))]
     else:
         paths = make_gallery(args.out, analysis=not args.no_analysis)
     for path in paths:

@@ -138,8 +138,13 @@ def _rate_of(path: Path, times: np.ndarray) -> float:
     return rate
 
 
+#: text columns of a trajectory table that hold labels, not coordinates (left out when read)
+LABEL_COLUMNS = frozenset({"phone", "word"})
+
+
 def read_marker_table(path: str | os.PathLike[str], rate: float | None = None) -> MarkerData:
-    """Read TSV/CSV trajectories with a header ``[time] name_x name_y name_z ...`` (mm).
+    """Read TSV/CSV trajectories with a header ``[time] name_x name_y name_z ...`` (mm); label
+    columns (:data:`LABEL_COLUMNS`) are left out.
 
     Two-dimensional data (``name_x name_y`` only) gets z = 0. Without a time column, ``rate`` is
     required.
@@ -151,6 +156,12 @@ def read_marker_table(path: str | os.PathLike[str], rate: float | None = None) -
         raise InputError(path, "the marker table has no data rows")
     delim = "\t" if "\t" in lines[0] else ","
     header = [h.strip() for h in lines[0].split(delim)]
+    # text columns of labels (``phone``, ``word``: facetraj's labelled tables) are left out
+    labelled = {i for i, h in enumerate(header) if h.lower() in LABEL_COLUMNS}
+    if labelled:
+        header = [h for i, h in enumerate(header) if i not in labelled]
+        lines = [lines[0]] + [delim.join(v for i, v in enumerate(ln.split(delim)) if i not in labelled)
+                              for ln in lines[1:]]
     try:
         table = np.array([[float(v) if v.strip() not in {"", "nan", "NaN"} else np.nan
                            for v in ln.split(delim)] for ln in lines[1:]])
