@@ -84,12 +84,14 @@ class Compare(QObject):
         self.refresh()
 
     def clear(self) -> None:
+        had = bool(self.window.pins.shown(self.window.view))
         self.window.pins.clear()
-        self.refresh()
+        self.refresh(redraw=had)
 
-    def refresh(self) -> None:
-        """Show the pins of the utterance on screen: the panels redrawn with their curves, the
-        difference panel there while one is shown, the pinned faces in 3-D."""
+    def refresh(self, redraw: bool = False) -> None:
+        """Show the pins of the utterance on screen: the difference panel there while one is
+        shown, the pinned faces in 3-D, and (``redraw``: the pins shown changed without a new
+        result, which redraws the panels anyway) the panels redrawn with their curves."""
         w = self.window
         shown = w.pins.shown(w.view)
         self.clear_action.setEnabled(len(w.pins) > 0)
@@ -101,7 +103,7 @@ class Compare(QObject):
             tl.add_panel(self.panel, soon=True)
         elif not shown and self.panel in tl.panels:
             tl.remove_panel(self.panel, soon=True)
-        elif tl.view is not None:
+        elif redraw and tl.view is not None:
             tl.relayout(tl.xlim() if tl.axes else None, soon=True)
         self.changed.emit()
 

@@ -42,18 +42,24 @@ def _window(corpus: Path, size: tuple[int, int], utterance: str | None = None):
     from .main import build_window
 
     win = build_window(corpus, utterance=utterance, use_audio=False)
-    win.resize(*size)
+    win.place_on_screen(size)
     win.show()
     if not wait_until(lambda: win.view is not None and not win.busy):
         raise RuntimeError(f"the window did not load {corpus}")
+    win.place_on_screen(size)           # as facetraj does once the window is shown
     return win
 
 
 def _shoot(win, path: Path, t: float) -> Path:
     from .analysis.figures import settle
+    from .figure_canvas import BackgroundCanvas
 
     win.seek(t)
     settle()
+    for canvas in win.findChildren(BackgroundCanvas):     # the docked views' plots drawn
+        if canvas.isVisible():
+            canvas.finish()
+    settle(200)
     win.save_screenshot(path)
     log.info("wrote %s", path)
     return path
@@ -265,7 +271,6 @@ def mouth_figure(out: Path) -> list[Path]:
 
 def live_figure(out: Path) -> list[Path]:
     """The Live window after a file played through it (``live_window.png``)."""
-    from facetraj_engine.io.audio import read_audio
     from facetraj_engine.io.corpus import audio_path, load_corpus
     from facetraj_engine.workflow.model_cache import load_or_train
 
@@ -275,13 +280,12 @@ def live_figure(out: Path) -> list[Path]:
 
     corpus = load_corpus(DEFAULT_CORPUS)
     model = load_or_train(corpus)
-    audio = read_audio(audio_path(corpus.root, "s002"))
-    window = LiveWindow(model, None, audio, block_s=0.05, fast=True)
+    window = LiveWindow(model, None, None, block_s=0.05, fast=True)
     fit_to_screen(window, LIVE_SIZE)
     window.show()
     done = []
     window.takeFinished.connect(lambda: done.append(1))
-    window.start()
+    window.open_recording(audio_path(corpus.root, "s002"))     # Open recording…
     wait_until(lambda: bool(done), 120)
     path = _grab(window, out / "live_window.png")
     window.face.close_view()

@@ -101,7 +101,14 @@ from .timeline import LipPanel, PhoneTierPanel, SpectrogramPanel, Timeline, Wave
 from .transport import PlaybackClock
 from .view3d import FaceView
 from .viewer_model import DEFAULT_SENTENCE, SynthRequest, ViewerModel, load_model, view_summary, view_title
-from .window_frame import WindowDocks, WindowMenus, fit_to_screen, give_room
+from .window_frame import (
+    WindowDocks,
+    WindowMenus,
+    fit_to_screen,
+    give_room,
+    share_left_docks,
+    text_scroll,
+)
 from .workers import Progress, Task, TaskRunner
 
 __all__ = ["DEFAULT_SENTENCE", "SPEEDS", "MainWindow"]
@@ -191,7 +198,7 @@ class MainWindow(QMainWindow):
         self.settings = SynthSettingsPanel(self.synth_config, self)
         self.settings.configChanged.connect(self.set_synth_config)
         self.settings.searchChosen.connect(lambda cfg: self.set_synth_config(cfg, explicit=True))
-        self.settings_dock = self.docks.dock(self.settings, "Synthesis settings",
+        self.settings_dock = self.docks.dock(text_scroll(self.settings), "Synthesis settings",
                                         Qt.DockWidgetArea.LeftDockWidgetArea)
         self.resizeDocks([self.browser_dock], [400], Qt.Orientation.Horizontal)
         self.status = StatusArea(self.statusBar(), self.tasks)
@@ -237,6 +244,7 @@ class MainWindow(QMainWindow):
         the browser dock a quarter of the width (at most 400 px): a laptop keeps room for the face."""
         width = fit_to_screen(self, wanted)[2]
         self.resizeDocks([self.browser_dock], [min(400, width // 4)], Qt.Orientation.Horizontal)
+        share_left_docks(self, self.browser_dock, self.settings_dock, self.settings)
 
     # ================================================================== public contract
     def menu(self, name: str) -> QMenu:

@@ -154,6 +154,7 @@ class OpenedAudio:
     extra_dict: dict[str, list[str]] = field(default_factory=dict)
     labels: dict[str, Labels | None] = field(default_factory=dict)
     beside: MarkersBeside | None = None    # the marker file beside it (its markers: the original)
+    beside_error: str = ""                 # why that file could not be read
 
     def labels_for(self, source: str) -> Labels | None:
         """Labels of ``source`` (computed on the first call: run in a worker)."""
@@ -341,8 +342,11 @@ class AudioOpener(QObject):
         model = win.model
 
         def work(progress) -> tuple[OpenedAudio, str]:
-            opened.beside = read_markers_beside(audio_path, model.marker_names, model.marker_rate,
-                                                len(audio) / rate)
+            try:
+                opened.beside = read_markers_beside(audio_path, model.marker_names,
+                                                    model.marker_rate, len(audio) / rate)
+            except FacetrajError as exc:     # the recording opens without them, saying why
+                opened.beside_error = str(exc)
             if acoustic_only:
                 return opened, "none"
             progress(0.1, f"labelling {audio_path.name}")
@@ -372,7 +376,9 @@ class AudioOpener(QObject):
         utt = opened.utterance(source, win.model.marker_rate, win.model.marker_names)
         win.show_external(utt, opened.origin(source))
         beside = opened.beside
-        if beside is not None and not beside.usable:       # MOCHA's .ema beside its .wav
+        if opened.beside_error:
+            win.show_notice(f"{opened.beside_error}: {opened.path.name} opens without original markers")
+        elif beside is not None and not beside.usable:     # MOCHA's .ema beside its .wav
             win.show_notice(beside.hint(opened.path.name), "Import its folder…",
                             lambda: win.extension("own_data").do_import(opened.path.parent))
         elif beside is not None:

@@ -53,6 +53,9 @@ from facetraj_engine.labels.phoneset import ARPABET, SILENCE, SILENCE_LABELS, no
 
 log = logging.getLogger(__name__)
 
+#: an exported figure is at least this wide (px at 100 dpi; written at 150 dpi)
+EXPORT_MIN_WIDTH = 900
+
 FIXED_HINTS = ("FH", "FOREHEAD", "NB", "NOSE_BRIDGE", "BN", "UI", "HEAD", "REF")
 UPPER_HINTS = ("UL_C", "UL", "ULC", "UPPER_LIP")
 LOWER_HINTS = ("LL_C", "LL", "LLC", "LOWER_LIP")
@@ -329,7 +332,7 @@ def export_figure(window, path: Path) -> Path:
     if view is None:
         raise FacetrajError("no utterance is shown")
     tl.ensure_drawn()      # panels being built finished, a background draw waited for
-    size = (max(tl.width(), 640), int(max(tl.height(), tl.needed_height()) + 120))
+    size = (max(tl.width(), EXPORT_MIN_WIDTH), int(max(tl.height(), tl.needed_height()) + 160))
     fig, _layout = panels_figure(list(tl.panels), view, size, xlim=tl.xlim(),
                                  cursor=window.current_time(),
                                  caption=caption_text(view, window.pins.shown(view)))

@@ -136,18 +136,25 @@ def legend_entries(axes) -> list[LegendEntry]:
 
 
 #: the sample drawn before each name in the window's legend row (text: it wraps with the row)
-SAMPLES = {"solid": "━━", "dashed": "╺ ╸", "dotted": "┈┈", "dots": "•", "band": "▬"}
+SAMPLES = {"solid": "━━", "dashed": "╺\u00a0╸", "dotted": "┈┈", "dots": "•", "band": "▬"}
+
+
+def _unbroken(text: str) -> str:
+    """``text`` as rich text that is never broken across lines (non-breaking spaces, a word
+    joiner after each slash: "/p b m/")."""
+    return html.escape(text).replace(" ", "&nbsp;").replace("/", "/&#8288;")
 
 
 def legend_html(entries: Sequence[LegendEntry], note: str = "") -> str:
     """The legend row as rich text: each entry a coloured sample and its name, kept together
-    (the row wraps between entries, not inside one); ``note`` after them in grey.
+    (non-breaking spaces: the row wraps between entries, not inside one); ``note`` after them
+    in grey.
 
-    >>> legend_html([LegendEntry("original", "#1f5fbf", "dashed")])
-    '<span style="white-space:nowrap"><span style="color:#1f5fbf"><b>╺ ╸</b></span>&nbsp;original</span>'
+    >>> legend_html([LegendEntry("speech frames", "#222222", "dots")])
+    '<span style="color:#222222"><b>•</b></span>&nbsp;speech&nbsp;frames'
     """
-    parts = [f'<span style="white-space:nowrap"><span style="color:{e.color}"><b>{SAMPLES[e.style]}</b>'
-             f'</span>&nbsp;{html.escape(e.label)}</span>' for e in entries]
+    parts = [f'<span style="color:{e.color}"><b>{SAMPLES[e.style]}</b></span>&nbsp;'
+             f'{_unbroken(e.label)}' for e in entries]
     if note:
         parts.append(f'<span style="color:#777777">{html.escape(note)}</span>')
     return " &nbsp;&nbsp; ".join(parts)

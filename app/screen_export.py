@@ -63,14 +63,24 @@ def main_panels(context) -> list:
     return [PhoneTierPanel(context), LipPanel(context, "upper"), LipPanel(context, "lower")]
 
 
-def legend_columns(entries: Sequence[LegendEntry], width_px: float, dpi: float,
-                   size_pt: float = LEGEND_PT) -> int:
-    """How many legend columns fit ``width_px`` (an entry's width estimated from its text)."""
-    if not entries:
-        return 1
-    px = dpi / 72.0 * size_pt
-    widest = max((0.6 * len(e.label) + 4.5) * px for e in entries)
-    return max(1, min(len(entries), int(width_px // widest)))
+LEGEND_STYLE = dict(fontsize=LEGEND_PT, frameon=False, borderaxespad=0.0, handlelength=2.2,
+                    columnspacing=1.2, borderpad=0.2)
+
+
+def fitting_columns(fig: Figure, entries: Sequence[LegendEntry], width_px: float,
+                    style: dict | None = None) -> int:
+    """The most columns a legend of ``entries`` (drawn with ``style``) can have on ``fig`` and be
+    no wider than ``width_px``, measured."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    for ncol in range(len(entries), 1, -1):
+        legend = fig.legend(handles=legend_handles(entries), ncol=ncol, **(style or LEGEND_STYLE))
+        wide = legend.get_window_extent(renderer).width
+        legend.remove()
+        if wide <= width_px:
+            return ncol
+    return 1
 
 
 @dataclass
@@ -146,7 +156,7 @@ def _draw(fig: Figure, layout: FigureLayout, view: UtteranceView, heights: list[
         entries = (legend_entries(layout.axes) + list(extra)) if legend else []
         if not entries:
             break
-        ncol = legend_columns(entries, width - 12 * scale, fig.dpi)
+        ncol = fitting_columns(fig, entries, width - 12 * scale)
         rows = -(-len(entries) // ncol)
         needed = rows * 1.45 * LEGEND_PT * fig.dpi / 72.0 + 6 * scale
         if abs(needed - legend_px) < 1:
@@ -160,9 +170,8 @@ def _draw(fig: Figure, layout: FigureLayout, view: UtteranceView, heights: list[
     if entries:
         layout.legend = fig.legend(handles=legend_handles(entries), loc="upper left",
                                    bbox_to_anchor=(6 * scale / width, 1 - top / height),
-                                   ncol=legend_columns(entries, width - 12 * scale, fig.dpi),
-                                   fontsize=LEGEND_PT, frameon=False, borderaxespad=0.0,
-                                   handlelength=2.2, columnspacing=1.2, borderpad=0.2)
+                                   ncol=fitting_columns(fig, entries, width - 12 * scale),
+                                   **LEGEND_STYLE)
     return fig, layout
 
 
@@ -175,5 +184,5 @@ def point_entries(original: bool, pins: Sequence = ()) -> list[LegendEntry]:
     return out + [LegendEntry(f"{p.name} points", p.color, "dots") for p in pins]
 
 
-__all__ = ["FigureLayout", "PanelContext", "caption_text", "legend_columns", "main_panels",
+__all__ = ["FigureLayout", "PanelContext", "caption_text", "fitting_columns", "main_panels",
            "panels_figure", "point_entries"]

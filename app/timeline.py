@@ -53,6 +53,9 @@ BOTTOM_MARGIN_PX = 40.0
 TOP_MARGIN_PX = 4.0
 #: labels of silence in a phone tier (drawn grey on a grey band)
 SILENT = ("sil", "", "sp", "pau", "h#")
+#: the longest row name of the phone tier written at full size (7 pt) in the left margin (at 7 pt
+#: "phones (recognized)", 19 characters, is 98 px wide, the margin 100 px with the tick pad)
+ROW_NAME_CHARS = 16
 
 
 class _Canvas(BackgroundCanvas):
@@ -187,9 +190,10 @@ class PhoneTierPanel:
         ax.set_ylim(0, len(rows))
         # each row named beside it, the phones with where they came from (a y label "words
         # phones (aligned)" shrank to a few pixels); the title and status line say it in full
-        ax.set_yticks([k + 0.5 for k in range(len(rows))], [r[0] for r in rows], fontsize=7)
+        ax.set_yticks([k + 0.5 for k in range(len(rows))], [r[0] for r in rows])
         for tick, row in zip(ax.get_yticklabels(), rows, strict=True):
-            tick.set_color(row[3])
+            # a long name ("phones (recognized)") smaller, so that it stays in the left margin
+            tick.set(color=row[3], fontsize=max(5.5, min(7.0, 7.0 * ROW_NAME_CHARS / len(row[0]))))
         ax.tick_params(axis="y", length=0)
         if not view.utterance.phones:
             ax.text(0.5, 0.5 / len(rows), "no phone labels: acoustic-only synthesis",
@@ -274,6 +278,7 @@ class LipPanel:
 def draw_panel(panel: Panel, ax, view: UtteranceView, last: bool) -> None:
     """Draw ``panel`` in ``ax`` as the timeline does (the window's and exported figures): its
     content, its y label fitted, small ticks, the time labels under the last panel only."""
+    ax.tick_params(labelsize=7, length=2)   # first: a panel may size its own tick labels
     try:
         panel.draw(ax, view)
     except Exception:  # a broken panel must not take the window down
@@ -281,7 +286,6 @@ def draw_panel(panel: Panel, ax, view: UtteranceView, last: bool) -> None:
         ax.text(0.5, 0.5, f"{getattr(panel, 'title', 'panel')}: drawing failed",
                 transform=ax.transAxes, ha="center", va="center", color="red")
     refit_ylabels([ax])                     # every panel's label placed the same way
-    ax.tick_params(labelsize=7, length=2)
     if last:
         ax.set_xlabel("time (s)", fontsize=8)
     else:

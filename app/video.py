@@ -82,21 +82,13 @@ def _header(width: int, caption: str, entries) -> tuple[np.ndarray, Box | None, 
     from matplotlib.figure import Figure
 
     from .panel_layout import legend_handles
+    from .screen_export import fitting_columns
 
     px = 100 / 72.0
     lines = textwrap.wrap(caption, max(20, int(width / (0.55 * CAPTION_PT * px)))) if caption else []
     caption_h = len(lines) * 1.3 * CAPTION_PT * px + (4 if lines else 0)
-    # the legend's columns: as many as fit the width, measured
-    probe = Figure(figsize=(width / 100, 1), dpi=100)
-    renderer = FigureCanvasAgg(probe).get_renderer()
-    ncol = len(entries)
-    while ncol > 1:
-        legend = probe.legend(handles=legend_handles(entries), ncol=ncol, **HEADER_LEGEND)
-        fits = legend.get_window_extent(renderer).width <= width - 12
-        legend.remove()
-        if fits:
-            break
-        ncol -= 1
+    ncol = fitting_columns(Figure(figsize=(width / 100, 1), dpi=100), entries, width - 12,
+                           HEADER_LEGEND)
     rows = -(-len(entries) // ncol)
     height = int(np.ceil(8 + caption_h + rows * 1.45 * HEADER_LEGEND["fontsize"] * px + 6))
     height += height % 2

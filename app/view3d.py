@@ -249,6 +249,7 @@ class FaceView(QWidget):
         ``color``) beside the current face, each with its surface and lips, in its colour."""
         if self.synth is None:
             return
+        refit = len(pins) != len(self.pins)         # the faces' row changed: the camera fits it
         self.pins = list(pins)
         for pin in self.pins:
             if pin.color not in self._pin_sets:
@@ -261,7 +262,10 @@ class FaceView(QWidget):
         self._update_visibility()
         if self.frame >= 0:
             self._move_points(self.frame)
-        self.set_camera(self.preset)
+        if refit:
+            self.set_camera(self.preset)
+        else:
+            self.request_render()
 
     def _pin_offset(self, i: int) -> np.ndarray:
         """Where pin ``i``'s face goes: beside the synthesized face, to the talker's left."""

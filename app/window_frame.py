@@ -83,6 +83,18 @@ class FillScrollArea(QScrollArea):
             widget.resize(size)
 
 
+def text_scroll(widget: QWidget) -> QScrollArea:
+    """``widget`` (a panel of controls and wrapped text, e.g. the synthesis settings) in a
+    scroll area that gives it the height its text needs at the dock's width, scrolling when the
+    dock is shorter (a laptop screen): its lines never run into each other."""
+    scroll = QScrollArea()
+    scroll.setWidget(widget)
+    scroll.setWidgetResizable(True)
+    scroll.setFrameShape(QFrame.Shape.NoFrame)
+    scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+    return scroll
+
+
 class WindowDocks:
     """The docks of ``window``: movable, floatable, closable; extra docks in one area tabbed."""
 
@@ -186,3 +198,18 @@ def give_room(splitter, timeline, share: float) -> None:
     want = min(bottom + int(timeline.needed_height() - timeline.height()), int(share * total))
     if want > bottom + 8:
         splitter.setSizes([total - want, want])
+
+
+def share_left_docks(window: QMainWindow, top: QDockWidget, bottom: QDockWidget,
+                     panel: QWidget, least_top: int = 150) -> None:
+    """Two docks one above the other: ``bottom`` (holding ``panel``, controls and wrapped text)
+    the height its text needs at its width, ``top`` (a list, which scrolls) the rest but at
+    least ``least_top`` px (a laptop screen: the settings' lines all in view)."""
+    needed = panel.heightForWidth(max(bottom.width(), 200))
+    needed = needed if needed > 0 else panel.sizeHint().height()
+    total = top.height() + bottom.height()
+    if total <= 0:
+        return
+    # (+80: the notes the settings add once a synthesis is shown, a line or four)
+    low = max(total // 2, min(needed + 80, total - least_top))
+    window.resizeDocks([top, bottom], [total - low, low], Qt.Orientation.Vertical)

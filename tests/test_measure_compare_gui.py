@@ -48,6 +48,7 @@ def win(screen, qtbot, trained_cache):
     with qtbot.waitSignal(w.synthesisChanged, timeout=WAIT_MS):
         w.show()
     qtbot.waitExposed(w)
+    w.place_on_screen(WINDOW_SIZE)                # again once shown, as facetraj does
     qtbot.waitUntil(lambda: ready(w), timeout=WAIT_MS)
     yield w
     w.extension("analysis").close()

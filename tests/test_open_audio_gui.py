@@ -236,3 +236,15 @@ def test_the_search_shown_is_the_search_used_for_each_label_choice(window, qtbot
     assert win.view.synthesis.config.mode == "phonetic" and win.settings.shown_search() == "phonetic"
     assert "phonetic (the paper), N=3" in win.title.text()
     assert not win.settings.mode_reason.isVisible()
+
+
+def test_a_damaged_marker_file_beside_the_recording_does_not_stop_it(window, qtbot, clip):
+    """A recording whose marker file beside it cannot be read opens without original markers,
+    and a note over the panels names the file and says why."""
+    win = window
+    (clip.parent / "recording.c3d").write_bytes(b"\x02P not a c3d file")
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        assert win.open_audio(clip, acoustic_only=True)
+    qtbot.waitUntil(lambda: win.view.split == "external" and win.notice.isVisible(), timeout=WAIT_MS)
+    assert win.view.original is None
+    assert "recording.c3d" in win.notice.text.text() and "without original markers" in win.notice.text.text()

@@ -48,6 +48,7 @@ from facetraj_engine.method.model import Model
 from .common import (
     Canvas,
     NumberItem,
+    bar_labels,
     export_with_dialog,
     fill_table,
     heat_item,
@@ -82,8 +83,8 @@ def draw_phone_chart(fig: Figure, phones: list) -> None:
     lo, hi = float(rms.min()), float(rms.max())
     shade = (rms - lo) / (hi - lo) if hi > lo else np.zeros_like(rms)
     ax.barh(y, rms, color=colormaps["YlOrRd"](0.15 + 0.75 * shade), edgecolor="#555555", lw=0.4)
-    ax.set_yticks(y, [f"{p.phone} ({p.frames})" for p in phones],
-                  fontsize=max(5, min(8, 600 // len(phones))))
+    labels, size = bar_labels(fig, [f"{p.phone} ({p.frames})" for p in phones])
+    ax.set_yticks(y, labels, fontsize=size)
     ax.set_ylim(-0.6, len(phones) - 0.4)
     ax.set_xlim(0.0, 1.08 * hi)
     ax.set_xlabel("RMS lip error (mm), original vs synthesized", fontsize=8)
@@ -145,6 +146,7 @@ class ErrorView(QWidget):
         per_phone.addWidget(self.phone_chart)
         per_phone.setStretchFactor(0, 2)
         per_phone.setStretchFactor(1, 3)
+        per_phone.setSizes([240, 360])          # the table's rows in view, the chart under them
         per_phone.setChildrenCollapsible(False)
         self.tabs.addTab(per_phone, "Per phone")
         self.tabs.addTab(self.utt_table, "Per utterance")

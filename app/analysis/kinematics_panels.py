@@ -49,7 +49,7 @@ from facetraj_engine.evaluation.kinematics import (
 )
 from facetraj_engine.method.model import Model
 
-from .common import Canvas, NumberItem, export_with_dialog, fill_table, text_item
+from .common import Canvas, NumberItem, bar_labels, export_with_dialog, fill_table, text_item
 
 log = logging.getLogger(__name__)
 
@@ -290,8 +290,8 @@ def draw_timing_chart(fig: Figure, rows: list[LandmarkError], has_original: bool
     y = np.arange(len(rows))[::-1]
     ax.barh(y, ms, color=[LATE_COLOR if e > 0 else EARLY_COLOR for e in ms],
             edgecolor="#555555", lw=0.4, height=0.75)
-    ax.set_yticks(y, [f"{r.gesture} {r.label} {r.landmark}" for r in rows],
-                  fontsize=max(5, min(8, 520 // len(rows))))
+    labels, size = bar_labels(fig, [f"{r.gesture} {r.label} {r.landmark}" for r in rows])
+    ax.set_yticks(y, labels, fontsize=size)
     ax.set_ylim(-0.6, len(rows) - 0.4)
     lim = max(10.0, float(np.abs(ms).max()) * 1.1)
     ax.set_xlim(-lim, lim)
