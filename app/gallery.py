@@ -2,8 +2,10 @@
 
     xvfb-run -a -s "-screen 0 2000x1400x24" python -m facetraj_app.gallery docs/figures
 
-The main window as a phonetician meets it, at 1280x800 and 1920x1080: the default corpus, a 2-D
-MOCHA-TIMIT utterance (``../shared/data/mocha_fsew0_001``, read in place), an utterance with no
+The main window as a phonetician meets it, at 1280x800 and 1920x1080 and on a 1366x768 laptop
+with Kinematics and Errors docked; the walk-through of docs/app.md (Measure, Compare, the
+exports); the default corpus, a 2-D MOCHA-TIMIT utterance (``../shared/data/mocha_fsew0_001``,
+or under ``$FACETRAJ_SHARED``, read in place), an utterance with no
 original markers (File > Open audio of a WAV) and a long file (a few corpus utterances joined
 into one WAV); the dialogs of *Open audio* (the sentence, words missing from the dictionary, the
 error of a corrupt WAV) and the synthesis settings with each search mode's note, each shown
@@ -300,10 +302,11 @@ def video_figures(out: Path) -> list[Path]:
     import imageio.v3 as iio
 
     from facetraj_engine.config import SynthConfig
-    from facetraj_engine.io.corpus import load_corpus
+    from facetraj_engine.io.corpus import label_path, load_corpus
     from facetraj_engine.method.modes import choose_mode
     from facetraj_engine.workflow.model_cache import load_or_train
 
+    from .provenance import LabelOrigin
     from .screen_export import caption_text
     from .state import build_view
     from .video import VideoFrames, VideoSettings
@@ -318,7 +321,10 @@ def video_figures(out: Path) -> list[Path]:
         ("video_frame_acoustic.png", (1280, 544), False)]
     for name, size, labelled in cases:
         shown = utt if labelled else replace(utt, phones=[], words=[], label_source="none")
-        view = build_view(model, shown, "test", choose_mode(SynthConfig(), shown.phones).config)
+        origin = LabelOrigin("file", file=label_path(corpus.data_root, utt.name).name) if labelled \
+            else None
+        view = build_view(model, shown, "test", choose_mode(SynthConfig(), shown.phones).config,
+                          origin=origin)
         frames = VideoFrames(model, view.synthesis, view.original, shown.phones,
                              VideoSettings(*size), view=view, caption=caption_text(view))
         try:
@@ -357,10 +363,10 @@ def laptop_figures(out: Path) -> list[Path]:
 
 def measure_figures(out: Path) -> list[Path]:
     """The walk-through of docs/app.md: s002.flac opened (its labels and its markers beside it),
-    its labels aligned from s002.txt and pinned, then recognized, the cursor at the /b/ of "boy"
-    and the Measure table filtered to /b/ (``measure_boy.png``); the two faces side by side
-    there (``side_by_side.png``); the panels exported as a figure (``export_figure.png``) and a
-    video frame of the same (``video_frame_compare.png``)."""
+    its labels aligned from s002.txt and pinned, then recognized, the Measure table filtered to
+    /b/ and its first row clicked: the cursor at the /b/ of "boy" (``measure_boy.png``); the two
+    faces side by side there (``side_by_side.png``); the panels exported as a figure
+    (``export_figure.png``) and a video frame of the same (``video_frame_compare.png``)."""
     import imageio.v3 as iio
 
     from .analysis.figures import settle, wait_until
@@ -382,11 +388,13 @@ def measure_figures(out: Path) -> list[Path]:
     labels(lambda: win.audio_opener.switch("aligned"))
     win.extension("compare").pin()
     labels(lambda: win.audio_opener.switch("recognized"))
-    pin = win.pins.pins[0]
-    b = next(p for p in pin.view.utterance.phones if p.label == "b")
     table = win.extension("measure").open_table()
     table.filter.setText("b")
-    written = [_shoot(win, out / "measure_boy.png", 0.5 * (b.start + b.end))]
+    table.table.sortItems(2)                       # by start: the /b/ of "boy" first
+    table.table.cellClicked.emit(0, 0)             # a click on it: the cursor at its minimum
+    at = win.current_time()
+    written = [_shoot(win, out / "measure_boy.png", at)]
+    log.info("readout: %s", win.extension("measure").readout.text())
     win.view_bar.side_by_side.setChecked(True)
     win.view_bar.set_camera("front")
     settle(500)
@@ -400,7 +408,7 @@ def measure_figures(out: Path) -> list[Path]:
                          VideoSettings(1280, 544), view=view, pins=win.pins,
                          caption=caption_text(view, win.pins.shown(view)))
     try:
-        iio.imwrite(out / "video_frame_compare.png", frames.frame(0.5 * (b.start + b.end)))
+        iio.imwrite(out / "video_frame_compare.png", frames.frame(at))
     finally:
         frames.close()
     written.append(out / "video_frame_compare.png")

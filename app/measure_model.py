@@ -4,7 +4,7 @@ words them.
 
 * :meth:`Measure.readout_text`: at the cursor, the phone and word there, the upper and lower lip
   y and the aperture of the synthesis shown in 3-D, the original's and the difference, and each
-  pinned result's aperture and its difference (mm).
+  pinned result's phone there (its own labels'), aperture and difference (mm).
 * :meth:`Measure.rows`: the per-phone table (each phone's aperture at its minimum and at its
   midpoint, original, synthesized, error), filtered by phone; :meth:`Measure.write_csv`.
 """
@@ -71,8 +71,8 @@ class Measure:
                           v.utterance.phones, v.utterance.words)
 
     def pin_readouts(self, t: float) -> list[tuple[Pin, LipReadout]]:
-        return [(p, readout_at(t, p.view.times, p.view.shown, self.upper, self.lower))
-                for p in self.pins]
+        return [(p, readout_at(t, p.view.times, p.view.shown, self.upper, self.lower,
+                               phones=p.view.utterance.phones)) for p in self.pins]
 
     def readout_text(self, t: float) -> str:
         """One line: where the cursor is and how far apart the lips are there."""
@@ -87,8 +87,9 @@ class Measure:
         if r.has_original:
             parts.append(f"original {mm(r.original_aperture)} (synthesized − original "
                          f"{mm(r.difference, signed=True)})")
-        for pin, pr in self.pin_readouts(t):
-            parts.append(f"{pin.name} {mm(pr.aperture)} (this − {pin.name} "
+        for pin, pr in self.pin_readouts(t):     # with the pin's phone there (its labels')
+            phone = f" /{pr.phone}/" if pr.phone else ""
+            parts.append(f"{pin.name}{phone} {mm(pr.aperture)} (this − {pin.name} "
                          f"{mm(r.aperture - pr.aperture, signed=True)})")
         return "  ·  ".join(parts)
 

@@ -34,6 +34,7 @@ from .style import CURSOR_COLOR, LABEL_MARGIN_PX
 from .timeline import BOTTOM_MARGIN_PX, TOP_MARGIN_PX, LipPanel, PhoneTierPanel, draw_panel
 
 CAPTION_PT = 9.0
+CAPTION_SEPARATOR = "  ·  "
 LEGEND_PT = 8.0
 
 
@@ -52,10 +53,8 @@ def caption_text(view: UtteranceView, pins: Sequence = ()) -> str:
     the labels came from, and each pinned result shown with it."""
     utt = view.utterance
     text = f" “{utt.text}”" if utt.text and view.label_origin.source != "recognized" else ""
-    out = f"{utt.name} ({view.split}){text}. Synthesized: {settings_text(view)}."
-    for pin in pins:
-        out += f" {pin.name.capitalize()}: {pin.settings}."
-    return out
+    parts = [f"{utt.name} ({view.split}){text}", f"synthesized: {settings_text(view)}"]
+    return CAPTION_SEPARATOR.join(parts + [f"{pin.name}: {pin.settings}" for pin in pins])
 
 
 def main_panels(context) -> list:

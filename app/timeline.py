@@ -41,6 +41,7 @@ from .style import (
     TRIANGULAR_COLOR,
     fit_ylabel,
     refit_ylabels,
+    text_width_px,
 )
 from .tier_labels import FittedLabels, Span
 from .workers import STEP_MS
@@ -53,9 +54,10 @@ BOTTOM_MARGIN_PX = 40.0
 TOP_MARGIN_PX = 4.0
 #: labels of silence in a phone tier (drawn grey on a grey band)
 SILENT = ("sil", "", "sp", "pau", "h#")
-#: the longest row name of the phone tier written at full size (7 pt) in the left margin (at 7 pt
-#: "phones (recognized)", 19 characters, is 98 px wide, the margin 100 px with the tick pad)
-ROW_NAME_CHARS = 16
+#: the widest row name of the phone tier (its glyphs' outline, px at 100 dpi) written at full
+#: size (7 pt) in the left margin (100 px, less the tick pad and what the outline leaves out);
+#: a wider one ("phones (recognized)": 98 px) smaller
+ROW_NAME_PX = 82.0
 
 
 class _Canvas(BackgroundCanvas):
@@ -193,7 +195,8 @@ class PhoneTierPanel:
         ax.set_yticks([k + 0.5 for k in range(len(rows))], [r[0] for r in rows])
         for tick, row in zip(ax.get_yticklabels(), rows, strict=True):
             # a long name ("phones (recognized)") smaller, so that it stays in the left margin
-            tick.set(color=row[3], fontsize=max(5.5, min(7.0, 7.0 * ROW_NAME_CHARS / len(row[0]))))
+            width = text_width_px(row[0], 7.0)
+            tick.set(color=row[3], fontsize=max(5.0, min(7.0, 7.0 * ROW_NAME_PX / width)))
         ax.tick_params(axis="y", length=0)
         if not view.utterance.phones:
             ax.text(0.5, 0.5 / len(rows), "no phone labels: acoustic-only synthesis",

@@ -181,7 +181,7 @@ class VideoFrames:
                  view=None, pins=None, caption: str = ""):
         from .pins import PinBoard
         from .provenance import settings_text
-        from .screen_export import PanelContext, point_entries
+        from .screen_export import CAPTION_SEPARATOR, PanelContext, point_entries
         from .state import view_of_synthesis
 
         settings = settings or VideoSettings()
@@ -193,8 +193,8 @@ class VideoFrames:
         height = settings.height - settings.height % 16
         context = PanelContext(model, closed_lips(model), pins if pins is not None else PinBoard())
         shown_pins = context.pins.shown(view)
-        caption = caption or (f"{title.rstrip('.')}. " if title else "") + \
-            f"Synthesized: {settings_text(view)}."
+        caption = caption or CAPTION_SEPARATOR.join(([title] if title else [])
+                                                    + [f"synthesized: {settings_text(view)}"])
         if width < 640:
             raise ValueError(f"video size {settings.width}x{settings.height} is too small "
                              "(at least 640x304)")

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import csv
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -176,10 +177,15 @@ def test_the_b_of_boy_aligned_against_recognized_from_the_window(screen, win, qt
     resynthesize(w, qtbot, lambda: w.audio_opener.switch("recognized"))
     view, pin = w.view, w.pins.pins[0]
     assert view.utterance.label_source == "recognized" and w.pins.shown(view) == [pin]
-    t = middle(pin.view.utterance.phones, "b")             # the aligned /b/ of "boy"
-    w.seek(t)
+    table = w.extension("measure").open_table()            # Measure: the /b/ rows
+    table.filter.setText("b")
+    table.table.sortItems(2)
+    first = min((r for r in table.measure.rows("b")), key=lambda r: r.start)
+    table.table.cellClicked.emit(0, 0)                      # the /b/ of "boy": its minimum
+    qtbot.waitUntil(lambda: abs(w.current_time() - first.min_time) < 1.0 / 60, timeout=5000)
     text = w.extension("measure").readout.text()
-    assert "aperture" in text and "original" in text and "pin 1" in text
+    assert "/b/" in text and f"aperture {first.min_synthesized:.1f} mm" in text
+    assert "original" in text and re.search(r"pin 1 /\w+/ \d+\.\d mm \(this − pin 1 [+-]\d", text), text
     tl = w.timeline
     tl.canvas.finish()
     tier = next(p for p in tl.shown if p.title == "phones")
