@@ -16,8 +16,10 @@ from PyQt6.QtWidgets import (
     QCheckBox,
     QComboBox,
     QFileDialog,
+    QFrame,
     QHBoxLayout,
     QLabel,
+    QPushButton,
     QSizePolicy,
     QSlider,
     QStyle,
@@ -168,6 +170,46 @@ class TitleBar(QWidget):
         for label, text in zip((self.heading, self.details), self._texts, strict=True):
             width = max(20, self.width() - 12)
             label.setText(label.fontMetrics().elidedText(text, Qt.TextElideMode.ElideRight, width))
+
+
+class NoticeBar(QFrame):
+    """A hint over the panels that stays until closed (or replaced): a sentence, and a button
+    that does what it suggests (e.g. *Import its folder…* for markers the model cannot show)."""
+
+    def __init__(self, parent: QWidget | None = None):
+        super().__init__(parent)
+        self.setObjectName("notice")
+        self.setStyleSheet("#notice { background: #fff4d6; border: 1px solid #e0c36a; }")
+        self.text = QLabel("")
+        self.text.setWordWrap(True)
+        self.text.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
+        self.button = QPushButton("")
+        close = QToolButton()
+        close.setText("×")
+        close.setToolTip("hide this note")
+        close.setAutoRaise(True)
+        close.clicked.connect(self.hide)
+        lay = QHBoxLayout(self)
+        lay.setContentsMargins(6, 2, 2, 2)
+        lay.addWidget(self.text, 1)
+        lay.addWidget(self.button)
+        lay.addWidget(close)
+        self._action: Callable[[], object] | None = None
+        self.button.clicked.connect(self._run)
+        self.hide()
+
+    def show_notice(self, text: str, action_text: str = "",
+                    action: Callable[[], object] | None = None) -> None:
+        self.text.setText(text)
+        self._action = action
+        self.button.setText(action_text)
+        self.button.setVisible(bool(action_text and action))
+        self.show()
+
+    def _run(self) -> None:
+        self.hide()
+        if self._action is not None:
+            self._action()
 
 
 class TransportBar(QWidget):

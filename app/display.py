@@ -48,3 +48,36 @@ def require_display(what: str) -> None:
 
     raise FacetrajError(f"{what} needs a display, and neither DISPLAY nor WAYLAND_DISPLAY is set: "
                         "run it in a desktop session or under xvfb-run")
+
+
+#: Qt's sound back ends report what they do not find (PipeWire, PulseAudio, the FFmpeg version)
+#: on every start; at the debug level of this logger they show with -vv only
+QT_AUDIO_NOISE = ("qt.multimedia", "PulseAudioService", "qt.qpa.xcb")
+QT_LOGGER = "facetraj_app.qt"
+
+
+def route_qt_messages() -> None:
+    """Qt's own messages go to Python's logging (logger ``facetraj_app.qt``) instead of straight
+    to stderr: ``-q`` then shows none of them (``facetraj live -q`` without a microphone printed
+    a dozen ``qt.multimedia`` lines before its one-line error); the sound back ends' start-up
+    reports at debug level, other warnings as warnings, critical messages as errors. Call it
+    before the QApplication is made."""
+    os.environ.setdefault("QT_LOGGING_RULES", "qt.multimedia.*=false;qt.multimedia.ffmpeg=false")
+    from PyQt6.QtCore import QtMsgType, qInstallMessageHandler
+
+    qt_log = logging.getLogger(QT_LOGGER)
+    levels = {QtMsgType.QtDebugMsg: logging.DEBUG, QtMsgType.QtInfoMsg: logging.INFO,
+              QtMsgType.QtWarningMsg: logging.WARNING, QtMsgType.QtCriticalMsg: logging.ERROR,
+              QtMsgType.QtFatalMsg: logging.CRITICAL}
+
+    def handler(mode, context, message) -> None:
+        try:
+            category = context.category or ""
+            noise = category.startswith(QT_AUDIO_NOISE) or message.startswith(QT_AUDIO_NOISE)
+            level = logging.DEBUG if noise else levels.get(mode, logging.WARNING)
+            qt_log.log(level, "%s%s", f"{category}: " if category and category != "default" else "",
+                       message)
+        except Exception:       # a message handler must never raise into Qt
+            pass
+
+    qInstallMessageHandler(handler)

@@ -2,8 +2,10 @@
 
     xvfb-run -a -s "-screen 0 2000x1400x24" python -m facetraj_app.gallery docs/figures
 
-The main window as a phonetician meets it, at 1280x800 and 1920x1080: the default corpus, a 2-D
-MOCHA-TIMIT utterance (``../shared/data/mocha_fsew0_001``, read in place), an utterance with no
+The main window as a phonetician meets it, at 1280x800 and 1920x1080 and on a 1366x768 laptop
+with Kinematics and Errors docked; the walk-through of docs/app.md (Measure, Compare, the
+exports); the default corpus, a 2-D MOCHA-TIMIT utterance (``../shared/data/mocha_fsew0_001``,
+or under ``$FACETRAJ_SHARED``, read in place), an utterance with no
 original markers (File > Open audio of a WAV) and a long file (a few corpus utterances joined
 into one WAV); the dialogs of *Open audio* (the sentence, words missing from the dictionary, the
 error of a corrupt WAV) and the synthesis settings with each search mode's note, each shown
@@ -25,14 +27,15 @@ from pathlib import Path
 
 import numpy as np
 
-from facetraj_engine.data import PhoneSegment
-
 log = logging.getLogger(__name__)
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_CORPUS = ROOT / "data_samples"
-MOCHA = ROOT.parent / "shared" / "data" / "mocha_fsew0_001"
+#: the reference material beside the repository (``$FACETRAJ_SHARED``, else ``../shared``)
+SHARED = Path(os.environ.get("FACETRAJ_SHARED") or ROOT.parent / "shared")
+MOCHA = SHARED / "data" / "mocha_fsew0_001"
 SIZES = {"1280x800": (1280, 800), "1920x1080": (1920, 1080)}
+LAPTOP = (1366, 768)
 LONG_FILE_UTTERANCES = 4
 
 
@@ -41,18 +44,24 @@ def _window(corpus: Path, size: tuple[int, int], utterance: str | None = None):
     from .main import build_window
 
     win = build_window(corpus, utterance=utterance, use_audio=False)
-    win.resize(*size)
+    win.place_on_screen(size)
     win.show()
     if not wait_until(lambda: win.view is not None and not win.busy):
         raise RuntimeError(f"the window did not load {corpus}")
+    win.place_on_screen(size)           # as facetraj does once the window is shown
     return win
 
 
 def _shoot(win, path: Path, t: float) -> Path:
     from .analysis.figures import settle
+    from .figure_canvas import BackgroundCanvas
 
     win.seek(t)
     settle()
+    for canvas in win.findChildren(BackgroundCanvas):     # the docked views' plots drawn
+        if canvas.isVisible():
+            canvas.finish()
+    settle(200)
     win.save_screenshot(path)
     log.info("wrote %s", path)
     return path
@@ -264,22 +273,21 @@ def mouth_figure(out: Path) -> list[Path]:
 
 def live_figure(out: Path) -> list[Path]:
     """The Live window after a file played through it (``live_window.png``)."""
-    from facetraj_engine.io.audio import read_audio
     from facetraj_engine.io.corpus import audio_path, load_corpus
     from facetraj_engine.workflow.model_cache import load_or_train
 
     from .analysis.figures import wait_until
-    from .live import LiveWindow
+    from .live import LIVE_SIZE, LiveWindow
+    from .window_frame import fit_to_screen
 
     corpus = load_corpus(DEFAULT_CORPUS)
     model = load_or_train(corpus)
-    audio = read_audio(audio_path(corpus.root, "s002"))
-    window = LiveWindow(model, None, audio, block_s=0.05, fast=True)
-    window.resize(1400, 800)
+    window = LiveWindow(model, None, None, block_s=0.05, fast=True)
+    fit_to_screen(window, LIVE_SIZE)
     window.show()
     done = []
     window.takeFinished.connect(lambda: done.append(1))
-    window.start()
+    window.open_recording(audio_path(corpus.root, "s002"))     # Open recording…
     wait_until(lambda: bool(done), 120)
     path = _grab(window, out / "live_window.png")
     window.face.close_view()
@@ -289,36 +297,124 @@ def live_figure(out: Path) -> list[Path]:
 
 def video_figures(out: Path) -> list[Path]:
     """Frames of ``facetraj video`` at its default size and a small one, and acoustic-only."""
+    from dataclasses import replace
+
     import imageio.v3 as iio
 
     from facetraj_engine.config import SynthConfig
-    from facetraj_engine.io.corpus import load_corpus
+    from facetraj_engine.io.corpus import label_path, load_corpus
     from facetraj_engine.method.modes import choose_mode
-    from facetraj_engine.method.pipeline import synthesize
     from facetraj_engine.workflow.model_cache import load_or_train
 
+    from .provenance import LabelOrigin
+    from .screen_export import caption_text
+    from .state import build_view
     from .video import VideoFrames, VideoSettings
 
     corpus = load_corpus(DEFAULT_CORPUS)
     model = load_or_train(corpus)
     utt = corpus.utterance(corpus.info.test[0])
-    original = model.normalise_markers(utt.markers)
     written = []
-    cases: list[tuple[str, tuple[int, int], list[PhoneSegment]]] = [
-        ("video_frame.png", (1280, 544), utt.phones),
-        ("video_frame_640x320.png", (640, 320), utt.phones),
-        ("video_frame_acoustic.png", (1280, 544), [])]
-    for name, size, phones in cases:
-        res = synthesize(model, utt.audio, utt.sample_rate, phones or None,
-                         choose_mode(SynthConfig(), phones).config, n_frames=utt.n_frames)
-        frames = VideoFrames(model, res, original, phones, VideoSettings(*size),
-                             title=utt.text or utt.name)
+    cases: list[tuple[str, tuple[int, int], bool]] = [
+        ("video_frame.png", (1280, 544), True),
+        ("video_frame_640x320.png", (640, 320), True),
+        ("video_frame_acoustic.png", (1280, 544), False)]
+    for name, size, labelled in cases:
+        shown = utt if labelled else replace(utt, phones=[], words=[], label_source="none")
+        origin = LabelOrigin("file", file=label_path(corpus.data_root, utt.name).name) if labelled \
+            else None
+        view = build_view(model, shown, "test", choose_mode(SynthConfig(), shown.phones).config,
+                          origin=origin)
+        frames = VideoFrames(model, view.synthesis, view.original, shown.phones,
+                             VideoSettings(*size), view=view, caption=caption_text(view))
         try:
             iio.imwrite(out / name, frames.frame(2.38 if utt.duration > 2.38 else 0.0))
         finally:
             frames.close()
         written.append(out / name)
         log.info("wrote %s", out / name)
+    return written
+
+
+def _ready(win) -> bool:
+    return win.view is not None and not win.busy and not win.timeline.building
+
+
+def laptop_figures(out: Path) -> list[Path]:
+    """The window on a 1366 x 768 laptop screen (the size ``place_on_screen`` gives it there)
+    with Kinematics and Errors docked: the lip panels keep their height, the legend is in its
+    row above them, the waveform and spectrogram give way (``app_1366x768_docks.png``)."""
+    from .analysis.figures import wait_until
+
+    win = _window(DEFAULT_CORPUS, LAPTOP)
+    views = win.extension("analysis")
+    for key in ("kinematics", "errors"):
+        views.view_actions[key].trigger()
+        wait_until(lambda k=key: k in views.widgets and _ready(win))
+    errors = views.widgets["errors"]
+    errors.per_split.setValue(4)
+    errors.start()
+    wait_until(lambda: errors.report is not None and _ready(win), 600)
+    path = _shoot(win, out / "app_1366x768_docks.png", 2.38)
+    views.close()
+    win.close()
+    return [path]
+
+
+def measure_figures(out: Path) -> list[Path]:
+    """The walk-through of docs/app.md: s002.flac opened (its labels and its markers beside it),
+    its labels aligned from s002.txt and pinned, then recognized, the Measure table filtered to
+    /b/ and its first row clicked: the cursor at the /b/ of "boy" (``measure_boy.png``); the two
+    faces side by side there (``side_by_side.png``); the panels exported as a figure
+    (``export_figure.png``) and a video frame of the same (``video_frame_compare.png``)."""
+    import imageio.v3 as iio
+
+    from .analysis.figures import settle, wait_until
+    from .main import WINDOW_SIZE
+    from .own_data import export_figure
+    from .plotter_widget import grab_with_3d
+    from .screen_export import caption_text
+    from .video import VideoFrames, VideoSettings
+
+    win = _window(DEFAULT_CORPUS, WINDOW_SIZE, "s002")
+
+    def labels(change) -> None:
+        done = []
+        win.synthesisChanged.connect(lambda: done.append(1))
+        change()
+        wait_until(lambda: bool(done) and _ready(win), 600)
+
+    labels(lambda: win.open_audio(DEFAULT_CORPUS / "s002.flac"))
+    labels(lambda: win.audio_opener.switch("aligned"))
+    win.extension("compare").pin()
+    labels(lambda: win.audio_opener.switch("recognized"))
+    table = win.extension("measure").open_table()
+    table.filter.setText("b")
+    table.table.sortItems(2)                       # by start: the /b/ of "boy" first
+    table.table.cellClicked.emit(0, 0)             # a click on it: the cursor at its minimum
+    at = win.current_time()
+    written = [_shoot(win, out / "measure_boy.png", at)]
+    log.info("readout: %s", win.extension("measure").readout.text())
+    win.view_bar.side_by_side.setChecked(True)
+    win.view_bar.set_camera("front")
+    settle(500)
+    win.face.rerender()
+    grab_with_3d(win.face).save(str(out / "side_by_side.png"))
+    written.append(out / "side_by_side.png")
+    win.view_bar.side_by_side.setChecked(False)
+    written.append(export_figure(win, out / "export_figure.png"))
+    view = win.view
+    frames = VideoFrames(win.model, view.synthesis, view.original, view.utterance.phones,
+                         VideoSettings(1280, 544), view=view, pins=win.pins,
+                         caption=caption_text(view, win.pins.shown(view)))
+    try:
+        iio.imwrite(out / "video_frame_compare.png", frames.frame(at))
+    finally:
+        frames.close()
+    written.append(out / "video_frame_compare.png")
+    for path in written:
+        log.info("wrote %s", path)
+    win.close()
     return written
 
 
@@ -332,6 +428,8 @@ def make_gallery(out: Path, analysis: bool = True) -> list[Path]:
         written += mouth_figure(out)
         written += live_figure(out)
         written += app_figures(out, Path(tmp))
+        written += laptop_figures(out)
+        written += measure_figures(out)
         written += dialog_figures(out, Path(tmp))
     if analysis:
         written += make_figures(DEFAULT_CORPUS, out)
@@ -346,6 +444,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--no-analysis", action="store_true", help="leave out the analysis views")
     p.add_argument("--only-dialogs", action="store_true",
                    help="just the dialogs and the settings panel (a quick look)")
+    p.add_argument("--only", choices=["video", "mouth", "live", "app", "laptop", "measure"],
+                   action="append", help="just these pictures (a quick look)")
     args = p.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     app = QApplication.instance() or QApplication(sys.argv[:1])
@@ -353,6 +453,13 @@ def main(argv: list[str] | None = None) -> int:
         args.out.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryDirectory(prefix="facetraj-gallery-") as tmp:
             paths = dialog_figures(args.out, Path(tmp))
+    elif args.only:
+        args.out.mkdir(parents=True, exist_ok=True)
+        makers = {"video": video_figures, "mouth": mouth_figure, "live": live_figure,
+                  "laptop": laptop_figures, "measure": measure_figures}
+        with tempfile.TemporaryDirectory(prefix="facetraj-gallery-") as tmp:
+            paths = [p for name in args.only for p in
+                     (app_figures(args.out, Path(tmp)) if name == "app" else makers[name](args.out))]
     else:
         paths = make_gallery(args.out, analysis=not args.no_analysis)
     for path in paths:

@@ -23,7 +23,7 @@ from matplotlib.backends.backend_qtagg import FigureCanvasQTAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.transforms import Bbox
-from PyQt6.QtCore import QTimer, pyqtSignal
+from PyQt6.QtCore import QEvent, QObject, QTimer, pyqtSignal
 from PyQt6.QtWidgets import (
     QApplication,
     QComboBox,
@@ -37,6 +37,7 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
+from facetraj_engine.analysis.lips import closed_lips
 from facetraj_engine.config import SynthConfig
 from facetraj_engine.errors import FacetrajError
 from facetraj_engine.io.audio import read_audio, write_audio
@@ -46,8 +47,9 @@ from facetraj_engine.method.model import Model
 from .live_input import MIC_RATE, FileFeeder, InputHealth, InputLost, MicFeeder, input_devices
 from .live_phones import PhonePanel
 from .plotter_widget import grab_with_3d
-from .style import SPEECH_DOT_COLOR, SYNTH_COLOR, TRIANGULAR_COLOR
+from .style import CLOSED_COLOR, SPEECH_DOT_COLOR, SYNTH_COLOR, TRIANGULAR_COLOR
 from .view3d import FaceView
+from .window_frame import fit_to_screen
 
 log = logging.getLogger(__name__)
 
@@ -58,6 +60,10 @@ NO_INPUT_DEVICE_COMMAND = ("no audio input device found (is a microphone connect
                            "server running?); use --from-file FILE to play a file through live "
                            "mode (or Open recording... in the app's Live window)")
 SHOWN_S = 4.0
+#: the input box shows this many characters at least (a file name, a device's description)
+DEVICE_BOX_CHARS = 30
+#: the Live window's size where the screen has room for it
+LIVE_SIZE = (1400, 800)
 TICK_MS = 15
 PLOT_EVERY_S = 0.2
 __all__ = ["MIC_RATE", "FileFeeder", "LiveWindow", "MicFeeder", "input_devices", "run_live"]
@@ -70,6 +76,7 @@ class LiveWindow(QMainWindow):
     """
 
     takeFinished = pyqtSignal()
+    closed = pyqtSignal()
 
     def __init__(self, model: Model, config: SynthConfig | None = None,
                  from_file: tuple[np.ndarray, int] | None = None, block_s: float = 0.01,
@@ -102,6 +109,9 @@ class LiveWindow(QMainWindow):
         if from_file is not None:
             self.device_box.insertItem(0, "file")
             self.device_box.setCurrentIndex(0)
+        # wide enough for a file's name or a device's ("file: cmu" was all it showed)
+        self.device_box.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToContents)
+        self.device_box.setMinimumContentsLength(DEVICE_BOX_CHARS)
         bar.addWidget(QLabel(" input: "))
         bar.addWidget(self.device_box)
         self.start_action = bar.addAction("Start", self.start)
@@ -137,32 +147,43 @@ class LiveWindow(QMainWindow):
             self.message.setText("press Start")
 
     def _build_panels(self) -> None:
-        """The scrolling upper and lower lip panels, in the main window's colours, with a legend."""
-        self.figure = Figure(figsize=(5, 4), tight_layout=True)
+        """The scrolling upper and lower lip panels, in the main window's colours, with the
+        talker's closed lips as a dashed line and a legend above the panels (never over the
+        curves)."""
+        self.figure = Figure(figsize=(5, 4), layout="constrained")
         self.canvas = FigureCanvasQTAgg(self.figure)
         self.axes = [self.figure.add_subplot(2, 1, k + 1) for k in range(2)]
         self.lines, self.dots = [], []
         smoothing = self.config.smoothing
         line_label = f"synthesized, {smoothing}" if smoothing != "none" else "synthesized"
         line_color = TRIANGULAR_COLOR if smoothing == "triangular" else SYNTH_COLOR
-        for ax, which in zip(self.axes, ("upper", "lower"), strict=True):
+        closed = closed_lips(self.model).markers
+        self.closed_y = [float(closed[self.model.upper_lip, 1]), float(closed[self.model.lower_lip, 1])]
+        for ax, which, closed_y in zip(self.axes, ("upper", "lower"), self.closed_y, strict=True):
             ax.set_ylabel(f"{which} lip y (mm)", fontsize=8)
             ax.set_xlim(-SHOWN_S, 0.0)
+            ax.set_ylim(closed_y - 2.0, closed_y + 8.0)
+            ax.tick_params(labelsize=7)
             # the main window's colours (app/style.py); animated: left out of full draws,
             # blitted over the cached background (_plot)
             (line,) = ax.plot([], [], color=line_color, lw=1.6, animated=True, label=line_label)
             (dots,) = ax.plot([], [], ls="none", marker=".", ms=3, color=SPEECH_DOT_COLOR,
                               animated=True, label="speech frames (live energy)")
+            ax.axhline(closed_y, color=CLOSED_COLOR, lw=0.9, ls=(0, (6, 3)), zorder=0.5,
+                       label="closed (the talker's /p b m/)")
             self.lines.append(line)
             self.dots.append(dots)
-        # the legend (part of the background: drawn with the axes, not per frame)
-        self.axes[0].legend(handles=[Line2D([], [], color=line_color, lw=1.6, label=line_label),
-                                     Line2D([], [], ls="none", marker=".", ms=5,
-                                            color=SPEECH_DOT_COLOR,
-                                            label="speech frames (live energy)")],
-                            loc="upper left", fontsize=7, ncol=2, frameon=True, framealpha=0.85)
+        # the legend: part of the background (drawn with the axes, not per frame), above them
+        self.legend = self.figure.legend(
+            handles=[Line2D([], [], color=line_color, lw=1.6, label=line_label),
+                     Line2D([], [], ls="none", marker=".", ms=5, color=SPEECH_DOT_COLOR,
+                            label="speech frames (live energy)"),
+                     Line2D([], [], color=CLOSED_COLOR, lw=0.9, ls=(0, (6, 3)),
+                            label="closed (the talker's /p b m/)")],
+            loc="outside upper center", fontsize=7, ncol=2, frameon=False)
         self.axes[1].set_xlabel("time (s, 0 = now)", fontsize=8)
         self._background = None
+
     # ------------------------------------------------------------------ a file
     def open_recording(self, path: str | Path) -> bool:
         """Play the recording at ``path`` through live mode (a new take); a file that cannot be
@@ -177,6 +198,7 @@ class LiveWindow(QMainWindow):
         if self.device_box.count() == len(self.devices):
             self.device_box.insertItem(0, "file")
         self.device_box.setItemText(0, f"file: {Path(path).name}")
+        self.device_box.setToolTip(str(path))
         self.device_box.setCurrentIndex(0)
         self.start_action.setEnabled(True)
         self.start()
@@ -254,8 +276,13 @@ class LiveWindow(QMainWindow):
         self.takeFinished.emit()
 
     def closeEvent(self, event) -> None:
-        self.stop()                 # the recognizer's thread ends with the take
+        """The take ends (the recognizer's thread with it), the 3-D view is let go, and
+        ``closed`` says so (the main window's Live toggle follows it)."""
+        self.stop()
+        self._timer.stop()
+        self.face.close_view()
         super().closeEvent(event)
+        self.closed.emit()
 
     @property
     def n_frames(self) -> int:
@@ -400,19 +427,19 @@ class LiveWindow(QMainWindow):
         t = (np.arange(n) - (n - 1)) / self.model.marker_rate
         speech = np.asarray(self.speech[-n:])
         rescale = False
-        for ax, line, dots, k in zip(self.axes, self.lines, self.dots,
-                                     (self.model.upper_lip, self.model.lower_lip), strict=True):
+        for ax, line, dots, k, closed_y in zip(self.axes, self.lines, self.dots,
+                                               (self.model.upper_lip, self.model.lower_lip),
+                                               self.closed_y, strict=True):
             y = markers[:, k, 1]
             line.set_data(t, y)
             mid = float(np.median(y))
             dots.set_data(t[speech], np.full(int(speech.sum()), mid))
-            lo, hi = float(y.min()), float(y.max())
+            lo, hi = min(float(y.min()), closed_y), max(float(y.max()), closed_y)
             pad = 0.15 * max(hi - lo, 0.5)
             y0, y1 = ax.get_ylim()
             # outside the axes, or using less than half of them: new limits (and a full draw)
-            top = 3 * pad if ax is self.axes[0] else pad       # room for the legend
-            if lo < y0 or hi > y1 or (hi - lo + pad + top) < 0.5 * (y1 - y0):
-                ax.set_ylim(lo - pad, hi + top)
+            if lo < y0 or hi > y1 or (hi - lo + 2 * pad) < 0.5 * (y1 - y0):
+                ax.set_ylim(lo - pad, hi + pad)
                 rescale = True
         if rescale or self._background is None:
             self.canvas.draw_idle()             # _on_full_draw blits the lines
@@ -444,7 +471,7 @@ def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = Non
     seconds) and closes."""
     from facetraj_engine.threads import one_blas_thread
 
-    from .display import ensure_display, require_display
+    from .display import ensure_display, require_display, route_qt_messages
 
     # what the options name is read first: a bad file or model is an error before any window
     audio = read_audio(from_file) if from_file is not None else None
@@ -453,11 +480,12 @@ def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = Non
         ensure_display()
     require_display("the Live window (facetraj live without -o)")
     one_blas_thread()       # the stream is synthesized beside the rendering (facetraj_engine.threads)
+    route_qt_messages()     # -q: only the one-line error, no Qt sound back-end reports
     app = QApplication.instance() or QApplication(sys.argv[:1])
     if audio is None and not input_devices():
         raise FacetrajError(NO_INPUT_DEVICE_COMMAND)
     window = LiveWindow(model, config, audio, block_s, fast, device, phones)
-    window.resize(1400, 800)
+    fit_to_screen(window, LIVE_SIZE)
     window.show()
 
     def finish() -> None:
@@ -475,11 +503,16 @@ def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = Non
     return 0
 
 
-class LiveToggle:
+class LiveToggle(QObject):
     """The window extension of live mode: a "Live" toggle in a toolbar that opens the Live window
-    on the main window's model (the microphone; no device: the window says so) and closes it."""
+    on the main window's model (the microphone; no device: the window says so) and closes it.
+
+    The toggle follows the Live window whichever way it closes (its close button, the toggle,
+    the main window closing: that closes the Live window first, so that quitting never leaves it
+    open, nor a slot pointing at a deleted toggle)."""
 
     def __init__(self, window):
+        super().__init__(window)
         self.window = window
         self.live: LiveWindow | None = None
         bar = window.addToolBar("Live")
@@ -488,21 +521,38 @@ class LiveToggle:
         self.action.setCheckable(True)
         self.action.setToolTip("the face follows the microphone (live mode)")
         self.action.toggled.connect(self.toggled)
+        window.installEventFilter(self)
 
     def toggled(self, on: bool) -> None:
         if on and self.live is None:
             if self.window.model is None:
                 self.window.show_error("live mode needs a model: wait for training to finish")
-                self.action.setChecked(False)
+                self._set_checked(False)
                 return
             self.live = LiveWindow(self.window.model)
-            self.live.destroyed.connect(lambda *_: self.action.setChecked(False))
-            self.live.resize(1400, 800)
+            self.live.closed.connect(self._live_closed)
+            fit_to_screen(self.live, LIVE_SIZE)
             self.live.show()
         elif not on and self.live is not None:
-            live, self.live = self.live, None
-            live.stop()
-            live.close()
+            self.live.close()                   # closed -> _live_closed
+
+    def _live_closed(self) -> None:
+        """The Live window closed (by its close button, the toggle or the main window)."""
+        live, self.live = self.live, None
+        self._set_checked(False)
+        if live is not None:
+            live.closed.disconnect(self._live_closed)
+            live.deleteLater()
+
+    def _set_checked(self, on: bool) -> None:
+        self.action.blockSignals(True)
+        self.action.setChecked(on)
+        self.action.blockSignals(False)
+
+    def eventFilter(self, obj, event) -> bool:
+        if obj is self.window and event.type() == QEvent.Type.Close and self.live is not None:
+            self.live.close()                   # the main window closes: the Live window first
+        return False
 
 
 def install(window) -> LiveToggle:

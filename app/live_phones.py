@@ -130,7 +130,8 @@ class PhoneTier(QWidget):
             p.fillRect(rect, QColor(*COLOURS[kind], int(40 + 215 * np.clip(conf, 0, 1))))
             p.setPen(QColor(255, 255, 255))
             p.drawLine(rect.topRight(), rect.bottomRight())
-            if rect.width() > 14 and kind != "sil":
+            # a label only where it fits its box whole (never cut, never over the next one)
+            if kind != "sil" and p.fontMetrics().horizontalAdvance(label) + 4 <= rect.width():
                 p.setPen(QColor(0, 0, 0) if conf < 0.6 else QColor(255, 255, 255))
                 p.drawText(rect, Qt.AlignmentFlag.AlignCenter, label)
         p.end()

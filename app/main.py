@@ -5,13 +5,12 @@ from __future__ import annotations
 
 import gc
 import logging
-import os
 import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from .display import ensure_display, require_display
+from .display import ensure_display, require_display, route_qt_messages
 from .phases import mark
 
 log = logging.getLogger(__name__)
@@ -65,14 +64,14 @@ def build_window(corpus: Path | str | None, model: Path | None = None, utterance
     A view set that fails to install is logged and left out; the window still opens.
     """
     with matplotlib_without_property_docs():
-        from . import analysis, live, own_data
+        from . import analysis, compare, live, measure, own_data
         from .main_window import MainWindow
 
     mark("window modules imported")
     window = MainWindow(None if corpus is None else Path(corpus), model_path=model, utterance=utterance,
                         start_time=time, use_audio=use_audio)
     mark("main window built")
-    for extension in (own_data, analysis, live):
+    for extension in (own_data, analysis, live, compare, measure):
         try:
             extension.install(window)
         except Exception:
@@ -93,7 +92,7 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
     mark("run_app")
     xvfb = ensure_display() if screenshot else None
     require_display("the facetraj window")
-    os.environ.setdefault("QT_LOGGING_RULES", "qt.multimedia.*=false;qt.multimedia.ffmpeg=false")
+    route_qt_messages()
     from PyQt6.QtCore import QTimer
     from PyQt6.QtWidgets import QApplication
 
@@ -109,7 +108,7 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
         from .recordings import RecordingQueue
 
         window.add_extension("recordings", RecordingQueue(window, recordings))
-    window.resize(*WINDOW_SIZE)
+    window.place_on_screen(WINDOW_SIZE)
     status = {"code": 0}
     if screenshot:
         out = Path(screenshot)
@@ -142,6 +141,7 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
         # the pending events (paints, resizes) through before rendering and grabbing
         window.synthesisChanged.connect(lambda: QTimer.singleShot(0, shoot))
     window.show()
+    QTimer.singleShot(0, lambda: window.place_on_screen(WINDOW_SIZE))   # its frame is known now
     try:
         rc = app.exec()
     finally:

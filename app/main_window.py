@@ -79,6 +79,7 @@ from .browser import UtteranceBrowser
 from .controls import (
     SPEEDS,
     LoopRange,
+    NoticeBar,
     TitleBar,
     TransportBar,
     ViewBar,
@@ -108,7 +109,14 @@ from .viewer_model import (
     view_title,
     voice_match_tip,
 )
-from .window_frame import WindowDocks, WindowMenus
+from .window_frame import (
+    WindowDocks,
+    WindowMenus,
+    fit_to_screen,
+    give_room,
+    share_left_docks,
+    text_scroll,
+)
 from .workers import Progress, Task, TaskRunner
 
 __all__ = ["DEFAULT_SENTENCE", "SPEEDS", "MainWindow"]
@@ -119,6 +127,8 @@ log = logging.getLogger(__name__)
 #: writes a window screenshot in half the time of the default level and about as small (PNG is
 #: lossless either way: the same pixels)
 PNG_QUALITY = 80
+#: the largest share of the height the panels take from the 3-D view to show every panel
+PANELS_SHARE = 0.72
 
 class MainWindow(QMainWindow):
     """Speech plays while original and synthesized face points move, with the lip trajectories."""
@@ -161,6 +171,7 @@ class MainWindow(QMainWindow):
     corpus = property(lambda self: self.state.corpus, doc="The corpus (None until one is opened).")
     view = property(lambda self: self.state.view, doc="The utterance shown (``UtteranceView``).")
     synth_config = property(lambda self: self.state.synth_config, doc="The synthesis settings.")
+    pins = property(lambda self: self.state.pins, doc="Results kept to compare (``app/pins.py``).")
     displayed_frame = property(lambda self: self.playback.displayed_frame, doc="The frame on screen.")
     busy = property(lambda self: self.tasks.busy, doc="Whether foreground work (model, synthesis) runs.")
     correlations_running = property(lambda self: self.scores.running,
@@ -174,17 +185,20 @@ class MainWindow(QMainWindow):
         self.plotter = self.face.plotter
         self.plotter.interactor.setFocusPolicy(Qt.FocusPolicy.NoFocus)
         self.timeline = Timeline(self)
-        for panel in (WaveformPanel(), SpectrogramPanel(), PhoneTierPanel(),
+        for panel in (WaveformPanel(), SpectrogramPanel(), PhoneTierPanel(self),
                       LipPanel(self, "upper"), LipPanel(self, "lower")):
             self.timeline.panels.append(panel)
         self.timeline.seekRequested.connect(self.seek)
+        # panels left out for lack of room: more of the height for them
+        self.timeline.laidOut.connect(lambda: give_room(self.splitter, self.timeline, PANELS_SHARE))
         self.marker_panels = MarkerPanels(self.timeline)
         self.view_bar = ViewBar(self.face)
         self.camera_buttons = self.view_bar.camera_buttons
         self.transport = self._build_transport()
         self.title = TitleBar()
+        self.notice = NoticeBar()
         self.splitter = _split(_column([self.view_bar, self.face, self.transport], 2, stretch=self.face),
-                               _column([self.title, self.timeline], 0, stretch=self.timeline))
+                               _column([self.notice, self.title, self.timeline], 0, stretch=self.timeline))
         self.setCentralWidget(self.splitter)
         self.browser = UtteranceBrowser(self)
         self.browser.utteranceSelected.connect(self.set_utterance)
@@ -192,7 +206,7 @@ class MainWindow(QMainWindow):
         self.settings = SynthSettingsPanel(self.synth_config, self)
         self.settings.configChanged.connect(self.set_synth_config)
         self.settings.searchChosen.connect(lambda cfg: self.set_synth_config(cfg, explicit=True))
-        self.settings_dock = self.docks.dock(self.settings, "Synthesis settings",
+        self.settings_dock = self.docks.dock(text_scroll(self.settings), "Synthesis settings",
                                         Qt.DockWidgetArea.LeftDockWidgetArea)
         self.resizeDocks([self.browser_dock], [400], Qt.Orientation.Horizontal)
         self.status = StatusArea(self.statusBar(), self.tasks)
@@ -216,8 +230,10 @@ class MainWindow(QMainWindow):
                                                lambda: _given(ask_corpus_folder(self), self.open_corpus))
         self.action_open_audio = self.menus.action("File", "Open &audio for synthesis…",
                                               lambda: self.audio_opener.ask())
-        self.action_screenshot = self.menus.action("File", "Save &screenshot…",
-                                              lambda: _given(ask_screenshot_path(self), self.save_screenshot))
+        self.action_screenshot = self.menus.action(
+            "File", "Save &screenshot…",
+            lambda: _given(ask_screenshot_path(self),
+                           lambda p: self.show_status(f"wrote {self.save_screenshot(p)}")))
         self.menu("File").addSeparator()
         self.menus.action("File", "&Quit", self.close).setShortcut(QKeySequence.StandardKey.Quit)
         self.view_menu = self.menu("View")
@@ -230,6 +246,13 @@ class MainWindow(QMainWindow):
         self.menus.action("View", "Remove the marker trajectory panels", self.marker_panels.clear)
         self.analysis_menu = self.menu("Analysis")
         self.menus.action("Help", "Keys", lambda: QMessageBox.information(self, "Keys", KEYS_HELP))
+
+    def place_on_screen(self, wanted: tuple[int, int]) -> None:
+        """``wanted`` size where the screen has room, else its free area, centred (``fit_to_screen``);
+        the browser dock a quarter of the width (at most 400 px): a laptop keeps room for the face."""
+        width = fit_to_screen(self, wanted)[2]
+        self.resizeDocks([self.browser_dock], [min(400, width // 4)], Qt.Orientation.Horizontal)
+        share_left_docks(self, self.browser_dock, self.settings_dock, self.settings)
 
     # ================================================================== public contract
     def menu(self, name: str) -> QMenu:
@@ -270,6 +293,10 @@ class MainWindow(QMainWindow):
     def show_status(self, text: str, timeout_ms: int = 0) -> None:
         """A message in the status bar (a temporary one with ``timeout_ms``)."""
         self.status.show(text, timeout_ms)
+
+    def show_notice(self, text: str, action_text: str = "", action: Callable[[], Any] | None = None) -> None:
+        """A hint over the panels until closed, with a button doing ``action``."""
+        self.notice.show_notice(text, action_text, action)
 
     def add_extension(self, name: str, extension: object) -> None:
         self._extensions[name] = extension
@@ -335,7 +362,8 @@ class MainWindow(QMainWindow):
         self.browser.populate({"test": list(info.test), "train": list(info.train)}, texts)
         self.status_label.setText(f"{corpus.root}: {len(info.train)} training and {len(info.test)} test "
                                   f"utterances, {model.n_markers} markers, {model.pca.n_components} PCs")
-        self._show_planar(model.is_planar)
+        self.dimensions_label.setVisible(model.is_planar)   # midsagittal (2-D) data shown as such:
+        self.view_bar.set_planar(model.is_planar)           # a status-bar note, the profile camera
         self.marker_panels.set_model(model)
         self.modelReady.emit()
         if first:
@@ -351,11 +379,6 @@ class MainWindow(QMainWindow):
 
     def _start_sweep(self) -> None:
         self.scores.start(self.state, lambda _r: self.correlationsDone.emit())
-
-    def _show_planar(self, planar: bool) -> None:
-        """Midsagittal (2-D) data is shown as such: the profile camera and a status-bar note."""
-        self.dimensions_label.setVisible(planar)
-        self.view_bar.set_planar(planar)
 
     # ================================================================== synthesis
     def set_synth_config(self, cfg: SynthConfig, explicit: bool = False) -> None:
@@ -480,9 +503,8 @@ class MainWindow(QMainWindow):
 
     # ================================================================== files
     def open_audio(self, audio_path: Path, labels_path: Path | None = None, **kw) -> bool:
-        """Synthesize from an audio file that has no original markers; phone labels from
-        ``labels_path``, ``text=`` (aligned), ``recognize=True``, ``acoustic_only=True`` or the
-        files beside the audio (``facetraj_app.open_audio.AudioOpener.open``)."""
+        """Synthesize from an audio file (its labels: ``labels_path``, ``text=``, ``recognize=True``,
+        ``acoustic_only=True`` or beside it; markers beside it: ``AudioOpener.open``)."""
         return self.audio_opener.open(Path(audio_path), labels_path, **kw)
 
     def show_external(self, utt: Utterance, origin: LabelOrigin | None = None) -> None:
@@ -493,15 +515,11 @@ class MainWindow(QMainWindow):
         self.set_utterance(name)
 
     def save_screenshot(self, path: Path) -> Path:
-        """Render the whole window (with the 3-D view) to a PNG."""
+        """Render the whole window (with every 3-D view shown, the PC modes' too, as on screen:
+        ``grab_with_3d``) to a PNG."""
         self.face.rerender()
         self.timeline.ensure_drawn()
-        pix = grab_with_3d(self)        # every 3-D view shown (the PC modes' too), as on screen
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        if not pix.save(str(path), "PNG", PNG_QUALITY):
-            raise FacetrajError(f"{path}: cannot write the screenshot")
-        return path
+        return _write_png(grab_with_3d(self), Path(path))
 
     def closeEvent(self, event) -> None:
         self.playback.stop()
@@ -509,6 +527,14 @@ class MainWindow(QMainWindow):
         self.tasks.close()
         self.face.close_view()
         super().closeEvent(event)
+
+
+def _write_png(image, path: Path) -> Path:
+    """Save a grabbed window (a ``QPixmap``) as ``path``, its folder made if need be."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not image.save(str(path), "PNG", PNG_QUALITY):
+        raise FacetrajError(f"{path}: cannot write the screenshot")
+    return path
 
 
 def error_message(exc: BaseException) -> str:

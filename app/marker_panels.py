@@ -35,10 +35,12 @@ class MarkerPanel:
             return
         k, a = names.index(self.marker), "xyz".index(self.axis)
         t = view.times
-        ax.plot(t, view.triangular[:, k, a], color=TRIANGULAR_COLOR, lw=1.6)
-        ax.plot(t, view.spline[:, k, a], color=SPLINE_COLOR, lw=1.3)
+        ax.plot(t, view.triangular[:, k, a], color=TRIANGULAR_COLOR, lw=1.6,
+                label="synthesized, triangular")
+        ax.plot(t, view.spline[:, k, a], color=SPLINE_COLOR, lw=1.3, label="synthesized, spline")
         if view.original is not None:
-            ax.plot(t, view.original[:, k, a], color=ORIGINAL_COLOR, lw=1.5, ls=(0, (2, 1.5)))
+            ax.plot(t, view.original[:, k, a], color=ORIGINAL_COLOR, lw=1.5, ls=(0, (2, 1.5)),
+                    label="original")
         fit_ylabel(ax, f"{self.marker}\n{self.axis} (mm)")
 
 def jaw_marker(names: list[str]) -> str | None:

@@ -34,6 +34,7 @@ from PyQt6.QtWidgets import (
 from facetraj_engine.data import Provenance, Utterance
 from facetraj_engine.errors import FacetrajError, InputError
 from facetraj_engine.io.audio import read_audio
+from facetraj_engine.io.markers_beside import MarkersBeside, read_markers_beside
 from facetraj_engine.labels.phoneset import ARPABET
 
 from .provenance import LabelOrigin
@@ -152,6 +153,8 @@ class OpenedAudio:
     label_file: Path | None = None
     extra_dict: dict[str, list[str]] = field(default_factory=dict)
     labels: dict[str, Labels | None] = field(default_factory=dict)
+    beside: MarkersBeside | None = None    # the marker file beside it (its markers: the original)
+    beside_error: str = ""                 # why that file could not be read
 
     def labels_for(self, source: str) -> Labels | None:
         """Labels of ``source`` (computed on the first call: run in a worker), by the one rule
@@ -189,7 +192,8 @@ class OpenedAudio:
         labels = self.labels_for(source)
         return Utterance(name=self.name, audio=self.audio, sample_rate=self.rate,
                          phones=list(labels.phones) if labels else [],
-                         words=list(labels.words) if labels else [], markers=None,
+                         words=list(labels.words) if labels else [],
+                         markers=self.beside.markers if self.beside is not None else None,
                          marker_rate=marker_rate, marker_names=list(marker_names),
                          text=self.text or "",
                          label_source=labels.source if labels else "none",
@@ -237,6 +241,9 @@ class AudioHost(Protocol):
     view: UtteranceView | None
 
     def show_error(self, message: str) -> None: ...
+    def show_status(self, text: str, timeout_ms: int = 0) -> None: ...
+    def show_notice(self, text: str, action_text: str = "", action: Callable | None = None) -> None: ...
+    def extension(self, name: str) -> object: ...
     def run_task(self, fn: Callable, on_done: Callable | None, label: str, **options) -> object: ...
     def show_external(self, utt: Utterance, origin: LabelOrigin | None = None) -> None: ...
 
@@ -331,7 +338,14 @@ class AudioOpener(QObject):
                 win.show_error(str(exc))
                 return
 
+        model = win.model
+
         def work(progress) -> tuple[OpenedAudio, str]:
+            try:
+                opened.beside = read_markers_beside(audio_path, model.marker_names,
+                                                    model.marker_rate, len(audio) / rate)
+            except FacetrajError as exc:     # the recording opens without them, saying why
+                opened.beside_error = str(exc)
             if acoustic_only:
                 return opened, "none"
             progress(0.1, f"labelling {audio_path.name}")
@@ -362,6 +376,14 @@ class AudioOpener(QObject):
         self.opened[opened.name] = opened
         utt = opened.utterance(source, win.model.marker_rate, win.model.marker_names)
         win.show_external(utt, opened.origin(source))
+        beside = opened.beside
+        if opened.beside_error:
+            win.show_notice(f"{opened.beside_error}: {opened.path.name} opens without original markers")
+        elif beside is not None and not beside.usable:     # MOCHA's .ema beside its .wav
+            win.show_notice(beside.hint(opened.path.name), "Import its folder…",
+                            lambda: win.extension("own_data").do_import(opened.path.parent))
+        elif beside is not None:
+            win.show_status(f"original markers from {beside.path.name}", 8000)
 
     # -- switching
     def switch(self, source: str) -> None:

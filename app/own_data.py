@@ -44,6 +44,7 @@ from PyQt6.QtWidgets import (
 )
 
 from facetraj_app.analysis.common import ask_save_path
+from facetraj_engine.analysis.apertures import frame_labels
 from facetraj_engine.errors import FacetrajError
 from facetraj_engine.io.corpus import FolderScan, init_corpus, scan_folder
 from facetraj_engine.io.export import write_trajectories
@@ -54,6 +55,9 @@ from facetraj_engine.labels.labelmap import MOCHA_TO_ARPABET, read_label_map
 from facetraj_engine.labels.phoneset import ARPABET, SILENCE, SILENCE_LABELS, normalise_label
 
 log = logging.getLogger(__name__)
+
+#: an exported figure is at least this wide (px at 100 dpi; written at 150 dpi)
+EXPORT_MIN_WIDTH = 900
 
 FIXED_HINTS = ("FH", "FOREHEAD", "NB", "NOSE_BRIDGE", "BN", "UI", "HEAD", "REF")
 UPPER_HINTS = ("UL_C", "UL", "ULC", "UPPER_LIP")
@@ -321,26 +325,43 @@ class ImportDialog(QDialog):
 
 # ---------------------------------------------------------------------- exports
 def export_trajectories(window, path: Path, which: str = "synthesized") -> Path:
-    """Write the current utterance's ``synthesized`` or ``original`` markers (C3D, TSV or NPZ)."""
+    """Write the current utterance's ``synthesized`` or ``original`` markers (C3D, TSV or NPZ);
+    a TSV or CSV carries the phone and the word of each frame in two more columns."""
     view, model = window.view, window.model
     if view is None:
         raise FacetrajError("no utterance is shown")
     markers = view.shown if which == "synthesized" else view.original
     if markers is None:
         raise FacetrajError(f"{view.utterance.name} has no original markers")
+    times = view.times[:len(markers)]
+    labels = {"phone": frame_labels(view.utterance.phones, times),
+              "word": frame_labels(view.utterance.words, times)}
     return write_trajectories(path, markers, model.marker_rate, model.marker_names,
                               view.synthesis.arrays() if view.synthesis is not None else None,
-                              which=which)
+                              which=which, labels=labels)
 
 
 def export_figure(window, path: Path) -> Path:
-    """Save the time-aligned panels as PNG, SVG or PDF (by the suffix)."""
+    """Save the time-aligned panels as PNG, SVG or PDF (by the suffix): the window's panels drawn
+    again as on screen (the same curves, closed lines, speech dots, phones and pins, over the
+    time range shown, the cursor where it is), every one of them (also those the window has no
+    room for), with a caption naming the utterance, its labels and how it was synthesized, and
+    the legend above them."""
+    from .screen_export import caption_text, panels_figure
+
     suffix = path.suffix.lower().lstrip(".")
     if suffix not in ("png", "svg", "pdf"):
         raise FacetrajError(f"{path}: unknown figure format (use .png, .svg or .pdf)")
-    window.timeline.ensure_drawn()      # panels being built finished, a background draw waited for
+    view, tl = window.view, window.timeline
+    if view is None:
+        raise FacetrajError("no utterance is shown")
+    tl.ensure_drawn()      # panels being built finished, a background draw waited for
+    size = (max(tl.width(), EXPORT_MIN_WIDTH), int(max(tl.height(), tl.needed_height()) + 160))
+    fig, _layout = panels_figure(list(tl.panels), view, size, xlim=tl.xlim(),
+                                 cursor=window.current_time(),
+                                 caption=caption_text(view, window.pins.shown(view)))
     with atomic_write(path) as tmp:
-        window.timeline.figure.savefig(tmp, format=suffix, dpi=150, facecolor="white")
+        fig.savefig(tmp, format=suffix, dpi=150, facecolor="white")
     return path
 
 
@@ -353,10 +374,16 @@ def export_video(window, path: Path) -> None:
         raise FacetrajError("no utterance is shown")
     utt = view.utterance
 
+    from .screen_export import caption_text
+
+    pins = window.pins
+    caption = caption_text(view, pins.shown(view))
+
     def work(progress):
         return render_video(model, view.synthesis, utt.audio, utt.sample_rate, path,
                             original=view.original, overwrite=True, progress=progress,
-                            title=utt.text or utt.name, phones=utt.phones)
+                            title=utt.text or utt.name, phones=utt.phones, view=view, pins=pins,
+                            caption=caption)
 
     window.run_task(work, lambda p: window.show_status(f"wrote {p}"), f"rendering {path.name}")
 
@@ -396,8 +423,8 @@ class OwnData:
     def _wrote(self, path: Path) -> None:
         self.window.show_status(f"wrote {path}")
 
-    def do_import(self) -> None:
-        dlg = ImportDialog(self.window)
+    def do_import(self, folder: Path | None = None) -> None:
+        dlg = ImportDialog(self.window, folder)
         if dlg.exec() == QDialog.DialogCode.Accepted and dlg.result_path:
             self.window.open_corpus(dlg.result_path)
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from facetraj_engine.config import SynthConfig
-from facetraj_engine.method.modes import SEARCHES, search_of
+from facetraj_engine.method.modes import MODES, SEARCHES, search_of
 
 #: The searches the settings offer, by key (:func:`search_key`): the title's name of each, and one
 #: line on each, shown under the selector (both from the modes' one home, ``facetraj_engine.method.modes``).
@@ -104,3 +104,18 @@ def mode_reason(requested: SynthConfig, used: SynthConfig, reason: str) -> str:
     if want == got:
         return ""
     return f"{reason} (the settings ask for {want}); choose a search to override"
+
+
+SMOOTHING_NAMES = {"triangular": "triangular", "spline": "spline", "none": "unsmoothed"}
+
+
+def settings_text(view, short: bool = False) -> str:
+    """How a view was synthesized: the smoothing, the search the synthesis used
+    (``Synthesis.config``), N where labels are searched, and where the labels came from (in a
+    word or two with ``short``: a legend's entry). ``view``: an ``UtteranceView``."""
+    cfg, origin = view.synthesis.config, view.label_origin
+    n = f", N={cfg.n_context_phones}" if MODES[cfg.mode].needs_labels else ""
+    if short:
+        return f"{search_title(cfg)}{n}, {SMOOTHING_NAMES[cfg.smoothing]}; labels: {origin.short()}"
+    return (f"{SMOOTHING_NAMES[cfg.smoothing]} synthesis, {search_title(cfg)}{n};  "
+            f"labels: {origin.text()}")

@@ -107,3 +107,25 @@ def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig,
     return UtteranceView(utterance=utt, split=split, synthesis=res, original=original,
                          triangular=triangular, spline=spline, speech=speech, times=res.times,
                          mode_reason=mode_reason, voice_match=res.voice_match, origin=origin)
+
+
+def view_of_synthesis(model: Model, synthesis: Synthesis, audio: np.ndarray | None = None,
+                      sample_rate: int = 16000, phones=(), original: np.ndarray | None = None,
+                      name: str = "speech", text: str = "", words=(),
+                      split: str = "external") -> UtteranceView:
+    """The view of a synthesis made elsewhere (``facetraj video``): both smoothings and the
+    speech frames of ``audio`` (none without it) derived as :func:`build_view` derives them."""
+    cfg = synthesis.config
+    triangular, spline = (synthesis.markers if cfg.smoothing == kind else resmooth(model, synthesis, kind)
+                          for kind in ("triangular", "spline"))
+    if audio is None:
+        audio = np.zeros(int(round(synthesis.times[-1] * sample_rate)) + 1)
+        speech = np.zeros(len(synthesis.times), dtype=bool)
+    else:
+        speech = speech_mask(audio, sample_rate, synthesis.times)
+    utt = Utterance(name=name, audio=audio, sample_rate=sample_rate, phones=list(phones or []),
+                    markers=None, marker_rate=model.marker_rate,
+                    marker_names=list(model.marker_names), words=list(words or []), text=text,
+                    label_source="file" if phones else "none")
+    return UtteranceView(utterance=utt, split=split, synthesis=synthesis, original=original,
+                         triangular=triangular, spline=spline, speech=speech, times=synthesis.times)

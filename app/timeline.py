@@ -16,16 +16,19 @@ right or middle drag to pan, double-click to show the whole utterance.
 from __future__ import annotations
 
 import logging
+from collections.abc import Sequence
 from typing import Protocol
 
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.transforms import Bbox, IdentityTransform
-from PyQt6.QtCore import QTimer, pyqtSignal
-from PyQt6.QtWidgets import QSizePolicy, QVBoxLayout, QWidget
+from PyQt6 import sip
+from PyQt6.QtCore import Qt, QTimer, pyqtSignal
+from PyQt6.QtWidgets import QLabel, QSizePolicy, QVBoxLayout, QWidget
 
 from .figure_canvas import BackgroundCanvas
+from .panel_layout import GAP_PX, fit_heights, legend_entries, legend_html, panel_min_px, panel_priority
 from .state import UtteranceView
 from .style import (
     CLOSED_COLOR,
@@ -38,13 +41,23 @@ from .style import (
     TRIANGULAR_COLOR,
     fit_ylabel,
     refit_ylabels,
+    text_width_px,
 )
+from .tier_labels import FittedLabels, Span
 from .workers import STEP_MS
 
 log = logging.getLogger(__name__)
 
 #: the timeline's bottom margin: the time tick labels and "time (s)"
 BOTTOM_MARGIN_PX = 40.0
+#: the timeline's top margin (px)
+TOP_MARGIN_PX = 4.0
+#: labels of silence in a phone tier (drawn grey on a grey band)
+SILENT = ("sil", "", "sp", "pau", "h#")
+#: the widest row name of the phone tier (its glyphs' outline, px at 100 dpi) written at full
+#: size (7 pt) in the left margin (100 px, less the tick pad and what the outline leaves out);
+#: a wider one ("phones (recognized)": 98 px) smaller
+ROW_NAME_PX = 82.0
 
 
 class _Canvas(BackgroundCanvas):
@@ -62,6 +75,11 @@ class _Canvas(BackgroundCanvas):
 
 
 class Panel(Protocol):
+    """A time-aligned panel. Optional attributes: ``min_px`` (the least height it is readable at,
+    default 48) and ``priority`` (panels of low priority are left out first when the timeline is
+    short: ``app/panel_layout.py``). Curves named with a matplotlib ``label`` appear in the
+    timeline's legend row, never in a legend over the panel."""
+
     title: str
     height: float
 
@@ -74,6 +92,8 @@ class WaveformPanel:
 
     title = "waveform"
     height = 0.8
+    min_px = 24.0
+    priority = 20               # left out before every other panel but the spectrogram
 
     def draw(self, ax, view: UtteranceView) -> None:
         x = view.utterance.audio
@@ -117,6 +137,8 @@ class SpectrogramPanel:
 
     title = "spectrogram"
     height = 1.3
+    min_px = 40.0
+    priority = 10               # the first left out on a short timeline
     max_freq = 8000.0
 
     def draw(self, ax, view: UtteranceView) -> None:
@@ -134,62 +156,91 @@ class SpectrogramPanel:
         ax.set_ylabel("kHz", fontsize=8)
 
 
+def tier_rows(view: UtteranceView, pins: Sequence = ()) -> list[tuple[str, list, str]]:
+    """The rows of the phone tier, bottom up: (name, segments, kind "phones" | "words", colour):
+    the phones, a pinned result's phones where its labels differ (``pins``: objects with ``name``,
+    ``view`` and ``color``), then the words."""
+    utt = view.utterance
+    rows = [(f"phones ({view.label_origin.short()})" if utt.phones else "phones", list(utt.phones),
+             "phones", "black")]
+    for pin in pins:
+        phones = list(pin.view.utterance.phones)
+        if phones and phones != list(utt.phones):
+            rows.append((f"{pin.name}: {pin.view.label_origin.short()}", phones, "phones", pin.color))
+    if utt.words:
+        rows.append(("words", list(utt.words), "words", "black"))
+    return rows
+
+
 class PhoneTierPanel:
-    """Word and phone labels with their boundaries."""
+    """Word and phone labels with their boundaries (and the phones of a pinned result whose
+    labels differ: ``context.pins``), each row named beside it; a label is drawn only where it
+    fits (:class:`facetraj_app.tier_labels.FittedLabels`: phones left out, words shortened)."""
 
     title = "phones"
     height = 0.8
+    min_px = 30.0
+    priority = 90
+
+    def __init__(self, context=None):
+        self.context = context
+        self.labels: list[FittedLabels] = []     # the rows' label artists of the last draw
 
     def draw(self, ax, view: UtteranceView) -> None:
-        utt = view.utterance
-        ax.set_ylim(0, 2 if utt.words else 1)
+        pins = [p for p in getattr(getattr(self.context, "pins", None), "shown", lambda v: [])(view)]
+        rows = tier_rows(view, pins)
+        ax.set_ylim(0, len(rows))
         # each row named beside it, the phones with where they came from (a y label "words
         # phones (aligned)" shrank to a few pixels); the title and status line say it in full
-        rows = [f"phones ({view.label_origin.short()})"] if utt.phones else ["phones"]
-        rows += ["words"] if utt.words else []
-        ax.set_yticks([0.5, 1.5][:len(rows)], rows, fontsize=7)
+        ax.set_yticks([k + 0.5 for k in range(len(rows))], [r[0] for r in rows])
+        for tick, row in zip(ax.get_yticklabels(), rows, strict=True):
+            # a long name ("phones (recognized)") smaller, so that it stays in the left margin
+            width = text_width_px(row[0], 7.0)
+            tick.set(color=row[3], fontsize=max(5.0, min(7.0, 7.0 * ROW_NAME_PX / width)))
         ax.tick_params(axis="y", length=0)
-        if not utt.phones:
-            ax.text(0.5, 0.5, "no phone labels: acoustic-only synthesis", transform=ax.transAxes,
-                    ha="center", va="center", fontsize=8, color="#777777")
-        # the boundaries: one line collection per tier (an axvline each was 48 artists, a tenth
-        # of the timeline's first draw), x in data, y in axes coordinates as axvline's
+        if not view.utterance.phones:
+            ax.text(0.5, 0.5 / len(rows), "no phone labels: acoustic-only synthesis",
+                    transform=ax.transAxes, ha="center", va="center", fontsize=8, color="#777777")
+        # the boundaries: one line collection per row, x in data, y in axes coordinates
         across = ax.get_xaxis_transform()
-        phone_top = 1 / ax.get_ylim()[1]
-        for seg in utt.phones:
-            silent = seg.label in ("sil", "", "sp", "pau", "h#")
-            if silent:
-                ax.axvspan(seg.start, seg.end, 0, phone_top, color="#eeeeee", lw=0)
-            ax.text((seg.start + seg.end) / 2, 0.5, seg.label, ha="center", va="center",
-                    fontsize=8, color="#999999" if silent else "black", clip_on=True)
-        if utt.phones:
-            ax.vlines([seg.start for seg in utt.phones], 0, phone_top, transform=across,
-                      color="#888888", lw=0.6)
-        for w in utt.words:
-            ax.text((w.start + w.end) / 2, 1.5, w.label, ha="center", va="center", fontsize=8,
-                    style="italic", clip_on=True)
-        if utt.words:
-            ax.vlines([t for w in utt.words for t in (w.start, w.end)], 0.5, 1, transform=across,
-                      color="#888888", lw=0.6)
-        if utt.words:
-            ax.axhline(1, color="#bbbbbb", lw=0.5)
+        self.labels = []
+        for k, (_name, segments, kind, color) in enumerate(rows):
+            lo, hi = k / len(rows), (k + 1) / len(rows)
+            if kind == "phones":
+                for seg in segments:
+                    if seg.label in SILENT:
+                        ax.axvspan(seg.start, seg.end, lo, hi, color="#eeeeee", lw=0)
+            if segments:
+                ax.vlines(sorted({t for s in segments for t in (s.start, s.end)}), lo, hi,
+                          transform=across, color="#888888", lw=0.6)
+            if k:
+                ax.axhline(k, color="#bbbbbb", lw=0.5)
+            spans = [Span(s.start, s.end, s.label, k + 0.5,
+                          "#999999" if s.label in SILENT else color,
+                          "italic" if kind == "words" else "normal") for s in segments]
+            fitted = FittedLabels(ax, spans, fontsize=8, shorten=kind == "words")
+            ax.add_artist(fitted)
+            self.labels.append(fitted)
 
 
 class LipPanel:
-    """Upper- or lower-lip centre y: original (dotted), spline (dark) and triangular (light)
+    """Upper- or lower-lip centre y: original (dashed), spline (dark) and triangular (light)
     synthesis, and the speech/silence dots on a line through the middle (paper Figure 4); a
-    dashed line marks where the talker's lip is when the lips are closed (the window's
-    ``closed_lips``)."""
+    dashed line marks where the talker's lip is when the lips are closed. ``context`` gives the
+    ``model``, its ``closed_lips`` and the ``pins`` (results kept to compare: their curves in
+    their colours) — the main window, or a plain object for exports."""
 
     height = 1.2
+    min_px = 72.0
+    priority = 100
 
-    def __init__(self, window, which: str):
-        self.window = window
+    def __init__(self, context, which: str):
+        self.context = context
         self.which = which
         self.title = f"{which} lip y"
 
     def marker(self) -> int:
-        model = self.window.model
+        model = self.context.model
         return model.upper_lip if self.which == "upper" else model.lower_lip
 
     def draw(self, ax, view: UtteranceView) -> None:
@@ -204,26 +255,45 @@ class LipPanel:
             orig = view.original[:, k, 1]
             ax.plot(t, orig, color=ORIGINAL_COLOR, lw=1.5, ls=(0, (2, 1.5)), label="original")
             ys.append(orig)
-        closed = getattr(self.window, "closed_lips", None)
+        pins = getattr(self.context, "pins", None)
+        for pin in (pins.shown(view) if pins is not None else []):
+            y = pin.view.shown[:, k, 1]
+            ax.plot(pin.view.times[:len(y)], y, color=pin.color, lw=1.4, ls=(0, (6, 2)),
+                    label=pin.legend(pins.model_name))
+            ys.append(y)
+        closed = getattr(self.context, "closed_lips", None)
         closed_y = float(closed.markers[k, 1]) if closed is not None else None
         extra = [np.array([closed_y])] if closed_y is not None else []
         allv = np.concatenate([y[np.isfinite(y)] for y in ys] + extra)
         lo, hi = float(allv.min()), float(allv.max())
         pad = 0.12 * max(hi - lo, 0.5)
-        top = 0.45 * max(hi - lo, 0.5) if self.which == "upper" else pad   # room for the legend
-        ax.set_ylim(lo - pad, hi + top)
+        ax.set_ylim(lo - pad, hi + pad)          # no room kept for a legend: it is above the panels
         mid = (lo + hi) / 2
         sp = view.speech
         ax.plot(t[sp], np.full(int(sp.sum()), mid), ls="none", marker=".", ms=2.2,
                 color=SPEECH_DOT_COLOR, label="speech frames")
         if closed_y is not None:     # the talker's lip at closure (the middles of /p b m/)
-            ax.axhline(closed_y, color=CLOSED_COLOR, lw=0.9, ls=(0, (6, 3)), zorder=0.5)
-            ax.text(1.0, closed_y, "closed ", transform=ax.get_yaxis_transform(), ha="right",
-                    va="bottom", fontsize=6.5, color=CLOSED_COLOR)
+            ax.axhline(closed_y, color=CLOSED_COLOR, lw=0.9, ls=(0, (6, 3)), zorder=0.5,
+                       label="closed (the talker's /p b m/)")
         fit_ylabel(ax, f"{self.which} lip\ny (mm)")
-        if self.which == "upper":
-            ax.legend(loc="upper right", fontsize=7, ncol=4, frameon=True, framealpha=0.85,
-                      handlelength=2.2, borderpad=0.3)
+
+
+def draw_panel(panel: Panel, ax, view: UtteranceView, last: bool) -> None:
+    """Draw ``panel`` in ``ax`` as the timeline does (the window's and exported figures): its
+    content, its y label fitted, small ticks, the time labels under the last panel only."""
+    ax.tick_params(labelsize=7, length=2)   # first: a panel may size its own tick labels
+    try:
+        panel.draw(ax, view)
+    except Exception:  # a broken panel must not take the window down
+        log.exception("panel %r failed to draw", getattr(panel, "title", panel))
+        ax.text(0.5, 0.5, f"{getattr(panel, 'title', 'panel')}: drawing failed",
+                transform=ax.transAxes, ha="center", va="center", color="red")
+    refit_ylabels([ax])                     # every panel's label placed the same way
+    if last:
+        ax.set_xlabel("time (s)", fontsize=8)
+    else:
+        ax.tick_params(labelbottom=False)
+    ax.grid(axis="x", color="#dddddd", lw=0.5)
 
 
 # ---------------------------------------------------------------------- the timeline
@@ -233,6 +303,7 @@ class Timeline(QWidget):
     seekRequested = pyqtSignal(float)
     loopSelected = pyqtSignal(float, float)
     loopCleared = pyqtSignal()
+    laidOut = pyqtSignal()          # a relayout's panels are built (``hidden``: those left out)
 
     def __init__(self, parent: QWidget | None = None):
         super().__init__(parent)
@@ -240,11 +311,23 @@ class Timeline(QWidget):
         self.figure.set_facecolor("white")
         self.canvas = _Canvas(self.figure)
         self.canvas.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
+        # the legend of every panel's curves, in a row of its own above them (it wraps): never
+        # drawn over the data
+        self.legend_bar = QLabel()
+        self.legend_bar.setWordWrap(True)
+        self.legend_bar.setTextFormat(Qt.TextFormat.RichText)
+        self.legend_bar.setStyleSheet("font-size: 11px; padding: 0px 6px;")
+        self.legend_bar.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Minimum)
         lay = QVBoxLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
+        lay.setSpacing(0)
+        lay.addWidget(self.legend_bar)
         lay.addWidget(self.canvas)
         self.panels: list[Panel] = []
         self.axes: list = []
+        self.shown: list[Panel] = []            # the panels with an axes, in self.axes's order
+        self.hidden: list[Panel] = []           # left out for lack of room (panel_layout)
+        self.legend: list = []                  # the legend row's entries (panel_layout.LegendEntry)
         self.view: UtteranceView | None = None
         self.cursor_time = 0.0
         self.loop: tuple[float, float] | None = None
@@ -282,11 +365,19 @@ class Timeline(QWidget):
         self.relayout(xlim)
 
     def axes_of(self, panel: Panel):
-        """The matplotlib axes a panel was drawn in (None before the first layout)."""
+        """The matplotlib axes a panel was drawn in (None before the first layout, or while it is
+        left out for lack of room)."""
         try:
-            return self.axes[self.panels.index(panel)]
+            return self.axes[self.shown.index(panel)]
         except (ValueError, IndexError):
             return None
+
+    def _heights(self, panels: list[Panel]) -> list[float | None]:
+        """Each panel's height in pixels at the figure's present size (None: left out)."""
+        fig = self.figure
+        room = fig.get_figheight() * fig.dpi - BOTTOM_MARGIN_PX - TOP_MARGIN_PX
+        return fit_heights([p.height for p in panels], [panel_min_px(p) for p in panels],
+                           [panel_priority(p) for p in panels], room)
 
     @property
     def building(self) -> bool:
@@ -338,24 +429,26 @@ class Timeline(QWidget):
                 ax.remove()                     # first: 70 ms for eight panels)
                 yield
             fig.clear()
-            self.axes, self._spans, self._cursor = [], [], None
+            self.axes, self.shown, self.hidden, self._spans, self._cursor = [], [], [], [], None
             self._bg = None
             panels = list(self.panels)
             if not panels or self.view is None:
                 return
             yield
-            left, bottom = self._margins()
-            grid = fig.add_gridspec(len(panels), 1, height_ratios=[p.height for p in panels],
-                                    left=left, right=0.99, top=0.985, bottom=bottom, hspace=0.09)
+            heights = self._heights(panels)
+            self.shown = [p for p, h in zip(panels, heights, strict=True) if h is not None]
+            self.hidden = [p for p, h in zip(panels, heights, strict=True) if h is None]
+            grid = fig.add_gridspec(len(self.shown), 1, height_ratios=[h for h in heights if h is not None])
             self._grid = grid
+            self._place_grid([h for h in heights if h is not None])
             first = None
-            for i, panel in enumerate(panels):
+            for i, panel in enumerate(self.shown):
                 ax = fig.add_subplot(grid[i, 0], sharex=first)
                 first = first or ax
-                self._draw_panel(panel, ax, last=i == len(panels) - 1)
+                draw_panel(panel, ax, self.view, last=i == len(self.shown) - 1)
                 self.axes.append(ax)
                 yield
-            self.axes[-1].set_xlabel("time (s)", fontsize=8)
+            self._show_legend()
             # animated: left out of full draws, drawn over the saved background (_on_draw, set_cursor)
             self._cursor = Line2D([], [], color=CURSOR_COLOR, lw=1.2, animated=True,
                                   transform=IdentityTransform())
@@ -365,37 +458,54 @@ class Timeline(QWidget):
         finally:
             self.canvas.release()
 
-    def _margins(self) -> tuple[float, float]:
-        """The left and bottom margins as fractions of the figure: fixed in pixels (the y labels
-        and tick labels; the time axis), whatever the size."""
+    def _place_grid(self, heights: list[float]) -> None:
+        """The panels' grid in pixels: the margins (the y labels and tick labels; the time axis)
+        and the gaps fixed whatever the size, each panel its height of ``heights``."""
         fig = self.figure
-        return (min(0.3, LABEL_MARGIN_PX / max(fig.get_figwidth() * fig.dpi, 1.0)),
-                min(0.3, BOTTOM_MARGIN_PX / max(fig.get_figheight() * fig.dpi, 1.0)))
+        width, height = max(fig.get_figwidth() * fig.dpi, 1.0), max(fig.get_figheight() * fig.dpi, 1.0)
+        mean = max(sum(heights) / max(len(heights), 1), 1.0)
+        self._grid.set_height_ratios(heights)
+        self._grid.update(left=min(0.3, LABEL_MARGIN_PX / width), right=1 - min(0.05, 8 / width),
+                          top=1 - min(0.05, TOP_MARGIN_PX / height),
+                          bottom=min(0.3, BOTTOM_MARGIN_PX / height), hspace=GAP_PX / mean)
+
+    def _show_legend(self) -> None:
+        """The legend row: every named curve of the panels (their in-axes legends taken out),
+        and the panels left out for lack of room (nothing once the window is gone: a relayout's
+        last step may come after it)."""
+        if sip.isdeleted(self) or sip.isdeleted(self.legend_bar):
+            return
+        for ax in self.axes:
+            if ax.get_legend() is not None:
+                ax.get_legend().remove()
+        self.legend = legend_entries(self.axes)
+        note = f"no room for: {', '.join(p.title for p in self.hidden)}" if self.hidden else ""
+        self.legend_bar.setText(legend_html(self.legend, note))
+        self.legend_bar.setVisible(bool(self.legend or note))
+        self.laidOut.emit()
+
+    def needed_height(self) -> float:
+        """The height (px) the timeline needs to show every panel at its least readable height,
+        with its margins and legend row."""
+        panels = self.panels
+        return (sum(panel_min_px(p) for p in panels) + GAP_PX * max(len(panels) - 1, 0)
+                + BOTTOM_MARGIN_PX + TOP_MARGIN_PX
+                + (self.legend_bar.sizeHint().height() if self.legend_bar.isVisible() else 0))
 
     def _fit_to_size(self) -> None:
-        """After a resize: the margins in pixels and every y label fitted again (they were
-        fractions of the size the figure was built at: a narrower timeline cut "upper lip" off
-        its label)."""
+        """After a resize: the panels' heights and margins in pixels and every y label fitted
+        again (they were fractions of the size the figure was built at: a narrower timeline cut
+        "upper lip" off its label); a relayout when the panels left out change."""
         if self._grid is None or not self.axes:
             return
-        left, bottom = self._margins()
-        self._grid.update(left=left, bottom=bottom)
+        heights = self._heights(self.panels)
+        if [p for p, h in zip(self.panels, heights, strict=True) if h is not None] != self.shown:
+            self.relayout(self.xlim(), soon=True)
+            return
+        self._place_grid([h for h in heights if h is not None])
         for ax in self.axes:            # (GridSpec.update moves only pyplot's figures' axes)
             ax.set_position(ax.get_subplotspec().get_position(self.figure))
         refit_ylabels(self.axes)
-
-    def _draw_panel(self, panel: Panel, ax, last: bool) -> None:
-        try:
-            panel.draw(ax, self.view)
-        except Exception:  # a broken panel must not take the window down
-            log.exception("panel %r failed to draw", getattr(panel, "title", panel))
-            ax.text(0.5, 0.5, f"{getattr(panel, 'title', 'panel')}: drawing failed",
-                    transform=ax.transAxes, ha="center", va="center", color="red")
-        refit_ylabels([ax])                     # every panel's label placed the same way
-        ax.tick_params(labelsize=7, length=2)
-        if not last:
-            ax.tick_params(labelbottom=False)
-        ax.grid(axis="x", color="#dddddd", lw=0.5)
 
     def _draw_loop_spans(self) -> None:
         for s in self._spans:

@@ -1,5 +1,7 @@
-"""Video export: the 3-D face (points and the app's face surface) beside the lip trajectories
-and the phones, with the speech muxed in; one legend over both halves.
+"""Video export: the 3-D face (points and the app's face surface) beside the window's lip panels
+and phones (``app/screen_export.py``: the same curves, closed lines, speech dots and pins), with
+the speech muxed in; a caption naming the utterance, its labels and its settings, and one
+legend over both halves.
 
 Rendering is off screen (``pyvista.Plotter(off_screen=True)`` and matplotlib's Agg canvas), so
 it runs without a window; frames go to the ffmpeg binary shipped by ``imageio-ffmpeg`` as H.264
@@ -24,15 +26,16 @@ from facetraj_engine.io.files import atomic_write
 from facetraj_engine.method.model import Model
 from facetraj_engine.method.pipeline import Synthesis
 
-from .style import BACKGROUND, CURSOR_COLOR, ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
+from .style import BACKGROUND, CURSOR_COLOR, ORIGINAL_COLOR, SYNTH_COLOR
 from .surface import Mouth, face_triangles, lip_contours
 from .view3d import CAMERA_PRESETS, MarkerSet
 
 log = logging.getLogger(__name__)
 
-HEADER_HEIGHT = 56          # px: the band over both halves with the title and the legend
-PANEL_LEFT_PX = 76          # px left of the lip panels: their tick labels and two-line y labels
-TIER_SHARE = 0.16           # of the lip panels' height: the phone tier under them
+CAPTION_PT = 10.0           # the caption's size in the header band over both halves
+#: the legend's look under it
+HEADER_LEGEND = dict(fontsize=8.5, frameon=False, borderaxespad=0.0, borderpad=0.2,
+                     handlelength=2.0, columnspacing=1.0, handletextpad=0.5)
 
 
 @dataclass(frozen=True)
@@ -56,9 +59,9 @@ class VideoLayout:
     height: int
     scene: Box                  # the 3-D face
     legend: Box                 # the legend (explains both halves)
-    title: Box | None           # the utterance's text (None without a title)
+    title: Box | None           # the caption (None without one)
     lips: tuple[Box, Box]       # upper and lower lip y panels
-    tier: Box                   # the phone tier under the lip panels
+    tier: Box                   # the phone tier over the lip panels (as in the window)
     phone_labels: tuple[Box, ...]   # each phone label drawn in the tier
 
 
@@ -68,134 +71,76 @@ def _box(bbox, fig_height: float, dx: int = 0, dy: int = 0) -> Box:
             int(np.ceil(bbox.x1)) + dx, int(np.ceil(fig_height - bbox.y0)) + dy)
 
 
-def _header(width: int, height: int, title: str, original: bool, surface: bool):
-    """The band over the frame: the utterance's text on the left, one legend on the right that
-    explains both halves (the point colours of the 3-D face and the curves of the lip panels).
-    Returns (RGB image, title box or None, legend box)."""
+def _header(width: int, caption: str, entries) -> tuple[np.ndarray, Box | None, Box]:
+    """The band over the frame: the caption (the utterance, its labels, how it was synthesized)
+    wrapped on top, and under it one legend that explains both halves (the point colours of the
+    3-D face and the curves of the lip panels) in as many columns as fit. Its height follows
+    what it holds. Returns (RGB image, caption box or None, legend box)."""
+    import textwrap
+
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
 
+    from .panel_layout import legend_handles
+    from .screen_export import fitting_columns
+
+    px = 100 / 72.0
+    lines = textwrap.wrap(caption, max(20, int(width / (0.55 * CAPTION_PT * px)))) if caption else []
+    caption_h = len(lines) * 1.3 * CAPTION_PT * px + (4 if lines else 0)
+    ncol = fitting_columns(Figure(figsize=(width / 100, 1), dpi=100), entries, width - 12,
+                           HEADER_LEGEND)
+    rows = -(-len(entries) // ncol)
+    height = int(np.ceil(8 + caption_h + rows * 1.45 * HEADER_LEGEND["fontsize"] * px + 6))
+    height += height % 2
     fig = Figure(figsize=(width / 100, height / 100), dpi=100, facecolor="white")
     canvas = FigureCanvasAgg(fig)
-    handles = []
-    if original:
-        handles.append(Line2D([], [], color=ORIGINAL_COLOR, ls=":", lw=1.5, marker="o", ms=7,
-                              label="original"))
-    handles.append(Line2D([], [], color=SYNTH_COLOR, lw=1.5, marker="o", ms=7, label="synthesized"))
-    if surface:
-        handles.append(Patch(facecolor=SURFACE_COLOR, edgecolor="#9a7b62",
-                             label="face surface (synthesized)"))
-    legend = fig.legend(handles=handles, loc="center right", ncol=len(handles), fontsize=10,
-                        frameon=True, borderaxespad=0.5, handlelength=2.6)
+    text = (fig.text(6 / width, 1 - 6 / height, "\n".join(lines), ha="left", va="top",
+                     fontsize=CAPTION_PT, color="#222222") if lines else None)
+    legend = fig.legend(handles=legend_handles(entries), ncol=ncol, loc="upper left",
+                        bbox_to_anchor=(6 / width, 1 - (8 + caption_h) / height), **HEADER_LEGEND)
     canvas.draw()
     renderer = canvas.get_renderer()
-    title_box = None
-    if title:
-        text = fig.text(0.01, 0.5, title, fontsize=11, va="center", ha="left")
-        room = legend.get_window_extent(renderer).x0 - 0.02 * width
-        if text.get_window_extent(renderer).width > room:
-            # no room beside the legend: the title on a top row, the legend on a row under it
-            legend.set_loc("lower right")
-            legend.set_bbox_to_anchor((1.0, 0.0), transform=fig.transFigure)
-            for item in legend.get_texts():
-                item.set_fontsize(9)
-            text.set_fontsize(10)
-            text.set_y(0.75)
-            room = 0.98 * width
-            shown = title
-            while text.get_window_extent(renderer).width > room and len(shown) > 4:
-                shown = shown[:-2]
-                text.set_text(shown.rstrip() + "…")
-        canvas.draw()
-        title_box = _box(text.get_window_extent(renderer), height)
+    title_box = _box(text.get_window_extent(renderer), height) if text is not None else None
     legend_box = _box(legend.get_window_extent(renderer), height)
     image = np.asarray(canvas.buffer_rgba())[:height, :width, :3].copy()
     return image, title_box, legend_box
 
 
 class _LipPanels:
-    """Upper and lower lip y with a phone tier under them, on an Agg canvas; a moving cursor is
-    blitted over a background drawn once."""
+    """The window's phone tier and upper and lower lip panels (``screen_export.panels_figure``:
+    the same curves, closed lines, speech dots, phones and pins) on an Agg canvas; a moving
+    cursor is blitted over a background drawn once."""
 
-    def __init__(self, model: Model, times: np.ndarray, synth: np.ndarray,
-                 original: np.ndarray | None, phones: Sequence[PhoneSegment] | None,
-                 width: int, height: int):
+    def __init__(self, view, context, width: int, height: int):
         from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from matplotlib.figure import Figure
+
+        from .screen_export import main_panels, panels_figure
 
         self.width, self.height = width, height
-        self.fig = Figure(figsize=(width / 100, height / 100), dpi=100, facecolor="white")
+        self.panels = main_panels(context)
+        # a small frame's panels as small as they can be read (a 640 x 320 video keeps both lips)
+        self.fig, self.layout = panels_figure(self.panels, view, (width, height), legend=False,
+                                              min_scale=float(np.clip(height / 420, 0.45, 1.0)))
         self.canvas = FigureCanvasAgg(self.fig)
-        grid = self.fig.add_gridspec(3, 1, height_ratios=[(1 - TIER_SHARE) / 2] * 2 + [TIER_SHARE],
-                                     hspace=0.12, left=PANEL_LEFT_PX / width, right=0.97,
-                                     top=0.97, bottom=44 / height)
-        upper = self.fig.add_subplot(grid[0])
-        lower = self.fig.add_subplot(grid[1], sharex=upper)
-        tier = self.fig.add_subplot(grid[2], sharex=upper)
-        self.axes = (upper, lower, tier)
-        self.cursors = []
-        for ax, idx, name in ((upper, model.upper_lip, "upper lip\ny (mm)"),
-                              (lower, model.lower_lip, "lower lip\ny (mm)")):
-            if original is not None:
-                ax.plot(times, original[:, idx, 1], color=ORIGINAL_COLOR, lw=1.5, ls=":")
-            ax.plot(times, synth[:, idx, 1], color=SYNTH_COLOR, lw=1.5)
-            ax.set_ylabel(name, fontsize=9)
-            ax.tick_params(labelsize=8, labelbottom=False)
-            ax.grid(alpha=0.3)
-        upper.set_xlim(times[0], times[-1])
-        self.phone_texts = self._draw_tier(tier, phones or [], times)
-        for ax in self.axes:
-            self.cursors.append(ax.axvline(times[0], color=CURSOR_COLOR, lw=1.2, animated=True))
-        self.canvas.draw()
-        self._hide_crowded_labels()
+        self.cursors = [ax.axvline(view.times[0], color=CURSOR_COLOR, lw=1.2, animated=True)
+                        for ax in self.layout.axes]
         self.canvas.draw()
         self.background = self.canvas.copy_from_bbox(self.fig.bbox)
 
-    @staticmethod
-    def _draw_tier(ax, phones: Sequence[PhoneSegment], times: np.ndarray) -> list:
-        ax.set_yticks([])
-        ax.set_ylim(0, 1)
-        ax.set_ylabel("phones", fontsize=9, rotation=0, ha="right", va="center")
-        ax.tick_params(labelsize=8)
-        ax.set_xlabel("time (s)", fontsize=9)
-        texts = []
-        if not phones:
-            texts.append(ax.text(0.5, 0.5, "no phone labels (acoustic-only synthesis)",
-                                 transform=ax.transAxes, ha="center", va="center", fontsize=9,
-                                 color="#555555"))
-            return texts
-        for k, seg in enumerate(phones):
-            if seg.end <= times[0] or seg.start >= times[-1]:
-                continue
-            ax.axvspan(seg.start, seg.end, color="#e9ecef" if k % 2 else "#f8f9fa", lw=0)
-            ax.axvline(seg.start, color="#adb5bd", lw=0.6)
-            if seg.label != "sil":
-                mid = (max(seg.start, times[0]) + min(seg.end, times[-1])) / 2
-                texts.append(ax.text(mid, 0.5, seg.label, ha="center", va="center", fontsize=9,
-                                     clip_on=True))
-        return texts
+    def entries(self):
+        """The legend entries of the panels' curves."""
+        from .panel_layout import legend_entries
 
-    def _hide_crowded_labels(self) -> None:
-        """A phone label wider than its segment, or overlapping the one before, is not drawn
-        (short phones at a long file's scale): the tier shows no overlapping text."""
-        renderer = self.canvas.get_renderer()
-        tier_box = self.axes[2].get_window_extent(renderer)
-        last_right = -np.inf
-        for t in self.phone_texts:
-            bb = t.get_window_extent(renderer)
-            inside = bb.x0 >= tier_box.x0 and bb.x1 <= tier_box.x1
-            if not inside or bb.x0 < last_right + 2:
-                t.set_visible(False)
-            else:
-                last_right = bb.x1
+        return legend_entries(self.layout.axes)
 
     def boxes(self, dx: int, dy: int) -> tuple[tuple[Box, Box], Box, tuple[Box, ...]]:
         renderer = self.canvas.get_renderer()
-        up, lo, tier = (_box(ax.get_window_extent(renderer), self.height, dx, dy) for ax in self.axes)
-        labels = tuple(_box(t.get_window_extent(renderer), self.height, dx, dy)
-                       for t in self.phone_texts if t.get_visible())
+        axes = dict(zip([p.title for p in self.layout.shown], self.layout.axes, strict=True))
+        up, lo, tier = (_box(axes[name].get_window_extent(renderer), self.height, dx, dy)
+                        for name in ("upper lip y", "lower lip y", "phones"))
+        tier_panel = self.panels[0]
+        labels = tuple(_box(extent, self.height, dx, dy) for fitted in tier_panel.labels[:1]
+                       for _text, extent, _span in fitted.drawn)
         return (up, lo), tier, labels
 
     def image(self, t: float) -> np.ndarray:
@@ -219,31 +164,70 @@ def _fit_camera(plotter, neutral: np.ndarray, planar: bool) -> None:
 
 
 class VideoFrames:
-    """The frames of a video: a header with the utterance's text and the legend, the 3-D face (the
-    app's face surface under the synthesized points, the original points over it) on the left,
-    and the lip panels with the phone tier on the right. ``frame(t)`` is the RGB image at time
-    ``t``; ``layout`` says where each part is. Call ``close()`` when done."""
+    """The frames of a video: a header with the caption (the utterance, its labels, how it was
+    synthesized) and one legend, the 3-D face (the app's face surface under the synthesized
+    points, the original points over it) on the left, and on the right the window's phone tier
+    and lip panels (the same curves, closed lines, speech dots and pinned results as on screen).
+    ``frame(t)`` is the RGB image at time ``t``; ``layout`` says where each part is. Call
+    ``close()`` when done.
+
+    ``view``: the window's :class:`~facetraj_app.state.UtteranceView` (else made of
+    ``synthesis``, ``audio`` and ``phones``); ``pins``: the window's
+    :class:`~facetraj_app.pins.PinBoard`; ``caption``: else made of ``title`` and the settings."""
 
     def __init__(self, model: Model, synthesis: Synthesis, original: np.ndarray | None = None,
                  phones: Sequence[PhoneSegment] | None = None, settings: VideoSettings | None = None,
-                 title: str = ""):
-        import pyvista as pv
+                 title: str = "", *, audio: np.ndarray | None = None, sample_rate: int = 16000,
+                 view=None, pins=None, caption: str = ""):
+        from .pins import PinBoard
+        from .provenance import settings_text
+        from .screen_export import CAPTION_SEPARATOR, PanelContext, point_entries
+        from .state import view_of_synthesis
 
         settings = settings or VideoSettings()
-        self.model, self.synthesis, self.original = model, synthesis, original
+        view = view or view_of_synthesis(model, synthesis, audio, sample_rate, phones or (),
+                                         original, text=title)
+        self.model, self.view = model, view
+        self.synthesis, self.original = view.synthesis, view.original
         width = settings.width - settings.width % 16
         height = settings.height - settings.height % 16
-        if height < HEADER_HEIGHT + 240 or width < 640:
+        context = PanelContext(model, closed_lips(model), pins if pins is not None else PinBoard())
+        shown_pins = context.pins.shown(view)
+        caption = caption or CAPTION_SEPARATOR.join(([title] if title else [])
+                                                    + [f"synthesized: {settings_text(view)}"])
+        if width < 640:
             raise ValueError(f"video size {settings.width}x{settings.height} is too small "
                              "(at least 640x304)")
         half = width // 2
-        body = height - HEADER_HEIGHT
-        self.size = (width, height)
+        self._half = half
+        self._scene(model, half, view.original is not None)
+        entries = point_entries(view.original is not None)
+        header_h = _header(width, caption, entries)[0].shape[0]        # the panels' entries below
+        body = height - header_h
+        if body < 240:
+            raise ValueError(f"video size {settings.width}x{settings.height} is too small "
+                             "(at least 640x304)")
+        self.panels = _LipPanels(view, context, width - half, body)
+        header, title_box, legend_box = _header(width, caption, entries + self.panels.entries())
+        if header.shape[0] != header_h:            # more legend rows: the panels a little lower
+            body = height - header.shape[0]
+            self.panels = _LipPanels(view, context, width - half, body)
+        self.header, self.size, self._body = header, (width, height), body
+        self.plotter.window_size = (half, body)
+        lips, tier, labels = self.panels.boxes(half, header.shape[0])
+        self.layout = VideoLayout(width, height, (0, header.shape[0], half, height), legend_box,
+                                  title_box, lips, tier, labels)
+        self.pins = shown_pins
+
+    def _scene(self, model: Model, half: int, original: bool) -> None:
+        """The off-screen 3-D scene: the synthesized face with its surface, mouth and lip
+        contours, and the original points over it."""
+        import pyvista as pv
 
         neutral = model.neutral_face()
         contours = lip_contours(neutral, model.upper_lip, model.lower_lip, list(model.lip_corners))
         triangles = face_triangles(neutral, contours)
-        self.plotter = pv.Plotter(off_screen=True, window_size=(half, body))
+        self.plotter = pv.Plotter(off_screen=True, window_size=(half, 300))
         self.plotter.set_background(BACKGROUND)
         self.plotter.remove_all_lights()
         self.plotter.add_light(pv.Light(light_type="headlight", intensity=0.75))
@@ -253,32 +237,21 @@ class VideoFrames:
         self.synth_set = MarkerSet(self.plotter, "synthesized", SYNTH_COLOR, neutral, contours,
                                    triangles, mouth)
         self.orig_set = None
-        if original is not None:
+        if original:
             self.orig_set = MarkerSet(self.plotter, "original", ORIGINAL_COLOR, neutral, contours, None)
         _fit_camera(self.plotter, neutral, model.is_planar)
-
-        header, title_box, legend_box = _header(width, HEADER_HEIGHT, title, original is not None,
-                                                len(triangles) > 0)
-        self.header = header
-        self.panels = _LipPanels(model, synthesis.times, synthesis.markers, original, phones,
-                                 width - half, body)
-        lips, tier, labels = self.panels.boxes(half, HEADER_HEIGHT)
-        self.layout = VideoLayout(width, height, (0, HEADER_HEIGHT, half, height), legend_box,
-                                  title_box, lips, tier, labels)
-        self._half = half
 
     def frame(self, t: float) -> np.ndarray:
         """The RGB frame ``(height, width, 3)`` at ``t`` seconds."""
         times = self.synthesis.times
         f = int(np.clip(round(t * self.model.marker_rate), 0, len(times) - 1))
-        self.synth_set.set_points(self.synthesis.markers[f])
+        self.synth_set.set_points(self.view.shown[f])
         if self.orig_set is not None:
             pts = self.original[min(f, len(self.original) - 1)]
             if np.isfinite(pts).all():       # a frame with a marker not seen keeps the last one
                 self.orig_set.set_points(pts)
         self.plotter.render()
-        body = self.size[1] - HEADER_HEIGHT
-        left = np.asarray(self.plotter.screenshot(return_img=True))[:body, :self._half, :3]
+        left = np.asarray(self.plotter.screenshot(return_img=True))[:self._body, :self._half, :3]
         right = self.panels.image(t)
         return np.ascontiguousarray(
             np.concatenate([self.header, np.concatenate([left, right], axis=1)], axis=0))
@@ -291,11 +264,13 @@ def render_video(model: Model, synthesis: Synthesis, audio: np.ndarray, sample_r
                  path: str | os.PathLike[str], original: np.ndarray | None = None,
                  settings: VideoSettings | None = None, overwrite: bool = False,
                  progress: Callable[[float, str], None] | None = None,
-                 title: str = "", phones: Sequence[PhoneSegment] | None = None) -> Path:
+                 title: str = "", phones: Sequence[PhoneSegment] | None = None,
+                 view=None, pins=None, caption: str = "") -> Path:
     """Write an MP4 (H.264 + AAC) of the synthesized (and original) face points and lip panels.
 
     ``original`` is the head-normalised original ``(T, M, 3)`` or ``None``; ``phones`` the phone
-    segments shown in the tier under the lip panels (none: the tier says so).
+    segments shown in the tier over the lip panels (none: the tier says so). From the window:
+    its ``view``, ``pins`` and ``caption`` (what is on screen; :class:`VideoFrames`).
     """
     import imageio_ffmpeg
 
@@ -305,7 +280,8 @@ def render_video(model: Model, synthesis: Synthesis, audio: np.ndarray, sample_r
     if path.exists() and not overwrite:
         raise FileExistsError(f"{path}: already exists; choose to overwrite it (--overwrite) "
                               "or give another name")
-    frames = VideoFrames(model, synthesis, original, phones, settings, title)
+    frames = VideoFrames(model, synthesis, original, phones, settings, title, audio=audio,
+                         sample_rate=sample_rate, view=view, pins=pins, caption=caption)
     n_video = int(np.floor(synthesis.times[-1] * settings.fps)) + 1
     try:
         with tempfile.TemporaryDirectory() as tmpdir:

@@ -120,27 +120,32 @@ class MarkerSet:
             self._add_cavity(plotter, name, vertices)
 
     def _add_cavity(self, plotter: pv.BasePlotter, name: str, vertices: np.ndarray) -> None:
-        """A dark backing behind the mouth opening (a fan over its outline, moved CAVITY_DEPTH_MM
-        straight back and a little wider than it): an open mouth shows dark, a closed one skin,
-        instead of the background through a hole."""
+        """A dark pouch behind the mouth opening: walls from the opening's outline back to a
+        wider outline CAVITY_DEPTH_MM behind it, closed at the back. Whatever the angle, a line
+        of sight through an open mouth ends on it (dark), never on the background (a backing
+        behind the opening alone left a see-through sliver at the far corner in the ¾ view);
+        a closed mouth shows skin."""
         self._cavity_loop = self.mouth.opening_loop(self.n_markers)
         n = len(self._cavity_loop)
-        faces = np.column_stack([np.full(n, 3), np.full(n, n), np.arange(n),
-                                 (np.arange(n) + 1) % n]).ravel()
+        i, j = np.arange(n), (np.arange(n) + 1) % n
+        walls = np.concatenate([np.column_stack([i, j, n + j]), np.column_stack([i, n + j, n + i])])
+        back = np.column_stack([np.full(n, 2 * n), n + i, n + j])
+        tri = np.concatenate([walls, back])
+        faces = np.column_stack([np.full(len(tri), 3), tri]).ravel()
         self.cavity = pv.PolyData(self._cavity_points(vertices - self._inset), faces=faces)
         self.cavity_actor = plotter.add_mesh(self.cavity, color=CAVITY_COLOR, name=f"{name}-mouth",
                                              reset_camera=False, pickable=False, lighting=False,
                                              render=False)
 
     def _cavity_points(self, surface: np.ndarray) -> np.ndarray:
-        """The backing's outline and centre for the surface's vertices ``surface``: the opening
-        moved back (z is forward), a tenth wider and twice as tall about its centre (behind
-        the lips: the opaque surface hides what is not behind the opening)."""
+        """The pouch's points for the surface's vertices ``surface``: the opening's outline as
+        it is, the same moved back (z is forward), a tenth wider and twice as tall about its
+        centre, and the centre of the back."""
         loop = surface[self._cavity_loop]
         centre = loop.mean(axis=0)
-        out = centre + (loop - centre) * [1.1, 2.0, 1.0]    # taller: it fills the opening seen
-        out[:, 2] = loop[:, 2] - CAVITY_DEPTH_MM             # from above or below too
-        return np.vstack([out, centre - [0.0, 0.0, CAVITY_DEPTH_MM]])
+        back = centre + (loop - centre) * [1.1, 2.0, 1.0]
+        back[:, 2] = loop[:, 2] - CAVITY_DEPTH_MM
+        return np.vstack([loop, back, centre - [0.0, 0.0, CAVITY_DEPTH_MM]])
 
     def set_points(self, pts: np.ndarray) -> None:
         """Move the markers (and their lip lines and surface) to ``pts``, in place: the same
@@ -192,6 +197,9 @@ class FaceView(QWidget):
         self.preset = "three-quarter"
         self._orig = self._syn = None
         self._offset = np.zeros(3)
+        self.pins: list = []                    # the pinned results shown (app/pins.py: Pin)
+        self._pin_sets: dict[str, MarkerSet] = {}   # by colour: made once, reused
+        self._pin_frames: list[np.ndarray] = []
         self._hover_name = ""
         self.plotter.iren.add_observer("MouseMoveEvent", self._on_mouse_move)
 
@@ -214,6 +222,8 @@ class FaceView(QWidget):
         tri = stored_face_triangles(neutral, self.contours)
         closed = closed if closed is not None else closed_lips(model)
         mouth = Mouth.between(neutral, self.contours, closed.markers) if self.closed_mouth else None
+        self._tri, self._mouth = tri, mouth     # the pinned faces' too
+        self._pin_sets = {}
         self.synth = MarkerSet(self.plotter, "synthesized", SYNTH_COLOR, neutral, self.contours, tri,
                                mouth)
         # the original markers have a surface too: shown when the synthesized ones are hidden
@@ -234,14 +244,45 @@ class FaceView(QWidget):
         self._update_visibility()
         self.frame = -1
 
+    def set_pins(self, pins: list) -> None:
+        """Show ``pins`` (results kept to compare, ``app/pins.py``: each with its ``view`` and
+        ``color``) beside the current face, each with its surface and lips, in its colour."""
+        if self.synth is None:
+            return
+        refit = len(pins) != len(self.pins)         # the faces' row changed: the camera fits it
+        self.pins = list(pins)
+        for pin in self.pins:
+            if pin.color not in self._pin_sets:
+                self._pin_sets[pin.color] = MarkerSet(self.plotter, f"pin-{pin.color}", pin.color,
+                                                      self.neutral, self.contours, self._tri,
+                                                      self._mouth)
+        for pin in self.pins:
+            self._pin_sets[pin.color].name = pin.name     # the hover's "UL_C (pin 1)"
+        self._pin_frames = [_fill_nan(p.view.shown, self.neutral) for p in self.pins]
+        self._update_visibility()
+        if self.frame >= 0:
+            self._move_points(self.frame)
+        if refit:
+            self.set_camera(self.preset)
+        else:
+            self.request_render()
+
+    def _pin_offset(self, i: int) -> np.ndarray:
+        """Where pin ``i``'s face goes: beside the synthesized face, to the talker's left."""
+        return self._offset + (i + 1) * 2 * self._half_gap
+
     def _update_visibility(self) -> None:
         self.ahead = -1
         if self.synth is None:
             return
+        shown = {p.color for p in self.pins}
+        for color, mset in self._pin_sets.items():
+            mset.set_visible(color in shown, self.show_surface)
         has_orig = self._orig is not None or self.view is None
-        # one surface: the synthesized face's, or the original's when only it is shown
+        # overlaid, one surface: the synthesized face's, or the original's when only it is
+        # shown; side by side, each face its own (closure compared face to face)
         self.original.set_visible(self.show_original and has_orig,
-                                  self.show_surface and not self.show_synth)
+                                  self.show_surface and (not self.show_synth or self.side_by_side))
         self.synth.set_visible(self.show_synth, self.show_surface)
         self._offset = self._half_gap if (self.side_by_side and has_orig) else np.zeros(3)
 
@@ -277,6 +318,8 @@ class FaceView(QWidget):
         self.synth.set_points(self._syn[k] + self._offset)
         if self._orig is not None:
             self.original.set_points(self._orig[min(k, len(self._orig) - 1)] - self._offset)
+        for i, (pin, frames) in enumerate(zip(self.pins, self._pin_frames, strict=True)):
+            self._pin_sets[pin.color].set_points(frames[min(k, len(frames) - 1)] + self._pin_offset(i))
 
     def request_render(self) -> None:
         """One render of the changed scene: at once in a native window (it swaps only its own
@@ -319,6 +362,7 @@ class FaceView(QWidget):
         d = np.asarray(direction, float)
         d /= np.linalg.norm(d)
         pts = [self.neutral + self._offset, self.neutral - self._offset]
+        pts += [self.neutral + self._pin_offset(i) for i in range(len(self.pins))]
         allp = np.concatenate(pts)
         centre = (allp.min(axis=0) + allp.max(axis=0)) / 2
         self.plotter.camera_position = [tuple(centre + 400 * d), tuple(centre), up]
@@ -348,7 +392,9 @@ class FaceView(QWidget):
         if self.model is None:
             return None
         best, label = radius, None
-        for mset, visible in ((self.synth, self.show_synth), (self.original, self.show_original)):
+        pinned = [(self._pin_sets[p.color], True) for p in self.pins]
+        for mset, visible in ((self.synth, self.show_synth), (self.original, self.show_original),
+                              *pinned):
             if mset is None or not visible or not mset.actor.GetVisibility():
                 continue
             d = np.linalg.norm(self._project(mset.current) - np.array([x, y]), axis=1)

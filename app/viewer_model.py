@@ -30,11 +30,12 @@ from facetraj_engine.evaluation.scores import evaluate_utterance
 from facetraj_engine.io.corpus import Corpus, held_transcript, label_source
 from facetraj_engine.io.labelfiles import LABEL_SUFFIXES
 from facetraj_engine.method.model import Model
-from facetraj_engine.method.modes import MODES, choose_mode
+from facetraj_engine.method.modes import choose_mode
 from facetraj_engine.progress import Progress
 
 from .phases import mark
-from .provenance import LabelOrigin, search_key, search_title
+from .pins import PinBoard
+from .provenance import LabelOrigin, search_key, settings_text
 from .state import UtteranceView, build_view
 
 log = logging.getLogger(__name__)
@@ -100,12 +101,14 @@ class ViewerModel:
     request: SynthRequest | None = None      # the latest utterance asked for
     generation: int = 0
     mode_chosen: bool = False                # the user picked a search mode in the settings
+    pins: PinBoard = field(default_factory=PinBoard)   # results kept to compare (app/pins.py)
 
     # ------------------------------------------------------------------ corpus and model
     def set_model(self, corpus: Corpus, model: Model, texts: dict[str, str]) -> str | None:
         """Use a newly loaded corpus and model: forget the view, the request and the utterances
         opened from files. Returns the utterance to show first (the one asked for, or the default)."""
         self.corpus, self.model, self.texts = corpus, model, texts
+        self.pins.set_model(Path(corpus.root).name, model.marker_names)   # pins are kept
         self.external.clear()
         self.external_origin.clear()
         self.view = None
@@ -253,20 +256,19 @@ class ViewerModel:
         return [(s, u) for s in ("test", "train") for u in getattr(info, s)]
 
 
-SMOOTHING_NAMES = {"triangular": "triangular", "spline": "spline", "none": "unsmoothed"}
+def view_heading(view: UtteranceView) -> str:
+    """What is shown: the utterance, its split and its sentence (not for recognized labels: the
+    sentence is not what they say)."""
+    utt = view.utterance
+    text = f" — “{utt.text}”" if utt.text and view.label_origin.source != "recognized" else ""
+    return f"{utt.name} ({view.split}){text}"
 
 
 def view_title(view: UtteranceView) -> str:
-    """The title over the panels: utterance, split, text, how the 3-D synthesis was made (the
-    search the synthesis used, ``Synthesis.config``) and where the labels came from. The text of
-    recognized labels is not shown: it is not what they say."""
-    utt, cfg = view.utterance, view.synthesis.config
-    origin = view.label_origin
-    text = f" — “{utt.text}”" if utt.text and origin.source != "recognized" else ""
-    n = f", N={cfg.n_context_phones}" if MODES[cfg.mode].needs_labels else ""
-    dims = "2-D" if np.nanmax(np.abs(view.shown[..., 0]), initial=0.0) < 1e-9 else "3-D"  # midsagittal
-    return (f"{utt.name} ({view.split}){text}    ·    {dims}: {SMOOTHING_NAMES[cfg.smoothing]} "
-            f"synthesis, {search_title(cfg)}{n};  labels: {origin.text()}")
+    """The title over the panels: :func:`view_heading`, then how the synthesis was made
+    (:func:`settings_text`), in 2-D for midsagittal data (x = 0 for every marker)."""
+    dims = "2-D" if np.nanmax(np.abs(view.shown[..., 0]), initial=0.0) < 1e-9 else "3-D"
+    return f"{view_heading(view)}    ·    {dims}: {settings_text(view)}"
 
 
 def view_summary(view: UtteranceView) -> str:

@@ -1,14 +1,15 @@
 """The main window's menus and docks: menus by name (new ones before Help), menu entries whose
-engine errors are reported rather than raised, and docks tabbed together by area, each view in a
-scroll area so that no dock can push the window wider than the screen."""
+engine errors are reported rather than raised, docks tabbed together by area, each view in a
+scroll area so that no dock can push the window wider than the screen, and windows sized and
+placed to fit the screen they open on (:func:`fit_to_screen`)."""
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from typing import Any
 
-from PyQt6.QtCore import Qt
-from PyQt6.QtGui import QAction
+from PyQt6.QtCore import QEvent, QSize, Qt, QTimer
+from PyQt6.QtGui import QAction, QGuiApplication
 from PyQt6.QtWidgets import QDockWidget, QFrame, QMainWindow, QMenu, QScrollArea, QWidget
 
 from facetraj_engine.errors import FacetrajError
@@ -48,6 +49,52 @@ class WindowMenus:
         return action
 
 
+class FillScrollArea(QScrollArea):
+    """The scroll area of a dock: its view fills the viewport (its tables, plots and splitters
+    stretch or shrink to the dock) and is never made smaller than its least size
+    (``minimumSizeHint``), scrolling then. Unlike ``setWidgetResizable``, the view's height never
+    follows its preferred height for its width: a view with word-wrapped text was made as tall
+    as all its plots' preferred sizes (905 px in a 637 px dock) and its bottom cut off (Figure
+    5's x label was). No dock can make the window taller or wider."""
+
+    def setWidget(self, widget: QWidget) -> None:
+        super().setWidget(widget)
+        widget.installEventFilter(self)
+        self._fit()
+
+    def viewportEvent(self, event) -> bool:
+        if event.type() == QEvent.Type.Resize:
+            self._fit()
+        return super().viewportEvent(event)
+
+    def eventFilter(self, obj, event) -> bool:
+        if obj is self.widget() and event.type() == QEvent.Type.LayoutRequest:
+            QTimer.singleShot(0, self._fit)         # after the layout has its new least size
+        return False
+
+    def _fit(self) -> None:
+        widget = self.widget()
+        if widget is None:
+            return
+        least = widget.minimumSizeHint().expandedTo(widget.minimumSize())
+        room = self.viewport().size()
+        size = QSize(max(room.width(), least.width()), max(room.height(), least.height()))
+        if widget.size() != size:
+            widget.resize(size)
+
+
+def text_scroll(widget: QWidget) -> QScrollArea:
+    """``widget`` (a panel of controls and wrapped text, e.g. the synthesis settings) in a
+    scroll area that gives it the height its text needs at the dock's width, scrolling when the
+    dock is shorter (a laptop screen): its lines never run into each other."""
+    scroll = QScrollArea()
+    scroll.setWidget(widget)
+    scroll.setWidgetResizable(True)
+    scroll.setFrameShape(QFrame.Shape.NoFrame)
+    scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+    return scroll
+
+
 class WindowDocks:
     """The docks of ``window``: movable, floatable, closable; extra docks in one area tabbed."""
 
@@ -71,13 +118,9 @@ class WindowDocks:
         widening the window (a main window grows to fit the minimum widths of its docks: four
         analysis views took it from 1600 to 1864 px and it stayed so after they closed). The
         first dock of an area gets :func:`dock_width` of the window."""
-        scroll = QScrollArea()
+        scroll = FillScrollArea()
         scroll.setWidget(widget)
-        scroll.setWidgetResizable(True)
         scroll.setFrameShape(QFrame.Shape.NoFrame)
-        # across only: the views fill the dock's height (their tables, plots and splitters
-        # stretch or shrink), so no dock can make the window taller either
-        scroll.setVerticalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
         dock = self.dock(scroll, title, area)
         previous = self.last.get(area)
         if previous is not None:
@@ -99,3 +142,74 @@ def dock_width(window_width: int) -> int:
     (560, 448, 620)
     """
     return int(min(620, max(420, 0.35 * window_width)))
+
+
+def fitted_geometry(wanted: tuple[int, int], available: tuple[int, int, int, int],
+                    frame: tuple[int, int] = (0, 0),
+                    minimum: tuple[int, int] = (0, 0)) -> tuple[int, int, int, int]:
+    """Where a window of ``wanted`` size goes on a screen whose free area is ``available``
+    ``(x, y, width, height)``: as large as wanted but no larger than the free area (less the
+    window frame's ``frame`` width and height), at least ``minimum``, centred. Returns the
+    window's ``(x, y, width, height)`` without its frame.
+
+    >>> fitted_geometry((1600, 1000), (0, 0, 1920, 1200))
+    (160, 100, 1600, 1000)
+    >>> fitted_geometry((1600, 1000), (0, 0, 1366, 768))      # a laptop: the whole screen
+    (0, 0, 1366, 768)
+    >>> fitted_geometry((1600, 1000), (0, 28, 1366, 740), frame=(2, 30))
+    (0, 28, 1364, 710)
+    """
+    ax, ay, aw, ah = available
+    w = max(minimum[0], min(wanted[0], aw - frame[0]))
+    h = max(minimum[1], min(wanted[1], ah - frame[1]))
+    x = ax + max(0, (aw - frame[0] - w) // 2)
+    y = ay + max(0, (ah - frame[1] - h) // 2)
+    return x, y, w, h
+
+
+def fit_to_screen(window: QWidget, wanted: tuple[int, int]) -> tuple[int, int, int, int]:
+    """Size and place ``window`` by :func:`fitted_geometry` on its screen (the one it is on, else
+    the primary one): on a 1366 x 768 laptop a window that wants 1600 x 1000 fills the screen
+    instead of reaching past it. Call it again once the window is shown: its frame (title bar,
+    borders) is known then."""
+    screen = window.screen() or QGuiApplication.primaryScreen()
+    free = screen.availableGeometry()
+    if window.isVisible():
+        outer, inner = window.frameGeometry(), window.geometry()
+        frame = (outer.width() - inner.width(), outer.height() - inner.height())
+    else:
+        frame = (0, 0)
+    minimum = window.minimumSizeHint()
+    x, y, w, h = fitted_geometry(wanted, (free.x(), free.y(), free.width(), free.height()), frame,
+                                 (min(minimum.width(), free.width()), min(minimum.height(), free.height())))
+    window.resize(w, h)
+    window.move(x, y)
+    return x, y, w, h
+
+
+def give_room(splitter, timeline, share: float) -> None:
+    """Panels the timeline left out for lack of room (analysis panels on a laptop screen): the
+    lower side of ``splitter`` (the panels) grows to show them, up to ``share`` of the height,
+    the 3-D view above giving it up; once per layout, the user's own split kept otherwise."""
+    if not timeline.hidden:
+        return
+    top, bottom = splitter.sizes()
+    total = top + bottom
+    want = min(bottom + int(timeline.needed_height() - timeline.height()), int(share * total))
+    if want > bottom + 8:
+        splitter.setSizes([total - want, want])
+
+
+def share_left_docks(window: QMainWindow, top: QDockWidget, bottom: QDockWidget,
+                     panel: QWidget, least_top: int = 150) -> None:
+    """Two docks one above the other: ``bottom`` (holding ``panel``, controls and wrapped text)
+    the height its text needs at its width, ``top`` (a list, which scrolls) the rest but at
+    least ``least_top`` px (a laptop screen: the settings' lines all in view)."""
+    needed = panel.heightForWidth(max(bottom.width(), 200))
+    needed = needed if needed > 0 else panel.sizeHint().height()
+    total = top.height() + bottom.height()
+    if total <= 0:
+        return
+    # (+80: the notes the settings add once a synthesis is shown, a line or four)
+    low = max(total // 2, min(needed + 80, total - least_top))
+    window.resizeDocks([top, bottom], [total - low, low], Qt.Orientation.Vertical)

@@ -33,8 +33,55 @@ def edited_model_file(src: Path, dst: Path, **arrays) -> Path:
 
 @pytest.fixture(scope="session", autouse=True)
 def _isolated_cache(tmp_path_factory):
-    """One private model cache for the whole session, never the user's."""
+    """One private model cache for the whole session, never the user's (a run on a screen of its
+    own, started by the ``screen`` fixture, shares its parent's: the model is trained once)."""
+    from screens import SCREEN_ENV
+
+    if os.environ.get(SCREEN_ENV) and os.environ.get("FACETRAJ_CACHE_DIR"):
+        return
     os.environ["FACETRAJ_CACHE_DIR"] = str(tmp_path_factory.mktemp("cache"))
+
+
+@pytest.fixture(scope="session")
+def _screen_runs():
+    from screens import ScreenRuns
+
+    return ScreenRuns()
+
+
+@pytest.fixture(params=["1920x1200", "1366x768"])
+def screen(request, _screen_runs):
+    """The screen size a test is for (``screens.SCREENS``). On a display of that size (a child run)
+    the test runs here; otherwise the module's tests for that size run once in a child pytest on
+    a private Xvfb of the size (the trained model cache shared), and this test reports its
+    outcome there without running its body here (``pytest_pyfunc_call``)."""
+    from screens import SCREEN_ENV, SCREENS, Screen
+
+    size = request.param
+    assert size in SCREENS
+    here = os.environ.get(SCREEN_ENV)
+    if here == size:
+        return Screen(size, local=True)
+    if here:
+        pytest.skip(f"a test for the {size} screen, in the {here} screen's run")
+    if not os.environ.get("DISPLAY"):
+        pytest.skip("the screen tests need Xvfb")
+    request.getfixturevalue("trained_cache")           # trained here once, read by the child
+    outcome, message = _screen_runs.outcome(str(request.node.path), size, request.node.name)
+    if outcome == "failed" or outcome == "missing":
+        pytest.fail(f"on a {size} screen:\n{message}", pytrace=False)
+    if outcome == "skipped":
+        pytest.skip(message)
+    return Screen(size, local=False)
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_pyfunc_call(pyfuncitem):
+    """A test whose screen is not this display's ran in its own child (the ``screen`` fixture)."""
+    screen = pyfuncitem.funcargs.get("screen")
+    if screen is not None and not screen.local:
+        return True
+    return None
 
 
 @pytest.fixture(scope="session")

@@ -1,10 +1,17 @@
 """Pictures for the GUI tests: Qt images as arrays, a widget's place on the screen as the X
-server shows it (3-D views included), and a heartbeat that measures how long the event loop
-stalls."""
+server shows it (3-D views included), a heartbeat that measures how long the event loop
+stalls, and screens of a given size (:data:`SCREENS`: a test asks for the ``screen`` fixture of
+tests/conftest.py and runs on a private Xvfb of each size)."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+import tempfile
 import time
+from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from PyQt6.QtCore import QElapsedTimer, QObject, QPoint, QTimer
@@ -67,3 +74,188 @@ class Heartbeat(QObject):
         self._beat()
         self.timer.stop()
         return self.longest
+
+
+# ---------------------------------------------------------------------- screens of a given size
+#: the screens every window is tested on (issue 39): a large desktop and a small laptop
+SCREENS = ("1920x1200", "1366x768")
+#: set in a test run that has a screen of that size ("WxH"); tests for other sizes skip there
+SCREEN_ENV = "FACETRAJ_TEST_SCREEN"
+
+
+@dataclass(frozen=True)
+class Screen:
+    """The screen a test is for: ``local`` when this process's display is that size (the test
+    runs here), else the test ran in a child process on a private Xvfb of the size."""
+
+    size: str
+    local: bool
+
+    @property
+    def width(self) -> int:
+        return int(self.size.split("x")[0])
+
+    @property
+    def height(self) -> int:
+        return int(self.size.split("x")[1])
+
+
+def private_xvfb(size: str) -> tuple[subprocess.Popen, str]:
+    """An Xvfb of one screen ``size`` ("WxH") on a free display; (the process, ":N")."""
+    read, write = os.pipe()
+    proc = subprocess.Popen(["Xvfb", "-displayfd", str(write), "-screen", "0", f"{size}x24",
+                             "-nolisten", "tcp"], pass_fds=(write,), stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, start_new_session=True)
+    os.close(write)
+    with os.fdopen(read) as fh:
+        number = fh.readline().strip()
+    if not number:
+        proc.kill()
+        raise RuntimeError(f"Xvfb did not start a {size} screen")
+    return proc, f":{number}"
+
+
+class ScreenRuns:
+    """The tests of a module for one screen size, run once in a child pytest on a private Xvfb of
+    that size (a Qt process has one display); each test's outcome is then looked up by its name."""
+
+    def __init__(self):
+        self._results: dict[tuple[str, str], dict[str, tuple[str, str]]] = {}
+
+    def outcome(self, path: str, size: str, name: str) -> tuple[str, str]:
+        """("passed" | "failed" | "skipped" | "missing", the message) of test ``name`` (its
+        function name with the parameters) of the module at ``path`` on a ``size`` screen."""
+        key = (path, size)
+        if key not in self._results:
+            self._results[key] = self._run(path, size)
+        return self._results[key].get(name, ("missing", f"{name} did not run on the {size} screen"))
+
+    @staticmethod
+    def _run(path: str, size: str) -> dict[str, tuple[str, str]]:
+        import xml.etree.ElementTree as ET
+
+        proc, display = private_xvfb(size)
+        try:
+            with tempfile.TemporaryDirectory(prefix="facetraj-screen-") as tmp:
+                report = Path(tmp) / "report.xml"
+                env = {**os.environ, "DISPLAY": display, SCREEN_ENV: size}
+                env.pop("WAYLAND_DISPLAY", None)
+                run = subprocess.run([sys.executable, "-m", "pytest", path, "-k", size, "-q",
+                                      "-p", "no:cacheprovider", f"--junitxml={report}"],
+                                     env=env, capture_output=True, text=True, timeout=1800)
+                if not report.exists():
+                    return {"": ("failed", run.stdout[-4000:] + run.stderr[-4000:])}
+                out = {}
+                for case in ET.parse(report).getroot().iter("testcase"):
+                    bad = [c for c in case if c.tag in ("failure", "error")]
+                    skip = case.find("skipped")
+                    if bad:
+                        out[case.get("name")] = ("failed", (bad[0].get("message") or "") + "\n"
+                                                 + (bad[0].text or ""))
+                    elif skip is not None:
+                        out[case.get("name")] = ("skipped", skip.get("message") or "")
+                    else:
+                        out[case.get("name")] = ("passed", "")
+                return out
+        finally:
+            proc.terminate()
+            proc.wait(10)
+
+
+def project(plotter, points: np.ndarray) -> np.ndarray:
+    """Where world ``points`` ``(n, 3)`` are in a 3-D view's widget: pixels ``(n, 2)``, x right
+    and y down from its top left (VTK's display y runs up)."""
+    from vtkmodules.vtkRenderingCore import vtkCoordinate
+
+    coord = vtkCoordinate()
+    coord.SetCoordinateSystemToWorld()
+    height = plotter.interactor.height()
+    out = []
+    for p in np.asarray(points, dtype=float):
+        coord.SetValue(*p)
+        x, y = coord.GetComputedDoubleDisplayValue(plotter.renderer)
+        out.append((x, height - y))
+    return np.array(out)
+
+
+def pixels_inside(image: np.ndarray, polygon: np.ndarray) -> np.ndarray:
+    """The pixels ``(n, 3)`` of ``image`` whose centres lie inside ``polygon`` ``(k, 2)`` (x, y
+    in the image's pixels)."""
+    from matplotlib.path import Path as Polygon
+
+    x0, y0 = np.floor(polygon.min(axis=0)).astype(int)
+    x1, y1 = np.ceil(polygon.max(axis=0)).astype(int)
+    ys, xs = np.mgrid[max(y0, 0):max(y1, 0), max(x0, 0):max(x1, 0)]
+    centres = np.column_stack([xs.ravel() + 0.5, ys.ravel() + 0.5])
+    inside = Polygon(polygon).contains_points(centres)
+    return image[ys.ravel()[inside], xs.ravel()[inside]]
+
+
+def colour_of(hex_colour: str) -> np.ndarray:
+    return np.array([int(hex_colour[i:i + 2], 16) for i in (1, 3, 5)], dtype=float)
+
+
+def near(pixels: np.ndarray, hex_colour: str, tol: float = 40.0) -> int:
+    """How many of ``pixels`` ``(n, 3)`` are within ``tol`` of ``hex_colour``."""
+    return int((np.linalg.norm(pixels.astype(float) - colour_of(hex_colour), axis=-1) < tol).sum())
+
+
+def overlap(a, b) -> bool:
+    """Whether two matplotlib bboxes overlap by more than a pixel."""
+    return a.x0 < b.x1 - 1 and b.x0 < a.x1 - 1 and a.y0 < b.y1 - 1 and b.y0 < a.y1 - 1
+
+
+def view_settled(win, key: str) -> bool:
+    """Analysis view ``key`` is open, has done its work and drawn it, and so has the window."""
+    from facetraj_app.figure_canvas import BackgroundCanvas
+
+    w = win.extension("analysis").widgets.get(key)
+    if w is None or win.busy or win.timeline.building:
+        return False
+    if key == "similarity" and w.clustering is None:
+        return False
+    if key == "pc_modes" and not w.is_ready:
+        return False
+    return not any(c.busy for c in w.findChildren(BackgroundCanvas))
+
+
+def figure_texts(fig) -> list:
+    """Every visible text of a figure: titles, axis labels, tick labels, legends' texts."""
+    out = list(fig.texts)
+    for legend in fig.legends:
+        out += [*legend.get_texts(), legend.get_title()]
+    for ax in fig.axes:
+        out += [ax.title, ax.xaxis.label, ax.yaxis.label]
+        for axis in (ax.xaxis, ax.yaxis):       # the tick labels drawn: those in the view
+            lo, hi = sorted(axis.get_view_interval())
+            out += [label for tick, label in zip(axis.get_ticklocs(), axis.get_ticklabels(),
+                                                 strict=True) if lo <= tick <= hi]
+        legend = ax.get_legend()
+        if legend is not None:
+            out += [*legend.get_texts(), legend.get_title()]
+    return [t for t in out if t.get_visible() and t.get_text().strip()]
+
+
+def assert_legible(fig, renderer, what: str) -> None:
+    """Every text of ``fig`` inside it and none over another; no legend over an axes' data (a
+    legend inside an axes must keep clear of its lines, bars and points)."""
+    box = fig.bbox
+    texts = [(t.get_text(), t.get_window_extent(renderer)) for t in figure_texts(fig)]
+    for text, e in texts:
+        assert e.x0 >= box.x0 - 1 and e.y0 >= box.y0 - 1 and e.x1 <= box.x1 + 1 \
+            and e.y1 <= box.y1 + 1, (what, text, e)
+    for i, (a, ea) in enumerate(texts):
+        for b, eb in texts[i + 1:]:
+            assert not overlap(ea, eb), (what, a, b)
+    for ax in fig.axes:
+        legend = ax.get_legend()
+        if legend is None:
+            continue
+        lb = legend.get_window_extent(renderer)
+        for bar in ax.patches:
+            assert not overlap(lb, bar.get_window_extent(renderer)), (what, "legend over a bar")
+        for line in ax.lines:
+            xy = line.get_transform().transform(line.get_xydata())
+            xy = xy[np.isfinite(xy).all(axis=1)]
+            inside = ((xy[:, 0] > lb.x0) & (xy[:, 0] < lb.x1) & (xy[:, 1] > lb.y0) & (xy[:, 1] < lb.y1))
+            assert not inside.any(), (what, "legend over a line", line.get_label())

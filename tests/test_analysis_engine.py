@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from facetraj_engine.analysis.errors import (
+    MIN_CORRELATION_FRAMES,
     SegmentError,
     analyse_utterance,
     error_report,
@@ -133,9 +134,11 @@ def test_phone_errors_pooled(toy_model, toy_corpus, tmp_path):
     assert len(rep.utterances) == len(toy_corpus.info.test)
     labels = {p.phone for p in rep.phones}
     assert "m" in labels and "sil" in labels
-    corr = [p.correlation for p in rep.phones if np.isfinite(p.correlation)]
-    assert corr == sorted(corr)                               # worst first
+    rms = [p.rms for p in rep.phones if np.isfinite(p.rms)]
+    assert rms == sorted(rms, reverse=True)                   # worst (largest RMS error) first
     assert all(p.rms >= 0 for p in rep.phones)
+    # a correlation only over enough frames (a held closure's few frames said nothing)
+    assert all(np.isnan(p.correlation) for p in rep.phones if p.frames < MIN_CORRELATION_FRAMES)
     assert rep.worst == sorted(rep.worst, key=lambda s: -s.error)
     # one phone recomputed by hand from an analysis
     a = analyse_utterance(toy_model, toy_corpus.utterance(toy_corpus.info.test[0]), "test")

@@ -290,16 +290,17 @@ def test_error_view_matches_engine_and_jumps(qtbot, model, corpus, view):
     rep = error_report(model, subset_corpus(corpus, 2), ("test",))
     assert [w.phone_table.item(r, 0).text() for r in range(w.phone_table.rowCount())] == \
         [p.phone for p in rep.phones]
-    assert cell_values(w.phone_table, 1) == pytest.approx([p.correlation for p in rep.phones], nan_ok=True)
-    assert cell_values(w.phone_table, 2) == pytest.approx([p.rms for p in rep.phones])
+    assert cell_values(w.phone_table, 1) == pytest.approx([p.rms for p in rep.phones])
+    assert cell_values(w.phone_table, 2) == pytest.approx([p.frames for p in rep.phones])
+    assert cell_values(w.phone_table, 4) == pytest.approx([p.correlation for p in rep.phones], nan_ok=True)
     assert cell_values(w.utt_table, 5) == pytest.approx([u.rms for u in rep.utterances])
-    # under the table: the per-phone correlations as bars, sorted, one per phone with a value
+    # under the table: the per-phone RMS errors as bars, the worst at the top, with frame counts
     w.phone_chart.finish()                              # built and drawn off the GUI thread
     ax = w.phone_chart.figure.axes[0]
-    finite = sorted(p.correlation for p in rep.phones if p.correlation == p.correlation)
-    assert [b.get_width() for b in ax.patches] == pytest.approx(finite)
-    assert [t.get_text() for t in ax.get_yticklabels()][-1] == max(
-        (p for p in rep.phones if p.correlation == p.correlation), key=lambda p: p.correlation).phone
+    shown = sorted(p.rms for p in rep.phones if p.rms == p.rms)
+    assert [b.get_width() for b in ax.patches] == pytest.approx(shown)
+    worst = rep.phones[0]
+    assert [t.get_text() for t in ax.get_yticklabels()][-1] == f"{worst.phone} ({worst.frames})"
     # the tables' columns fill the width, none narrower than its contents
     w.resize(1400, 700)
     w.tabs.setCurrentIndex(1)
@@ -474,7 +475,11 @@ def test_installed_in_main_window(qtbot, corpus, model):
     views.show_panels(list(PANELS))
     assert all(views.panel_actions[k].isChecked() for k in PANELS)
     qtbot.waitUntil(lambda: not win.timeline.building, timeout=WAIT_MS)
-    assert len(win.timeline.axes) == len(win.timeline.panels) == 5 + len(PANELS)
+    tl = win.timeline
+    assert len(tl.panels) == 5 + len(PANELS)
+    # what has no room is left out (app/panel_layout.py): the spectrogram and waveform first
+    assert len(tl.axes) == len(tl.shown) == len(tl.panels) - len(tl.hidden)
+    assert all(p.title in ("spectrogram", "waveform") for p in tl.hidden), tl.hidden
     # the inspector follows the cursor
     ins = views.widgets["inspector"]
     with qtbot.waitSignal(ins.inspected, timeout=5000):

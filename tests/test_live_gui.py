@@ -65,8 +65,9 @@ def test_live_window_plays_a_file_and_its_take_reopens(qtbot, default_model, utt
     assert np.abs(saved - on_screen(view).astype(float)).mean() < 6
     assert window.lines[0].get_color() == style.TRIANGULAR_COLOR
     assert window.dots[0].get_color() == style.SPEECH_DOT_COLOR
-    legend = [t.get_text() for t in window.axes[0].get_legend().get_texts()]
-    assert legend == ["synthesized, triangular", "speech frames (live energy)"]
+    legend = [t.get_text() for t in window.legend.get_texts()]        # above the panels
+    assert legend == ["synthesized, triangular", "speech frames (live energy)",
+                      "closed (the talker's /p b m/)"]
     # the take: WAV + C3D, reopened like any utterance's files
     path, wav = window.save_take(tmp_path / "take.c3d")
     back, back_rate = read_audio(wav)

@@ -63,20 +63,29 @@ def _colour_pixels(img, box, hex_colour, tol=40):
 
 @pytest.mark.parametrize("size", [(1280, 544), (640, 320)])
 def test_video_frame_has_legend_surface_and_phone_tier_inside(default_model, default_corpus, size):
-    """A rendered frame: the legend and the phone tier lie inside the frame and show what they
-    should (the legend's colours, phone labels inside the tier); the face surface is drawn."""
-    from facetraj_app.style import ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
+    """A rendered frame shows what the window shows: the caption (the utterance, its labels, its
+    settings) and the legend above both halves, inside the frame and apart; on the right the
+    window's phone tier over its lip panels, with the same curves (both smoothings, the original,
+    the speech dots, the closed line), the phone labels inside the tier and apart; the face
+    surface in the 3-D half."""
+    from facetraj_app.screen_export import caption_text
+    from facetraj_app.state import build_view
+    from facetraj_app.style import (
+        CLOSED_COLOR,
+        ORIGINAL_COLOR,
+        SPLINE_COLOR,
+        SURFACE_COLOR,
+        SYNTH_COLOR,
+        TRIANGULAR_COLOR,
+    )
     from facetraj_app.video import VideoFrames, VideoSettings
     from facetraj_engine.config import SynthConfig
     from facetraj_engine.method.modes import choose_mode
-    from facetraj_engine.method.pipeline import synthesize
 
     utt = default_corpus.utterance(default_corpus.info.test[0])
-    res = synthesize(default_model, utt.audio, utt.sample_rate, utt.phones,
-                     choose_mode(SynthConfig(), utt.phones).config, n_frames=utt.n_frames)
-    original = default_model.normalise_markers(utt.markers)
-    frames = VideoFrames(default_model, res, original, utt.phones, VideoSettings(*size),
-                         title=utt.text or utt.name)
+    view = build_view(default_model, utt, "test", choose_mode(SynthConfig(), utt.phones).config)
+    frames = VideoFrames(default_model, view.synthesis, view.original, utt.phones,
+                         VideoSettings(*size), view=view, caption=caption_text(view))
     try:
         t = utt.duration / 2
         img = frames.frame(t)
@@ -85,17 +94,21 @@ def test_video_frame_has_legend_surface_and_phone_tier_inside(default_model, def
     lay = frames.layout
     whole = (0, 0, lay.width, lay.height)
     assert img.shape == (lay.height, lay.width, 3) and lay.width == size[0]
-    # the legend: inside the frame, clear of the 3-D scene and the panels, showing both colours
-    assert _inside(lay.legend, whole)
-    assert not _overlap(lay.legend, lay.scene) and not _overlap(lay.legend, lay.tier)
-    assert _colour_pixels(img, lay.legend, SYNTH_COLOR) > 10
-    assert _colour_pixels(img, lay.legend, ORIGINAL_COLOR) > 10
-    assert lay.title is not None and _inside(lay.title, whole)
+    # the caption and the legend: inside the frame, apart, clear of the 3-D scene and the panels
+    assert _inside(lay.legend, whole) and lay.title is not None and _inside(lay.title, whole)
     assert not _overlap(lay.title, lay.legend)
-    # the phone tier: inside the frame, under the lower lip panel, its labels inside it
-    assert _inside(lay.tier, whole) and lay.tier[1] >= lay.lips[1][3]
+    for part in (lay.scene, lay.tier, *lay.lips):
+        assert not _overlap(lay.legend, part) and not _overlap(lay.title, part)
+    for colour in (SYNTH_COLOR, ORIGINAL_COLOR, TRIANGULAR_COLOR, SPLINE_COLOR):
+        assert _colour_pixels(img, lay.legend, colour) > 10, colour
+    assert _colour_pixels(img, lay.legend, CLOSED_COLOR, tol=30) > 3
+    for colour in (TRIANGULAR_COLOR, SPLINE_COLOR, ORIGINAL_COLOR):  # the curves, as on screen
+        assert _colour_pixels(img, lay.lips[0], colour) > 20, colour
+    # the phone tier: inside the frame, over the lip panels as in the window, its labels inside
+    # it and apart
+    assert _inside(lay.tier, whole) and lay.tier[3] <= lay.lips[0][1]
     real = [p for p in utt.phones if p.label != "sil"]
-    assert 0 < len(lay.phone_labels) <= len(real)
+    assert 0 < len(lay.phone_labels) <= len(utt.phones)
     if size[0] >= 1280:
         assert len(lay.phone_labels) >= len(real) // 2
     for label in lay.phone_labels:

@@ -55,6 +55,27 @@ def _cmap(name: str):
 NAN_COLOR = "#eeeeee"
 
 
+def bar_labels(fig: Figure, labels: list[str], share: float = 0.8, max_pt: float = 8.0,
+               min_pt: float = 5.0) -> tuple[list[str], float]:
+    """The y tick labels of a bar per label on ``fig`` (about ``share`` of its height for the
+    bars) and their font size: as large as a bar's height allows (up to ``max_pt``); where even
+    ``min_pt`` does not fit a bar, only every second, third, ... label is written (the others
+    blank), so that no label is ever drawn over the next.
+
+    >>> f = Figure(figsize=(4, 2), dpi=100)          # 160 px of bars
+    >>> bar_labels(f, list("abcd"))[1], bar_labels(f, list("abcdefghijklmnopqrst"))[1]
+    (8.0, 5.0)
+    >>> bar_labels(f, [str(i) for i in range(40)])[0][:6]      # every third, the top one kept
+    ['0', '', '', '3', '', '']
+    """
+    per_bar_pt = share * fig.get_figheight() * 72.0 / max(len(labels), 1)
+    size = max(min_pt, min(max_pt, 0.75 * per_bar_pt))
+    step = max(1, int(np.ceil(1.3 * size / per_bar_pt)))
+    # counted from the last (the top bar's label, the worst, always shown)
+    n = len(labels)
+    return [lab if (n - 1 - i) % step == 0 else "" for i, lab in enumerate(labels)], size
+
+
 def vertical_split(top: QWidget, bottom: QWidget, sizes: tuple[int, int]) -> QSplitter:
     """``top`` over ``bottom`` in a splitter (neither collapsible), shared as ``sizes``."""
     split = QSplitter(Qt.Orientation.Vertical)

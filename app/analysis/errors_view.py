@@ -1,9 +1,9 @@
 """Error analysis: which phones synthesize worst, which utterances, which segments.
 
 The view runs :func:`facetraj_engine.analysis.errors.error_report` in a background worker and shows
-correlation
-and RMS lip error per phone, a sortable per-utterance list and the worst segments; a click on an
-utterance or a segment jumps there (utterance and time). :class:`LipErrorPanel` adds
+the RMS lip error (mm) per phone, worst first, with its frame count (and the correlation where a
+phone has enough frames for one to mean something), a sortable per-utterance list and the worst
+segments; a click on an utterance or a segment jumps there (utterance and time). :class:`LipErrorPanel` adds
 ``|original - synthesized|`` of the lips to the time-aligned stack with the worst segments of
 the current utterance highlighted.
 """
@@ -32,9 +32,9 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from facetraj_app.style import ORIGINAL_COLOR, SYNTH_COLOR
 from facetraj_engine.analysis.common import subset_corpus
 from facetraj_engine.analysis.errors import (
+    MIN_CORRELATION_FRAMES,
     ErrorReport,
     error_report,
     lip_error,
@@ -48,6 +48,7 @@ from facetraj_engine.method.model import Model
 from .common import (
     Canvas,
     NumberItem,
+    bar_labels,
     export_with_dialog,
     fill_table,
     heat_item,
@@ -59,30 +60,35 @@ from .common import (
 
 log = logging.getLogger(__name__)
 
+#: the lip error panel's curves (not the original/synthesized colours: both are errors)
+UPPER_ERROR_COLOR, LOWER_ERROR_COLOR = "#7048e8", "#0c8599"
 SPLITS = {"test": ("test",), "train": ("train",), "train + test": ("train", "test")}
 
 
 def draw_phone_chart(fig: Figure, phones: list) -> None:
-    """Per-phone correlation as horizontal bars, sorted (best at the top), coloured like the
+    """Per-phone RMS lip error (mm) as horizontal bars, the worst at the top, each phone named
+    with its frame count (a phone of few frames is one to read with care); coloured like the
     table's cells; constrained layout keeps the title and the x label inside."""
     fig.clear()
     fig.set_layout_engine("constrained")
     ax = fig.add_subplot(111)
-    phones = sorted((p for p in phones if p.correlation == p.correlation), key=lambda p: p.correlation)
+    phones = sorted((p for p in phones if p.rms == p.rms), key=lambda p: p.rms)
     if not phones:
-        ax.text(0.5, 0.5, "no phone has enough frames for a correlation", ha="center",
-                va="center", transform=ax.transAxes, color="#555555")
+        ax.text(0.5, 0.5, "no phone has a lip error", ha="center", va="center",
+                transform=ax.transAxes, color="#555555")
         ax.set_axis_off()
         return
-    r = np.array([p.correlation for p in phones])
+    rms = np.array([p.rms for p in phones])
     y = np.arange(len(phones))
-    ax.barh(y, r, color=colormaps["RdYlGn"](np.clip(r, 0.0, 1.0)), edgecolor="#555555", lw=0.4)
-    ax.set_yticks(y, [p.phone for p in phones], fontsize=max(5, min(8, 600 // len(phones))))
+    lo, hi = float(rms.min()), float(rms.max())
+    shade = (rms - lo) / (hi - lo) if hi > lo else np.zeros_like(rms)
+    ax.barh(y, rms, color=colormaps["YlOrRd"](0.15 + 0.75 * shade), edgecolor="#555555", lw=0.4)
+    labels, size = bar_labels(fig, [f"{p.phone} ({p.frames})" for p in phones])
+    ax.set_yticks(y, labels, fontsize=size)
     ax.set_ylim(-0.6, len(phones) - 0.4)
-    ax.set_xlim(min(0.0, float(r.min()) - 0.05), 1.0)
-    ax.axvline(0.0, color="k", lw=0.6)
-    ax.set_xlabel("correlation r, original vs synthesized lip y", fontsize=8)
-    ax.set_title("Per phone, sorted (best at the top)", fontsize=9)
+    ax.set_xlim(0.0, 1.08 * hi)
+    ax.set_xlabel("RMS lip error (mm), original vs synthesized", fontsize=8)
+    ax.set_title("Per phone, worst at the top (frames)", fontsize=9)
     ax.tick_params(axis="x", labelsize=7)
     ax.grid(axis="x", alpha=0.3)
 
@@ -118,9 +124,11 @@ class ErrorView(QWidget):
         top.addWidget(self.splits)
         top.addWidget(QLabel("utterances:"))
         top.addWidget(self.per_split)
-        top.addWidget(self.run_btn)
         top.addStretch(1)
-        top.addWidget(csv_btn)
+        second = QHBoxLayout()
+        second.addWidget(self.run_btn)
+        second.addWidget(self.progress, 1)
+        second.addWidget(csv_btn)
 
         self.phone_table = QTableWidget()
         self.utt_table = QTableWidget()
@@ -138,6 +146,7 @@ class ErrorView(QWidget):
         per_phone.addWidget(self.phone_chart)
         per_phone.setStretchFactor(0, 2)
         per_phone.setStretchFactor(1, 3)
+        per_phone.setSizes([240, 360])          # the table's rows in view, the chart under them
         per_phone.setChildrenCollapsible(False)
         self.tabs.addTab(per_phone, "Per phone")
         self.tabs.addTab(self.utt_table, "Per utterance")
@@ -147,7 +156,7 @@ class ErrorView(QWidget):
         self.status.setWordWrap(True)
         lay = QVBoxLayout(self)
         lay.addLayout(top)
-        lay.addWidget(self.progress)
+        lay.addLayout(second)
         lay.addWidget(self.status)
         lay.addWidget(self.tabs, 1)
         self.jumpRequested.connect(self._jump)
@@ -182,11 +191,11 @@ class ErrorView(QWidget):
         self.report = report
         finite = [p.rms for p in report.phones if p.rms == p.rms]
         rms_lo, rms_max = (min(finite), max(finite)) if finite else (0.0, 1.0)
-        rows = [[text_item(p.phone), heat_item(p.correlation, 0.0, 1.0, "{:.3f}", "RdYlGn"),
-                 heat_item(p.rms, rms_lo, rms_max, "{:.2f}", "YlOrRd"), NumberItem(p.frames, "{:.0f}"),
-                 NumberItem(p.segments, "{:.0f}")] for p in report.phones]
-        fill_table(self.phone_table, ["phone", "correlation (lips y)", "RMS error (mm)", "frames",
-                                      "segments"], rows)
+        rows = [[text_item(p.phone), heat_item(p.rms, rms_lo, rms_max, "{:.2f}", "YlOrRd"),
+                 NumberItem(p.frames, "{:.0f}"), NumberItem(p.segments, "{:.0f}"),
+                 heat_item(p.correlation, 0.0, 1.0, "{:.3f}", "RdYlGn")] for p in report.phones]
+        fill_table(self.phone_table, ["phone", "RMS error (mm)", "frames", "segments",
+                                      f"r (lips y; {MIN_CORRELATION_FRAMES}+ frames)"], rows)
         self._draw_phone_chart(report)
         finite = [u.rms for u in report.utterances if u.rms == u.rms]
         rms_ulo, rms_u = (min(finite), max(finite)) if finite else (0.0, 1.0)
@@ -208,7 +217,7 @@ class ErrorView(QWidget):
                             "Click an utterance or a segment to go there.")
 
     def _draw_phone_chart(self, report: ErrorReport) -> None:
-        """Per-phone correlation as horizontal bars (built and drawn off the GUI thread)."""
+        """Per-phone RMS error as horizontal bars (built and drawn off the GUI thread)."""
         self.phone_chart.rebuild(partial(draw_phone_chart, phones=list(report.phones)))
 
     def _utt_clicked(self, row: int, _col: int) -> None:
@@ -277,15 +286,15 @@ class LipErrorPanel:
             return
         err = lip_error(self.model, view.original, view.synthesis.markers)
         t = view.times[: len(err)]
-        ax.plot(t, err[:, 0], color=ORIGINAL_COLOR, lw=1.1, label="upper lip")
-        ax.plot(t, err[:, 1], color=SYNTH_COLOR, lw=1.1, label="lower lip")
+        ax.plot(t, err[:, 0], color=UPPER_ERROR_COLOR, lw=1.1, label="error, upper lip")
+        ax.plot(t, err[:, 1], color=LOWER_ERROR_COLOR, lw=1.1, label="error, lower lip")
         segs = worst_segments(segment_errors(view.utterance.phones, view.times, err,
                                              view.utterance.name), self.worst)
         self.last_segments = segs
         for s in segs:
             ax.axvspan(s.start, s.end, color="#e03131", alpha=0.15, lw=0)
-            ax.text(0.5 * (s.start + s.end), 0.95, f"{s.label} {s.error:.1f}",
+            ax.text(0.5 * (s.start + s.end), 0.97, f"{s.label} {s.error:.1f}",
                     transform=ax.get_xaxis_transform(), ha="center", va="top", fontsize=7,
                     color="#c92a2a", clip_on=True)
-        ax.set_ylim(bottom=0)
-        ax.legend(loc="upper right", fontsize=7, ncol=2, framealpha=0.8)
+        top = float(np.nanmax(err)) if np.isfinite(err).any() else 1.0
+        ax.set_ylim(0, 1.35 * max(top, 0.1))    # the worst segments' labels above the curves

@@ -143,7 +143,7 @@ def make_figures(corpus_dir: Path, out: Path, per_split: int = 6,
             w.start_sweep()
             _finish(lambda w=w: w.sweep_result is not None, "the N sweep")
         if key == "pc_modes":
-            w.set_sd_units(2.5)
+            w.set_sd_units(3.0)             # PC1 at its closing end: the lips meet
         if key == "errors":
             w.per_split.setValue(per_split)
             w.start()

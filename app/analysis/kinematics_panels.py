@@ -49,7 +49,7 @@ from facetraj_engine.evaluation.kinematics import (
 )
 from facetraj_engine.method.model import Model
 
-from .common import Canvas, NumberItem, export_with_dialog, fill_table, text_item
+from .common import Canvas, NumberItem, bar_labels, export_with_dialog, fill_table, text_item
 
 log = logging.getLogger(__name__)
 
@@ -84,15 +84,14 @@ class LipMeasurePanel:
     def draw(self, ax, view) -> None:
         syn = getattr(model_lip_measures(self.model, view.synthesis.markers), self.measure)
         t = view.times[: len(syn)]
-        ax.plot(t, syn, color=SYNTH_COLOR, lw=1.3, label="synthesized")
+        ax.plot(t, syn, color=SYNTH_COLOR, lw=1.3, label="synthesized (3-D view's)")
         if view.original is not None:
             orig = getattr(model_lip_measures(self.model, view.original), self.measure)
             ax.plot(view.times[: len(orig)], orig, color=ORIGINAL_COLOR, lw=1.3, ls=(0, (2, 1.5)),
                     label="original")
         if self.closed is not None:
-            ax.axhline(self.closed, color=CLOSED_COLOR, lw=0.9, ls=(0, (6, 3)), zorder=0.5)
-            ax.text(1.0, self.closed, "closed ", transform=ax.get_yaxis_transform(), ha="right",
-                    va="bottom", fontsize=6.5, color=CLOSED_COLOR)
+            ax.axhline(self.closed, color=CLOSED_COLOR, lw=0.9, ls=(0, (6, 3)), zorder=0.5,
+                       label="closed (the talker's /p b m/)")
         ax.set_ylabel(MEASURES[self.measure][1], fontsize=8)
 
 
@@ -291,8 +290,8 @@ def draw_timing_chart(fig: Figure, rows: list[LandmarkError], has_original: bool
     y = np.arange(len(rows))[::-1]
     ax.barh(y, ms, color=[LATE_COLOR if e > 0 else EARLY_COLOR for e in ms],
             edgecolor="#555555", lw=0.4, height=0.75)
-    ax.set_yticks(y, [f"{r.gesture} {r.label} {r.landmark}" for r in rows],
-                  fontsize=max(5, min(8, 520 // len(rows))))
+    labels, size = bar_labels(fig, [f"{r.gesture} {r.label} {r.landmark}" for r in rows])
+    ax.set_yticks(y, labels, fontsize=size)
     ax.set_ylim(-0.6, len(rows) - 0.4)
     lim = max(10.0, float(np.abs(ms).max()) * 1.1)
     ax.set_xlim(-lim, lim)
@@ -319,7 +318,7 @@ class VelocityPanel:
 
     def draw(self, ax, view) -> None:
         m = self.controls.measure(view)
-        ax.plot(m.times, m.v_synthesized, color=SYNTH_COLOR, lw=1.2, label="synthesized")
+        ax.plot(m.times, m.v_synthesized, color=SYNTH_COLOR, lw=1.2, label="synthesized (3-D view's)")
         sets = [(m.synthesized, SYNTH_COLOR, 0.08)]
         if m.v_original is not None:
             ax.plot(m.times, m.v_original, color=ORIGINAL_COLOR, lw=1.2, ls=(0, (2, 1.5)),
@@ -344,5 +343,4 @@ class VelocityPanel:
                 ly += [on, on, np.nan, off, off, np.nan]
             ax.plot(lx, ly, color=color, lw=0.6, alpha=0.6)
         ax.set_ylabel(f"{self.controls.model.marker_names[m.marker]}\nspeed (mm/s)", fontsize=8)
-        ax.set_ylim(bottom=0)
-        ax.legend(loc="upper right", fontsize=7, ncol=2, framealpha=0.8)
+        ax.set_ylim(bottom=0)           # the curves' names: in the timeline's legend row

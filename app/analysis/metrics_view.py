@@ -95,18 +95,21 @@ def draw_metrics(fig: Figure, rows: list[Table2Row], curves: list[SweepCurve]) -
         ax1.set_title("Table 2: mean correlation on speech frames", fontsize=8)
     ax1.set_ylabel("correlation r", fontsize=8)
     ax1.tick_params(labelsize=7)
+    figure5 = "Figure 5: correlation against N (triangular)"
     if curves:
         for c in curves:
             style = "-o" if c.split == "test" else "--s"
             ax2.plot(c.ns, c.whole_face, style, ms=4, label=f"{c.split} (whole face)")
-        ax2.legend(fontsize=7)
+        # above the plot, as Table 2's: never over the curves
+        ax2.legend(fontsize=7, ncol=2, loc="lower center", bbox_to_anchor=(0.5, 1.0), frameon=False,
+                   title=figure5, title_fontsize=8)
         ax2.set_xticks(curves[0].ns)
     else:
         ax2.text(0.5, 0.5, "Run N sweep", ha="center", va="center", transform=ax2.transAxes,
                  color="#888888")
+        ax2.set_title(figure5, fontsize=8)
     ax2.set_xlabel("N (context-phones searched)", fontsize=8)
     ax2.set_ylabel("correlation r", fontsize=8)
-    ax2.set_title("Figure 5: correlation against N (triangular)", fontsize=8)
     ax2.tick_params(labelsize=7)
 
 
@@ -152,7 +155,7 @@ class MetricsView(QWidget):
         self.table.verticalHeader().setVisible(False)
         self.table.verticalHeader().setDefaultSectionSize(self.table.fontMetrics().height() + 6)
         self.canvas = Canvas(6, 5.2)
-        self.canvas.setMinimumHeight(320)
+        self.canvas.setMinimumHeight(260)
         lay = QVBoxLayout(self)
         lay.addWidget(self._options(exp))
         lay.addWidget(vertical_split(self.table, self.canvas, (300, 520)), 1)
@@ -242,8 +245,12 @@ class MetricsView(QWidget):
         fill_table(self.table, head, rows)
         self.table.resizeRowsToContents()
         rows_height = sum(self.table.rowHeight(r) for r in range(self.table.rowCount()))
-        # every row in view (the rows needed scrolling), up to half the dock
-        self.table.setMinimumHeight(min(440, rows_height + self.table.horizontalHeader().height()
+        # every row in view (the rows needed scrolling), up to 30 % of the screen's height: on a
+        # laptop screen the table scrolls rather than push the plots (Figure 5's x label) out
+        # of the dock
+        screen = self.screen().availableGeometry().height() if self.screen() else 1000
+        self.table.setMinimumHeight(min(440, int(0.3 * screen),
+                                        rows_height + self.table.horizontalHeader().height()
                                         + 2 * self.table.frameWidth() + 2))
         self.status.setText(f"Table 2: {len(self.rows)} conditions (grey: the paper's)")
         self._draw()

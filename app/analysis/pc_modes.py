@@ -1,7 +1,9 @@
 """The principal component mode explorer (the paper's Figure 2).
 
-Pick a PC and drag its coefficient over +-3 standard deviations: the 3-D view shows the neutral
-face (grey), the displaced face (orange) and displacement arrows; beside it the front projection
+Pick a PC and drag its coefficient over +-3 standard deviations (the slider's ends say which way
+the mouth opens; the line under it gives the coefficient in mm and the lip aperture against the
+talker's closure): the 3-D view shows the neutral face (grey), the displaced face (orange, its
+lips closing where they meet, as in the main view) and displacement arrows; beside it the front projection
 as in Figure 2 (circles: neutral, arrows: displacement) and the variance share of every PC.
 "Animate" sweeps the mode back and forth. All shapes come from ``model.mode_shape``.
 
@@ -33,9 +35,17 @@ from PyQt6.QtWidgets import (
 
 from facetraj_app.plotter_widget import make_plotter
 from facetraj_app.style import BACKGROUND, SYNTH_COLOR
-from facetraj_app.surface import lip_contours, stored_face_triangles
+from facetraj_app.surface import Mouth, lip_contours, stored_face_triangles
 from facetraj_app.view3d import MarkerSet
-from facetraj_engine.analysis.pc_modes import describe_mode, mode_displacement, mode_sd, variance_shares
+from facetraj_engine.analysis.lips import closed_lips
+from facetraj_engine.analysis.pc_modes import (
+    describe_mode,
+    mode_aperture,
+    mode_displacement,
+    mode_sd,
+    opening_direction,
+    variance_shares,
+)
 from facetraj_engine.method.model import Model
 
 from ..workers import one_per_pass
@@ -67,6 +77,10 @@ class PCModeExplorer(QWidget):
         self.window_ = window
         self.sd = mode_sd(model)
         self.neutral = model.neutral_face()
+        # the talker's lips at closure: the mouth shuts there (as in the main view) and the
+        # readout says how far from it the lips are
+        self.closed = getattr(window, "closed_lips", None) or closed_lips(model)
+        self.closed_aperture = float(self.closed.gap(model.upper_lip, model.lower_lip))
         self.component = 0
         self.value = 0.0
         self._phase = 0.0
@@ -82,6 +96,7 @@ class PCModeExplorer(QWidget):
         lay = QVBoxLayout(self)
         lay.addLayout(rows[0])
         lay.addLayout(rows[1])
+        lay.addWidget(self.value_label)
         lay.addWidget(self.description)
         lay.addLayout(rows[2])
         lay.addWidget(split, 1)
@@ -109,7 +124,7 @@ class PCModeExplorer(QWidget):
         self.slider.valueChanged.connect(self._slider_moved)
         self.slider.setMinimumWidth(220)
         self.value_label = QLabel()
-        self.value_label.setMinimumWidth(150)
+        self.value_label.setWordWrap(True)
         self.animate_btn = QPushButton("Animate")
         self.animate_btn.setCheckable(True)
         self.animate_btn.toggled.connect(self.set_animating)
@@ -134,11 +149,13 @@ class PCModeExplorer(QWidget):
         component.addWidget(self.combo, 1)
         component.addWidget(reset)
         component.addWidget(self.animate_btn)
+        # the slider's ends say which way the mouth opens (the component's effect on the lip
+        # aperture), the line under it the value with its unit and the aperture it gives
+        self.minus_label, self.plus_label = QLabel("−3 SD"), QLabel("+3 SD")
         slider_row = QHBoxLayout()
-        slider_row.addWidget(QLabel("-3 SD"))
+        slider_row.addWidget(self.minus_label)
         slider_row.addWidget(self.slider, 1)
-        slider_row.addWidget(QLabel("+3 SD"))
-        slider_row.addWidget(self.value_label)
+        slider_row.addWidget(self.plus_label)
         view_bar = QHBoxLayout()
         view_bar.addWidget(QLabel("3-D:"))
         for name in CAMERAS:
@@ -176,7 +193,9 @@ class PCModeExplorer(QWidget):
         except Exception:   # a degenerate marker layout: points and arrows only
             log.debug("no face surface for the PC explorer", exc_info=True)
             tri = None
-        self.face_set = MarkerSet(self.plotter, "displaced", SYNTH_COLOR, self.neutral, contours, tri)
+        mouth = Mouth.between(self.neutral, contours, self.closed.markers)
+        self.face_set = MarkerSet(self.plotter, "displaced", SYNTH_COLOR, self.neutral, contours, tri,
+                                  mouth)
         self.displaced = self.face_set.points
 
     def _build_guides(self) -> None:
@@ -257,6 +276,13 @@ class PCModeExplorer(QWidget):
         if self.combo.currentIndex() != k:
             self.combo.setCurrentIndex(k)
         self.description.setText(describe_mode(self.model, k).text())
+        ends = mode_aperture(self.model, k, np.array([-3.0, 3.0]))
+        way = opening_direction((float(ends[0]), float(ends[1])))
+        self.minus_label.setText("−3 SD" + {1: " · closes", -1: " · opens", 0: ""}[way])
+        self.plus_label.setText("+3 SD" + {1: " · opens", -1: " · closes", 0: ""}[way])
+        self.slider.setToolTip(f"PC{k + 1}: the lip aperture goes from {ends[0]:.1f} mm at −3 SD to "
+                               f"{ends[1]:.1f} mm at +3 SD (the lips meet at "
+                               f"{self.closed_aperture:.1f} mm)")
         self.set_value(self.slider.value() / SLIDER_STEPS * self.sd[k], move_slider=False)
 
     def set_sd_units(self, sds: float) -> None:
@@ -273,8 +299,7 @@ class PCModeExplorer(QWidget):
             self.slider.blockSignals(True)
             self.slider.setValue(int(round(value / self.sd[self.component] * SLIDER_STEPS)))
             self.slider.blockSignals(False)
-        sd = self.sd[self.component]
-        self.value_label.setText(f"{self.value:+.2f} ({self.value / sd:+.2f} SD)")
+        self.value_label.setText(self.readout())
         if not hasattr(self, "arrows"):
             return                          # the scene is still being built (one_per_pass)
         shape = self.model.mode_shape(self.component, self.value)
@@ -287,6 +312,15 @@ class PCModeExplorer(QWidget):
         self.plotter.render()
         self.canvas.when_idle(self._update_plots)
         self.valueChanged.emit(self.component, self.value)
+
+    def readout(self) -> str:
+        """The coefficient with its unit and the lip aperture it gives, against closure."""
+        k, sd = self.component, self.sd[self.component]
+        gap = float(mode_aperture(self.model, k, np.array([self.value / sd]))[0])
+        beyond = gap - self.closed_aperture
+        state = ("lips closed" if beyond <= 0 else f"open {beyond:.1f} mm beyond closure")
+        return (f"PC{k + 1} = {self.value:+.1f} mm ({self.value / sd:+.2f} SD) · lip aperture "
+                f"{gap:.1f} mm: {state} (the lips meet at {self.closed_aperture:.1f} mm)")
 
     def _update_plots(self) -> None:
         """The 2-D projection's arrows and title and the highlighted variance bar for the current

@@ -82,12 +82,19 @@ def worst_segments(errors: Sequence[SegmentError], count: int = 5,
     return sorted(keep, key=lambda s: -s.error)[:count]
 
 
+#: the fewest pooled frames a phone's correlation is given for: over fewer (a held closure of 14
+#: frames, a short vowel) the lips hardly move and r says nothing (an /m/ ranked worst by r -0.13
+#: though its lips were within 0.7 mm); its RMS error in mm means something at any length
+MIN_CORRELATION_FRAMES = 30
+
+
 @dataclass
 class PhoneError:
-    """Correlation and RMS error of one phone, pooled over every frame labelled with it.
+    """RMS error and correlation of one phone, pooled over every frame labelled with it.
 
-    ``correlation`` is the mean of the upper-lip-y and lower-lip-y Pearson correlations over the
-    pooled frames; ``rms`` the root mean square lip error (mm, both lip markers).
+    ``rms`` is the root mean square lip error (mm, both lip markers): what the phones are ranked
+    by. ``correlation`` is the mean of the upper-lip-y and lower-lip-y Pearson correlations over
+    the pooled frames, NaN when there are fewer than ``MIN_CORRELATION_FRAMES`` of them.
     """
 
     phone: str
@@ -165,9 +172,11 @@ class ErrorReport:
     worst: list[SegmentError] = field(default_factory=list)
 
 
-def phone_errors(analyses: Sequence[UtteranceAnalysis]) -> list[PhoneError]:
-    """Pool the frames of every phone over ``analyses`` and score each phone, worst
-    (lowest correlation) first; phones with under 3 frames get NaN correlation."""
+def phone_errors(analyses: Sequence[UtteranceAnalysis],
+                 min_frames: int = MIN_CORRELATION_FRAMES) -> list[PhoneError]:
+    """Pool the frames of every phone over ``analyses`` and score each phone, worst (the largest
+    RMS lip error in mm) first; a correlation only for phones of at least ``min_frames``
+    frames (else NaN)."""
     pooled: dict[str, list[np.ndarray]] = {}
     errs: dict[str, list[np.ndarray]] = {}
     nseg: dict[str, int] = {}
@@ -184,14 +193,14 @@ def phone_errors(analyses: Sequence[UtteranceAnalysis]) -> list[PhoneError]:
         y = np.concatenate(pooled[p])
         ok = np.isfinite(y).all(axis=(1, 2))
         y = y[ok]
-        r = [pearson(y[:, 0, j], y[:, 1, j]) for j in range(2)]
+        r = [pearson(y[:, 0, j], y[:, 1, j]) for j in range(2)] if len(y) >= max(min_frames, 3) else []
         r = [x for x in r if np.isfinite(x)]
         e = np.concatenate(errs[p])
         e = e[np.isfinite(e).all(axis=1)]
         out.append(PhoneError(p, float(np.mean(r)) if r else float("nan"),
                               float(np.sqrt(np.mean(e**2))) if e.size else float("nan"),
                               int(ok.sum()), nseg.get(p, 0)))
-    out.sort(key=lambda x: (np.nan_to_num(x.correlation, nan=np.inf), x.phone))
+    out.sort(key=lambda x: (-np.nan_to_num(x.rms, nan=-np.inf), x.phone))
     return out
 
 
@@ -221,6 +230,6 @@ def write_error_csv(path: str | os.PathLike[str], report: ErrorReport, overwrite
                      overwrite)
 
 
-__all__ = ["ErrorReport", "PhoneError", "SegmentError", "UtteranceAnalysis", "UtteranceError",
-           "analyse_utterance", "error_report", "lip_error", "phone_errors", "segment_errors",
-           "worst_segments", "write_error_csv"]
+__all__ = ["MIN_CORRELATION_FRAMES", "ErrorReport", "PhoneError", "SegmentError", "UtteranceAnalysis",
+           "UtteranceError", "analyse_utterance", "error_report", "lip_error", "phone_errors",
+           "segment_errors", "worst_segments", "write_error_csv"]

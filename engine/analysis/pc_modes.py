@@ -35,6 +35,26 @@ def mode_displacement(model: Model, component: int, value: float) -> np.ndarray:
     return model.mode_shape(component, value) - model.neutral_face()
 
 
+def mode_aperture(model: Model, component: int, sds: np.ndarray) -> np.ndarray:
+    """The lip aperture (mm: upper to lower lip centre marker) of the face with PC ``component``
+    at each of ``sds`` standard deviations: which way of the slider opens the mouth, and where it
+    passes the talker's closed aperture (``facetraj_engine.analysis.lips.closed_lips``)."""
+    sd = float(mode_sd(model)[component])
+    faces = np.stack([model.mode_shape(component, float(s) * sd) for s in np.atleast_1d(sds)])
+    return np.linalg.norm(faces[:, model.upper_lip] - faces[:, model.lower_lip], axis=-1)
+
+
+def opening_direction(apertures_at_minus_plus: tuple[float, float], least_mm: float = 1.0) -> int:
+    """+1 when the mode opens the mouth towards +SD (the aperture grows by ``least_mm`` or more),
+    -1 towards -SD, 0 when it hardly changes the aperture.
+
+    >>> opening_direction((8.0, 30.0)), opening_direction((20.0, 12.0)), opening_direction((15.0, 15.4))
+    (1, -1, 0)
+    """
+    lo, hi = apertures_at_minus_plus
+    return 0 if abs(hi - lo) < least_mm else (1 if hi > lo else -1)
+
+
 @dataclass
 class ModeSummary:
     """How one PC moves the face."""
@@ -65,4 +85,5 @@ def describe_mode(model: Model, component: int, count: int = 4) -> ModeSummary:
                        [(model.marker_names[i], float(share[i])) for i in top], axis)
 
 
-__all__ = ["ModeSummary", "describe_mode", "mode_displacement", "mode_sd", "variance_shares"]
+__all__ = ["ModeSummary", "describe_mode", "mode_aperture", "mode_displacement", "mode_sd",
+           "opening_direction", "variance_shares"]

@@ -17,6 +17,10 @@ from .common import rate_of_times
 from .recording import MarkerRecording
 from .registry import MarkerFormat
 
+#: text columns of a trajectory table that hold labels, not coordinates (left out when read:
+#: facetraj's labelled tables, :func:`facetraj_engine.io.export.write_labelled_table`)
+LABEL_COLUMNS = frozenset({"phone", "word"})
+
 
 def _table(path: Path) -> tuple[list[str], np.ndarray]:
     lines = [ln for ln in read_text(path, "marker file").splitlines() if ln.strip()]
@@ -24,6 +28,11 @@ def _table(path: Path) -> tuple[list[str], np.ndarray]:
         raise InputError(path, "the marker table has no data rows")
     delim = "\t" if "\t" in lines[0] else ","
     header = [h.strip() for h in lines[0].split(delim)]
+    labelled = {i for i, h in enumerate(header) if h.lower() in LABEL_COLUMNS}
+    if labelled:
+        header = [h for i, h in enumerate(header) if i not in labelled]
+        lines = [lines[0]] + [delim.join(v for i, v in enumerate(ln.split(delim)) if i not in labelled)
+                              for ln in lines[1:]]
     try:
         table = np.array([[float(v) if v.strip() not in {"", "nan", "NaN"} else np.nan
                            for v in ln.split(delim)] for ln in lines[1:]])
@@ -37,7 +46,8 @@ def _table(path: Path) -> tuple[list[str], np.ndarray]:
 
 
 def read_marker_table(path: str | Path, rate: float | None = None) -> MarkerRecording:
-    """Read TSV/CSV trajectories; without a time column, ``rate`` is required."""
+    """Read TSV/CSV trajectories (label columns, :data:`LABEL_COLUMNS`, left out); without a
+    time column, ``rate`` is required."""
     path = Path(path)
     header, table = _table(path)
     times = None

@@ -1,0 +1,115 @@
+"""Compare: keep the result on screen as a pin and see the next one beside it (an extension of
+the main window, using its public contract and its ``pins``, ``app/pins.py``).
+
+*Pin this result* keeps the synthesis shown; change the search, the labels (an opened
+recording's label source), N, the smoothing or the model, and the lip panels draw the pinned
+curves in the pin's colour (the legend row names how each was made), the phone tier adds the
+pin's phones where its labels differ, the 3-D view shows the pinned face beside the current one,
+and a panel draws the difference of the lip aperture, this result minus each pin's.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from PyQt6.QtCore import QObject, pyqtSignal
+from PyQt6.QtGui import QKeySequence
+from PyQt6.QtWidgets import QLabel
+
+from .pins import aperture_difference
+
+
+class PinDifferencePanel:
+    """Timeline panel: the lip aperture of the result on screen minus each pinned one's (mm),
+    in the pins' colours, with a line at 0."""
+
+    title = "aperture minus pin"
+    height = 0.8
+    min_px = 48.0
+    priority = 60
+
+    def __init__(self, window):
+        self.window = window
+
+    def draw(self, ax, view) -> None:
+        model = self.window.model
+        ax.axhline(0.0, color="#888888", lw=0.7)
+        low = high = 0.0
+        for pin in self.window.pins.shown(view):
+            diff = aperture_difference(view, pin, model.upper_lip, model.lower_lip)
+            ax.plot(view.times[:len(diff)], diff, color=pin.color, lw=1.3,
+                    label=f"aperture: this − {pin.name}")
+            if np.isfinite(diff).any():
+                low, high = min(low, float(np.nanmin(diff))), max(high, float(np.nanmax(diff)))
+        pad = 0.12 * max(high - low, 1.0)
+        ax.set_ylim(low - pad, high + pad)
+        ax.set_ylabel("aperture\n− pin (mm)", fontsize=8)
+
+
+class Compare(QObject):
+    """The pins' toolbar (*Pin this result*, *Clear pins*, what is pinned), the difference panel
+    and the pinned faces in 3-D, following the window's result. ``changed`` after the pins shown
+    change (a pin kept or cleared, a new result)."""
+
+    changed = pyqtSignal()
+
+    def __init__(self, window):
+        super().__init__(window)
+        self.window = window
+        self.panel = PinDifferencePanel(window)
+        bar = window.addToolBar("Compare")
+        bar.setObjectName("compare-toolbar")
+        self.pin_action = bar.addAction("Pin this result", self.pin)
+        self.pin_action.setShortcut(QKeySequence("Ctrl+P"))
+        self.pin_action.setToolTip("keep the result on screen to compare the next one with it "
+                                   "(another search, labels, N, smoothing or model) (Ctrl+P)")
+        self.clear_action = bar.addAction("Clear pins", self.clear)
+        self.label = QLabel("")
+        self.label.setStyleSheet("padding-left: 6px; color: #444444;")
+        bar.addWidget(self.label)
+        menu = window.menu("View")
+        menu.addSeparator()
+        menu.addAction(self.pin_action)
+        menu.addAction(self.clear_action)
+        window.synthesisChanged.connect(self.refresh)
+        self.refresh()
+
+    def pin(self) -> None:
+        """Keep the result on screen as a pin."""
+        view = self.window.view
+        if view is None:
+            self.window.show_status("nothing to pin yet", 4000)
+            return
+        pin = self.window.pins.pin(view)
+        self.window.show_status(f"{pin.name} kept: {pin.settings}; change a setting to compare", 8000)
+        self.refresh()
+
+    def clear(self) -> None:
+        had = bool(self.window.pins.shown(self.window.view))
+        self.window.pins.clear()
+        self.refresh(redraw=had)
+
+    def refresh(self, redraw: bool = False) -> None:
+        """Show the pins of the utterance on screen: the difference panel there while one is
+        shown, the pinned faces in 3-D, and (``redraw``: the pins shown changed without a new
+        result, which redraws the panels anyway) the panels redrawn with their curves."""
+        w = self.window
+        shown = w.pins.shown(w.view)
+        self.clear_action.setEnabled(len(w.pins) > 0)
+        self.label.setText("  ".join(f"{p.name}: {p.settings}" for p in shown) if shown else
+                           (f"{len(w.pins)} pinned (another utterance)" if len(w.pins) else ""))
+        w.face.set_pins(shown)
+        tl = w.timeline
+        if shown and self.panel not in tl.panels:
+            tl.add_panel(self.panel, soon=True)
+        elif not shown and self.panel in tl.panels:
+            tl.remove_panel(self.panel, soon=True)
+        elif redraw and tl.view is not None:
+            tl.relayout(tl.xlim() if tl.axes else None, soon=True)
+        self.changed.emit()
+
+
+def install(window) -> Compare:
+    """Add the pins to ``window``; also ``window.extension("compare")``."""
+    compare = Compare(window)
+    window.add_extension("compare", compare)
+    return compare

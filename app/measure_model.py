@@ -1,0 +1,128 @@
+"""What the Measure readout and table show, without Qt: the numbers come from the engine
+(:mod:`facetraj_engine.analysis.apertures`), this module picks them for the utterance on screen and
+words them.
+
+* :meth:`Measure.readout_text`: at the cursor, the phone and word there, the upper and lower lip
+  y and the aperture of the synthesis shown in 3-D, the original's and the difference, and each
+  pinned result's phone there (its own labels'), aperture and difference (mm).
+* :meth:`Measure.rows`: the per-phone table (each phone's aperture at its minimum and at its
+  midpoint, original, synthesized, error), filtered by phone; :meth:`Measure.write_csv`.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from facetraj_engine.analysis.apertures import (
+    LipReadout,
+    PhoneAperture,
+    frame_labels,
+    phone_apertures,
+    readout_at,
+    write_phone_apertures_csv,
+)
+
+from .pins import Pin
+from .state import UtteranceView
+
+#: the per-phone table's columns: (heading, value of a PhoneAperture, format)
+TABLE_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("phone", "phone", "{}"), ("word", "word", "{}"), ("start (s)", "start", "{:.3f}"),
+    ("min: original", "min_original", "{:.1f}"), ("min: synthesized", "min_synthesized", "{:.1f}"),
+    ("min: error", "min_error", "{:+.1f}"), ("mid: original", "mid_original", "{:.1f}"),
+    ("mid: synthesized", "mid_synthesized", "{:.1f}"), ("mid: error", "mid_error", "{:+.1f}"),
+)
+
+
+def mm(value: float, signed: bool = False) -> str:
+    """A length in mm for the readout ("—" when there is none).
+
+    >>> mm(11.234), mm(-0.26, signed=True), mm(float("nan"))
+    ('11.2 mm', '-0.3 mm', '—')
+    """
+    if not math.isfinite(value):
+        return "—"
+    return f"{value:+.1f} mm" if signed else f"{value:.1f} mm"
+
+
+@dataclass
+class Measure:
+    """The numbers of the utterance on screen: its ``view``, the model's lip markers
+    (``upper``, ``lower``) and the ``pins`` shown with it."""
+
+    view: UtteranceView | None = None
+    upper: int = 0
+    lower: int = 0
+    pins: list[Pin] = field(default_factory=list)
+    _rows: list[PhoneAperture] | None = None
+
+    def set_view(self, view: UtteranceView | None, upper: int, lower: int, pins: list[Pin]) -> None:
+        self.view, self.upper, self.lower, self.pins = view, upper, lower, list(pins)
+        self._rows = None
+
+    def readout(self, t: float) -> LipReadout | None:
+        v = self.view
+        if v is None:
+            return None
+        return readout_at(t, v.times, v.shown, self.upper, self.lower, v.original,
+                          v.utterance.phones, v.utterance.words)
+
+    def pin_readouts(self, t: float) -> list[tuple[Pin, LipReadout]]:
+        return [(p, readout_at(t, p.view.times, p.view.shown, self.upper, self.lower,
+                               phones=p.view.utterance.phones)) for p in self.pins]
+
+    def readout_text(self, t: float) -> str:
+        """One line: where the cursor is and how far apart the lips are there."""
+        r = self.readout(t)
+        if r is None:
+            return ""
+        where = f"{t:.3f} s"
+        if r.phone:
+            where += f"  /{r.phone}/" + (f" in “{r.word}”" if r.word else "")
+        parts = [where, f"upper lip y {r.upper_y:.1f}, lower {r.lower_y:.1f}",
+                 f"aperture {mm(r.aperture)}"]
+        if r.has_original:
+            parts.append(f"original {mm(r.original_aperture)} (synthesized − original "
+                         f"{mm(r.difference, signed=True)})")
+        for pin, pr in self.pin_readouts(t):     # with the pin's phone there (its labels')
+            phone = f" /{pr.phone}/" if pr.phone else ""
+            parts.append(f"{pin.name}{phone} {mm(pr.aperture)} (this − {pin.name} "
+                         f"{mm(r.aperture - pr.aperture, signed=True)})")
+        return "  ·  ".join(parts)
+
+    def rows(self, phone_filter: str = "") -> list[PhoneAperture]:
+        """The per-phone table, only the phones named in ``phone_filter`` (space separated;
+        all when empty)."""
+        v = self.view
+        if v is None:
+            return []
+        if self._rows is None:
+            self._rows = phone_apertures(v.times, v.shown, self.upper, self.lower,
+                                         v.utterance.phones, v.utterance.words, v.original)
+        wanted = set(phone_filter.lower().replace(",", " ").replace("/", " ").split())
+        return [r for r in self._rows if not wanted or r.phone.lower() in wanted]
+
+    def write_csv(self, path: str | os.PathLike[str], phone_filter: str = "") -> Path:
+        return write_phone_apertures_csv(path, self.rows(phone_filter))
+
+    def frame_labels(self) -> dict[str, list[str]]:
+        """The phone and word of each frame (the trajectory table's label columns)."""
+        v = self.view
+        if v is None:
+            return {}
+        return {"phone": frame_labels(v.utterance.phones, v.times),
+                "word": frame_labels(v.utterance.words, v.times)}
+
+
+def cell(row: PhoneAperture, attribute: str, fmt: str) -> tuple[str, float | str]:
+    """A table cell: its text and the value it sorts by."""
+    value = getattr(row, attribute)
+    if isinstance(value, str):
+        return value, value
+    return ("" if not math.isfinite(value) else fmt.format(value)), float(value)
+
+
+__all__ = ["TABLE_COLUMNS", "Measure", "cell", "mm"]

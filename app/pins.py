@@ -1,0 +1,111 @@
+"""Results kept to compare (pins), without Qt.
+
+A phonetician pins the result on screen, changes something (the search, the labels, N, the
+smoothing, the model) and sees the next result beside the pinned one: the lip panels draw each
+pin's curves in its colour with a legend naming how it was made, the 3-D view shows the pinned
+face beside the current one, a panel draws the difference of the lip aperture (this result
+minus each pin's), and the Measure readout gives both at the cursor. :class:`PinBoard` holds the
+pins; a pin is shown with the utterance it was made of (same name and length), and with a model
+of the same marker set.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from facetraj_engine.analysis.apertures import aperture
+
+from .provenance import settings_text
+from .state import UtteranceView
+
+#: the pins' colours, in turn: apart from the original's blue and the synthesis's oranges
+PIN_COLORS = ("#2f9e44", "#9c36b5", "#0b7285")
+#: the most pins kept at once (the oldest goes)
+MAX_PINS = len(PIN_COLORS)
+
+
+@dataclass(frozen=True, eq=False)
+class Pin:
+    """A result kept: its view (the synthesis and its tracks), its number and colour, how it was
+    made (``settings``), and the model it was made with (``model_name``: the corpus it was
+    trained on; ``marker_names``: its marker set)."""
+
+    number: int
+    view: UtteranceView
+    color: str
+    settings: str
+    model_name: str = ""
+    marker_names: tuple[str, ...] = ()
+
+    @property
+    def name(self) -> str:
+        return f"pin {self.number}"
+
+    def legend(self, model_name: str = "") -> str:
+        """The legend's entry: the pin and how it was made (its model too when it is not
+        ``model_name``, the current one)."""
+        other = f"; model {self.model_name}" if self.model_name and self.model_name != model_name else ""
+        return f"{self.name}: {self.settings}{other}"
+
+    def matches(self, view: UtteranceView) -> bool:
+        """Whether this pin is of ``view``'s utterance (same name, same length) and another
+        result than ``view`` itself."""
+        return (self.view is not view and self.view.utterance.name == view.utterance.name
+                and self.view.n_frames == view.n_frames
+                and len(self.view.utterance.audio) == len(view.utterance.audio))
+
+
+@dataclass
+class PinBoard:
+    """The pins kept (at most :data:`MAX_PINS`, the oldest dropped first); ``model_name``: the
+    current model's, for the legends; ``marker_names``: its marker set (pins of another are not
+    shown)."""
+
+    pins: list[Pin] = field(default_factory=list)
+    model_name: str = ""
+    marker_names: tuple[str, ...] = ()
+    _count: int = 0
+
+    def pin(self, view: UtteranceView) -> Pin:
+        """Keep ``view`` (the result on screen) as a new pin."""
+        used = {p.color for p in self.pins}
+        if len(self.pins) >= MAX_PINS:
+            used.discard(self.pins.pop(0).color)
+        color = next(c for c in PIN_COLORS if c not in used)
+        self._count += 1
+        pin = Pin(self._count, view, color, settings_text(view, short=True), self.model_name,
+                  self.marker_names)
+        self.pins.append(pin)
+        return pin
+
+    def clear(self) -> None:
+        self.pins.clear()
+
+    def remove(self, pin: Pin) -> None:
+        if pin in self.pins:
+            self.pins.remove(pin)
+
+    def set_model(self, model_name: str, marker_names: Sequence[str]) -> None:
+        self.model_name, self.marker_names = model_name, tuple(marker_names)
+
+    def shown(self, view: UtteranceView | None) -> list[Pin]:
+        """The pins to show with ``view``: of its utterance, with the current marker set."""
+        if view is None:
+            return []
+        return [p for p in self.pins
+                if p.matches(view) and (not p.marker_names or p.marker_names == self.marker_names)]
+
+    def __len__(self) -> int:
+        return len(self.pins)
+
+
+def aperture_difference(view: UtteranceView, pin: Pin, upper: int, lower: int) -> np.ndarray:
+    """Per frame, the lip aperture of ``view``'s synthesis (the 3-D view's) minus the pin's (mm)."""
+    n = min(view.n_frames, pin.view.n_frames)
+    return (aperture(view.shown[:n], upper, lower) - aperture(pin.view.shown[:n], upper, lower))
+
+
+__all__ = ["MAX_PINS", "PIN_COLORS", "Pin", "PinBoard", "aperture_difference"]

@@ -1,0 +1,78 @@
+"""Measure's words and Compare's pins without a display (app/measure_model.py, app/pins.py,
+app/panel_layout.py): the readout at the /b/ of "boy" against the engine's numbers, the table's
+filter, the pins kept, shown and let go, and the panels' heights on a short timeline."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from facetraj_app.measure_model import Measure
+from facetraj_app.panel_layout import fit_heights
+from facetraj_app.pins import MAX_PINS, PIN_COLORS, PinBoard, aperture_difference
+from facetraj_app.state import build_view
+from facetraj_engine.analysis.apertures import aperture, readout_at
+from facetraj_engine.config import SynthConfig
+
+
+@pytest.fixture(scope="module")
+def views(default_model, default_corpus):
+    utt = default_corpus.utterance("s002")
+    return (build_view(default_model, utt, "train", SynthConfig()),
+            build_view(default_model, utt, "train", SynthConfig(n_context_phones=1)))
+
+
+def test_the_readout_at_the_b_of_boy(default_model, views):
+    n3, n1 = views
+    pins = PinBoard(model_name="data_samples", marker_names=tuple(default_model.marker_names))
+    pin = pins.pin(n3)
+    assert pins.shown(n3) == [] and pins.shown(n1) == [pin]        # not with itself
+    m = Measure()
+    m.set_view(n1, default_model.upper_lip, default_model.lower_lip, pins.shown(n1))
+    b = next(p for p in n1.utterance.phones if p.label == "b")
+    t = 0.5 * (b.start + b.end)
+    text = m.readout_text(t)
+    r = readout_at(t, n1.times, n1.shown, default_model.upper_lip, default_model.lower_lip,
+                   n1.original, n1.utterance.phones, n1.utterance.words)
+    p = readout_at(t, n3.times, n3.shown, default_model.upper_lip, default_model.lower_lip)
+    assert text.startswith(f"{t:.3f} s  /b/ in “boy”")
+    assert f"aperture {r.aperture:.1f} mm" in text
+    assert f"original {r.original_aperture:.1f} mm (synthesized − original {r.difference:+.1f} mm)" in text
+    assert f"pin 1 /b/ {p.aperture:.1f} mm (this − pin 1 {r.aperture - p.aperture:+.1f} mm)" in text
+    rows = m.rows("b, /oy/")
+    assert {row.phone for row in rows} == {"b", "oy"} and rows == sorted(rows, key=lambda x: x.start)
+    assert m.rows("") == m.rows() and len(m.rows()) > len(rows)
+    labels = m.frame_labels()
+    assert labels["phone"][n1.frame_at(t)] == "b" and labels["word"][n1.frame_at(t)] == "boy"
+    diff = aperture_difference(n1, pin, default_model.upper_lip, default_model.lower_lip)
+    np.testing.assert_allclose(diff, aperture(n1.shown, default_model.upper_lip, default_model.lower_lip)
+                               - aperture(n3.shown, default_model.upper_lip, default_model.lower_lip))
+
+
+def test_pins_keep_three_in_distinct_colours_and_name_their_settings(default_model, views):
+    n3, n1 = views
+    pins = PinBoard(model_name="data_samples", marker_names=tuple(default_model.marker_names))
+    kept = [pins.pin(v) for v in (n3, n1, n3, n1)]
+    assert len(pins) == MAX_PINS and kept[0] not in pins.pins      # the oldest went
+    assert sorted(p.color for p in pins.pins) == sorted(PIN_COLORS)
+    assert kept[3].color == kept[0].color                          # its colour reused
+    assert "N=1" in kept[1].legend("data_samples") and "model" not in kept[1].legend("data_samples")
+    assert kept[1].legend("my_corpus").endswith("; model data_samples")
+    pins.set_model("other", ["A", "B"])                            # another marker set: not shown
+    assert pins.shown(n1) == []
+    pins.clear()
+    assert len(pins) == 0
+
+
+def test_a_short_timeline_leaves_out_the_spectrogram_first():
+    # waveform, spectrogram, phones, upper lip, lower lip, aperture (the window's priorities)
+    heights, least, priority = [0.8, 1.3, 0.8, 1.2, 1.2, 0.9], [24, 40, 30, 72, 72, 48], \
+        [20, 10, 90, 100, 100, 50]
+    tall = fit_heights(heights, least, priority, 700)
+    assert None not in tall and all(h >= m for h, m in zip(tall, least, strict=True))
+    short = fit_heights(heights, least, priority, 300)
+    assert short[1] is None and short[0] is not None                # the spectrogram first
+    shorter = fit_heights(heights, least, priority, 260)
+    assert shorter[0] is None and shorter[1] is None
+    assert all(h >= m for h, m in zip(shorter, least, strict=True) if h is not None)
+    assert sum(h for h in shorter if h is not None) + 6 * 3 <= 260
