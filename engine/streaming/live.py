@@ -67,9 +67,10 @@ def live_mode(config: SynthConfig, model: Model, phones: bool = True) -> ModeCho
     (:func:`facetraj_engine.method.modes.choose_mode`) gives recognized labels -- the robust mode with the
     model's cross-validated settings, and the closure step, but not the chain over frames
     (``facetraj_engine.method.chain``: its forward-backward needs the whole input); acoustic-only, the
-    paper's search without it (as ``facetraj live`` was)."""
+    paper's search and the closure step with the model's bilabial-closure detector, as ``facetraj
+    synth --mode acoustic`` (``facetraj_engine.streaming.synthesizer``)."""
     if not phones:
-        return ModeChoice(config.with_(mode="acoustic", closure=False), "acoustic-only, chosen")
+        return ModeChoice(config.with_(mode="acoustic"), "acoustic-only, chosen")
     streamed = [PhoneSegment(0.0, 1.0, SILENCE)]       # phones to come: the rule needs to know
     rule = choose_mode(config.with_(mode="phonetic"), streamed, Provenance("recognized"),
                        tuned=model.tuned)
@@ -215,6 +216,15 @@ class LiveStream:
         if self.phonetic is None:
             return None
         return self.phonetic.phones.snapshot(since_s)
+
+    @property
+    def closure_probability(self) -> np.ndarray | None:
+        """Per frame so far, the bilabial-closure detector's probability (acoustic-only with the
+        closure step and a model with a detector; else ``None``)."""
+        closure = self.acoustic.closure if self.acoustic is not None else None
+        if closure is None or closure.detector is None:
+            return None
+        return closure.detector.probabilities()
 
     @property
     def voice_ratio(self) -> float:
