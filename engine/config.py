@@ -117,6 +117,9 @@ class SynthConfig:
         closure (``facetraj_engine.method.closure_detector``; models without one close none).
     closure_threshold : the detector's probability from which a frame is closed (runs of 2
         frames or more).
+    closure_second_opinion : beside recognized labels, close the lips also where the detector
+        finds a closure and no /p b m/ is recognized, trusted as far as the voice matches the
+        training voice (whose recognized labels the step trusts least).
     rest_pause_s, rest_taper_s : pauses longer than this rest the face; the tapers inside them.
     """
 
@@ -143,7 +146,8 @@ class SynthConfig:
     closure: bool = True
     closure_taper_s: float = 0.05
     closure_detector: bool = True
-    closure_threshold: float = 0.14
+    closure_threshold: float = 0.12
+    closure_second_opinion: bool = True
     rest_pause_s: float = 0.15
     rest_taper_s: float = 0.05
 

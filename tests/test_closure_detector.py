@@ -139,11 +139,25 @@ def test_the_aims_on_real_voices(default_model):
     assert score.vowels_shut <= 0.05 and score.vowel_max >= 17.0
 
 
-def test_labels_close_the_lips_and_the_detector_stays_out(default_model, held_out):
+def test_beside_recognized_phones_only_where_the_voice_matches(default_model, held_out):
+    """With labels the detector is a second opinion only beside recognized ones, and only as far
+    as the voice matches the training voice (measured: it helps there, 35 % -> 98 % of the
+    held-out /p b m/; on the ARCTIC voices it would shut 2 vowels and 8 more consonants for one
+    more /p b m/: docs/experiments/closure_second_opinion.py)."""
     u = held_out[0]
-    res = synthesize(default_model, u.audio, u.sample_rate, u.phones,
-                     SynthConfig(mode="robust"), provenance=Provenance("recognized"))
-    assert res.closure.probability is None                   # labels: the detector is not asked
+    cfg = SynthConfig(mode="robust")
+    exact = synthesize(default_model, u.audio, u.sample_rate, u.phones, cfg)
+    assert exact.closure.probability is None                 # hand-checked: not asked
+    res = synthesize(default_model, u.audio, u.sample_rate, u.phones, cfg,
+                     provenance=Provenance("recognized"))
+    labelled = sum(s.label in ("p", "b", "m") for s in u.phones)
+    assert res.voice_match == 1.0 and res.closure.probability is not None
+    # the training voice's recognized /p b m/ are trusted 1 - match = 0: only the detector's
+    assert len(res.closure.intervals) >= labelled >= 1 and np.all(res.closure.strengths == 1.0)
+    other = synthesize(default_model, second_voice(u.audio, u.sample_rate), u.sample_rate,
+                       u.phones, cfg, provenance=Provenance("recognized"))
+    assert other.voice_match == 0.0 and other.closure.probability is None
+    assert len(other.closure.intervals) == labelled
     off = synthesize(default_model, u.audio, u.sample_rate, None,
                      ACOUSTIC.with_(closure_detector=False))
     assert off.closure.probability is None and len(off.closure.intervals) == 0

@@ -5,11 +5,12 @@ With recognized labels the closure step closes the lips at the recognized /p b m
 ``1 - voice match``. Where the detector and the recognizer disagree the detector could be a
 second opinion: add its closures where no recognized /p b m/ is (fully, or trusted by the voice
 match: the detector is trained on the training voice's own sounds), or weaken the recognized
-/p b m/ where it finds no closure. Each variant re-runs only the closure step on the same
-synthesis (``facetraj synth``'s default with recognized labels) and is scored as
-``facetraj report --closure`` scores it: on the default corpus's held-out sentences (its
-recognized labels, the exact ones as the reference) and on the CMU ARCTIC samples (recognized;
-their transcripts aligned as the reference).
+/p b m/ where it finds no closure. The detector is the one acoustic-only synthesis uses: its
+search part (the acoustic-only search of the same audio) mixed in by the voice match. Each
+variant re-runs only the closure step on the same synthesis (``facetraj synth``'s default with
+recognized labels) and is scored as ``facetraj report --closure`` scores it: on the default
+corpus's held-out sentences (its recognized labels, the exact ones as the reference) and on the
+CMU ARCTIC samples (recognized; their transcripts aligned as the reference).
 
     python docs/experiments/closure_second_opinion.py [../shared/data/arctic_samples]
 """
@@ -27,7 +28,8 @@ from facetraj_engine.evaluation.closure_eval import arctic_references
 from facetraj_engine.io.corpus import load_corpus
 from facetraj_engine.io.labelling import label_audio, relabelled
 from facetraj_engine.method.closure import ClosurePlan
-from facetraj_engine.method.closure_detector import closure_runs
+from facetraj_engine.method.closure_detector import closure_runs, input_probability
+from facetraj_engine.method.closure_search import search_rows
 from facetraj_engine.method.modes import choose_mode
 from facetraj_engine.method.pipeline import _smoothed, synthesize
 from facetraj_engine.method.training import train
@@ -67,8 +69,10 @@ def score(model, items, threshold: float) -> None:
         cfg = choose_mode(SynthConfig(), phones, prov, tuned=model.tuned).config
         res = synthesize(model, audio, rate, phones, cfg, n_frames=n_frames, confidence=conf,
                          provenance=prov)
-        from facetraj_engine.method.closure_detector import input_probability
-        p = input_probability(model.detector, model.config, audio, rate, res.times)
+        acoustic = synthesize(model, audio, rate, None, SynthConfig(mode="acoustic", closure=False),
+                              n_frames=n_frames)            # the search's opinion: its own search
+        p = input_probability(model.detector, model.config, audio, rate, res.times,
+                              search=search_rows(model, acoustic.frames), match=res.voice_match)
         for name, plan in variants(model, res, p, threshold).items():
             pcs = _smoothed(model, res.raw_pcs, res.times, res.config, res.config.smoothing, plan)
             a = lip_aperture(model.to_markers(pcs), model.upper_lip, model.lower_lip)

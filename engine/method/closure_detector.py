@@ -414,3 +414,16 @@ def closure_runs(p: np.ndarray, times: np.ndarray, threshold: float, min_frames:
     if open_end and stops[keep][-1] == len(t):
         out[-1, 1] = np.inf
     return np.round(out, 12)
+
+
+def beside(runs: np.ndarray, intervals: np.ndarray) -> np.ndarray:
+    """The closures of ``runs`` ``(J, 2)`` that overlap none of ``intervals`` ``(I, 2)`` (where
+    the detector and the labels disagree: a closure with no labelled /p b m/).
+
+    >>> beside(np.array([[0.1, 0.2], [0.5, 0.6]]), np.array([[0.15, 0.3]])).tolist()
+    [[0.5, 0.6]]
+    """
+    runs = np.asarray(runs, dtype=np.float64).reshape(-1, 2)
+    iv = np.asarray(intervals, dtype=np.float64).reshape(-1, 2)
+    overlaps = (runs[:, None, 0] < iv[None, :, 1]) & (runs[:, None, 1] > iv[None, :, 0])
+    return runs[~overlaps.any(axis=1)]

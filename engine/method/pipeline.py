@@ -23,7 +23,7 @@ from ..io.labelfiles import validate_phones
 from ..labels.phoneset import SILENCE, map_labels, normalise_label
 from ..threads import frame_threads
 from .closure import ClosurePlan, aperture_functional, apply_closure, closure_intervals, closure_strengths
-from .closure_detector import closure_runs, input_probability
+from .closure_detector import beside, closure_runs, input_probability
 from .closure_search import search_rows
 from .context import segment_index
 from .model import Model
@@ -217,28 +217,50 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
                  ) -> ClosurePlan | None:
     """Where the closure step acts (``None``: off, or a model file without its statistics): the
     labelled /p b m/, trusted as :func:`~facetraj_engine.method.closure.closure_strengths` says (for
-    recognized labels by the voice ``match``; NaN: unknown, untrusted); without labels, the
-    closures the model's detector finds (``config.closure_detector``, fully trusted; ``lsf``: the
-    input's unwarped LSFs at ``times``, when computed; ``frames``: the acoustic-only search's,
-    whose opinion counts by the voice ``match``); and the pauses by energy (``filtered``:
+    recognized labels by the voice ``match``; NaN: unknown, untrusted), and beside recognized
+    ones the detector's closures where none is recognized, trusted by the voice ``match``
+    (``config.closure_second_opinion``); without labels, the closures the model's detector finds
+    (``config.closure_detector``, fully trusted; ``lsf``: the input's unwarped LSFs at ``times``,
+    when computed; ``frames``: the acoustic-only search's, whose opinion counts by the voice
+    ``match``); and the pauses by energy (``filtered``:
     :func:`~facetraj_engine.method.speech.filtered_energy_db` of the audio, when already
     computed)."""
     if not config.closure or model.closure is None:
         return None
     intervals, strengths, p = np.zeros((0, 2)), np.zeros(0), None
+    detecting = config.closure_detector and model.detector is not None
     if segs:
-        trust = closure_strengths(len(segs), (provenance or Provenance()).kind,
-                                  match if np.isfinite(match) else 1.0)
+        kind = (provenance or Provenance()).kind
+        trust = closure_strengths(len(segs), kind, match if np.isfinite(match) else 1.0)
         intervals, strengths = closure_intervals(segs, trust)
-    elif config.closure_detector and model.detector is not None:
-        search = search_rows(model, frames) if frames is not None and model.detector.search \
-            is not None else None
-        p = input_probability(model.detector, model.config, audio, sample_rate, times, lsf, search,
-                              match)
-        intervals = closure_runs(p, times, config.closure_threshold, model.detector.spec.min_frames)
+        if detecting and kind == "recognized" and config.closure_second_opinion and \
+                np.isfinite(match) and match > 0:
+            p, runs = _detected(model, audio, sample_rate, times, lsf, None, match, config)
+            added = beside(runs, intervals)
+            intervals = np.concatenate([intervals, added])
+            strengths = np.concatenate([strengths, np.full(len(added), match)])
+    elif detecting:
+        p, intervals = _detected(model, audio, sample_rate, times, lsf, frames, match, config)
         strengths = np.ones(len(intervals))
     return ClosurePlan(intervals, strengths, pauses(audio, sample_rate, times, config.rest_pause_s,
                                                     filtered=filtered), p)
+
+
+def _detected(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
+              lsf: np.ndarray | None, frames: FrameWeights | None, match: float,
+              config: SynthConfig) -> tuple[np.ndarray, np.ndarray]:
+    """The detector's probabilities and closures of an input (:func:`plan_closure`); the
+    acoustic-only search is made here when its opinion counts (``match`` above 0) and ``frames``
+    is not that search's."""
+    det = model.detector
+    if lsf is None:
+        lsf = model.input_lsf(audio, sample_rate, times, frame_threads())
+    if frames is None and det.search is not None and np.isfinite(match) and match > 0:
+        acoustic = config.with_(mode="acoustic")
+        frames = mode_of(acoustic).search(SearchInput(model, lsf, times, acoustic)).frames
+    search = search_rows(model, frames) if frames is not None and det.search is not None else None
+    p = input_probability(det, model.config, audio, sample_rate, times, lsf, search, match)
+    return p, closure_runs(p, times, config.closure_threshold, det.spec.min_frames)
 
 
 class SpeechEnergy:
