@@ -364,8 +364,9 @@ def format_markdown(data: dict) -> list[str]:
              f"neighbours: compare the rows with labels). The *closure step* "
              f"(`engine/method/closure.py`) runs after eq 8 and the smoothing: the lips close at "
              f"the labelled /p b m/ (recognized ones trusted as far as the voice is not the "
-             f"training voice), without labels where the bilabial-closure detector finds a "
-             f"closure (`engine/method/closure_detector.py`), and the face rests in pauses. The "
+             f"training voice, and beside them the detector's closures as far as it is), without "
+             f"labels where the bilabial-closure detector finds a closure "
+             f"(`engine/method/closure_detector.py`), and the face rests in pauses. The "
              f"*second voice* is each held-out sentence made to sound as a shorter vocal tract "
              f"and a higher voice (`engine/evaluation/second_voice.py`), its face the original's. "
              f"Computed by `facetraj report --closure` (`engine/evaluation/closure_eval.py`).", "",
@@ -394,17 +395,19 @@ def detector_markdown(data: dict) -> list[str]:
     if not rows:
         return []
     lines = ["### The bilabial-closure detector", "",
-             "Where the closures of the detector (`engine/method/closure_detector.py`; no phone "
-             "labels) fall, against the reference labels: the /p b m/ a closure reaches (*found*), "
-             "and the closures that reach none (*false*), by what most of their frames are. "
-             "Streamed (`facetraj live --acoustic-only`), its probabilities are the offline ones "
-             "frame for frame.", "",
-             "| Data | Synthesis | /p b m/ found | Closures | Reaching a /p b m/ | False per minute | "
-             "False on a vowel | on another consonant | in silence |",
-             "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+             "Where the closures of the detector (`engine/method/closure_detector.py`) fall, "
+             "against the reference labels: the /p b m/ a closure reaches (*found*), and the "
+             "closures that reach none (*false*), by what most of their frames are. Without phone "
+             "labels it makes every closure; beside recognized ones it adds its closures where "
+             "none is recognized, trusted by the voice match (the training voice's sentences "
+             "only: other voices match 0). Streamed (`facetraj live --acoustic-only`), its "
+             "probabilities are the offline ones frame for frame at one voice match.", "",
+             "| Data | Labels | Synthesis | /p b m/ found | Closures | Reaching a /p b m/ | "
+             "False per minute | False on a vowel | on another consonant | in silence |",
+             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
         d = r["detector"]
-        lines.append(f"| {r['data']} | {r['synthesis']} | {d['found']} of {d['n']} "
+        lines.append(f"| {r['data']} | {r['labels']} | {r['synthesis']} | {d['found']} of {d['n']} "
                      f"({100 * d['recall']:.0f} %) | {d['closures']} | "
                      f"{_percent(d, 'precision')} | {d['false_per_minute']:.1f} | "
                      f"{d['false_vowel']} | {d['false_consonant']} | {d['false_silence']} |")
