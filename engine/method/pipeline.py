@@ -242,6 +242,7 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
     elif detecting:
         p, intervals = _detected(model, audio, sample_rate, times, lsf, frames, match, config)
         strengths = np.ones(len(intervals))
+        log.info("closure step: the lips close at %d closures the detector found", len(intervals))
     return ClosurePlan(intervals, strengths, pauses(audio, sample_rate, times, config.rest_pause_s,
                                                     filtered=filtered), p)
 
