@@ -39,6 +39,9 @@ class TrainConfig:
     lsf_context_frames : the robust mode's acoustic context (``facetraj_engine.method.selection``): each
     codeword
         also stores its LSF vectors this many marker frames before and after it (0: none).
+    closure_detector : train the bilabial-closure detector
+        (``facetraj_engine.method.closure_detector``: where the lips close without phone labels).
+    closure_detector_ridge : its logistic regression's L2 penalty (on standardised features).
     """
 
     audio_rate: int = 16000
@@ -55,6 +58,8 @@ class TrainConfig:
     distance_scale: DistanceScale = "max"
     index_cells: int | None = None
     lsf_context_frames: int = 3
+    closure_detector: bool = True
+    closure_detector_ridge: float = 100.0
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -107,6 +112,14 @@ class SynthConfig:
     closure : after the smoothing, close the lips at the labelled /p b m/ and rest the face in
         pauses (``facetraj_engine.method.closure``, beyond the paper; the paper's tables run without it).
     closure_taper_s : the closure's raised-cosine tapers outside each /p b m/.
+    closure_detector : without phone labels (the acoustic-only mode, ``facetraj live
+        --acoustic-only``), close the lips where the model's bilabial-closure detector finds a
+        closure (``facetraj_engine.method.closure_detector``; models without one close none).
+    closure_threshold : the detector's probability from which a frame is closed (runs of 2
+        frames or more).
+    closure_second_opinion : beside recognized labels, close the lips also where the detector
+        finds a closure and no /p b m/ is recognized, trusted as far as the voice matches the
+        training voice (whose recognized labels the step trusts least).
     rest_pause_s, rest_taper_s : pauses longer than this rest the face; the tapers inside them.
     """
 
@@ -132,6 +145,9 @@ class SynthConfig:
     chain_beta: float = 0.1
     closure: bool = True
     closure_taper_s: float = 0.05
+    closure_detector: bool = True
+    closure_threshold: float = 0.12
+    closure_second_opinion: bool = True
     rest_pause_s: float = 0.15
     rest_taper_s: float = 0.05
 

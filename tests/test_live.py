@@ -24,7 +24,7 @@ def test_live_from_file_writes_the_offline_synthesis(model_file, default_model, 
     wav = default_corpus.root / f"{default_corpus.info.test[0]}.flac"
     out = tmp_path / "take.tsv"
     assert main(["-q", "live", "--model", str(model_file), "--from-file", str(wav),
-                 "--as-fast-as-possible", "--acoustic-only", "-o", str(out)]) == 0
+                 "--as-fast-as-possible", "--acoustic-only", "--no-closure", "-o", str(out)]) == 0
     assert capsys.readouterr().out.strip() == str(out)
     take = read_marker_table(out)
     audio, rate = read_audio(wav)
@@ -35,6 +35,27 @@ def test_live_from_file_writes_the_offline_synthesis(model_file, default_model, 
     # the take exists: not replaced without --overwrite
     assert main(["-q", "live", "--model", str(model_file), "--from-file", str(wav),
                  "--as-fast-as-possible", "--acoustic-only", "-o", str(out)]) != 0
+
+
+def test_live_acoustic_only_closes_the_lips_where_the_detector_finds_closures(
+        model_file, default_model, default_corpus, tmp_path):
+    """Without --no-closure the acoustic-only take has the closure step: the lips shut at the
+    closures the model's detector finds (the offline ones: ``facetraj synth --mode acoustic``)."""
+    from facetraj_engine.evaluation.closure import lip_aperture
+
+    wav = default_corpus.root / f"{default_corpus.info.test[0]}.flac"
+    out = tmp_path / "take.tsv"
+    assert main(["-q", "live", "--model", str(model_file), "--from-file", str(wav),
+                 "--as-fast-as-possible", "--acoustic-only", "-o", str(out)]) == 0
+    take = read_marker_table(out)
+    audio, rate = read_audio(wav)
+    offline = synthesize(default_model, audio, rate, None, SynthConfig(mode="acoustic"))
+    a = lip_aperture(take.markers, default_model.upper_lip, default_model.lower_lip)
+    times = np.arange(len(a)) / default_model.marker_rate
+    assert len(offline.closure.intervals) >= 1
+    for t0, t1 in offline.closure.intervals:
+        inside = (times >= t0 - 0.02) & (times < t1)
+        assert a[inside].min() <= default_model.closure.closed + 0.5
 
 
 def test_live_from_file_with_phones_writes_them_beside_the_take(model_file, default_model,

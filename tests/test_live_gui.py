@@ -36,8 +36,8 @@ def _image_std(image) -> float:
 
 def test_live_window_plays_a_file_and_its_take_reopens(qtbot, default_model, utterance, tmp_path):
     audio, rate = utterance
-    window = live.LiveWindow(default_model, None, (audio, rate), block_s=0.05, fast=True,
-                             phones=False)                # acoustic-only: equal to offline
+    window = live.LiveWindow(default_model, SynthConfig(closure=False), (audio, rate),
+                             block_s=0.05, fast=True, phones=False)  # the search: equal to offline
     qtbot.addWidget(window)
     window.resize(1200, 700)
     window.show()

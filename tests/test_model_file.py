@@ -117,6 +117,14 @@ DAMAGE = [
     ("distances", lambda a, m: -a, "array 'distances' is not a matrix of distances"),
     ("distances", _asymmetric, "array 'distances' is not a matrix of distances"),
     ("distances", _diagonal, "array 'distances' is not a matrix of distances"),
+    ("cd_weights", lambda a, m: _one(a, np.nan), "array 'cd_weights' holds NaN or infinite values"),
+    ("cd_mean", lambda a, m: a[:-1], "array 'cd_mean' has shape"),
+    ("cs_weights", lambda a, m: a[:-2], "array 'cs_weights' has shape"),
+    ("cd_scale", lambda a, m: -a, "the closure detector's arrays hold a scale that is not positive"),
+    ("cs_scale", lambda a, m: 0 * a, "the closure detector's arrays hold a scale that is not positive"),
+    ("cd_lsf_mean", lambda a, m: a + 10.0, "or a mean log LSF at or above log(pi)"),
+    ("cd_weights", None, "its closure detector is incomplete"),
+    ("cs_mean", None, "its closure detector is incomplete"),
 ]
 
 
@@ -143,6 +151,13 @@ def test_finite_values_whose_sum_overflows_are_read(saved, tmp_path):
     assert Model.load(ok).codebook.pcs[1, 0] == 1.7e308
 
 
+def _detector(meta: dict, spec: dict | None = None, **changes) -> dict:
+    """``meta`` with its closure detector's settings (``spec``) or other entries changed."""
+    det = dict(meta["closure_detector"])
+    det.update(spec={**det["spec"], **(spec or {})}, **changes)
+    return {**meta, "closure_detector": det}
+
+
 @pytest.mark.parametrize("edit, phrase", [
     (lambda m: {**m, "phones": [p for p in m["phones"] if p != "sil"]},
      "metadata 'phones' is"),
@@ -153,6 +168,15 @@ def test_finite_values_whose_sum_overflows_are_read(saved, tmp_path):
     (lambda m: {**m, "tuned": {"settings": {"n_context_phones": 2.5}}},
      "setting 'n_context_phones' is 2.5, not a whole number"),
     (lambda m: {**m, "tuned": ["x"]}, "metadata 'tuned' is ['x'], not an object"),
+    (lambda m: _detector(m, spec={"colour": 1}), "has settings this facetraj does not know (colour)"),
+    (lambda m: _detector(m, spec={"n_lsf": 40}), "uses 40 LSFs of 18"),
+    (lambda m: _detector(m, spec={"back": 0}), "setting 'back' is 0, not a whole number from 1 to 600"),
+    (lambda m: _detector(m, spec={"offsets": [0, 0]}), "setting 'offsets' is [0, 0], not distinct"),
+    (lambda m: _detector(m, spec={"gate_db": [-10, -20]}), "setting 'gate_db' is [-10, -20]"),
+    (lambda m: _detector(m, bias="x"), "not an object with the detector's settings and bias"),
+    (lambda m: _detector(m, search_bias=float("nan")), "not an object with the detector's settings"),
+    (lambda m: {k: v for k, v in m.items() if k != "closure_detector"},
+     "its closure detector is incomplete"),
 ])
 def test_metadata_damage_is_refused(saved, tmp_path, edit, phrase):
     meta = json.loads(str(_arrays(saved)["meta"]))

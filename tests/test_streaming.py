@@ -20,7 +20,7 @@ from facetraj_engine.method.smoothing import TriangularStream, triangular_smooth
 from facetraj_engine.method.speaker import choose_warp, warp_lsf
 from facetraj_engine.streaming.synthesizer import StreamConfig, StreamingSynthesizer, stream_synthesize
 
-ACOUSTIC = SynthConfig(mode="acoustic", closure=False)   # live mode has no closure step yet
+ACOUSTIC = SynthConfig(mode="acoustic", closure=False)   # the search alone (test_closure_detector: the step)
 
 
 def _in_blocks(stream, x, sizes):

@@ -1,14 +1,19 @@
-"""Lips that close, measured for the report (issue 25): the closure of every synthesis mode and
-label source on the default corpus's held-out sentences (with their correlations) and on real
-voices the model was not trained on (CMU ARCTIC sentences, speech only), each synthesized the way
-the commands do it (:func:`facetraj_engine.workflow.recording.synthesize_recording` is ``facetraj synth``;
+"""Lips that close, measured for the report (issues 25 and 40): the closure of every synthesis
+mode and label source on the default corpus's held-out sentences (with their correlations), on
+their second voice (:mod:`facetraj_engine.evaluation.second_voice`: the same articulation, another
+voice's formants and pitch) and on real voices the model was not trained on (CMU ARCTIC
+sentences, speech only), each synthesized the way the commands do it
+(:func:`facetraj_engine.workflow.recording.synthesize_recording` is ``facetraj synth``;
 :func:`facetraj_engine.streaming.live.stream_file` is ``facetraj live --from-file``, with phones
 recognized as they are spoken or ``--acoustic-only``).
 
 The measure is :mod:`facetraj_engine.evaluation.closure`: /p b m/ within 1 mm of the training talker's
-closed aperture, the median minimum at /p b m/, the median vowel maximum and the median pause
-aperture. On the corpus the reference labels are its exact ones; on the ARCTIC sentences, their
-transcripts aligned, whatever labels the synthesis itself was given.
+closed aperture, the median minimum at /p b m/, the median vowel maximum, the median pause
+aperture, and the vowels and other consonants shut. On the corpus (and its second voice) the
+reference labels are its exact ones; on the ARCTIC sentences, their transcripts aligned, whatever
+labels the synthesis itself was given. Where the bilabial-closure detector made the closures
+(no phone labels), its own score too: the /p b m/ its closures reach and the closures that reach
+none (:func:`facetraj_engine.evaluation.closure.detector_score`).
 """
 
 from __future__ import annotations
@@ -29,21 +34,29 @@ from ..io.corpus import Corpus
 from ..io.files import read_json, write_json
 from ..io.label_rule import label_audio, read_transcript
 from ..io.labelling import relabelled
+from ..method.closure_detector import closure_runs
 from ..method.model import Model
 from ..method.modes import choose_mode
 from ..method.pipeline import Synthesis, synthesize
-from ..streaming.live import LiveConfig, stream_file
+from ..streaming.live import FileTake, LiveConfig, stream_file
 from ..streaming.recognizer import RecognizerConfig, RunningCmn
 from ..workflow.recording import LabelRequest, synthesize_recording
-from .closure import ClosureScore, closure_score, lip_aperture
+from .closure import ClosureScore, DetectorScore, closure_score, detector_score, lip_aperture
 from .scores import speech_mask, trajectory_correlations
+from .second_voice import second_voice
 
 CLOSURE_EVAL_FILE = "closure_eval.json"
 #: The real voices of the report, read from ``../shared`` when present (never copied).
 ARCTIC_DIR = "data/arctic_samples"
-#: The aims of issue 25: /p b m/ within 1 mm, default mode.
+#: The aims of issues 25 and 40: /p b m/ within 1 mm, default mode; without phones at most 5 %
+#: of the vowels shut.
 AIMS = {"corpus exact": 0.9, "arctic aligned": 0.8, "arctic recognized": 0.7,
-        "arctic acoustic": 0.5, "vowel max mm": 17.0}
+        "arctic acoustic": 0.5, "vowel max mm": 17.0, "vowels shut": 0.05}
+#: How the report names the acoustic-only synthesis with the closure step, and live mode's.
+ACOUSTIC_STEP = "acoustic-only + closure step: the detector's closures, rest in pauses (--mode acoustic)"
+LIVE_ACOUSTIC = "live mode, acoustic-only (--acoustic-only): the detector's closures"
+#: Live mode's audio blocks (a typical audio callback).
+LIVE_BLOCK_S = 0.01
 
 
 @dataclass
@@ -56,10 +69,12 @@ class ClosureRow:
     synthesis: str
     score: dict
     correlations: dict = field(default_factory=dict)
+    detector: dict | None = None
 
     def to_json(self) -> dict:
         return {"data": self.data, "labels": self.labels, "synthesis": self.synthesis,
-                **self.score, **{f"r_{k}": v for k, v in self.correlations.items()}}
+                **self.score, **{f"r_{k}": v for k, v in self.correlations.items()},
+                **({"detector": self.detector} if self.detector is not None else {})}
 
 
 @dataclass
@@ -85,19 +100,49 @@ CORPUS_CONDITIONS = (
     ("recognized", "default (robust + closure step)", SynthConfig(), True),
     ("recognized", "the paper's phonetic mode", SynthConfig(closure=False), False),
     ("none", "acoustic-only (paper)", SynthConfig(mode="acoustic", closure=False), False),
-    ("none", "acoustic-only + rest in pauses (--mode acoustic)", SynthConfig(mode="acoustic"), False),
+    ("none", ACOUSTIC_STEP, SynthConfig(mode="acoustic"), False),
 )
 
 
 def _scored(model: Model, res: Synthesis, reference: Sequence[PhoneSegment], utt=None
             ) -> tuple[ClosureScore, dict]:
-    aperture = lip_aperture(res.markers, model.upper_lip, model.lower_lip)
-    score = closure_score(aperture, res.times, reference, model.closure.closed)
+    return _aperture_scored(model, res.markers, res.times, reference, utt)
+
+
+def _aperture_scored(model: Model, markers: np.ndarray, times: np.ndarray,
+                     reference: Sequence[PhoneSegment], utt=None) -> tuple[ClosureScore, dict]:
+    """The closure of ``markers`` at the ``reference`` phones, and (``utt`` with markers: its
+    original face, speech and audio) their correlations with the original face."""
+    aperture = lip_aperture(markers, model.upper_lip, model.lower_lip)
+    score = closure_score(aperture, times, reference, model.closure.closed)
     if utt is None or utt.markers is None:
         return score, {}
-    mask = speech_mask(utt.audio, utt.sample_rate, res.times)
-    return score, trajectory_correlations(model.normalise_markers(utt.markers), res.markers, mask,
+    mask = speech_mask(utt.audio, utt.sample_rate, times)
+    return score, trajectory_correlations(model.normalise_markers(utt.markers), markers, mask,
                                           model)
+
+
+def _detected(res: Synthesis, reference: Sequence[PhoneSegment]) -> DetectorScore | None:
+    """The detector's score on one synthesis, when its closures were the detector's."""
+    if res.closure is None or res.closure.probability is None:
+        return None
+    return detector_score(res.closure.intervals, res.times, reference)
+
+
+def _take_detected(model: Model, take: FileTake, config: SynthConfig,
+                   reference: Sequence[PhoneSegment]) -> DetectorScore | None:
+    """The detector's score on one streamed take (its probabilities, as the stream found them)."""
+    p = take.stream.closure_probability if take.stream is not None else None
+    if p is None or not len(p):
+        return None
+    times = np.arange(len(p)) / model.marker_rate
+    runs = closure_runs(p, times, config.closure_threshold, model.detector.spec.min_frames)
+    return detector_score(runs, times, reference)
+
+
+def _pooled_detector(parts: Sequence[DetectorScore | None]) -> dict | None:
+    found = [p for p in parts if p is not None]
+    return DetectorScore.pooled(found).to_json() if found else None
 
 
 def corpus_rows(model: Model, corpus: Corpus, progress: Callable[[float, str], None]
@@ -110,7 +155,7 @@ def corpus_rows(model: Model, corpus: Corpus, progress: Callable[[float, str], N
         if kind not in by_kind:
             by_kind[kind] = relabelled(corpus, kind, split="test")
         lab = by_kind[kind]
-        scores, cors = [], []
+        scores, cors, found = [], [], []
         for utt_id in lab.info.test:
             ref, utt = corpus.utterance(utt_id), lab.utterance(utt_id)
             phones = None if kind == "none" else utt.phones
@@ -119,13 +164,63 @@ def corpus_rows(model: Model, corpus: Corpus, progress: Callable[[float, str], N
                              source=utt.name, confidence=utt.confidence, provenance=utt.provenance)
             s, r = _scored(model, res, ref.phones, utt)
             scores.append(s)
-            cors.append([r[m] for m in ("whole_face", "lower_lip", "upper_lip")])
-        mean = np.nanmean(np.array(cors), axis=0)
+            cors.append(r)
+            found.append(_detected(res, ref.phones))
         rows.append(ClosureRow(f"{corpus.root.name} test", kind, name,
-                               ClosureScore.pooled(scores).to_json(),
-                               dict(zip(("whole_face", "lower_lip", "upper_lip"), mean.tolist(),
-                                        strict=True))))
+                               ClosureScore.pooled(scores).to_json(), _mean_correlations(cors),
+                               _pooled_detector(found)))
     return rows
+
+
+def _mean_correlations(cors: Sequence[dict]) -> dict:
+    """The correlations of utterances, averaged (as Table 2 averages them)."""
+    keys = ("whole_face", "lower_lip", "upper_lip")
+    mean = np.nanmean(np.array([[r[m] for m in keys] for r in cors]), axis=0)
+    return dict(zip(keys, mean.tolist(), strict=True))
+
+
+# --------------------------------------------------------------------------- streamed, second voice
+#: The acoustic-only conditions of the corpus's held-out sentences in their own voice and in the
+#: second voice: (synthesis shown, config offline or ``None`` for live mode's stream).
+ACOUSTIC_CONDITIONS = (
+    ("acoustic-only (paper)", SynthConfig(mode="acoustic", closure=False)),
+    (ACOUSTIC_STEP, SynthConfig(mode="acoustic")),
+    (LIVE_ACOUSTIC, None),
+)
+
+
+def acoustic_rows(model: Model, corpus: Corpus, progress: Callable[[float, str], None],
+                  voices: Sequence[str] = ("training", "second")) -> list[ClosureRow]:
+    """The held-out sentences in the training voice, streamed acoustic-only (``facetraj live
+    --acoustic-only``), and in the second voice (:func:`second_voice`) under every condition of
+    :data:`ACOUSTIC_CONDITIONS`: the detector on a voice it was not trained on."""
+    conditions = [(v, name, cfg) for v in voices for name, cfg in ACOUSTIC_CONDITIONS
+                  if v == "second" or cfg is None]
+    parts: dict[tuple[str, str], tuple[list, list, list]] = {c[:2]: ([], [], []) for c in conditions}
+    test = list(corpus.info.test)
+    for j, utt_id in enumerate(test):
+        progress(j / len(test), f"closure: acoustic-only, {utt_id}")
+        utt = corpus.utterance(utt_id)
+        audio = {"training": utt.audio}
+        if "second" in voices:
+            audio["second"] = second_voice(utt.audio, utt.sample_rate)
+        for voice, name, cfg in conditions:
+            if cfg is None:
+                take = stream_file(model, audio[voice], utt.sample_rate, LIVE_BLOCK_S,
+                                   config=LiveConfig(phones=False))
+                markers, found = take.frames.markers, _take_detected(model, take, SynthConfig(),
+                                                                     utt.phones)
+            else:
+                res = synthesize(model, audio[voice], utt.sample_rate, None, cfg,
+                                 n_frames=utt.n_frames, source=utt.name)
+                markers, found = res.markers, _detected(res, utt.phones)
+            s, r = _aperture_scored(model, markers, utt.frame_times(len(markers)), utt.phones, utt)
+            for part, x in zip(parts[(voice, name)], (s, r, found), strict=True):
+                part.append(x)
+    data = {"training": f"{corpus.root.name} test", "second": f"{corpus.root.name} test, second voice"}
+    return [ClosureRow(data[voice], "none", name, ClosureScore.pooled(scores).to_json(),
+                       _mean_correlations(cors), _pooled_detector(found))
+            for (voice, name), (scores, cors, found) in parts.items()]
 
 
 # --------------------------------------------------------------------------- real voices
@@ -137,8 +232,7 @@ ARCTIC_CONDITIONS = (
     ("recognized", "the paper's phonetic mode", "recognize", SynthConfig(closure=False), True),
     ("none", "default: synth with the recording alone (recognizes its phones)", "alone",
      SynthConfig(), False),
-    ("none", "acoustic-only + rest in pauses (--mode acoustic)", "none",
-     SynthConfig(mode="acoustic"), True),
+    ("none", ACOUSTIC_STEP, "none", SynthConfig(mode="acoustic"), True),
     ("none", "acoustic-only (paper)", "none", SynthConfig(mode="acoustic", closure=False), True),
 )
 
@@ -157,10 +251,8 @@ LIVE_CONDITIONS = (
         recognizer=RecognizerConfig(cmn_every=None)), SynthConfig(), False),
     ("live mode, the six as takes of one Live window (cepstral mean kept)", LiveConfig(),
      SynthConfig(), True),
-    ("live mode, acoustic-only (--acoustic-only)", LiveConfig(phones=False), SynthConfig(), False),
+    (LIVE_ACOUSTIC, LiveConfig(phones=False), SynthConfig(), False),
 )
-#: Live mode's audio blocks (a typical audio callback).
-LIVE_BLOCK_S = 0.01
 
 
 def arctic_references(folder: Path) -> dict[Path, tuple[np.ndarray, int, list[PhoneSegment]]]:
@@ -181,14 +273,24 @@ def live_closure(model: Model, refs: dict[Path, tuple[np.ndarray, int, list[Phon
     --as-fast-as-possible`` streams them (blocks of ``block_s``), each from a cold start, or
     (``session``) one after the other as takes of one Live window, which keeps the recognizer's
     running cepstral mean from take to take."""
-    scores = []
+    return live_scores(model, refs, config, block_s, synth, session)[0]
+
+
+def live_scores(model: Model, refs: dict[Path, tuple[np.ndarray, int, list[PhoneSegment]]],
+                config: LiveConfig, block_s: float = LIVE_BLOCK_S,
+                synth: SynthConfig | None = None, session: bool = False
+                ) -> tuple[ClosureScore, DetectorScore | None]:
+    """:func:`live_closure`, and the detector's score where the stream's closures were its."""
+    scores, found = [], []
     cmn = RunningCmn(prior_frames=config.recognizer.cmn_prior_frames,
                      speech_share=config.recognizer.cmn_speech_share) if session else None
     for audio, rate, ref in refs.values():
-        frames = stream_file(model, audio, rate, block_s, synth, config, cmn=cmn).frames
-        aperture = lip_aperture(frames.markers, model.upper_lip, model.lower_lip)
-        scores.append(closure_score(aperture, frames.times, ref, model.closure.closed))
-    return ClosureScore.pooled(scores)
+        take = stream_file(model, audio, rate, block_s, synth, config, cmn=cmn)
+        aperture = lip_aperture(take.frames.markers, model.upper_lip, model.lower_lip)
+        scores.append(closure_score(aperture, take.frames.times, ref, model.closure.closed))
+        found.append(_take_detected(model, take, synth or SynthConfig(), ref))
+    det = [f for f in found if f is not None]
+    return ClosureScore.pooled(scores), (DetectorScore.pooled(det) if det else None)
 
 
 def arctic_rows(model: Model, folder: Path, progress: Callable[[float, str], None]) -> list[ClosureRow]:
@@ -200,7 +302,7 @@ def arctic_rows(model: Model, folder: Path, progress: Callable[[float, str], Non
     steps = len(ARCTIC_CONDITIONS) + len(LIVE_CONDITIONS)
     for k, (kind, name, how, cfg, explicit) in enumerate(ARCTIC_CONDITIONS):
         progress(k / steps, f"closure: ARCTIC {kind}, {name}")
-        scores = []
+        scores, found = [], []
         for w, (audio, rate, ref) in refs.items():
             request = LabelRequest(transcript=w.with_suffix(".txt") if how == "transcript" else None,
                                    recognize=how == "recognize")
@@ -211,12 +313,15 @@ def arctic_rows(model: Model, folder: Path, progress: Callable[[float, str], Non
                 done = synthesize_recording(model, path, cfg, request, explicit=explicit,
                                             audio=(audio, rate))
             scores.append(_scored(model, done.synthesis, ref)[0])
-        rows.append(ClosureRow(folder.name, kind, name, ClosureScore.pooled(scores).to_json()))
+            found.append(_detected(done.synthesis, ref))
+        rows.append(ClosureRow(folder.name, kind, name, ClosureScore.pooled(scores).to_json(),
+                               detector=_pooled_detector(found)))
     for k, (name, config, synth, session) in enumerate(LIVE_CONDITIONS):
         progress((len(ARCTIC_CONDITIONS) + k) / steps, f"closure: ARCTIC, {name}")
-        score = live_closure(model, refs, config, synth=synth, session=session)
+        score, det = live_scores(model, refs, config, synth=synth, session=session)
         rows.append(ClosureRow(folder.name, "recognized, streamed" if config.phones else "none",
-                               name, score.to_json()))
+                               name, score.to_json(),
+                               detector=det.to_json() if det is not None else None))
     return rows
 
 
@@ -227,9 +332,10 @@ def evaluate_closure(model: Model, corpus: Corpus, arctic: str | os.PathLike[str
     progress = progress or (lambda f, m: None)
     if model.closure is None:
         raise ValueError("the model has no closure statistics: train it again")
-    out = ClosureEval(model.closure.closed, corpus_rows(model, corpus, lambda f, m: progress(0.7 * f, m)))
+    out = ClosureEval(model.closure.closed, corpus_rows(model, corpus, lambda f, m: progress(0.5 * f, m)))
+    out.rows += acoustic_rows(model, corpus, lambda f, m: progress(0.5 + 0.25 * f, m))
     if arctic is not None and Path(arctic).is_dir():
-        out.rows += arctic_rows(model, Path(arctic), lambda f, m: progress(0.7 + 0.3 * f, m))
+        out.rows += arctic_rows(model, Path(arctic), lambda f, m: progress(0.75 + 0.25 * f, m))
     progress(1.0, "closure: done")
     return out
 
@@ -246,25 +352,64 @@ def read_closure_eval(path: str | os.PathLike[str]) -> dict | None:
 # --------------------------------------------------------------------------- the report section
 def format_markdown(data: dict) -> list[str]:
     """The report's section "Lips that close"."""
-    lines = ["## Lips that close (issue 25)", "",
+    lines = ["## Lips that close (issues 25 and 40)", "",
              f"The lip aperture (upper-lip centre y minus lower-lip centre y) at its smallest inside "
              f"each /p b m/, against the training talker's closed aperture, "
              f"{data['closed']:.1f} mm (the median of the original markers' minima at the "
              f"training /p b m/). *Within 1 mm*: the share of /p b m/ that close to within 1 mm; "
              f"beside it the median minimum, the median over vowels of each vowel's largest "
-             f"aperture (lips that stay shut cannot pass) and the median aperture in pauses over "
-             f"150 ms. The *closure step* (`engine/method/closure.py`) runs after eq 8 and the "
-             f"smoothing: the lips close at the labelled /p b m/ (recognized ones trusted as far "
-             f"as the voice is not the training voice) and the face rests in pauses. Computed by "
-             f"`facetraj report --closure` (`engine/evaluation/closure_eval.py`).", "",
+             f"aperture (lips that stay shut cannot pass), the median aperture in pauses over "
+             f"150 ms, and where the lips shut with no /p b m/ there: the share of vowels whose "
+             f"largest aperture is within 1 mm of closed (*vowels shut*), and of the other "
+             f"consonants whose smallest is (*consonants shut*; the tapers of a closure reach its "
+             f"neighbours: compare the rows with labels). The *closure step* "
+             f"(`engine/method/closure.py`) runs after eq 8 and the smoothing: the lips close at "
+             f"the labelled /p b m/ (recognized ones trusted as far as the voice is not the "
+             f"training voice, and beside them the detector's closures as far as it is), without "
+             f"labels where the bilabial-closure detector finds a closure "
+             f"(`engine/method/closure_detector.py`), and the face rests in pauses. The "
+             f"*second voice* is each held-out sentence made to sound as a shorter vocal tract "
+             f"and a higher voice (`engine/evaluation/second_voice.py`), its face the original's. "
+             f"Computed by `facetraj report --closure` (`engine/evaluation/closure_eval.py`).", "",
              "| Data | Labels | Synthesis | /p b m/ | Within 1 mm | Median min (mm) | "
-             "Vowel max (mm) | Pause (mm) | Whole face | Lower lip | Upper lip |",
-             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+             "Vowel max (mm) | Pause (mm) | Vowels shut | Consonants shut | Whole face | "
+             "Lower lip | Upper lip |",
+             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in data["rows"]:
         cor = [f"{r[k]:.3f}" if f"{k}" in r else "–" for k in ("r_whole_face", "r_lower_lip",
                                                                   "r_upper_lip")]
         lines.append(f"| {r['data']} | {r['labels']} | {r['synthesis']} | {r['n']} | "
                      f"{100 * r['within']:.0f} % | {r['median_min']:.1f} | {r['vowel_max']:.1f} | "
-                     f"{r['pause']:.1f} | " + " | ".join(cor) + " |")
-    lines.append("")
-    return lines
+                     f"{r['pause']:.1f} | {_percent(r, 'vowels_shut')} | "
+                     f"{_percent(r, 'consonants_shut')} | " + " | ".join(cor) + " |")
+    return [*lines, "", *detector_markdown(data)]
+
+
+def _percent(row: dict, key: str) -> str:
+    v = row.get(key)
+    return "–" if v is None or not np.isfinite(v) else f"{100 * v:.1f} %"
+
+
+def detector_markdown(data: dict) -> list[str]:
+    """The detector's own table: where its closures fell, per data set and mode."""
+    rows = [r for r in data["rows"] if r.get("detector")]
+    if not rows:
+        return []
+    lines = ["### The bilabial-closure detector", "",
+             "Where the closures of the detector (`engine/method/closure_detector.py`) fall, "
+             "against the reference labels: the /p b m/ a closure reaches (*found*), and the "
+             "closures that reach none (*false*), by what most of their frames are. Without phone "
+             "labels it makes every closure; beside recognized ones it adds its closures where "
+             "none is recognized, trusted by the voice match (the training voice's sentences "
+             "only: other voices match 0). Streamed (`facetraj live --acoustic-only`), its "
+             "probabilities are the offline ones frame for frame at one voice match.", "",
+             "| Data | Labels | Synthesis | /p b m/ found | Closures | Reaching a /p b m/ | "
+             "False per minute | False on a vowel | on another consonant | in silence |",
+             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        d = r["detector"]
+        lines.append(f"| {r['data']} | {r['labels']} | {r['synthesis']} | {d['found']} of {d['n']} "
+                     f"({100 * d['recall']:.0f} %) | {d['closures']} | "
+                     f"{_percent(d, 'precision')} | {d['false_per_minute']:.1f} | "
+                     f"{d['false_vowel']} | {d['false_consonant']} | {d['false_silence']} |")
+    return [*lines, ""]

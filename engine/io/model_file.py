@@ -187,6 +187,7 @@ def check_meta(path: Path, meta: dict, newest: int, fmt: str) -> None:
     if not isinstance(meta.get("corpus_fingerprint", ""), str):
         raise bad("corpus_fingerprint", "text")
     _check_tuned(path, meta.get("tuned", {}))
+    _check_detector_meta(path, meta.get("closure_detector"), meta["config"].get("lpc_order", 18))
     closed, d0 = meta.get("closure_closed"), meta.get("voice_distance")
     if closed is not None and (not _is_num(closed) or not abs(closed) < 1e6):
         raise bad("closure_closed", "a lip aperture in mm")
@@ -219,6 +220,47 @@ def _check_tuned(path: Path, tuned) -> None:
             raise ModelFileError(path, f"metadata 'tuned' setting {key!r} is {value!r:.40}, not "
                                        f"{'a whole number' if kind is int else 'a number'} "
                                        f"from {lo:g} to {hi:g}")
+
+
+#: the bilabial-closure detector's feature settings (``facetraj_engine.method.closure_detector.
+#: DetectorSpec``): their kind and range
+DETECTOR_SPEC = {"back": (1, 600, int), "floor_db": (-200.0, -1e-3, float),
+                 "n_lsf": (1, 64, int), "prior_frames": (0.0, 1e9, float),
+                 "min_frames": (1, 600, int)}
+
+
+def _check_detector_meta(path: Path, det, lpc_order: int) -> None:
+    """The closure detector's metadata (``None``: a model without one): its feature settings in
+    range, known to this facetraj, and a finite bias."""
+    if det is None:
+        return
+
+    def bad(what: str) -> ModelFileError:
+        return ModelFileError(path, f"metadata 'closure_detector' {what}")
+
+    spec = det.get("spec") if isinstance(det, dict) else None
+    biases = [det.get(k) for k in ("bias", "search_bias") if k in det] if spec is not None else []
+    if not isinstance(spec, dict) or "bias" not in det or \
+            not all(_is_num(b) and math.isfinite(b) for b in biases):
+        raise bad(f"is {det!r:.60}, not an object with the detector's settings and bias")
+    unknown = set(spec) - set(DETECTOR_SPEC) - {"gate_db", "offsets"}
+    if unknown:
+        raise bad(f"has settings this facetraj does not know ({', '.join(sorted(unknown))}): "
+                  f"written by a newer version?")
+    for key, (lo, hi, kind) in DETECTOR_SPEC.items():
+        v = spec.get(key)
+        if not _is_num(v) or not lo <= v <= hi or (kind is int and not _is_int(v)):
+            what = "a whole number" if kind is int else "a number"
+            raise bad(f"setting {key!r} is {v!r:.40}, not {what} from {lo:g} to {hi:g}")
+    if _is_int(lpc_order) and spec["n_lsf"] > lpc_order:        # (a bad order: check_config's)
+        raise bad(f"uses {spec['n_lsf']} LSFs of {lpc_order}")
+    gate, offsets = spec.get("gate_db"), spec.get("offsets")
+    if not (isinstance(gate, list) and len(gate) == 2 and all(_is_num(g) for g in gate)
+            and gate[0] < gate[1] <= 0):
+        raise bad(f"setting 'gate_db' is {gate!r:.40}, not two dips in dB, the first lower")
+    if not (isinstance(offsets, list) and 0 < len(offsets) <= 121 and
+            all(_is_int(o) and abs(o) <= 60 for o in offsets) and len(set(offsets)) == len(offsets)):
+        raise bad(f"setting 'offsets' is {offsets!r:.40}, not distinct frame offsets within 60")
 
 
 def check_config(path: Path, config: dict) -> None:
@@ -255,6 +297,8 @@ REQUIRED = ("fixed", "reference", "pca_mean", "pca_components", "pca_variances",
             "cb_lsf", "cb_pcs", "cb_token_utt", "cb_token_start", "cb_token_end", "means",
             "distances", "coord_std")
 INDEX = ("ix_centroids", "ix_order", "ix_offsets")
+DETECTOR = ("cd_lsf_mean", "cd_mean", "cd_scale", "cd_weights")
+DETECTOR_SEARCH = ("cs_mean", "cs_scale", "cs_weights")
 _DAMAGED_INDEX = "its LSF index does not match its codebook (damaged file?)"
 #: the tolerance of the structural checks (orthonormal PCs, symmetric distances)
 _TOL = 1e-6
@@ -270,6 +314,9 @@ def _expected(meta: dict, a: dict[str, np.ndarray]) -> dict[str, tuple[str, tupl
     p_order, ctx = cfg.get("lpc_order", 18), 2 * cfg.get("context", 3) + 1
     k, n_ctx, n_fixed = rows("pca_components", 2), rows("cb_contexts", 2), rows("fixed", 1)
     n_cw, n_cells = n_ctx * meta["n_per_phone"], rows("ix_centroids", 2)
+    spec = (meta.get("closure_detector") or {}).get("spec", {})
+    n_lsf, n_det = spec.get("n_lsf", -1), len(spec.get("offsets", [])) * (1 + spec.get("n_lsf", 0))
+    n_search = n_det + 2 * len(spec.get("offsets", []))
     return {
         "fixed": ("i", (n_fixed,)), "reference": ("f", (n_fixed, 3)),
         "pca_mean": ("f", (3 * m,)), "pca_components": ("f", (k, 3 * m)),
@@ -283,6 +330,10 @@ def _expected(meta: dict, a: dict[str, np.ndarray]) -> dict[str, tuple[str, tupl
         "ix_offsets": ("i", (n_cells + 1,)),
         "cb_lsf_context": ("f", (n_cw, 2, p_order)),
         "closure_direction": ("f", (k,)), "rest_pcs": ("f", (k,)),
+        "cd_lsf_mean": ("f", (n_lsf,)), "cd_mean": ("f", (n_det,)), "cd_scale": ("f", (n_det,)),
+        "cd_weights": ("f", (n_det,)),
+        "cs_mean": ("f", (n_search,)), "cs_scale": ("f", (n_search,)),
+        "cs_weights": ("f", (n_search,)),
     }
 
 
@@ -343,6 +394,10 @@ def _check_values(path: Path, meta: dict, a: dict[str, np.ndarray]) -> None:
     if a["pca_variances"].sum() > meta["pca_total_variance"] * (1 + _TOL):
         raise ModelFileError(path, "the PCs' variances add up to more than the total variance "
                                    "(metadata 'pca_total_variance')")
+    if "cd_scale" in a and (np.any(a["cd_scale"] <= 0) or np.any(a.get("cs_scale", 1.0) <= 0)
+                            or np.any(a["cd_lsf_mean"] >= np.log(np.pi))):
+        raise ModelFileError(path, "the closure detector's arrays hold a scale that is not "
+                                   "positive or a mean log LSF at or above log(pi)")
     d = a["distances"]
     scale = max(float(np.abs(d).max()), 1.0)
     if np.any(d < 0) or np.abs(d - d.T).max() > _TOL * scale or np.abs(np.diag(d)).max() > _TOL * scale:
@@ -375,6 +430,10 @@ def check_arrays(path: Path, meta: dict, a: dict[str, np.ndarray]) -> dict[str, 
     if ("closure_closed" in meta) != ("closure_direction" in a) or \
             ("closure_direction" in a) != ("rest_pcs" in a):
         raise ModelFileError(path, "its closure statistics are incomplete (damaged file?)")
+    search = "search_bias" in (meta.get("closure_detector") or {})
+    if any((name in a) != ("closure_detector" in meta) for name in DETECTOR) or \
+            any((name in a) != search for name in DETECTOR_SEARCH):
+        raise ModelFileError(path, "its closure detector is incomplete (damaged file?)")
     out = dict(a)
     for name, (kind, shape) in _expected(meta, a).items():
         if name in a:

@@ -9,7 +9,10 @@ Synthesis (2.3): ``pipeline.synthesize``: input LSFs; the mode's search (``modes
 by eq 4 (``similarity``), by the LSF index (acoustic-only) or both (``selection``, the robust mode
 beyond the paper), then eqs 5-8 (``synthesis``)); ``smoothing``; PCs back to face points.
 ``speaker`` warps another voice's LSFs. ``modes`` is every mode's one home, and
-``modes.choose_mode`` the one rule for which mode the labels allow.
+``modes.choose_mode`` the one rule for which mode the labels allow. Beyond the paper, after the
+smoothing: ``closure`` (lips that close at /p b m/, a face that rests in pauses) and
+``closure_detector`` (where the lips close without phone labels; ``closure_search``: the
+acoustic search's own opinion).
 
 Equation modules are plain array functions, each naming its equation, with doctests; where a
 vectorised form replaces the formula (``synthesis.grid_weights``, ``lsf.chebyshev_real_roots``,

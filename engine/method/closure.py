@@ -52,11 +52,14 @@ class ClosureStats:
 @dataclass(frozen=True)
 class ClosurePlan:
     """Where the step acts on one input: ``intervals`` ``(J, 2)`` seconds of /p b m/ and their
-    ``strengths`` ``(J,)`` in [0, 1]; ``pauses`` ``(P, 2)`` seconds."""
+    ``strengths`` ``(J,)`` in [0, 1]; ``pauses`` ``(P, 2)`` seconds; ``probability``: per frame,
+    the bilabial-closure detector's (:mod:`facetraj_engine.method.closure_detector`) when it
+    ran."""
 
     intervals: np.ndarray
     strengths: np.ndarray
     pauses: np.ndarray
+    probability: np.ndarray | None = None
 
 
 # --------------------------------------------------------------------------- the aperture

@@ -23,6 +23,7 @@ from ..io.files import atomic_write, write_npz
 from ..io.model_file import read_model_file
 from .chain import join_scale
 from .closure import ClosureStats
+from .closure_detector import ClosureDetector
 from .codebook import Codebook
 from .lsf import lsf_at
 from .lsf_index import LsfIndex, build_index
@@ -67,6 +68,9 @@ class Model:
         (:mod:`facetraj_engine.method.closure`); ``None`` in older model files (no closure step).
     voice_distance : ``D0``, the training voice's distance to its own codebook
         (:mod:`facetraj_engine.method.voice_match`); NaN in older model files.
+    detector : the bilabial-closure detector (:mod:`facetraj_engine.method.closure_detector`):
+        where the lips close without phone labels; ``None`` in older model files (their
+        acoustic-only synthesis closes no lips, as before).
     """
 
     config: TrainConfig
@@ -91,6 +95,7 @@ class Model:
     trained_labels: dict = field(default_factory=dict)
     closure: ClosureStats | None = None
     voice_distance: float = float("nan")
+    detector: ClosureDetector | None = None
 
     def __post_init__(self) -> None:
         # no fixed markers (head-corrected data) is an empty index array, not numpy's float []
@@ -210,6 +215,8 @@ class Model:
         }
         if self.closure is not None:
             meta["closure_closed"] = self.closure.closed
+        if self.detector is not None:
+            meta["closure_detector"] = self.detector.meta()
         arrays = {
             "meta": np.array(json.dumps(meta)),
             "fixed": self.fixed, "reference": self.reference,
@@ -224,6 +231,8 @@ class Model:
             arrays["cb_lsf_context"] = self.codebook.lsf_context
         if self.closure is not None:
             arrays.update(closure_direction=self.closure.direction, rest_pcs=self.closure.rest)
+        if self.detector is not None:
+            arrays.update(self.detector.arrays())
         if self.index is not None:
             arrays.update(ix_centroids=self.index.centroids, ix_order=self.index.order,
                           ix_offsets=self.index.offsets)
@@ -259,6 +268,8 @@ class Model:
                 closure=ClosureStats(float(meta["closure_closed"]), a["closure_direction"],
                                      a["rest_pcs"]) if "closure_closed" in meta else None,
                 voice_distance=float(meta.get("voice_distance") or "nan"),
+                detector=ClosureDetector.from_file(meta["closure_detector"], a)
+                if "closure_detector" in meta else None,
             )
         except KeyError as exc:
             raise ModelFileError(path, f"model file is incomplete: missing {exc}") from exc

@@ -24,6 +24,8 @@ from ..io.labelfiles import validate_phones
 from ..labels.phoneset import SILENCE, map_labels, normalise_label
 from ..threads import frame_threads
 from .closure import ClosurePlan, aperture_functional, apply_closure, closure_intervals, closure_strengths
+from .closure_detector import beside, closure_runs, input_probability
+from .closure_search import search_rows
 from .context import segment_index
 from .model import Model
 from .modes import mode_of
@@ -144,8 +146,10 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         if mode.weighs_labels:
             job.confidence = frame_confidence(list(phones), confidence, times)
     found = mode.search(job)
+    unwarped = warp == 1.0 and not (mode.weighs_labels and config.mean_normalise)
     plan = plan_closure(model, audio, sample_rate, times, job.segs, provenance,
-                        voice_match(ratio, 1.0), config, energy.filtered if config.closure else None)
+                        voice_match(ratio, 1.0), config, energy.filtered if config.closure else None,
+                        w if unwarped else None, found.frames)
     res = _finish(model, times, w, found.frames, config, found.segments, found.frame_segment,
                   warp, plan)
     res.voice_match, res.voice_ratio = voice_match(ratio, 1.0), ratio
@@ -219,22 +223,56 @@ def _smoothed(model: Model, raw: np.ndarray, times: np.ndarray, config: SynthCon
 
 def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
                  segs: Sequence[PhoneSegment] | None, provenance: Provenance | None,
-                 match: float, config: SynthConfig, filtered: np.ndarray | None = None
+                 match: float, config: SynthConfig, filtered: np.ndarray | None = None,
+                 lsf: np.ndarray | None = None, frames: FrameWeights | None = None
                  ) -> ClosurePlan | None:
     """Where the closure step acts (``None``: off, or a model file without its statistics): the
     labelled /p b m/, trusted as :func:`~facetraj_engine.method.closure.closure_strengths` says (for
-    recognized labels by the voice ``match``; NaN: unknown, untrusted), and the pauses by
-    energy (``filtered``: :func:`~facetraj_engine.method.speech.filtered_energy_db` of the audio, when
-    already computed)."""
+    recognized labels by the voice ``match``; NaN: unknown, untrusted), and beside recognized
+    ones the detector's closures where none is recognized, trusted by the voice ``match``
+    (``config.closure_second_opinion``); without labels, the closures the model's detector finds
+    (``config.closure_detector``, fully trusted; ``lsf``: the input's unwarped LSFs at ``times``,
+    when computed; ``frames``: the acoustic-only search's, whose opinion counts by the voice
+    ``match``); and the pauses by energy (``filtered``:
+    :func:`~facetraj_engine.method.speech.filtered_energy_db` of the audio, when already
+    computed)."""
     if not config.closure or model.closure is None:
         return None
-    intervals, strengths = np.zeros((0, 2)), np.zeros(0)
+    intervals, strengths, p = np.zeros((0, 2)), np.zeros(0), None
+    detecting = config.closure_detector and model.detector is not None
     if segs:
-        trust = closure_strengths(len(segs), (provenance or Provenance()).kind,
-                                  match if np.isfinite(match) else 1.0)
+        kind = (provenance or Provenance()).kind
+        trust = closure_strengths(len(segs), kind, match if np.isfinite(match) else 1.0)
         intervals, strengths = closure_intervals(segs, trust)
+        if detecting and kind == "recognized" and config.closure_second_opinion and \
+                np.isfinite(match) and match > 0:
+            p, runs = _detected(model, audio, sample_rate, times, lsf, None, match, config)
+            added = beside(runs, intervals)
+            intervals = np.concatenate([intervals, added])
+            strengths = np.concatenate([strengths, np.full(len(added), match)])
+    elif detecting:
+        p, intervals = _detected(model, audio, sample_rate, times, lsf, frames, match, config)
+        strengths = np.ones(len(intervals))
+        log.info("closure step: the lips close at %d closures the detector found", len(intervals))
     return ClosurePlan(intervals, strengths, pauses(audio, sample_rate, times, config.rest_pause_s,
-                                                    filtered=filtered))
+                                                    filtered=filtered), p)
+
+
+def _detected(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
+              lsf: np.ndarray | None, frames: FrameWeights | None, match: float,
+              config: SynthConfig) -> tuple[np.ndarray, np.ndarray]:
+    """The detector's probabilities and closures of an input (:func:`plan_closure`); the
+    acoustic-only search is made here when its opinion counts (``match`` above 0) and ``frames``
+    is not that search's."""
+    det = model.detector
+    if lsf is None:
+        lsf = model.input_lsf(audio, sample_rate, times, frame_threads())
+    if frames is None and det.search is not None and np.isfinite(match) and match > 0:
+        acoustic = config.with_(mode="acoustic")
+        frames = mode_of(acoustic).search(SearchInput(model, lsf, times, acoustic)).frames
+    search = search_rows(model, frames) if frames is not None and det.search is not None else None
+    p = input_probability(det, model.config, audio, sample_rate, times, lsf, search, match)
+    return p, closure_runs(p, times, config.closure_threshold, det.spec.min_frames)
 
 
 class SpeechEnergy:
@@ -255,8 +293,10 @@ def _voice_ratio(model: Model, energy: SpeechEnergy, times: np.ndarray, w: np.nd
     labels by the voice, the closure step's trust in recognized labels) or it is ``wanted``,
     else NaN (not computed)."""
     recognized = provenance is not None and provenance.kind == "recognized"
+    detector = model.detector is not None and model.detector.search is not None and \
+        config.closure_detector and not mode_of(config).needs_labels
     if not (wanted or (mode_of(config).weighs_labels and config.label_weight_by_voice) or
-            (config.closure and recognized)):
+            (config.closure and (recognized or detector))):
         return float("nan")
     return input_voice_ratio(model, energy.audio, energy.sample_rate, times, w, energy.filtered)
 

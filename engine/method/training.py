@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..config import TrainConfig
-from ..data import Utterance
+from ..data import PhoneSegment, Utterance
 from ..errors import InputError, warn_file
 from ..fanout import Skips, fan_out
 from ..io.corpus import Corpus
@@ -20,6 +20,8 @@ from ..io.labelfiles import validate_phones
 from ..labels.phoneset import SILENCE, apply_label_map
 from ..progress import Progress, no_progress
 from .closure import ClosureStats, aperture_functional, closure_stats
+from .closure_detector import ClosureDetector, bilabial_frames, train_detector, utterance_inputs
+from .closure_search import left_out_rows
 from .codebook import Codebook, codeword_times, concatenate, interpolate_frames
 from .context import context_ids
 from .lsf import lsf_at
@@ -225,6 +227,9 @@ def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = 
     progress(0.97, "closure and voice statistics")
     model.closure = closure_part(model, loaded, normed)
     model.voice_distance = voice_part(model, loaded)
+    if config.closure_detector:
+        progress(0.98, "closure detector")
+        model.detector = detector_part(model, loaded, label_map)
     progress(1.0, "done")
     return model
 
@@ -235,6 +240,26 @@ def closure_part(model: Model, loaded: Sequence[Utterance], normed: Sequence[np.
     a0, g = aperture_functional(model.pca, model.upper_lip, model.lower_lip)
     pcs = [model.to_pcs(n) for n in normed]
     return closure_stats(pcs, [u.phones for u in loaded], model.marker_rate, a0, g)
+
+
+def detector_part(model: Model, loaded: Sequence[Utterance],
+                  label_map: Mapping[str, str] | None = None) -> ClosureDetector | None:
+    """The bilabial-closure detector (:mod:`facetraj_engine.method.closure_detector`) of the
+    training utterances' marker frames, their /p b m/ labels as targets; its second part with the
+    acoustic search's opinion, each utterance searched without its own codewords
+    (:mod:`facetraj_engine.method.closure_search`)."""
+    lsf, energy, targets, search = [], [], [], []
+    for k, utt in enumerate(loaded):
+        times = utt.frame_times()
+        w, e = utterance_inputs(model.config, utt.audio, utt.sample_rate, times)
+        phones = [PhoneSegment(s.start, s.end, apply_label_map(s.label, label_map))
+                  for s in utt.phones]
+        lsf.append(w)
+        energy.append(e)
+        targets.append(bilabial_frames(phones, times))
+        search.append(left_out_rows(model, w, k))
+    return train_detector(lsf, energy, targets, ridge=model.config.closure_detector_ridge,
+                          search=search)
 
 
 def voice_part(model: Model, loaded: Sequence[Utterance], utterances: int = 40,

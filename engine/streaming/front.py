@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..method.closure_detector import frame_energy_db
 from ..method.lsf import ResampleStream, frame_lsf, frame_start, frame_starts, preemphasize
 from ..method.model import Model
 
@@ -71,16 +72,28 @@ class LsfFront:
         """``(stop - start, P)`` LSFs of frames ``start .. stop-1``; analysis samples not received
         yet are zero (only at the end of the audio). The samples before ``start``'s window must
         not have been released."""
-        t = np.arange(start, stop)
-        if len(t) == 0:
+        if stop <= start:
             return np.zeros((0, self.order))
+        return frame_lsf(self.frames(start, stop), self.order)
+
+    def lsf_energy(self, start: int, stop: int) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`lsf` of the frames, and their energies in dB
+        (:func:`facetraj_engine.method.closure_detector.frame_energy_db`)."""
+        if stop <= start:
+            return np.zeros((0, self.order)), np.zeros(0)
+        frames = self.frames(start, stop)
+        return frame_lsf(frames, self.order), frame_energy_db(frames)
+
+    def frames(self, start: int, stop: int) -> np.ndarray:
+        """The Hamming-windowed analysis frames ``(stop - start, n)`` of :meth:`lsf`."""
+        t = np.arange(start, stop)
         length = self.analysed
         starts = np.clip(frame_starts(t / self.rate, self._audio_rate), 0, length) - self._half
         idx = starts[:, None] + np.arange(self._n)[None, :]
         inside = (idx >= 0) & (idx < length)
         local = np.clip(idx - self._first, 0, max(len(self._buffer) - 1, 0))
         values = self._buffer[local] if len(self._buffer) else np.zeros(idx.shape)
-        return frame_lsf(np.where(inside, values, 0.0) * self._hamming[None, :], self.order)
+        return np.where(inside, values, 0.0) * self._hamming[None, :]
 
     def release(self, t: int) -> None:
         """Forget the samples before frame ``t``'s window (frames before t are done)."""

@@ -69,12 +69,14 @@ def live_mode(config: SynthConfig, model: Model, phones: bool = True,
     (:func:`facetraj_engine.method.modes.choose_mode`) gives recognized labels -- the robust mode with the
     model's cross-validated settings, and the closure step, but not the chain over frames
     (``facetraj_engine.method.chain``: its forward-backward needs the whole input); acoustic-only, the
-    paper's search without it (as ``facetraj live`` was). With ``labels`` known before the audio
-    (a file's, by the one rule) the rule decides by them, as ``synth`` does: aligned or recognized
-    labels, the robust mode; hand-checked ones, the stream's robust search with every label
-    trusted fully (a stream has no phonetic search of its own)."""
+    paper's search and the closure step with the model's bilabial-closure detector, as
+    ``facetraj synth --mode acoustic`` (``facetraj_engine.streaming.synthesizer``). With
+    ``labels`` known before the audio (a file's, by the one rule) the rule decides by them, as
+    ``synth`` does: aligned or recognized labels, the robust mode; hand-checked ones, the
+    stream's robust search with every label trusted fully (a stream has no phonetic search of its
+    own)."""
     if not phones:
-        return ModeChoice(config.with_(mode="acoustic", closure=False), "acoustic-only, chosen")
+        return ModeChoice(config.with_(mode="acoustic"), "acoustic-only, chosen")
     if labels is not None:
         rule = choose_mode(config.with_(mode="phonetic"), labels.phones, labels.provenance,
                            tuned=model.tuned)
@@ -234,6 +236,15 @@ class LiveStream:
         if self.phonetic is None:
             return None
         return self.phonetic.phones.snapshot(since_s)
+
+    @property
+    def closure_probability(self) -> np.ndarray | None:
+        """Per frame so far, the bilabial-closure detector's probability (acoustic-only with the
+        closure step and a model with a detector; else ``None``)."""
+        closure = self.acoustic.closure if self.acoustic is not None else None
+        if closure is None or closure.detector is None:
+            return None
+        return closure.detector.probabilities()
 
     @property
     def voice_ratio(self) -> float:

@@ -39,21 +39,19 @@ from ..method.search import acoustic_candidates, context_offsets, robust_weights
 from ..method.similarity import top_context_phones
 from ..method.smoothing import TriangularStream
 from ..method.synthesis import gamma_grid, weight_frames
-from ..method.voice_match import indexed_distances, trust_by_voice
+from ..method.voice_match import trust_by_voice
 from .closure import ClosureStream, pause_runs
 from .front import LsfFront
 from .phones import PhoneSnapshot
-from .speech import SILENT, SPEECH, UNRANGED, SpeechStream
+from .speech import SILENT, UNRANGED, SpeechStream
 from .synthesizer import StreamFrames
-from .voice import RunningVoice
+from .voice import RunningVoice, VoiceTracker
 
 #: Seconds of decided speech/silence the pauses are looked for in, before the frames emitted.
 PAUSE_LOOKBACK_S = 2.0
 #: Frames whose LSFs are computed together once their windows are in (before they are analysed:
 #: a frame waits for its phone far longer than for its window; fewer, larger numpy calls).
 LSF_BATCH = 6
-#: Speech frames whose voice distances are computed together (the running ratio moves slowly).
-VOICE_BATCH = 30
 
 
 class PhoneSource(Protocol):
@@ -118,7 +116,8 @@ class PhoneticSynthesizer:
         self.rate = model.marker_rate
         self.front = LsfFront(model, sample_rate)
         self.speech = SpeechStream(sample_rate, self.rate)
-        self.voice = RunningVoice(model.voice_distance)
+        self._voice = VoiceTracker(model, self.speech)
+        self.voice: RunningVoice = self._voice.voice
         cb = model.codebook
         self._ctx = model.config.lsf_context_frames if cb.lsf_context is not None else 0
         self._smoother = TriangularStream(self.rate, synth.triangle_s if synth.smoothing ==
@@ -134,8 +133,6 @@ class PhoneticSynthesizer:
         self._w0 = 0
         self._next = 0                                       # the next frame to analyse
         self._emitted = 0
-        self._pending: list[np.ndarray] = []                 # LSFs of analysed frames _voiced ...
-        self._voiced = 0
         self.labelled: list[bool] = []                       # per analysed frame: had a phone
 
     @property
@@ -219,7 +216,7 @@ class PhoneticSynthesizer:
                                                                    self._grouped),
                                            self.model.codebook.lsf, self.model.codebook.pcs,
                                            self._gammas).pcs
-        self._pending.append(w)
+        self._voice.add(w)
         self.labelled += labelled.tolist()
         self._next = stop
         return raw
@@ -251,27 +248,13 @@ class PhoneticSynthesizer:
 
     # ------------------------------------------------------------------ out
     def _emit(self, smoothed: np.ndarray | None, final: bool) -> StreamFrames:
-        self._update_voice(final)
+        self._voice.update(final)
         pcs = np.zeros((0, self._k)) if smoothed is None else smoothed
         if self._closure is not None and (len(pcs) or final):
             pcs = self._closure.feed(pcs, self._plan(), final)
         index = np.arange(self._emitted, self._emitted + len(pcs))
         self._emitted += len(pcs)
         return StreamFrames(index, index / self.rate, pcs, self.model.to_markers(pcs))
-
-    def _update_voice(self, final: bool = False) -> None:
-        """The voice distances of the analysed frames now known to be speech, once there are
-        ``VOICE_BATCH`` of them (at the end: all)."""
-        pending = np.concatenate(self._pending) if self._pending else np.zeros((0, 1))
-        known = min(self.speech.known, self._voiced + len(pending))
-        speech = np.asarray(self.speech.decisions[self._voiced:known]) == SPEECH
-        if speech.sum() < VOICE_BATCH and not (final and known > self._voiced):
-            return
-        w = pending[:known - self._voiced][speech]
-        if len(w):
-            self.voice.add(indexed_distances(w, self.model.codebook.lsf, self.model.lsf_index()))
-        self._pending = [pending[known - self._voiced:]]
-        self._voiced = known
 
     def _plan(self) -> ClosurePlan:
         """The settled /p b m/ and the pauses around the frames about to be emitted."""

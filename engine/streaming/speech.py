@@ -123,16 +123,18 @@ class SpeechStream:
         """Decide each marker frame whose filtered energy is known (``total``: the end)."""
         have = self._f0 + len(self._filtered)
         hop = self.config.energy_hop_s
+        levels = None                       # the floor and peak: one filtered history per call
         while total is None or self.known < total:
             j = int(round(self.known / self.marker_rate / hop))
             if total is None and j >= have:
                 break
             j = min(max(j, self._f0), have - 1)
-            self.decisions.append(self._decision(self._filtered[j - self._f0]) if have > self._f0
-                                  else UNRANGED)
+            if have > self._f0 and levels is None:
+                levels = np.percentile(self._filtered, [5, 99])
+            self.decisions.append(self._decision(self._filtered[j - self._f0], *levels)
+                                  if have > self._f0 else UNRANGED)
 
-    def _decision(self, value: float) -> int:
-        floor, peak = np.percentile(self._filtered, [5, 99])
+    def _decision(self, value: float, floor: float, peak: float) -> int:
         self.ranged = self.ranged or bool(peak - floor >= self.min_range_db)
         if not self.ranged:
             return UNRANGED

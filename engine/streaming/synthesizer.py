@@ -13,6 +13,13 @@ plus up to ``batch_frames - 1`` frames when frames are analysed in batches (live
 The frames emitted by the blocks and :meth:`StreamingSynthesizer.flush` together equal the
 offline synthesis of the whole audio, frame for frame (to rounding).
 
+With ``synth.closure`` (live mode, ``facetraj live --acoustic-only``) the closure step follows
+the smoothing (:mod:`facetraj_engine.streaming.closure`, no frames held): the lips close where
+the model's bilabial-closure detector finds a closure (:mod:`facetraj_engine.streaming.detector`:
+its probabilities need the frames up to 3 after a frame, which the smoothing has waited for
+already, so it adds no lookahead) and the face rests in the pauses found by energy so far
+(:mod:`facetraj_engine.streaming.speech`).
+
 Spline smoothing needs the whole utterance and is not available here.
 """
 
@@ -24,12 +31,18 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..config import SynthConfig
+from ..method.closure import ClosurePlan
+from ..method.closure_search import bilabial_codewords, search_rows
 from ..method.model import Model
 from ..method.search import acoustic_candidates
 from ..method.smoothing import TriangularStream
 from ..method.speaker import warp_lsf
-from ..method.synthesis import gamma_grid, weight_frames
+from ..method.synthesis import FrameWeights, gamma_grid, weight_frames
+from .closure import ClosureStream, pause_runs
+from .detector import DetectorStream
 from .front import LsfFront
+from .speech import SPEECH, UNRANGED, SpeechStream
+from .voice import VoiceTracker
 
 log = logging.getLogger(__name__)
 
@@ -107,6 +120,8 @@ class StreamingSynthesizer:
         self._lsf: list[np.ndarray] = []
         self._raw: list[np.ndarray] = []
         self._grouped = model.lsf_index().grouped(model.codebook.lsf)   # once, not per block
+        self.closure = StreamClosure(model, self.config.sample_rate, cfg) \
+            if cfg.closure and model.closure is not None else None
 
     @property
     def lookahead_s(self) -> float:
@@ -134,6 +149,8 @@ class StreamingSynthesizer:
     def feed(self, block: np.ndarray) -> StreamFrames:
         """Face frames completed by the next ``block`` of audio samples (mono)."""
         last = self.front.feed(block)           # frame t is complete once its window is in
+        if self.closure is not None:
+            self.closure.speech.feed(block)
         if last - self._next < self.config.batch_frames:
             last = self._next                           # not a whole batch yet: wait
         return self._emit(self._analyse(last), self._smoother.feed)
@@ -145,8 +162,11 @@ class StreamingSynthesizer:
         if total == 0:
             return self._emit(np.zeros((0, self.model.codebook.pcs.shape[1])), self._smoother.feed)
         raw = self._analyse(total)
+        if self.closure is not None:
+            self.closure.finish(total)
         frames = self._emit(raw, self._smoother.feed)
-        rest = self._emit(np.zeros((0, raw.shape[1])), lambda _: self._smoother.flush())
+        rest = self._emit(np.zeros((0, raw.shape[1])), lambda _: self._smoother.flush(),
+                          final=True)
         return StreamFrames(np.concatenate([frames.index, rest.index]),
                             np.concatenate([frames.times, rest.times]),
                             np.concatenate([frames.pcs, rest.pcs]),
@@ -158,23 +178,91 @@ class StreamingSynthesizer:
         k = self.model.codebook.pcs.shape[1]
         if stop <= self._next:
             return np.zeros((0, k))
-        w = self.front.lsf(self._next, stop)
-        if self.synth.speaker_warp != 1.0:
-            w = warp_lsf(w, self.synth.speaker_warp)
+        if self.closure is not None:
+            raw, energy = self.front.lsf_energy(self._next, stop)
+        else:
+            raw = self.front.lsf(self._next, stop)
+        w = warp_lsf(raw, self.synth.speaker_warp) if self.synth.speaker_warp != 1.0 else raw
         cb = self.model.codebook
         fw = weight_frames(w, acoustic_candidates(self.model, w, self.synth, self._grouped), cb.lsf, cb.pcs,
                            self._gammas)
+        if self.closure is not None:
+            self.closure.analysed(raw, energy, w, fw)
         self._lsf.append(w)
         self._raw.append(fw.pcs)
         self._next = stop
         self.front.release(stop)                        # samples before the next window: done
         return fw.pcs
 
-    def _emit(self, raw: np.ndarray, smoother) -> StreamFrames:
+    def _emit(self, raw: np.ndarray, smoother, final: bool = False) -> StreamFrames:
         pcs = smoother(raw)
+        if self.closure is not None:
+            pcs = self.closure.feed(pcs, final)
         index = np.arange(self._emitted, self._emitted + len(pcs))
         self._emitted += len(pcs)
         return StreamFrames(index, index / self.rate, pcs, self.model.to_markers(pcs))
+
+
+class StreamClosure:
+    """The closure step of an acoustic-only stream: the pauses by energy, the detector's
+    closures (the search's opinion counting by the running voice match), and the step on the
+    smoothed frames (none held)."""
+
+    def __init__(self, model: Model, sample_rate: int, synth: SynthConfig):
+        self.model, self.synth, self.rate = model, synth, model.marker_rate
+        self.speech = SpeechStream(sample_rate, self.rate)
+        self.detector = DetectorStream(model.detector, self.rate) \
+            if synth.closure_detector and model.detector is not None else None
+        searching = self.detector is not None and model.detector.search is not None
+        self.voice = VoiceTracker(model, self.speech) if searching else None
+        self._bilabial = bilabial_codewords(model) if searching else None
+        self.step = ClosureStream(model, 0, synth.closure_taper_s, synth.rest_taper_s)
+        self._final = False
+
+    @property
+    def match(self) -> float:
+        """The running voice match (the prior until it is measured)."""
+        return self.voice.voice.match if self.voice is not None else 0.0
+
+    def analysed(self, lsf: np.ndarray, energy_db: np.ndarray, w: np.ndarray,
+                 frames: FrameWeights) -> None:
+        """The next analysed frames' unwarped LSFs and energies, the LSFs searched ``w`` and the
+        search's weights."""
+        if self.detector is None:
+            return
+        search = None
+        if self.voice is not None:
+            self.voice.add(w)
+            self.voice.update()
+            search = search_rows(self.model, frames, self._bilabial)
+        self.detector.feed(lsf, energy_db, search, self.match)
+
+    def finish(self, total: int) -> None:
+        """The audio ended (``total`` frames in all)."""
+        self.speech.flush(total)
+        if self.detector is not None:
+            if self.voice is not None:
+                self.voice.update(final=True)
+            self.detector.flush(self.match)
+        self._final = True
+
+    def feed(self, pcs: np.ndarray, final: bool = False) -> np.ndarray:
+        """The smoothed frames after the step, as far as the plan is known now."""
+        if not len(pcs) and not final:
+            return pcs
+        return self.step.feed(pcs, self.plan(), final)
+
+    def plan(self) -> ClosurePlan:
+        """The detector's closures and the pauses around the frames about to be emitted."""
+        emitted = self.step.received - int(ClosureStream.KEEP_S * self.rate)
+        since = max(0, emitted)
+        intervals = self.detector.runs(since, self.synth.closure_threshold, self._final) \
+            if self.detector is not None else np.zeros((0, 2))
+        dec = np.asarray(self.speech.decisions[since:])
+        dec = np.where(dec == UNRANGED, SPEECH, dec)     # not ranged: nothing rests
+        times = np.arange(since, since + len(dec)) / self.rate
+        pauses = pause_runs(dec, times, self.synth.rest_pause_s) if len(dec) else np.zeros((0, 2))
+        return ClosurePlan(intervals, np.ones(len(intervals)), pauses)
 
 
 def stream_synthesize(model: Model, audio: np.ndarray, sample_rate: int, block: int,

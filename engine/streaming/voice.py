@@ -20,12 +20,15 @@ from collections import deque
 
 import numpy as np
 
-from ..method.voice_match import MAX_FRAMES, label_weight_scale, voice_match
+from ..method.voice_match import MAX_FRAMES, indexed_distances, label_weight_scale, voice_match
+from .speech import SPEECH, SpeechStream
 
 #: Speech frames heard before the running ratio counts (0.5 s of speech at 60 Hz).
 MIN_FRAMES = 30
 #: The voice match assumed until then.
 PRIOR_MATCH = 0.0
+#: Speech frames whose voice distances are computed together (the running ratio moves slowly).
+VOICE_BATCH = 30
 
 
 class RunningVoice:
@@ -70,3 +73,33 @@ class RunningVoice:
         """The factor of the robust mode's label weight
         (:func:`facetraj_engine.method.voice_match.label_weight_scale` of the running ratio)."""
         return label_weight_scale(self.ratio, by_voice)
+
+
+class VoiceTracker:
+    """A stream's :class:`RunningVoice` fed with the analysed frames' LSFs (:meth:`add`) once
+    its :class:`~facetraj_engine.streaming.speech.SpeechStream` has decided they are speech, in
+    batches of :data:`VOICE_BATCH` speech frames (:meth:`update`)."""
+
+    def __init__(self, model, speech: SpeechStream):
+        self.model, self.speech = model, speech
+        self.voice = RunningVoice(model.voice_distance)
+        self._pending: list[np.ndarray] = []             # LSFs of analysed frames _voiced ...
+        self._voiced = 0
+
+    def add(self, lsf: np.ndarray) -> None:
+        """The next analysed frames' LSFs."""
+        self._pending.append(lsf)
+
+    def update(self, final: bool = False) -> None:
+        """The voice distances of the analysed frames now known to be speech, once there are
+        ``VOICE_BATCH`` of them (``final``: all)."""
+        pending = np.concatenate(self._pending) if self._pending else np.zeros((0, 1))
+        known = min(self.speech.known, self._voiced + len(pending))
+        speech = np.asarray(self.speech.decisions[self._voiced:known]) == SPEECH
+        if speech.sum() < VOICE_BATCH and not (final and known > self._voiced):
+            return
+        w = pending[:known - self._voiced][speech]
+        if len(w):
+            self.voice.add(indexed_distances(w, self.model.codebook.lsf, self.model.lsf_index()))
+        self._pending = [pending[known - self._voiced:]]
+        self._voiced = known

@@ -137,8 +137,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--block-ms", type=real(0.0625, 10000), default=10.0,
                    help="audio block size in ms (default 10)")
     p.add_argument("--acoustic-only", action="store_true",
-                   help="the paper's acoustic search alone, without recognizing the phones "
-                        "(lower latency; the lips of a new voice do not close)")
+                   help="the paper's acoustic search without recognizing the phones (lower "
+                        "latency); the lips close where the model's bilabial-closure detector "
+                        "finds a closure")
     p.add_argument("--warp", type=real(0.5, 2.0), default=1.0, metavar="ALPHA",
                    help="with --acoustic-only: speaker warp of the input LSFs "
                         "(facetraj_engine.method.speaker; "
@@ -147,6 +148,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--quit-after", type=real(0, 1e6, lo_open=True), metavar="S",
                    help=argparse.SUPPRESS)
     g = p.add_argument_group("synthesis (paper 2.3)")
+    g.add_argument("--no-closure", dest="closure", action="store_false", default=None,
+                   help="no closure step: the lips are not closed (at the recognized /p b m/, or "
+                        "acoustic-only where the model's detector finds a closure) nor the face "
+                        "rested in pauses")
     g.add_argument("--smoothing", choices=["triangular", "none"])
     g.add_argument("--acoustic-prefilter", type=count_or_all, metavar="K|all",
                    help="weight the K codewords nearest to each frame (default 128)")
