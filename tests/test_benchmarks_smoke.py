@@ -28,7 +28,7 @@ def test_smoke_table(toy: Path, tmp_path: Path, capsys) -> None:
     for needle in ("## Machine", "CPU:", "numpy:", "| group | benchmark |"):
         assert needle in text
     expected = [
-        "LSF extraction (lsf_at)", "PCA (fit_pca)", "train() total",
+        "LSF extraction (lsf_at)", "PCA (pca_of)", "train() total",
         "train() peak traced memory (tracemalloc)",
         "phonetic, 1 s input", "phonetic, 2 s input", "acoustic, 1 s input", "acoustic, 2 s input",
         "LSF index build (k-means), codebook x4",

@@ -254,16 +254,6 @@ def test_train_with_a_bad_file(corpus_with_a_bad_file, tmp_path, capsys):
     np.testing.assert_array_equal(got.pca.components, want.pca.components)
 
 
-def test_training_in_two_processes_equals_one(toy_corpus):
-    from engine.method.training import train
-
-    a, b = train(toy_corpus, workers=1), train(toy_corpus, workers=2)
-    for x, y in ((a.codebook.lsf, b.codebook.lsf), (a.codebook.pcs, b.codebook.pcs),
-                 (a.codebook.contexts, b.codebook.contexts), (a.means, b.means),
-                 (a.index.order, b.index.order)):
-        np.testing.assert_array_equal(x, y)
-
-
 def test_report_with_a_bad_file(corpus_with_a_bad_file, tmp_path, capsys):
     root = corpus_with_a_bad_file
     out = tmp_path / "report"
