@@ -146,3 +146,30 @@ def test_training_in_two_processes_equals_one_to_the_bit(default_corpus, default
                  (a.closure.direction, b.closure.direction), (a.closure.rest, b.closure.rest)):
         np.testing.assert_array_equal(x, y)
     assert (a.closure.closed, a.voice_distance) == (b.closure.closed, b.voice_distance)
+
+
+def test_the_neutral_pose_in_blocks_is_the_pose_of_all_frames_at_once():
+    """``reference_pose`` fits a block of frames at a time (what it holds stays the same whatever
+    the corpus's length) and sums the aligned frames one after the other: the same bits as the
+    mean of every frame aligned at once."""
+    from engine.method.markers import kabsch, reference_pose
+
+    rng = np.random.default_rng(11)
+    pose = rng.normal(0, 30, (4, 3))
+    angles = rng.normal(0, 0.05, (500, 3))
+    frames = np.stack([pose @ _rotation(*a).T + rng.normal(0, 2, 3) for a in angles])
+    frames += rng.normal(0, 0.3, frames.shape)
+    ref = frames[0]
+    for _ in range(3):                                     # the computation of all at once
+        rot, trans = kabsch(frames, np.broadcast_to(ref, frames.shape))
+        ref = (np.einsum("tij,tmj->tmi", rot, frames) + trans[:, None, :]).mean(axis=0)
+    for block in (1, 7, 500, 8192):
+        np.testing.assert_array_equal(reference_pose(frames, np.arange(4), block=block), ref)
+
+
+def _rotation(a: float, b: float, c: float) -> np.ndarray:
+    ca, sa, cb, sb, cc, sc = np.cos(a), np.sin(a), np.cos(b), np.sin(b), np.cos(c), np.sin(c)
+    rx = np.array([[1, 0, 0], [0, ca, -sa], [0, sa, ca]])
+    ry = np.array([[cb, 0, sb], [0, 1, 0], [-sb, 0, cb]])
+    rz = np.array([[cc, -sc, 0], [sc, cc, 0], [0, 0, 1]])
+    return rz @ ry @ rx

@@ -293,7 +293,7 @@ def _codebook(p: _Passes, kept: Sequence[int], reads: Sequence[_Read], reference
         closure.add(done.closure)
         if done.voice is not None:
             frames[j] = done.voice
-    return concatenate(parts), frames
+    return concatenate(parts, release=True), frames
 
 
 # --------------------------------------------------------------------------- the whole
