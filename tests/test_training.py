@@ -4,6 +4,7 @@ utterance at a time; the result equals the computation on every frame at once to
 
 from __future__ import annotations
 
+import itertools
 import weakref
 from dataclasses import dataclass, field
 
@@ -173,3 +174,16 @@ def _rotation(a: float, b: float, c: float) -> np.ndarray:
     ry = np.array([[cb, 0, sb], [0, 1, 0], [-sb, 0, cb]])
     rz = np.array([[cc, -sc, 0], [sc, cc, 0], [0, 0, 1]])
     return rz @ ry @ rx
+
+
+def test_training_reports_its_progress_through_the_passes(toy_corpus):
+    """The bar of `facetraj train` (with its time left): fractions that never go back, from 0 to
+    1, each pass naming the utterance it is on."""
+    seen: list[tuple[float, str]] = []
+    train(toy_corpus, progress=lambda f, m: seen.append((f, m)), workers=2)
+    fractions = [f for f, _ in seen]
+    assert fractions[0] == 0.0 and fractions[-1] == 1.0
+    assert all(b >= a for a, b in itertools.pairwise(fractions))
+    first = toy_corpus.info.train[0]
+    for what in ("reading", "PCA", "codebook"):
+        assert f"{what}: {first}" in [m for _, m in seen]
