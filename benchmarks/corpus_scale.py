@@ -4,7 +4,8 @@ corpus repeated 1, 4 and 16 times (its files under new names as symbolic links, 
 
 Each size runs the real commands, with their defaults, in a child process: its wall time, its
 CPU time (user + system, the child and the workers it forked) and its peak resident memory (the
-largest single process among them, as ``/usr/bin/time -v`` reports it: ``os.wait4``'s rusage).
+largest single process among them, as ``/usr/bin/time -v`` reports it: ``os.wait4``'s rusage,
+taken by a small process that forks the command).
 The machine is shared: every size is run ``repeats`` times, the sizes taking turns, and the
 median is kept (memory, which noise does not move, as the largest). Then the growth exponents
 ``e`` of ``time ~ size^e`` (from the smallest to the largest size, and between the two largest),
@@ -25,7 +26,6 @@ import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -84,20 +84,34 @@ class Run:
     status: int
 
 
+#: A small process that forks the command and reports what ``os.wait4`` says of it, run with
+#: ``python -S`` (no site-packages: a few MB). Measured straight from this process, a child's
+#: peak would read as this process's (Linux keeps the larger of the parent's pages it was forked
+#: with and its own), as ``/usr/bin/time`` measures its child, not itself.
+_MEASURE = """
+import json, os, sys, time
+t = time.perf_counter()
+pid = os.fork()
+if pid == 0:
+    null = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(null, 1)
+    os.execv(sys.argv[1], sys.argv[1:])
+_, status, ru = os.wait4(pid, 0)
+print(json.dumps([time.perf_counter() - t, ru.ru_utime + ru.ru_stime, ru.ru_maxrss,
+                  os.waitstatus_to_exitcode(status)]))
+"""
+
+
 def run_command(argv: Sequence[str]) -> Run:
     """Run ``argv`` (its output thrown away) and measure it from outside: wall time, CPU time of
-    the child and the workers it waited for, and the largest single process's peak resident
-    memory (``os.wait4``)."""
-    t0 = time.perf_counter()
-    proc = subprocess.Popen(list(argv), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    err = proc.stderr.read() if proc.stderr is not None else b""
-    _, status, usage = os.wait4(proc.pid, 0)
-    wall = time.perf_counter() - t0
-    proc.returncode = os.waitstatus_to_exitcode(status)
-    if proc.returncode != 0:
-        log.warning("%s: exit status %d\n%s", " ".join(argv), proc.returncode,
-                    err.decode(errors="replace")[-2000:])
-    return Run(wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024.0, proc.returncode)
+    the process and the workers it waited for, and the largest single process's peak resident
+    memory (``os.wait4`` in a small process that forks it)."""
+    done = subprocess.run([sys.executable, "-S", "-c", _MEASURE, *argv], capture_output=True,
+                          text=True, check=False)
+    wall, cpu, peak_kib, status = json.loads(done.stdout.strip().splitlines()[-1])
+    if status != 0:
+        log.warning("%s: exit status %d\n%s", " ".join(argv), status, done.stderr[-2000:])
+    return Run(wall, cpu, peak_kib / 1024.0, status)
 
 
 @dataclass
