@@ -353,9 +353,10 @@ def _one_machine(fig: _Figures) -> list[str]:
         "visually similar to the input's).",
         "- **The codebook search is per-frame parallel.** Eqs 5-8 weigh each frame's candidates "
         "independently (`engine.threads.map_spans` splits the frames between threads), and eq 4 "
-        "scores an input phone against the tokens of its centre phone, whose number grows with "
-        "the corpus: the evaluation's time per utterance grows with the codebook, so its total "
-        "grows faster than the corpus. Split by utterance over machines that each hold the "
-        "model, or by phone over machines that each hold their phones' tokens, it scales out "
-        "without changing a result.",
+        "scores an input phone against groups of contexts (`engine.method.context_index`) whose "
+        "number grows with the distinct triphones, not with the corpus's length: the evaluation's "
+        "time per utterance stays nearly flat, its total about linear. Split by utterance over "
+        "machines that each hold the model, or by phone over machines that each hold their "
+        "phones' contexts, it scales out without changing a result; past one machine's memory "
+        "the codebook would be memory-mapped rather than copied into each process.",
     ]

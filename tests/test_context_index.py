@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from engine.method import similarity
 from engine.method.context_index import ContextIndex
 from engine.method.similarity import context_similarity, top_context_phones, top_contexts
 
@@ -19,6 +20,13 @@ def _queries(model, n: int, seed: int) -> np.ndarray:
     changed = real.copy()
     changed[np.arange(n), rng.integers(0, cb.shape[1], n)] = rng.integers(0, len(model.phones), n)
     return np.concatenate([real, changed, rng.integers(0, len(model.phones), (n, cb.shape[1]))])
+
+
+@pytest.fixture(autouse=True)
+def _by_groups(monkeypatch):
+    """The search by groups whatever the codebook's size (where the compiled kernel is there, it
+    takes the default corpus's codebook itself)."""
+    monkeypatch.setattr(similarity, "GROUPS_FROM", 0.0)
 
 
 @pytest.mark.parametrize(("context", "count"), [(3, 3), (3, 1), (2, 16), (1, 5), (0, 3)])

@@ -84,6 +84,11 @@ class ContextIndex:
                    np.cumsum(centre_groups) - centre_groups, centre_groups,
                    np.bincount(codebook[:, full], minlength=n_phones))
 
+    @property
+    def tokens_per_group(self) -> float:
+        """Codebook contexts per group, on average."""
+        return len(self.tokens) / max(len(self.centre), 1)
+
     def candidates(self, query: np.ndarray, s: np.ndarray, w1: float, bound: float,
                    rest: float, count: int) -> tuple[np.ndarray, np.ndarray]:
         """``(rows, contexts)``: the (query, codebook context) pairs among which each query's
@@ -92,24 +97,28 @@ class ContextIndex:
         first neighbours add at most. Of a context repeated in the codebook, only its first
         ``count`` copies can be among the best (the others score the same, with higher
         indices)."""
-        rows, grp = self._candidate_groups(query, s, bound, count)
+        rows, grp, sizes = self._candidate_groups(query, s, bound, count)
         full = (query.shape[1] - 1) // 2
-        qr = query[rows]
-        p = s[qr[:, full], self.centre[grp]] + w1 * (s[qr[:, full - 1], self.left[grp]] +
-                                                     s[qr[:, full + 1], self.right[grp]])
-        keep = p + rest + MARGIN >= _tau(rows, p, self.group_tokens[grp], len(query), count)[rows]
-        rows, dist = _expand(rows[keep], self.group_start[grp[keep]], self.group_size[grp[keep]])
-        dist = self.distinct[dist]
-        rows, tok = _expand(rows, self.start[dist], np.minimum(self.size[dist], count))
-        contexts = self.tokens[tok]
-        order = np.lexsort((contexts, rows))
-        return rows[order], contexts[order]
+        n = s.shape[0]
+        flat = s.ravel()
+        p = flat.take(np.repeat(query[:, full] * n, sizes) + self.centre.take(grp))
+        p += w1 * (flat.take(np.repeat(query[:, full - 1] * n, sizes) + self.left.take(grp)) +
+                   flat.take(np.repeat(query[:, full + 1] * n, sizes) + self.right.take(grp)))
+        keep = p + rest + MARGIN >= np.repeat(_tau(sizes, p, self.group_tokens.take(grp), count),
+                                              sizes)
+        grp = grp[keep]
+        rows, dist = _expand(rows[keep], self.group_start.take(grp), self.group_size.take(grp))
+        dist = self.distinct.take(dist)
+        rows, tok = _expand(rows, self.start.take(dist), np.minimum(self.size.take(dist), count))
+        contexts = self.tokens.take(tok)
+        order = np.argsort(rows * len(self.tokens) + contexts)
+        return rows.take(order), contexts.take(order)
 
     def _candidate_groups(self, query: np.ndarray, s: np.ndarray, bound: float, count: int
-                          ) -> tuple[np.ndarray, np.ndarray]:
-        """``(rows, groups)``: for every query, the groups of the centre phones whose similarity
-        to its centre is within ``bound`` of the best one (every centre when fewer than
-        ``count`` contexts reach the best); by query."""
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(rows, groups, sizes)``: for every query, the groups of the centre phones whose
+        similarity to its centre is within ``bound`` of the best one (every centre when fewer
+        than ``count`` contexts reach the best), by query; ``sizes`` the groups of each."""
         full = (query.shape[1] - 1) // 2
         centres, inverse = np.unique(query[:, full], return_inverse=True)
         inverse = inverse.ravel()
@@ -125,7 +134,7 @@ class ContextIndex:
                              minlength=len(centres)).astype(np.int64)
         u_start = np.cumsum(u_size) - u_size
         rows, at = _expand(np.arange(len(query)), u_start[inverse], u_size[inverse])
-        return rows, flat[at]
+        return rows, flat.take(at), u_size[inverse]
 
 
 def _expand(owner: np.ndarray, start: np.ndarray, size: np.ndarray
@@ -140,22 +149,22 @@ def _expand(owner: np.ndarray, start: np.ndarray, size: np.ndarray
     return np.repeat(owner, size), np.repeat(start, size) + offsets
 
 
-def _tau(rows: np.ndarray, p: np.ndarray, size: np.ndarray, n_queries: int, count: int
-         ) -> np.ndarray:
-    """Per query, a value that ``count`` of its candidate contexts reach or pass in ``p`` (rows
-    sorted by query): the larger of the ``count``-th largest group ``p`` and the largest ``p`` of a
-    group of ``count`` contexts or more (``-inf`` when neither exists)."""
-    sizes = np.bincount(rows, minlength=n_queries)
+def _tau(sizes: np.ndarray, p: np.ndarray, tokens: np.ndarray, count: int) -> np.ndarray:
+    """Per query (its ``sizes[q]`` candidate groups, in order), a value that ``count`` of its
+    candidate contexts reach or pass in ``p``: the larger of the ``count``-th largest group ``p``
+    and the largest ``p`` of a group of ``count`` contexts or more (``tokens``: each group's;
+    ``-inf`` when neither exists)."""
+    n_queries = len(sizes)
     starts = np.cumsum(sizes) - sizes
     width = int(sizes.max())
     grid = np.full((n_queries, width), -np.inf)
-    grid.ravel()[rows * width + np.arange(len(rows)) - np.repeat(starts, sizes)] = p
+    grid.ravel()[np.repeat(np.arange(n_queries) * width - starts, sizes) + np.arange(len(p))] = p
     by_groups = np.partition(grid, width - count, axis=1)[:, width - count] if count <= width \
         else np.full(n_queries, -np.inf)
-    big = np.where(size >= count, p, -np.inf)
-    by_size = np.maximum.reduceat(big, starts[sizes > 0]) if len(big) else big
-    tau = by_groups.copy()
-    tau[sizes > 0] = np.maximum(tau[sizes > 0], by_size)
+    big = np.where(tokens >= count, p, -np.inf)
+    some = sizes > 0
+    tau = by_groups
+    tau[some] = np.maximum(tau[some], np.maximum.reduceat(big, starts[some]))
     return tau
 
 

@@ -104,6 +104,11 @@ def format_table1(rows: Sequence[SimilarRow]) -> str:
     return "\n".join(lines)
 
 
+#: contexts per group of the codebook (``ContextIndex.tokens_per_group``) from which eq 4 is
+#: searched by groups even where the compiled kernel is there (the default corpus: 2)
+GROUPS_FROM = 4.0
+
+
 def context_weights(context: int, xi: float) -> np.ndarray:
     """The weights of eq 4 for columns ``[l_C .. l_1, c, r_1 .. r_C]``: ``xi^-i`` and 1 at c."""
     i = np.abs(np.arange(-context, context + 1)).astype(float)
@@ -160,10 +165,12 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     The result, including the lower-index-first tie order, is that of the full computation
     (tested). With a context (``context >= 1``) the contexts that can win are found by groups
     of the same centre and first neighbours (:mod:`engine.method.context_index`): their number
-    stops growing with the corpus, where the contexts of a centre phone grow with it. Without,
-    the compiled kernel (``engine.method.compiled_search``) finds the same contexts per centre
-    phone and scores them with the same additions, query by query, keeping each query's best
-    ``count`` as it goes, unless :mod:`engine.method.kernels` chooses numpy.
+    stops growing with the corpus, where the contexts of a centre phone grow with it. The
+    compiled kernel (``engine.method.compiled_search``), when :mod:`engine.method.kernels`
+    gives it, finds the same contexts per centre phone and scores them with the same additions,
+    query by query, keeping each query's best ``count`` as it goes: it is used while the
+    codebook holds fewer than :data:`GROUPS_FROM` contexts a group (it is then the faster,
+    docs/benchmarks.md), the groups from there on.
 
     Returns ``(top, scores)``, both ``(Q, count)``.
 
@@ -181,11 +188,13 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     count = min(count, n_cb)
     cols = np.arange(full - c, full + c + 1)
     tables = context_weights(c, xi)[:, None, None] * s                       # (2c+1) x n x n
-    if n_q > 0 and c >= 1:                        # the contexts that can win, by groups
-        rest = 2.0 * sum(xi ** (-i) for i in range(2, c + 1))
-        rows, cand = context_index(codebook, n_ph).candidates(q, s, xi ** -1.0, bound, rest, count)
-        return _best(q, codebook, rows, cand, tables, cols, count)
     kernel = compiled("compiled_search")
+    if n_q > 0 and c >= 1:                        # the contexts that can win, by groups
+        index = context_index(codebook, n_ph)
+        if kernel is None or index.tokens_per_group >= GROUPS_FROM:
+            rest = 2.0 * sum(xi ** (-i) for i in range(2, c + 1))
+            rows, cand = index.candidates(q, s, xi ** -1.0, bound, rest, count)
+            return _best(q, codebook, rows, cand, tables, cols, count)
     if kernel is not None and n_q > 0:             # the same scores compiled, query by query
         return kernel.top_context_scores(np.ascontiguousarray(q, dtype=np.int64),
                                          np.ascontiguousarray(codebook, dtype=np.int64),
