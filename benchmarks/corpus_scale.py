@@ -2,7 +2,8 @@
 corpus repeated 1, 4 and 16 times (its files under new names as symbolic links, with a
 ``corpus.json`` listing them: 16 times is 2.8 hours of training speech).
 
-Each size runs the real commands, with their defaults, in a child process: its wall time, its
+Each size runs the real commands in one process (``-j 1``: judged) and with their default
+(every core), each in a child process: its wall time, its
 CPU time (user + system, the child and the workers it forked) and its peak resident memory (the
 largest single process among them, as ``/usr/bin/time -v`` reports it: ``os.wait4``'s rusage,
 taken by a small process that forks the command).
@@ -122,7 +123,7 @@ class Size:
     factor: int
     train_hours: float
     root: Path
-    runs: dict[str, list[Run]] = field(default_factory=lambda: {"train": [], "eval": []})
+    runs: dict[str, list[Run]] = field(default_factory=lambda: {c: [] for c in COMMANDS})
 
     def wall(self, command: str) -> float:
         return min(r.wall for r in self.runs[command])
@@ -138,15 +139,22 @@ def _facetraj(*args: str) -> list[str]:
     return [sys.executable, "-m", "facetraj.cli", "-q", *args]
 
 
+#: the runs of each size: the commands in one process (judged: a job of the other users takes
+#: a core from a 2-process run, and the long runs of the large sizes meet more of them, which
+#: would decide the ratio), then with their default, every core
+COMMANDS = ("train", "eval", "train, every core", "eval, every core")
+
+
 def measure(sizes: Sequence[Size], repeats: int, workdir: Path) -> None:
-    """Train and evaluate every size ``repeats`` times, the sizes taking turns (each evaluation
-    with the model its size's training wrote)."""
+    """Train and evaluate every size ``repeats`` times, in one process and on every core, the
+    sizes taking turns (each evaluation with the model its size's training wrote)."""
     for r in range(repeats):
         for size in sizes:
             model = workdir / f"model-x{size.factor}.npz"
-            for command, argv in (("train", _facetraj("train", str(size.root), "-o", str(model),
-                                                      "--overwrite")),
-                                  ("eval", _facetraj("eval", str(model), str(size.root)))):
+            train = _facetraj("train", str(size.root), "-o", str(model), "--overwrite")
+            evaluate = _facetraj("eval", str(model), str(size.root))
+            for command, argv in zip(COMMANDS, ([*train, "-j", "1"], [*evaluate, "-j", "1"],
+                                                train, evaluate), strict=True):
                 run = run_command(argv)
                 size.runs[command].append(run)
                 log.info("%s x%d (run %d): %.1f s, %.1f s CPU, %.0f MiB", command, size.factor,
@@ -192,8 +200,16 @@ def _rows(sizes: Sequence[Size], smoke: bool) -> list[BenchRow]:
         rows.append(BenchRow("corpus", f"{command} x{top.factor} / x{base.factor}: time", ratio, "x",
                              aim=f"<= {TIME_AIM_RATIO:g} x" if top.factor == 16 else "",
                              ok=ratio <= TIME_AIM_RATIO if top.factor == 16 and not smoke else None,
-                             cpu=top.cpu(command) / base.cpu(command)))
+                             cpu=top.cpu(command) / base.cpu(command), note="one process"))
         rows += _growth(sizes, command)
+        every = f"{command}, every core"
+        rows += [BenchRow("corpus", f"{command} x{s.factor}, every core: time", s.wall(every), "s",
+                          note=f"{s.wall(command) / s.wall(every):.2f} x one process's; fastest "
+                               f"of " + ", ".join(f"{r.wall:.1f}" for r in s.runs[every]) + " s",
+                          cpu=s.cpu(every)) for s in sizes]
+        rows.append(BenchRow("corpus", f"{command} x{top.factor} / x{base.factor}, every core: "
+                                       f"time", top.wall(every) / base.wall(every), "x",
+                             cpu=top.cpu(every) / base.cpu(every)))
     return rows
 
 
@@ -283,20 +299,25 @@ def section(rows: Sequence[BenchRow]) -> list[str]:
         return []
     lines = ["## A lab's whole corpus: training and evaluation as the corpus grows (issue 41)", "",
              "The real commands (`facetraj train`, then `facetraj eval` with the model it wrote, "
-             "each with its defaults: every core) on the default corpus repeated (symbolic links "
+             "in one process, `-j 1`, and with their default, every core) on the default corpus "
+             "repeated (symbolic links "
              "under new names), each run a child process measured from outside: wall time (the "
              "fastest of the runs, the sizes taking turns: the machine is shared, and the other "
              "jobs only ever add time), CPU time of the child and its workers, and the "
              "peak resident memory of the largest process (`os.wait4`, as `/usr/bin/time -v`). "
-             "`benchmarks/corpus_scale.py`.", "",
-             "| size | training speech | train: time | CPU | peak | eval: time | CPU | peak |",
-             "|---|---:|---:|---:|---:|---:|---:|---:|"]
+             "The ratios and exponents are those of one process: the machine is shared by other "
+             "users' jobs, each of which takes a core from a run on both, and the longer runs of "
+             "the larger sizes meet more of them. `benchmarks/corpus_scale.py`.", "",
+             "| size | training speech | train: time | CPU | peak | every core | eval: time | "
+             "CPU | peak | every core |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for f in fig.factors:
         cells = [f"x{f}", f"{fig(f'x{f}: training speech'):.0f} min"]
         for command in ("train", "eval"):
             cells += [f"{fig(f'{command} x{f}: time'):.1f} s",
                       f"{fig(f'{command} x{f}: time', cpu=True):.1f} s",
-                      f"{fig(f'{command} x{f}: peak memory'):,.0f} MiB"]
+                      f"{fig(f'{command} x{f}: peak memory'):,.0f} MiB",
+                      f"{fig(f'{command} x{f}, every core: time'):.1f} s"]
         lines.append("| " + " | ".join(cells) + " |")
     lines += [""] + [_growth_line(fig, c) for c in ("train", "eval")] + [""] + _one_machine(fig)
     return [*lines, ""]
@@ -306,8 +327,10 @@ def _growth_line(fig: _Figures, command: str) -> str:
     lo, hi = fig.factors[0], fig.factors[-1]
     ratio = f"{command} x{hi} / x{lo}: time"
     at = f"{command}: at {HOURS:g} h of training speech (extrapolated)"
-    return (f"- `{command}`: x{hi} takes {fig(ratio):.1f} times the time of x{lo} "
-            f"({fig(ratio, cpu=True):.1f} times its CPU time); time ~ size^"
+    every = f"{command} x{hi} / x{lo}, every core: time"
+    return (f"- `{command}`: x{hi} takes {fig(ratio):.1f} times the time of x{lo} in one process "
+            f"({fig(ratio, cpu=True):.1f} times its CPU time; on every core {fig(every):.1f} "
+            f"times, {fig(every, cpu=True):.1f} times the CPU time); time ~ size^"
             f"{fig(f'{command}: time growth exponent'):.2f} "
             f"({fig.note(f'{command}: time growth exponent').split('; ')[-1]}); peak memory "
             f"{fig.note(f'{command}: peak memory per hour of training speech').split(': ')[-1]}."
