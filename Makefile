@@ -18,7 +18,7 @@ $(VENV)/.installed-run: pyproject.toml | $(BIN)/python
 # again whenever their fingerprint (engine/method/prebuilt.py: sources, processor) says they are
 # stale; without them numba compiles or loads its kernels in every process that uses them
 kernels: $(VENV)/.installed-run
-	@$(BIN)/python -m engine.method.aot || \
+	@$(BIN)/python -m facetraj_engine.method.aot || \
 	  echo "facetraj: prebuilt kernels not built (no C compiler?): numba's just-in-time ones will run"
 
 # the tests include the corpus generator's bit-for-bit reproduction check, hence the corpus extra
@@ -57,7 +57,7 @@ corpus: $(VENV)/.installed-corpus
 # every screenshot of the docs (docs/figures/), on a screen big enough for the 1920x1080 window;
 # the results figures come from `make report`
 figures: $(VENV)/.installed-test
-	$(if $(DISPLAY),,xvfb-run -a -s "-screen 0 2000x1400x24") $(BIN)/python -m app.gallery docs/figures
+	$(if $(DISPLAY),,xvfb-run -a -s "-screen 0 2000x1400x24") $(BIN)/python -m facetraj_app.gallery docs/figures
 	$(BIN)/python docs/figures/make_corpus_figures.py
 
 report: $(VENV)/.installed-test

@@ -8,13 +8,13 @@ import json
 import logging
 from pathlib import Path
 
-from engine.config import TrainConfig
-from engine.errors import InputError, ModelFileError
-from engine.io.cachedir import cache_dir
-from engine.io.corpus import Corpus
-from engine.io.model_file import is_compressed
-from engine.method.model import Model
-from engine.progress import Progress
+from facetraj_engine.config import TrainConfig
+from facetraj_engine.errors import InputError, ModelFileError
+from facetraj_engine.io.cachedir import cache_dir
+from facetraj_engine.io.corpus import Corpus
+from facetraj_engine.io.model_file import is_compressed
+from facetraj_engine.method.model import Model
+from facetraj_engine.progress import Progress
 
 log = logging.getLogger(__name__)
 
@@ -62,7 +62,7 @@ def load_or_train(corpus: Corpus, config: TrainConfig | None = None,
             return model
         except ModelFileError as exc:
             log.warning("ignoring unreadable cached model: %s", exc)
-    from engine.method.training import train
+    from facetraj_engine.method.training import train
 
     log.info("training the model on %s (first run; cached in %s)", corpus.root, path.parent)
     model = train(corpus, config=config, progress=lambda f, m: progress(0.02 + 0.96 * f, f"training: {m}"))

@@ -1,7 +1,7 @@
 """The main window's controls: the bars above and below the 3-D view (camera and display
 options; the transport), the loop range, keyboard shortcuts and the File-menu dialogs.
 
-:class:`ViewBar` drives a :class:`~app.view3d.FaceView` directly; :class:`TransportBar` only emits
+:class:`ViewBar` drives a :class:`~facetraj_app.view3d.FaceView` directly; :class:`TransportBar` only emits
 signals, which the main window wires to the playback clock.
 """
 
@@ -32,7 +32,7 @@ from .transport import PlaybackClock
 from .view3d import CAMERA_PRESETS, FaceView
 
 SPEEDS = (1.0, 0.5, 0.25)
-#: between the title's first line and the details (``app.viewer_model.view_title``)
+#: between the title's first line and the details (``facetraj_app.viewer_model.view_title``)
 TITLE_SEPARATOR = "    ·    "
 #: the camera buttons' texts (short: the bar fits a narrow 3-D view)
 CAMERA_LABELS = {"three-quarter": "¾ view"}

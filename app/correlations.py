@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import logging
 
-from engine.config import SynthConfig
-from engine.evaluation.scores import trajectory_correlations
-from engine.method.model import Model
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.evaluation.scores import trajectory_correlations
+from facetraj_engine.method.model import Model
 
 from .browser import UtteranceBrowser
 from .state import UtteranceView

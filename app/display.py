@@ -44,7 +44,7 @@ def require_display(what: str) -> None:
     instead of Qt aborting the process when it finds no platform to open windows on."""
     if has_display():
         return
-    from engine.errors import FacetrajError
+    from facetraj_engine.errors import FacetrajError
 
     raise FacetrajError(f"{what} needs a display, and neither DISPLAY nor WAYLAND_DISPLAY is set: "
                         "run it in a desktop session or under xvfb-run")

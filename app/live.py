@@ -1,11 +1,11 @@
 """Live mode: the synthesized face follows a microphone (QtMultimedia ``QAudioSource``) or a file
-played in real time, through live mode's stream (``engine.streaming.live``: phones recognized as
+played in real time, through live mode's stream (``facetraj_engine.streaming.live``: phones recognized as
 they are spoken, or acoustic-only).
 
 The window shows the 3-D face (synthesized points only), an input level meter, and the upper and
 lower lip y of the last few seconds scrolling, with speech/silence dots computed live (the
 energy of the 20 ms before each frame against the take's running floor and peak), and under them
-the phones (``app.live_phones``). Stop keeps the take: its audio, trajectories and phones can be
+the phones (``facetraj_app.live_phones``). Stop keeps the take: its audio, trajectories and phones can be
 saved (WAV + C3D/TSV + TextGrid) and opened like any utterance. A device that disappears ends the
 take with a message; what was recorded is kept.
 """
@@ -38,12 +38,12 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from engine.config import SynthConfig
-from engine.errors import FacetrajError
-from engine.io.audio import read_audio, write_audio
-from engine.io.export import write_trajectories
-from engine.method import kernels
-from engine.method.model import Model
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.errors import FacetrajError
+from facetraj_engine.io.audio import read_audio, write_audio
+from facetraj_engine.io.export import write_trajectories
+from facetraj_engine.method import kernels
+from facetraj_engine.method.model import Model
 
 from .live_input import MIC_RATE, FileFeeder, InputHealth, InputLost, MicFeeder, input_devices
 from .live_phones import PhonePanel
@@ -81,7 +81,7 @@ class LiveWindow(QMainWindow):
         self.model = model
         self.config = config or SynthConfig()
         self.from_file, self.block_s, self.fast = from_file, block_s, fast
-        self.stream = None                  # the take's engine.streaming.live.LiveStream
+        self.stream = None                  # the take's facetraj_engine.streaming.live.LiveStream
         self.warm_kernels = True            # off: a screenshot (the process ends with the take)
         self.feeder: FileFeeder | MicFeeder | None = None
         self.rate = MIC_RATE
@@ -195,14 +195,14 @@ class LiveWindow(QMainWindow):
     def _warm_kernels(self) -> None:
         """Load the compiled kernels in the background (numba: half a second, ten on the first
         run after an install); the stream runs numpy's until they are in, never waiting
-        (``engine.method.kernels.never_waiting``)."""
+        (``facetraj_engine.method.kernels.never_waiting``)."""
         if self.warm_kernels and kernels.kernel_choice() == "compiled" and not kernels.loaded():
             self.warm_kernels = False
             threading.Thread(target=kernels.warm_up, name="facetraj-kernels", daemon=True).start()
 
     def start(self) -> None:
         """Begin a take (the previous one is dropped)."""
-        from engine.streaming.live import LiveConfig, LiveStream  # the recognizer: with a take
+        from facetraj_engine.streaming.live import LiveConfig, LiveStream  # the recognizer: with a take
 
         self._warm_kernels()
 
@@ -292,7 +292,7 @@ class LiveWindow(QMainWindow):
     def save_take(self, path: str | Path, overwrite: bool = False) -> tuple[Path, Path]:
         """Write the take's trajectories to ``path`` (.c3d, .tsv, .csv or .npz), its audio to
         the WAV of the same name and its recognized phones to the TextGrid (with their
-        provenance, ``app.live_phones``); the first two paths."""
+        provenance, ``facetraj_app.live_phones``); the first two paths."""
         audio, rate, markers = self.take()
         path = Path(path)
         wav = path.with_suffix(".wav")
@@ -454,7 +454,7 @@ def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = Non
     window nobody asked for; the window itself offers to open a recording). With ``screenshot``,
     the window is saved to that PNG when the file has been played (or after ``quit_after``
     seconds) and closes."""
-    from engine.threads import one_blas_thread
+    from facetraj_engine.threads import one_blas_thread
 
     from .display import ensure_display, require_display
 
@@ -464,7 +464,7 @@ def run_live(model_loader: Callable[[], Model], config: SynthConfig | None = Non
     if screenshot:
         ensure_display()
     require_display("the Live window (facetraj live without -o)")
-    one_blas_thread()       # the stream is synthesized beside the rendering (engine.threads)
+    one_blas_thread()       # the stream is synthesized beside the rendering (facetraj_engine.threads)
     app = QApplication.instance() or QApplication(sys.argv[:1])
     if audio is None and not input_devices():
         raise FacetrajError(NO_INPUT_DEVICE_COMMAND)

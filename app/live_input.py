@@ -5,7 +5,7 @@ A feeder's ``poll()`` returns the samples that arrived since the last poll (mono
 [-1, 1]), ``None`` once a file has been played, and raises :class:`InputLost` when the device
 stops delivering (unplugged, or its sound server gone): the window then keeps the take so far
 and says so. A device that cannot record 16 kHz mono 16-bit records in its preferred format, at
-its own rate: the stream resamples (``engine.streaming``).
+its own rate: the stream resamples (``facetraj_engine.streaming``).
 """
 
 from __future__ import annotations

@@ -21,14 +21,14 @@ from PyQt6.QtCore import QRectF, Qt
 from PyQt6.QtGui import QColor, QPainter
 from PyQt6.QtWidgets import QComboBox, QLabel, QSizePolicy, QWidget
 
-from engine.data import PhoneSegment
-from engine.labels.phoneset import SILENCE
-from engine.method.closure import BILABIALS
+from facetraj_engine.data import PhoneSegment
+from facetraj_engine.labels.phoneset import SILENCE
+from facetraj_engine.method.closure import BILABIALS
 
 if TYPE_CHECKING:       # the recognizer is imported with the first take, not with the app
-    from engine.labels.provenance import Labels
-    from engine.streaming.live import LiveStream
-    from engine.streaming.recognizer import RunningCmn
+    from facetraj_engine.labels.provenance import Labels
+    from facetraj_engine.streaming.live import LiveStream
+    from facetraj_engine.streaming.recognizer import RunningCmn
 
 #: the switch's choices
 PHONES, ACOUSTIC = "phones + acoustics", "acoustic-only"
@@ -137,7 +137,7 @@ class PhoneTier(QWidget):
 
 
 class PhonePanel:
-    """The phones' part of a :class:`app.live.LiveWindow`: the switch and "Open recording..." in
+    """The phones' part of a :class:`facetraj_app.live.LiveWindow`: the switch and "Open recording..." in
     its toolbar, the tier under its lip panels, latency and voice in its status bar; the take's
     phones kept and saved. The recognizer's running cepstral mean is kept from take to take (a
     microphone session adapts once)."""
@@ -210,7 +210,7 @@ class PhonePanel:
         """The take's phones as a TextGrid at ``path`` (none acoustic-only)."""
         if self.labels is None:
             return None
-        from engine.io.labelling import write_labels
+        from facetraj_engine.io.labelling import write_labels
 
         write_labels(path, self.labels, duration, overwrite)
         self.saved = path

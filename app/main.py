@@ -85,7 +85,7 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
             time: float | None = None, model: Path | None = None,
             recordings: list[Path] | None = None) -> int:
     """Open the main window on ``corpus`` (and ``recordings`` without face data, synthesized with
-    its model: :class:`app.recordings.RecordingQueue`); with ``screenshot``, render it to that
+    its model: :class:`facetraj_app.recordings.RecordingQueue`); with ``screenshot``, render it to that
     PNG and exit.
 
     Returns the process exit status (2 when the corpus, model or utterance cannot be used in
@@ -98,9 +98,9 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
     from PyQt6.QtCore import QTimer
     from PyQt6.QtWidgets import QApplication
 
-    from engine.threads import one_blas_thread
+    from facetraj_engine.threads import one_blas_thread
 
-    one_blas_thread()       # synthesis runs beside the rendering (engine.threads)
+    one_blas_thread()       # synthesis runs beside the rendering (facetraj_engine.threads)
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("facetraj")
     mark("QApplication")

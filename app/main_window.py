@@ -15,7 +15,7 @@ Attributes
     ``model``, ``corpus``, ``view`` (``UtteranceView``, ``app/state.py``), ``synth_config`` (read
     from ``state``), ``plotter`` (a plotter widget, ``app/plotter_widget.py``), ``face`` (``FaceView``),
     ``timeline`` (``app/timeline.py``), ``analysis_menu``, ``marker_panels`` (``MarkerPanels``),
-    ``closed_lips`` (``engine.analysis.lips.ClosedLips`` of the model: the lips at closure),
+    ``closed_lips`` (``facetraj_engine.analysis.lips.ClosedLips`` of the model: the lips at closure),
     ``action_screenshot`` (File-menu entries of extensions go before it).
 
 Signals
@@ -67,13 +67,13 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from engine.analysis.lips import ClosedLips, closed_lips
-from engine.config import SynthConfig
-from engine.data import Utterance
-from engine.errors import FacetrajError
-from engine.io.corpus import Corpus, load_corpus
-from engine.method import kernels
-from engine.method.model import Model
+from facetraj_engine.analysis.lips import ClosedLips, closed_lips
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.data import Utterance
+from facetraj_engine.errors import FacetrajError
+from facetraj_engine.io.corpus import Corpus, load_corpus
+from facetraj_engine.method import kernels
+from facetraj_engine.method.model import Model
 
 from .browser import UtteranceBrowser
 from .cache import load_or_train
@@ -372,7 +372,7 @@ class MainWindow(QMainWindow):
         self.run_task(request.run, done, "synthesizing")
 
     def _warm_kernels(self) -> None:
-        """Load the compiled kernels (``engine.method.kernels``: numba's import and cache read,
+        """Load the compiled kernels (``facetraj_engine.method.kernels``: numba's import and cache read,
         about half a second) once, in the background after the first frame (numpy's), unless
         they are ready already (prebuilt at install: nothing to load)."""
         if not self._kernels_warming and self.warm_kernels and \
@@ -486,7 +486,7 @@ class MainWindow(QMainWindow):
     def open_audio(self, audio_path: Path, labels_path: Path | None = None, **kw) -> bool:
         """Synthesize from an audio file that has no original markers; phone labels from
         ``labels_path``, ``text=`` (aligned), ``recognize=True``, ``acoustic_only=True`` or the
-        files beside the audio (``app.open_audio.AudioOpener.open``)."""
+        files beside the audio (``facetraj_app.open_audio.AudioOpener.open``)."""
         return self.audio_opener.open(Path(audio_path), labels_path, **kw)
 
     def show_external(self, utt: Utterance, origin: LabelOrigin | None = None) -> None:

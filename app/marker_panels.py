@@ -1,15 +1,15 @@
 """Time-aligned panels of single marker coordinates (e.g. the jaw of midsagittal EMA data).
 
 :class:`MarkerPanels` keeps the panels the user added (View menu) and, for a planar model
-(:attr:`engine.method.model.Model.is_planar`: midsagittal 2-D data), puts the jaw beside the lips.
+(:attr:`facetraj_engine.method.model.Model.is_planar`: midsagittal 2-D data), puts the jaw beside the lips.
 """
 
 from __future__ import annotations
 
 from PyQt6.QtWidgets import QComboBox, QDialog, QDialogButtonBox, QFormLayout, QWidget
 
-from engine.errors import FacetrajError
-from engine.method.model import Model
+from facetraj_engine.errors import FacetrajError
+from facetraj_engine.method.model import Model
 
 from .style import ORIGINAL_COLOR, SPLINE_COLOR, TRIANGULAR_COLOR, fit_ylabel
 from .timeline import Timeline

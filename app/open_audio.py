@@ -1,7 +1,7 @@
 """Opening a recording for synthesis, with phone labels from wherever they can come from.
 
 "Open audio…" uses a label file or a ``.txt`` transcript beside the audio (the one rule,
-``engine.io.labelling.labels_for_audio``), otherwise asks for the sentence (:class:`SentenceDialog`:
+``facetraj_engine.io.labelling.labels_for_audio``), otherwise asks for the sentence (:class:`SentenceDialog`:
 empty = recognize the phones; or no labels, acoustic-only). Alignment runs in a worker with the
 window's busy indicator; words missing from the dictionary are asked for
 (:class:`MissingWordsDialog`) and the alignment retried. The :class:`LabelSourceBox` in the settings
@@ -31,19 +31,19 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from engine.data import Provenance, Utterance
-from engine.errors import FacetrajError, InputError
-from engine.io.audio import read_audio
-from engine.labels.phoneset import ARPABET
+from facetraj_engine.data import Provenance, Utterance
+from facetraj_engine.errors import FacetrajError, InputError
+from facetraj_engine.io.audio import read_audio
+from facetraj_engine.labels.phoneset import ARPABET
 
 from .provenance import LabelOrigin
 
 if TYPE_CHECKING:   # the labelling engine is imported when audio is opened (issue #15: cold start)
     import numpy as np
 
-    from engine.io.corpus import Corpus
-    from engine.labels.provenance import Labels
-    from engine.method.model import Model
+    from facetraj_engine.io.corpus import Corpus
+    from facetraj_engine.labels.provenance import Labels
+    from facetraj_engine.method.model import Model
 
     from .viewer_model import UtteranceView
 
@@ -155,8 +155,8 @@ class OpenedAudio:
 
     def labels_for(self, source: str) -> Labels | None:
         """Labels of ``source`` (computed on the first call: run in a worker)."""
-        from engine.io.labelfiles import read_label_file
-        from engine.io.labelling import label_audio
+        from facetraj_engine.io.labelfiles import read_label_file
+        from facetraj_engine.io.labelling import label_audio
 
         if source not in self.labels:
             if source == "none":
@@ -261,7 +261,7 @@ class AudioOpener(QObject):
                                               "Audio (*.wav *.flac);;All files (*)")
         if not path:
             return
-        from engine.io.labelling import beside
+        from facetraj_engine.io.labelling import beside
 
         path = Path(path)
         read = self._read(path)  # a corrupt file is reported before the sentence is asked for
@@ -284,7 +284,7 @@ class AudioOpener(QObject):
         if self.window.model is None:
             self.window.show_error("no model yet: open a corpus first")
             return None
-        from engine.method.pipeline import check_length
+        from facetraj_engine.method.pipeline import check_length
 
         try:
             audio, rate = read_audio(audio_path)
@@ -298,7 +298,7 @@ class AudioOpener(QObject):
     def open(self, audio_path: Path, labels_path: Path | None = None, text: str | None = None,
              recognize: bool = False, acoustic_only: bool = False,
              extra_dict: dict[str, list[str]] | None = None) -> bool:
-        """Open ``audio_path`` for synthesis; labels by ``engine.io.labelling.labels_for_audio``
+        """Open ``audio_path`` for synthesis; labels by ``facetraj_engine.io.labelling.labels_for_audio``
         (alignment or recognition in a worker), none with ``acoustic_only``. False when the
         audio cannot be read (the error is shown)."""
         read = self._read(audio_path)
@@ -310,8 +310,8 @@ class AudioOpener(QObject):
               labels_path: Path | None = None, text: str | None = None, recognize: bool = False,
               acoustic_only: bool = False,
               extra_dict: dict[str, list[str]] | None = None) -> None:
-        from engine.io.labelling import beside, labels_for_audio, read_transcript
-        from engine.labels.alignment import MissingWordsError
+        from facetraj_engine.io.labelling import beside, labels_for_audio, read_transcript
+        from facetraj_engine.labels.alignment import MissingWordsError
 
         win = self.window
         audio, rate = read

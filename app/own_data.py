@@ -3,7 +3,7 @@
 In: a dialog that describes a folder of recordings (audio + labels + markers) as a corpus: which
 markers are the fixed head references and which are the lip centres, and an editable table that
 maps the folder's labels onto ARPAbet (a MOCHA-TIMIT preset is provided). The description is
-written by the engine (:func:`engine.io.corpus.init_corpus`) and opened like any corpus.
+written by the engine (:func:`facetraj_engine.io.corpus.init_corpus`) and opened like any corpus.
 
 Out: the current synthesized or original trajectories (C3D, TSV, NPZ), the time-aligned panels as
 a figure (PNG, SVG, PDF), the model file, and a video (MP4) with a progress bar. Every file is
@@ -41,14 +41,14 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from app.analysis.common import ask_save_path
-from engine.errors import FacetrajError
-from engine.io.corpus import FolderScan, init_corpus, scan_folder
-from engine.io.export import write_trajectories
-from engine.io.files import atomic_write
-from engine.io.labelfiles import write_label_map
-from engine.labels.labelmap import MOCHA_TO_ARPABET, read_label_map
-from engine.labels.phoneset import ARPABET, SILENCE, SILENCE_LABELS, normalise_label
+from facetraj_app.analysis.common import ask_save_path
+from facetraj_engine.errors import FacetrajError
+from facetraj_engine.io.corpus import FolderScan, init_corpus, scan_folder
+from facetraj_engine.io.export import write_trajectories
+from facetraj_engine.io.files import atomic_write
+from facetraj_engine.io.labelfiles import write_label_map
+from facetraj_engine.labels.labelmap import MOCHA_TO_ARPABET, read_label_map
+from facetraj_engine.labels.phoneset import ARPABET, SILENCE, SILENCE_LABELS, normalise_label
 
 log = logging.getLogger(__name__)
 

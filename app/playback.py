@@ -8,7 +8,7 @@ rendered ahead right after a flush (``prepareDue``), so that the update at its t
 screen: its latency, and the uncertainty of that latency, are a fraction of a render's. An update
 that took too long makes the next one skip frames rather than drift, and at most one frame is asked
 for per flush (``frameDue``). Its :attr:`idle` gate is open while no sound plays: background work that must
-not disturb playback waits on it (:meth:`app.workers.Progress.wait_open`) instead of polling the
+not disturb playback waits on it (:meth:`facetraj_app.workers.Progress.wait_open`) instead of polling the
 clock.
 """
 

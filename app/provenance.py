@@ -1,9 +1,9 @@
 """What the window says about how the synthesis on screen was made (no Qt): the search it used
 (the one the synthesis result records, ``Synthesis.config``, never a second guess of the rule in
-``engine.method.modes.choose_mode``), why it differs from the settings, and where the phone
+``facetraj_engine.method.modes.choose_mode``), why it differs from the settings, and where the phone
 labels came from.
 
-Label sources are ``Utterance.label_source`` / ``engine.labels.alignment.Labels.source``
+Label sources are ``Utterance.label_source`` / ``facetraj_engine.labels.alignment.Labels.source``
 strings; one this module does not know reads as it is, so that a richer source shows without a
 change here.
 """
@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from engine.config import SynthConfig
+from facetraj_engine.config import SynthConfig
 
 #: The searches the settings offer, by key (:func:`search_key`): the title's name of each.
 SEARCH_NAMES = {
@@ -109,7 +109,7 @@ class LabelOrigin:
 def mode_reason(requested: SynthConfig, used: SynthConfig, reason: str) -> str:
     """The note under the search selector when the search used differs from the one the
     settings ask for ("" when it does not): the engine's ``reason``
-    (:meth:`engine.method.modes.ModeChoice.describe`, the one rule), and how to override it.
+    (:meth:`facetraj_engine.method.modes.ModeChoice.describe`, the one rule), and how to override it.
 
     >>> mode_reason(SynthConfig(), SynthConfig(mode="robust"), "robust mode: aligned labels")
     'robust mode: aligned labels (the settings ask for phonetic); choose a search to override'

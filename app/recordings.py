@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from engine.errors import InputError
-from engine.io.audio import AUDIO_SUFFIXES
+from facetraj_engine.errors import InputError
+from facetraj_engine.io.audio import AUDIO_SUFFIXES
 
 
 def recordings_in(path: Path) -> list[Path]:

@@ -2,7 +2,7 @@
 pyplot state, so it is safe inside the app and on a headless machine).
 
 ``make_report(corpus_dir, out_dir)`` is what ``facetraj report CORPUS -o DOCS_DIR`` runs: it
-computes the report with :func:`engine.report.write_report` and draws
+computes the report with :func:`facetraj_engine.report.write_report` and draws
 
 * ``results_figure5.png``: correlation against N for train and test (the paper's Figure 5);
 * ``results_figure4.png``: waveform, upper and lower lip y, original vs triangular vs spline
@@ -21,10 +21,10 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from engine.evaluation.paper import PAPER_TABLE2, TABLE2_N
-from engine.evaluation.scores import METRICS
-from engine.method.model import Model
-from engine.report import ComparisonRow, ReportData, write_report
+from facetraj_engine.evaluation.paper import PAPER_TABLE2, TABLE2_N
+from facetraj_engine.evaluation.scores import METRICS
+from facetraj_engine.method.model import Model
+from facetraj_engine.report import ComparisonRow, ReportData, write_report
 
 log = logging.getLogger(__name__)
 
@@ -147,7 +147,7 @@ def comparison(data: ReportData, path: Path) -> Path:
 
 
 def make_figures(data: ReportData, fig_dir: Path) -> dict[str, Path]:
-    """Draw every report figure into ``fig_dir`` (an :data:`engine.report.FigureMaker`)."""
+    """Draw every report figure into ``fig_dir`` (an :data:`facetraj_engine.report.FigureMaker`)."""
     fig_dir = Path(fig_dir)
     fig_dir.mkdir(parents=True, exist_ok=True)
     out: dict[str, Path] = {}
@@ -165,6 +165,6 @@ def make_report(corpus_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
     """Write ``out_dir/results.md``, ``out_dir/results.json`` and ``out_dir/figures/results_*.png``
     for the corpus in ``corpus_dir`` (trained on its train split unless ``model`` is given).
     Returns the path of ``results.md``. ``options``: ``workers``, ``skip``
-    (:func:`engine.report.write_report`)."""
+    (:func:`facetraj_engine.report.write_report`)."""
     return write_report(corpus_dir, out_dir, model=model, progress=progress, ns=ns,
                         figures=make_figures, **options)

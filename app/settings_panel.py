@@ -23,7 +23,7 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from engine.config import SynthConfig
+from facetraj_engine.config import SynthConfig
 
 from .provenance import MODE_NOTES, mode_reason, search_key
 

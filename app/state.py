@@ -10,13 +10,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from engine.config import SynthConfig
-from engine.data import Utterance
-from engine.evaluation.scores import speech_mask
-from engine.method import kernels
-from engine.method.kernels import use_kernels
-from engine.method.model import Model
-from engine.method.pipeline import Synthesis, resmooth, synthesize
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.data import Utterance
+from facetraj_engine.evaluation.scores import speech_mask
+from facetraj_engine.method import kernels
+from facetraj_engine.method.kernels import use_kernels
+from facetraj_engine.method.model import Model
+from facetraj_engine.method.pipeline import Synthesis, resmooth, synthesize
 
 from .provenance import LabelOrigin
 
@@ -44,9 +44,9 @@ class UtteranceView:
     triangular, spline : ``(T, M, 3)`` the synthesis smoothed each way (paper Figure 4).
     speech : ``(T,)`` bool, speech frames (112 ms median-filtered energy, paper section 3).
     times : ``(T,)`` frame times in seconds.
-    mode_reason : why the synthesis runs in its mode (:func:`engine.method.modes.choose_mode`).
+    mode_reason : why the synthesis runs in its mode (:func:`facetraj_engine.method.modes.choose_mode`).
     voice_match : how well the recording's voice matches the training voice, in [0, 1]
-        (:mod:`engine.method.voice_match`; NaN for a model file without the figure).
+        (:mod:`facetraj_engine.method.voice_match`; NaN for a model file without the figure).
     origin : where the phone labels came from (the file, the transcript aligned), if known.
     """
 
@@ -97,7 +97,7 @@ def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig,
                mode_reason: str = "", origin: LabelOrigin | None = None) -> UtteranceView:
     """Synthesize ``utt`` with ``config`` (its labels weighed by their confidence) and derive
     every track the window shows (slow: run in a worker). Raises the engine's
-    :class:`~engine.errors.FacetrajError` on bad input."""
+    :class:`~facetraj_engine.errors.FacetrajError` on bad input."""
     n_frames = utt.n_frames or None
     # the compiled kernels once loaded (in the background, after the first frame: numba's import
     # and cache read would delay it by about half a second), the numpy reference until then

@@ -13,9 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from engine.errors import InputError
-from engine.io.cachedir import cache_dir
-from engine.io.files import atomic_write
+from facetraj_engine.errors import InputError
+from facetraj_engine.io.cachedir import cache_dir
+from facetraj_engine.io.files import atomic_write
 
 log = logging.getLogger(__name__)
 
@@ -140,7 +140,7 @@ class Mouth:
     The lip markers sit on the outside of the lips: with the lips together, an upper and a lower
     marker are still a lip's thickness apart (about 11 mm at the centre). Each lip marker gets an
     *inner edge* point on the way to its partner on the other lip (the nearest in x), as far
-    from it as half their distance at closure (``engine.analysis.lips.closed_lips``), so that the
+    from it as half their distance at closure (``facetraj_engine.analysis.lips.closed_lips``), so that the
     two inner edges meet, and the mouth is shut, when the pair is no farther apart than at the
     talker's closures, and open by the rest when they part. The strips between each lip's
     markers and its inner edge are triangles over the markers and these extra points

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 from PyQt6.QtCore import QObject, QUrl, pyqtSignal
 
-from engine.io.audio import write_audio
+from facetraj_engine.io.audio import write_audio
 
 log = logging.getLogger(__name__)
 

@@ -17,12 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
-from engine.analysis.lips import closed_lips
-from engine.data import PhoneSegment, Utterance
-from engine.io.audio import write_audio
-from engine.io.files import atomic_write
-from engine.method.model import Model
-from engine.method.pipeline import Synthesis
+from facetraj_engine.analysis.lips import closed_lips
+from facetraj_engine.data import PhoneSegment, Utterance
+from facetraj_engine.io.audio import write_audio
+from facetraj_engine.io.files import atomic_write
+from facetraj_engine.method.model import Model
+from facetraj_engine.method.pipeline import Synthesis
 
 from .style import BACKGROUND, CURSOR_COLOR, ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
 from .surface import Mouth, face_triangles, lip_contours

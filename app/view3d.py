@@ -15,8 +15,8 @@ from PyQt6.QtCore import QPoint
 from PyQt6.QtGui import QCursor
 from PyQt6.QtWidgets import QToolTip, QVBoxLayout, QWidget
 
-from engine.analysis.lips import ClosedLips, closed_lips
-from engine.method.model import Model
+from facetraj_engine.analysis.lips import ClosedLips, closed_lips
+from facetraj_engine.method.model import Model
 
 from .plotter_widget import is_native, make_plotter
 from .state import UtteranceView
@@ -58,7 +58,7 @@ def _fill_nan(markers: np.ndarray, fallback: np.ndarray) -> np.ndarray:
 
 class MarkerSet:
     """One marker set in the scene: points, lip lines, optionally a surface, all sharing points.
-    The surface has the lips' inner edges too (``mouth``, :class:`app.surface.Mouth`): the mouth
+    The surface has the lips' inner edges too (``mouth``, :class:`facetraj_app.surface.Mouth`): the mouth
     closes where the lips meet. Adding them renders nothing (the owner renders the finished scene
     once)."""
 
@@ -198,7 +198,7 @@ class FaceView(QWidget):
     # ------------------------------------------------------------------ scene
     def set_model(self, model: Model, closed: ClosedLips | None = None) -> None:
         """Build the scene for ``model``'s marker set; ``closed``: the talker's lips at closure
-        (``engine.analysis.lips.closed_lips``, made here if not given), where the mouth shuts."""
+        (``facetraj_engine.analysis.lips.closed_lips``, made here if not given), where the mouth shuts."""
         self.model = model
         self.ahead = -1
         self.plotter.clear()
@@ -265,7 +265,7 @@ class FaceView(QWidget):
     def prepare_frame(self, k: int) -> None:
         """Render frame ``k`` ahead, off screen, so that ``show_frame(k)`` only has to put it on
         screen (playback: the render's time does not delay the frame's arrival). Native view
-        only (:func:`app.plotter_widget.is_native`), when shown; the frame on screen stays."""
+        only (:func:`facetraj_app.plotter_widget.is_native`), when shown; the frame on screen stays."""
         if self._syn is None or not is_native(self.plotter) or not self.plotter.isVisible():
             return
         k = int(np.clip(k, 0, len(self._syn) - 1))

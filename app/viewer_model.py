@@ -1,7 +1,7 @@
 """What the main window shows, without Qt: the viewer's state and its request/stale-result logic.
 
 :class:`ViewerModel` holds the corpus, the model, the synthesis settings, the utterances opened
-from files, the current :class:`~app.state.UtteranceView` and the latest synthesis request. Every
+from files, the current :class:`~facetraj_app.state.UtteranceView` and the latest synthesis request. Every
 new request (another utterance, other settings) gets a higher generation number; a result that
 arrives for an older generation, or for a model that has since been replaced, is stale and is
 dropped (:meth:`ViewerModel.accept`). The slow parts (:func:`load_model`, :meth:`SynthRequest.run`,
@@ -20,15 +20,15 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from engine.config import SynthConfig
-from engine.data import Utterance
-from engine.errors import FacetrajError
-from engine.evaluation.paper import FIGURE4_TEXT
-from engine.evaluation.scores import evaluate_utterance
-from engine.io.corpus import Corpus, label_path
-from engine.method.model import Model
-from engine.method.modes import choose_mode
-from engine.progress import Progress
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.data import Utterance
+from facetraj_engine.errors import FacetrajError
+from facetraj_engine.evaluation.paper import FIGURE4_TEXT
+from facetraj_engine.evaluation.scores import evaluate_utterance
+from facetraj_engine.io.corpus import Corpus, label_path
+from facetraj_engine.method.model import Model
+from facetraj_engine.method.modes import choose_mode
+from facetraj_engine.progress import Progress
 
 from .phases import mark
 from .provenance import LabelOrigin, search_key, search_title
@@ -69,7 +69,7 @@ class SynthRequest:
     def run(self, progress: Progress | None = None) -> UtteranceView:
         """Load and synthesize (slow: run in a worker). Without phone labels the synthesis is
         acoustic-only, and with labels not hand-checked robust unless the user chose the mode
-        (:func:`engine.method.modes.choose_mode`)."""
+        (:func:`facetraj_engine.method.modes.choose_mode`)."""
         utt = self.load()
         mark(f"utterance {utt.name} read")
         if progress is not None:

@@ -11,7 +11,7 @@ from PyQt6.QtCore import Qt
 from PyQt6.QtGui import QAction
 from PyQt6.QtWidgets import QDockWidget, QFrame, QMainWindow, QMenu, QScrollArea, QWidget
 
-from engine.errors import FacetrajError
+from facetraj_engine.errors import FacetrajError
 
 
 class WindowMenus:

@@ -36,7 +36,7 @@ def keep_long_lived() -> None:
 
     Called once a view has opened: its widgets, figures and artists live as long as the model,
     and a full pass over all of them (170-450 ms, measured while a panel was added with every
-    view open) froze the event loop. The price, as at start-up (``app.main.long_lived_objects``):
+    view open) froze the event loop. The price, as at start-up (``facetraj_app.main.long_lived_objects``):
     cyclic garbage already older than the young generations is kept, and objects alive now that
     die later in a reference cycle (the timeline's axes of this moment, at its next relayout)
     are not collected; a few megabytes per view opened.

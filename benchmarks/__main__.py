@@ -22,7 +22,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from engine.threads import limit_frame_threads, one_blas_thread
+from facetraj_engine.threads import limit_frame_threads, one_blas_thread
 
 from . import cli, corpus_scale, labels, live, scaling, startup, synth, train
 from .common import (
@@ -48,7 +48,7 @@ NOTES = REPO / "benchmarks" / "profile_notes.md"
 
 def display_available() -> tuple[bool, str]:
     """Whether a Qt window can open here, and why not."""
-    from app.display import has_display
+    from facetraj_app.display import has_display
 
     if has_display():
         return True, ""
@@ -112,8 +112,8 @@ def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS, factors: Sequence[i
 
 def profiles(ctx: BenchContext) -> dict[str, list[tuple[str, float, float]]]:
     """Where synthesis spends its time: cProfile of 10 s phonetic and 2 s acoustic-only input."""
-    from engine.config import SynthConfig
-    from engine.method.pipeline import synthesize
+    from facetraj_engine.config import SynthConfig
+    from facetraj_engine.method.pipeline import synthesize
 
     source = ctx.test_utts or ctx.train_utts
     model = ctx.model
@@ -169,7 +169,7 @@ def write_markdown(path: Path, rows: Sequence[BenchRow], ctx: BenchContext, elap
         "- `x RT` is the real-time factor, input duration / wall time (200 = 200 times faster than "
         "real time). Every synthesis call includes the LSF analysis of the input, eqs 4-8, "
         "smoothing and the rebuild of the markers from the PCs.",
-        "- Training times are measured inside one `engine.method.training.train()` call by wrapping the "
+        "- Training times are measured inside one `facetraj_engine.method.training.train()` call by wrapping the "
         "engine's functions; the codebook row is the remainder of the call. Peak memory is traced "
         "in a second call.",
         "- `s/s` (labels) is seconds of computation per second of speech (lower is better): "

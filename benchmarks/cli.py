@@ -28,9 +28,9 @@ from pathlib import Path
 
 import numpy as np
 
-from engine.data import PhoneSegment
-from engine.io.audio import write_audio
-from engine.io.labelfiles import write_textgrid
+from facetraj_engine.data import PhoneSegment
+from facetraj_engine.io.audio import write_audio
+from facetraj_engine.io.labelfiles import write_textgrid
 
 from .common import REPO, BenchContext, BenchRow, concatenate_input
 
@@ -127,7 +127,7 @@ def one_file(ctx: BenchContext, seconds: float | None = None) -> list[BenchRow]:
                              note=f"median of {runs}; runs {min(versions):.2f}-"
                                   f"{max(versions):.2f} s"))
         t0 = time.perf_counter()
-        from engine.method.model import Model
+        from facetraj_engine.method.model import Model
 
         Model.load(model)
         rows.append(BenchRow("cli", "model file load (Model.load, part of each run above)",

@@ -1,10 +1,10 @@
 """The prior of live recognition's running cepstral mean (issue 27): how many frames
-PocketSphinx's initial mean counts as (``engine.streaming.recognizer.CMN_PRIOR_FRAMES``), chosen
+PocketSphinx's initial mean counts as (``facetraj_engine.streaming.recognizer.CMN_PRIOR_FRAMES``), chosen
 on recordings that are neither the training voice nor a test recording, then checked.
 
 The choice: PocketSphinx's own test recordings (its 5.1.1 source distribution, ``test/data``:
 ``pip download --no-deps --no-binary :all: pocketsphinx==5.1.1``, unpack, pass the folder as
-``--pocketsphinx-data``); for each count, :func:`engine.evaluation.live_eval.prior_count_errors`
+``--pocketsphinx-data``); for each count, :func:`facetraj_engine.evaluation.live_eval.prior_count_errors`
 (the running mean's squared distance to each recording's whole mean, over every 5-frame block).
 
 The check (``--check COUNT ...``), each count against the others on what the choice never saw:
@@ -26,8 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
-from engine.io.audio import read_audio
-from engine.threads import one_blas_thread
+from facetraj_engine.io.audio import read_audio
+from facetraj_engine.threads import one_blas_thread
 
 log = logging.getLogger(__name__)
 
@@ -56,7 +56,7 @@ def read_recording(path: Path) -> tuple[np.ndarray, int]:
 
 def choose_count(folder: Path, counts: Sequence[float] = COUNTS) -> dict[float, float]:
     """The error of every count on the recordings of :data:`POCKETSPHINX_RECORDINGS` in ``folder``."""
-    from engine.evaluation.live_eval import frame_cepstra, prior_count_errors
+    from facetraj_engine.evaluation.live_eval import frame_cepstra, prior_count_errors
 
     cepstra = []
     for files in POCKETSPHINX_RECORDINGS.values():
@@ -71,10 +71,10 @@ def check(counts: Sequence[float]) -> list[str]:
     """Markdown rows: each count's phone agreement (corpus test sentences, real recordings) and
     ARCTIC closure of live mode."""
     from benchmarks.common import load_context
-    from engine.evaluation.closure_eval import ARCTIC_DIR, arctic_references, live_closure
-    from engine.evaluation.live_eval import phone_agreement
-    from engine.labels.alignment import recognize
-    from engine.streaming.live import LIVE_RECOGNIZER, LiveConfig
+    from facetraj_engine.evaluation.closure_eval import ARCTIC_DIR, arctic_references, live_closure
+    from facetraj_engine.evaluation.live_eval import phone_agreement
+    from facetraj_engine.labels.alignment import recognize
+    from facetraj_engine.streaming.live import LIVE_RECOGNIZER, LiveConfig
     from facetraj.paths import shared_path
 
     ctx = load_context()

@@ -20,10 +20,10 @@ from pathlib import Path
 import numpy as np
 import scipy
 
-from engine.data import PhoneSegment, Utterance
-from engine.io.corpus import Corpus, load_corpus
-from engine.method.model import Model
-from engine.method.training import MarkerSetup, train
+from facetraj_engine.data import PhoneSegment, Utterance
+from facetraj_engine.io.corpus import Corpus, load_corpus
+from facetraj_engine.method.model import Model
+from facetraj_engine.method.training import MarkerSetup, train
 
 log = logging.getLogger(__name__)
 

@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from engine.io.corpus import Corpus
+from facetraj_engine.io.corpus import Corpus
 
 from .common import BenchContext, BenchRow
 
@@ -256,7 +256,7 @@ def _train_hours(corpus: Corpus) -> float:
     """Hours of training speech (from the audio files' headers)."""
     import soundfile
 
-    from engine.io.corpus import audio_path
+    from facetraj_engine.io.corpus import audio_path
 
     return sum(soundfile.info(str(audio_path(corpus.data_root, u))).duration
                for u in corpus.info.train) / 3600.0
@@ -370,15 +370,15 @@ def _one_machine(fig: _Figures) -> list[str]:
         "- **Training is per-utterance parallel.** Each of its three passes maps an utterance to "
         "a small result (the neutral pose's samples and the codewords' LSF vectors; the moments "
         "of its head-normalised frames; its codewords' PC vectors and closure statistics), merged "
-        "in the utterances' order: `engine.fanout.fan_out` spreads it over one machine's cores, "
+        "in the utterances' order: `facetraj_engine.fanout.fan_out` spreads it over one machine's cores, "
         "and the same results could come from many machines, merged as the workers' are "
-        "(`engine.method.moments.Moments.merged`). What grows is the model (the codebook, "
+        "(`facetraj_engine.method.moments.Moments.merged`). What grows is the model (the codebook, "
         "linear in the speech); past one machine's memory it would be kept on disk and "
         "memory-mapped, or split by centre phone (eq 4 reads only the tokens of the phones "
         "visually similar to the input's).",
         "- **The codebook search is per-frame parallel.** Eqs 5-8 weigh each frame's candidates "
-        "independently (`engine.threads.map_spans` splits the frames between threads), and eq 4 "
-        "scores an input phone against groups of contexts (`engine.method.context_index`) whose "
+        "independently (`facetraj_engine.threads.map_spans` splits the frames between threads), and eq 4 "
+        "scores an input phone against groups of contexts (`facetraj_engine.method.context_index`) whose "
         "number grows with the distinct triphones, not with the corpus's length: the evaluation's "
         "time per utterance stays nearly flat, its total about linear. Split by utterance over "
         "machines that each hold the model, or by phone over machines that each hold their "

@@ -1,4 +1,4 @@
-"""Phone labelling benchmark (``engine.labels.alignment``): seconds of computation per second of speech
+"""Phone labelling benchmark (``facetraj_engine.labels.alignment``): seconds of computation per second of speech
 for forced alignment (two PocketSphinx passes, with and without the fit check against a free phone
 loop) and for phone recognition (all-phone search, then the phone sequence re-aligned).
 
@@ -12,8 +12,8 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 
-from engine.io.audio import read_audio
-from engine.labels.alignment import align, recognize
+from facetraj_engine.io.audio import read_audio
+from facetraj_engine.labels.alignment import align, recognize
 
 from .common import REPO, BenchContext, BenchRow, timed
 

@@ -28,8 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-from engine.streaming.live import LiveConfig, LiveStream
-from engine.threads import one_blas_thread
+from facetraj_engine.streaming.live import LiveConfig, LiveStream
+from facetraj_engine.threads import one_blas_thread
 
 from .common import BenchContext, BenchRow, concatenate_input, load_context, markdown_table
 
@@ -66,7 +66,7 @@ def _stream(model, audio: np.ndarray, rate: int, block_s: float, config: LiveCon
 
 
 def run(ctx: BenchContext) -> list[BenchRow]:
-    """The live rows, on one BLAS thread as live mode runs (``app.live.run_live``,
+    """The live rows, on one BLAS thread as live mode runs (``facetraj_app.live.run_live``,
     ``facetraj live -o``)."""
     with one_blas_thread():
         return _run(ctx)
@@ -119,8 +119,8 @@ def _latency_and_speed(model, audio: np.ndarray, rate: int, seconds: float, mode
 
 def closure_rows(ctx: BenchContext) -> list[BenchRow]:
     """Lip closure of ``facetraj live --from-file`` on the ARCTIC samples, both modes (the
-    measure of issue 25, through :func:`engine.evaluation.closure_eval.live_closure`)."""
-    from engine.evaluation.closure_eval import ARCTIC_DIR, arctic_references, live_closure
+    measure of issue 25, through :func:`facetraj_engine.evaluation.closure_eval.live_closure`)."""
+    from facetraj_engine.evaluation.closure_eval import ARCTIC_DIR, arctic_references, live_closure
     from facetraj.paths import shared_path
 
     folder = shared_path(ARCTIC_DIR)
@@ -156,8 +156,8 @@ def closure_rows(ctx: BenchContext) -> list[BenchRow]:
 
 def comparison_rows(ctx: BenchContext, refs) -> list[BenchRow]:
     """Live mode against ``facetraj synth`` of the same recordings
-    (:func:`engine.evaluation.live_eval.compare_live_offline`)."""
-    from engine.evaluation.live_eval import compare_live_offline
+    (:func:`facetraj_engine.evaluation.live_eval.compare_live_offline`)."""
+    from facetraj_engine.evaluation.live_eval import compare_live_offline
 
     c = compare_live_offline(ctx.model, refs)
     what = f"{len(refs)} ARCTIC recordings, facetraj synth (recognizing their phones) vs live --from-file"
@@ -176,14 +176,14 @@ def comparison_rows(ctx: BenchContext, refs) -> list[BenchRow]:
 
 def _live_fps(ctx: BenchContext, seconds: float) -> list[BenchRow]:
     """Face updates per second of the Live window playing test speech in real time."""
-    from app.display import has_display
+    from facetraj_app.display import has_display
 
     if not has_display():
         return [BenchRow("live", "Live window face updates", float("nan"), "fps",
                          note="skipped: no DISPLAY (run under xvfb-run, as make bench does)")]
     from PyQt6.QtWidgets import QApplication
 
-    from app.live import LiveWindow
+    from facetraj_app.live import LiveWindow
 
     app = QApplication.instance() or QApplication([])
     audio, rate, _ = concatenate_input(ctx.test_utts or ctx.train_utts, seconds)

@@ -44,7 +44,7 @@ def measure(corpus: Path, seconds: float, utterance: str | None = None, during_c
     from PyQt6.QtCore import QEventLoop, QTimer
     from PyQt6.QtWidgets import QApplication
 
-    from app.main_window import MainWindow
+    from facetraj_app.main_window import MainWindow
 
     app = QApplication.instance() or QApplication(sys.argv[:1])
 
@@ -62,7 +62,7 @@ def measure(corpus: Path, seconds: float, utterance: str | None = None, during_c
     win.resize(*size)
     win.show()
     try:
-        from app import analysis
+        from facetraj_app import analysis
 
         analysis.install(win)
     except Exception:  # the benchmark measures the main window; analysis views are optional

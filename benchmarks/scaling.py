@@ -5,7 +5,7 @@ codebook grows x1, x4, x16, with three ways of choosing the codewords each frame
 * exact prefilter: the K codewords nearest by eq 5, found by comparing every codeword
   (``SynthConfig(acoustic_probe=None)``), then eqs 6-8 over those K;
 * indexed (the default): the same K nearest looked up in the model's coarse k-means LSF index,
-  opening ``acoustic_probe`` cells (``engine.method.lsf_index``; time about sqrt(5L)).
+  opening ``acoustic_probe`` cells (``facetraj_engine.method.lsf_index``; time about sqrt(5L)).
 
 The larger codebooks replicate the trained one with jitter (LSFs + N(0, 0.01 rad), re-sorted;
 PCs + 5 % of each PC's standard deviation), which keeps the codeword density realistic; their
@@ -25,11 +25,11 @@ from dataclasses import replace
 
 import numpy as np
 
-from engine.config import SynthConfig
-from engine.evaluation.scores import speech_mask, trajectory_correlations
-from engine.method.codebook import Codebook
-from engine.method.model import Model
-from engine.method.pipeline import Synthesis, synthesize
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.evaluation.scores import speech_mask, trajectory_correlations
+from facetraj_engine.method.codebook import Codebook
+from facetraj_engine.method.model import Model
+from facetraj_engine.method.pipeline import Synthesis, synthesize
 
 from .common import BenchContext, BenchRow, Timing, best_time, concatenate_input, timed
 

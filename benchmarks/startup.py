@@ -2,10 +2,10 @@
 
 Cold start: ``facetraj --screenshot`` (the app on the default corpus with the cached model, as a
 user's second start) timed as a whole process, from launch to exit after the first frame is
-rendered and written; and ``import app.main_window`` alone. Each is the median of several runs
+rendered and written; and ``import facetraj_app.main_window`` alone. Each is the median of several runs
 in new processes (the first start, which may train and cache the model, is not counted).
 
-Evaluation: ``engine.evaluation.scores.evaluate`` over the whole default corpus (train and test,
+Evaluation: ``facetraj_engine.evaluation.scores.evaluate`` over the whole default corpus (train and test,
 phonetic and acoustic-only, both smoothings, as ``facetraj eval --acoustic`` runs it), serially
 and with one worker process per core; the two results are checked equal.
 """
@@ -54,7 +54,7 @@ def cold_start(ctx: BenchContext) -> list[BenchRow]:
                 str(Path(tmp) / "first.png")]
         _process_seconds(shot, 1)              # trains and caches the model, compiles the modules
         starts = _process_seconds(shot, runs)
-    imports = _process_seconds([sys.executable, "-c", "import app.main_window"], runs)
+    imports = _process_seconds([sys.executable, "-c", "import facetraj_app.main_window"], runs)
     med = statistics.median(starts)
     log.info("cold start: median %.2f s of %s", med, [round(s, 2) for s in starts])
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
@@ -64,15 +64,15 @@ def cold_start(ctx: BenchContext) -> list[BenchRow]:
                  ok=None if ctx.smoke else med <= COLD_START_AIM_S,
                  note=f"median of {runs}; runs {min(starts):.2f}-{max(starts):.2f} s; "
                       f"cached model; load average {load:.1f}"),
-        BenchRow("startup", "import app.main_window (whole process)", statistics.median(imports),
+        BenchRow("startup", "import facetraj_app.main_window (whole process)", statistics.median(imports),
                  "s", note=f"median of {runs}; runs {min(imports):.2f}-{max(imports):.2f} s"),
     ]
 
 
 def evaluation(ctx: BenchContext) -> list[BenchRow]:
     """``evaluate()`` on the whole corpus, serially and in one process per core."""
-    from engine.config import SynthConfig
-    from engine.evaluation.scores import default_workers, evaluate
+    from facetraj_engine.config import SynthConfig
+    from facetraj_engine.evaluation.scores import default_workers, evaluate
 
     configs = [SynthConfig(), SynthConfig(mode="acoustic")]
     workers = default_workers()

@@ -1,4 +1,4 @@
-"""Synthesis benchmark (paper section 2.3): real-time factor of :func:`engine.method.pipeline.synthesize` for
+"""Synthesis benchmark (paper section 2.3): real-time factor of :func:`facetraj_engine.method.pipeline.synthesize` for
 1 s, 10 s and 60 s of input, phonetic (N = 3) and acoustic-only, both with the default settings
 (acoustic-only: eqs 6-8 over the K = 128 codewords nearest by eq 5, found in the model's LSF index;
 the whole-codebook search of the paper is timed by the scaling benchmark).
@@ -7,9 +7,9 @@ The input is test-split speech joined end to end (with its phone labels) and cut
 real-time factor is input duration / wall time: 200 means 200 times faster than real time. Each
 call includes the LSF analysis of the input, eqs 4-8, smoothing and the PC-to-marker rebuild.
 Synthesis splits its per-frame stages between one thread per usable core by default
-(``engine.threads``); each figure is also measured on one frame thread. The per-stage table runs
+(``facetraj_engine.threads``); each figure is also measured on one frame thread. The per-stage table runs
 on one frame thread, so that the stages' times add up to the call's. The compiled kernels
-(``engine.method.kernels``) are loaded before any timing; the LSF analysis is then one compiled
+(``facetraj_engine.method.kernels``) are loaded before any timing; the LSF analysis is then one compiled
 stage instead of the numpy reference's three (``FACETRAJ_KERNELS=numpy`` times the reference).
 """
 
@@ -21,12 +21,12 @@ import time
 from collections.abc import Iterator, Sequence
 from unittest import mock
 
-from engine.config import SynthConfig
-from engine.method import kernels, lsf, pipeline
-from engine.method.lsf_index import LsfIndex
-from engine.method.model import Model
-from engine.method.pipeline import Synthesis, synthesize
-from engine.threads import frame_spans, frame_threads, limit_frame_threads
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.method import kernels, lsf, pipeline
+from facetraj_engine.method.lsf_index import LsfIndex
+from facetraj_engine.method.model import Model
+from facetraj_engine.method.pipeline import Synthesis, synthesize
+from facetraj_engine.threads import frame_spans, frame_threads, limit_frame_threads
 
 from .common import BenchContext, BenchRow, Timing, best_time, concatenate_input, timed
 

@@ -1,9 +1,9 @@
 """Training benchmark (paper sections 2.1-2.2): wall time and peak memory of
-:func:`engine.method.training.train`, split into LSF extraction, marker normalisation + PCA, and the rest of
+:func:`facetraj_engine.method.training.train`, split into LSF extraction, marker normalisation + PCA, and the rest of
 the codebook.
 
 The split is measured inside one ``train()`` call by wrapping the engine's own functions as
-``engine.method.training`` calls them (``lsf_at``; ``fill_gaps``, ``reference_pose``,
+``facetraj_engine.method.training`` calls them (``lsf_at``; ``fill_gaps``, ``reference_pose``,
 ``remove_head_motion``; ``pca_of``, the PCA of the merged moments); the codebook time is the
 remainder (context-phones, codeword times, PC interpolation, eqs 1-2). Peak memory is measured
 in a second call under ``tracemalloc`` (numpy reports its buffers to it), so that tracing does
@@ -20,8 +20,8 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from unittest import mock
 
-import engine.method.training as engine_training
-from engine.method.training import train
+import facetraj_engine.method.training as engine_training
+from facetraj_engine.method.training import train
 
 from .common import BenchContext, BenchRow, peak_rss_mib
 
@@ -39,7 +39,7 @@ TRAIN_AIM_S = 30.0
 
 @contextmanager
 def timed_engine_functions() -> Iterator[dict[str, float]]:
-    """Wrap the functions of :data:`STAGES` in ``engine.method.training``; yield seconds spent per
+    """Wrap the functions of :data:`STAGES` in ``facetraj_engine.method.training``; yield seconds spent per
     function."""
     spent: dict[str, float] = defaultdict(float)
 

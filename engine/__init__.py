@@ -19,8 +19,8 @@ shared          ``config`` (settings), ``data`` (an utterance), ``errors``, ``fa
 ``corpusgen``   building the default corpus (the ``corpus`` extra)
 ==============  ===========================================================================
 
-The entry points: :func:`engine.method.train`, :func:`engine.method.synthesize` and
-:func:`engine.evaluation.evaluate`. ``docs/architecture.md`` follows one request through them.
+The entry points: :func:`facetraj_engine.method.train`, :func:`facetraj_engine.method.synthesize` and
+:func:`facetraj_engine.evaluation.evaluate`. ``docs/architecture.md`` follows one request through them.
 """
 
 from __future__ import annotations
@@ -63,10 +63,10 @@ def lazy_exports(package: str, table: dict[str, str]) -> tuple[Callable, Callabl
 #: Module paths of version 0.1 before the stages, and where their names are now. Importing one
 #: still works, with a DeprecationWarning, until the next release.
 MOVED: dict[str, tuple[str, ...]] = {
-    "engine.formats": ("engine.io.files", "engine.io.audio", "engine.io.labelfiles",
-                       "engine.io.markerfiles"),
-    "engine.phones": ("engine.labels.phoneset", "engine.method.context"),
-    "engine.labelmap": ("engine.labels.labelmap", "engine.io.labelfiles"),
+    "facetraj_engine.formats": ("facetraj_engine.io.files", "facetraj_engine.io.audio", "facetraj_engine.io.labelfiles",
+                       "facetraj_engine.io.markerfiles"),
+    "engine.phones": ("facetraj_engine.labels.phoneset", "facetraj_engine.method.context"),
+    "engine.labelmap": ("facetraj_engine.labels.labelmap", "facetraj_engine.io.labelfiles"),
     **{f"engine.{old}": (f"engine.{new}",) for old, new in {
         "alignment": "labels.alignment", "c3d_check": "io.c3d_check", "corpus": "io.corpus",
         "model_file": "io.model_file", "cachedir": "io.cachedir", "hash_memo": "io.hash_memo",

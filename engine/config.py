@@ -35,8 +35,8 @@ class TrainConfig:
     distance_scale : how D (eq 2) is normalised before eq 3: ``max`` divides by the largest
         distance, ``median`` by the median off-diagonal distance, ``none`` leaves it in PC units.
     index_cells : cells of the coarse k-means index over the codebook LSFs used by acoustic-only
-        synthesis (``engine.method.lsf_index``); ``None`` takes ``round(sqrt(5L))``.
-    lsf_context_frames : the robust mode's acoustic context (``engine.method.selection``): each codeword
+        synthesis (``facetraj_engine.method.lsf_index``); ``None`` takes ``round(sqrt(5L))``.
+    lsf_context_frames : the robust mode's acoustic context (``facetraj_engine.method.selection``): each codeword
         also stores its LSF vectors this many marker frames before and after it (0: none).
     """
 
@@ -76,8 +76,8 @@ class SynthConfig:
     nu : override of eq 3's constant; ``None`` uses the model's.
     mode : ``phonetic`` (labels restrict the search, eq 4), ``acoustic`` (no labels) or
         ``robust`` (eq 4's and the acoustically nearest codewords together, the labels counting
-        as much as their confidence, with acoustic context: ``engine.method.selection``; the default for
-        labels that are not hand-checked, :func:`engine.method.modes.choose_mode`).
+        as much as their confidence, with acoustic context: ``facetraj_engine.method.selection``; the default for
+        labels that are not hand-checked, :func:`facetraj_engine.method.modes.choose_mode`).
     gamma_min, gamma_max, gamma_steps : the grid searched for gamma (eqs 6-7).
     smoothing : ``triangular`` (100 ms zero-phase window), ``spline`` or ``none``.
     triangle_s : the triangular window's total duration.
@@ -85,25 +85,25 @@ class SynthConfig:
     acoustic_prefilter : in acoustic mode, keep only the K codewords nearest to each frame by
         eq 5 before eqs 6-8; ``None`` weights all 5L codewords, as the paper does (slow).
     acoustic_probe : how the K nearest are found: among the members of this many cells of the
-        model's coarse LSF index (``engine.method.lsf_index``, fast, growth about sqrt(5L)); ``None``
+        model's coarse LSF index (``facetraj_engine.method.lsf_index``, fast, growth about sqrt(5L)); ``None``
         compares every codeword (exact, linear in 5L).
-    speaker_warp : speaker normalisation of the input LSFs (``engine.method.speaker``): a warp factor
+    speaker_warp : speaker normalisation of the input LSFs (``facetraj_engine.method.speaker``): a warp factor
         alpha (1.0: none; below 1 lowers the frequencies, for a voice with a shorter vocal tract
         than the training voice), or ``None`` to choose it per utterance (``choose_warp``).
     robust_candidates : robust mode: acoustically nearest codewords added to eq 4's (index search).
     label_weight : robust mode: kappa, the cost (eq 5 units) of a codeword eq 4 did not choose,
         times the label's confidence.
     label_weight_by_voice : robust mode: the labels weighed by the input's voice
-        (``engine.method.voice_match``): kappa times the voice's distance ratio ``D / D0`` (at
+        (``facetraj_engine.method.voice_match``): kappa times the voice's distance ratio ``D / D0`` (at
         least 1: eq 5's distances grow on a voice the codebook does not know), and each label's
-        confidence raised towards 1 as the voice match falls (:func:`engine.method.pipeline.
+        confidence raised towards 1 as the voice match falls (:func:`facetraj_engine.method.pipeline.
         trust_by_voice`).
     context_weight : robust mode: rho, the weight of the context frames in the distance.
     mean_normalise : robust mode: move the input LSFs' mean to the training speaker's.
     chain_beta : robust mode: beta, the join cost's weight of the chain over frames that makes
-        the codeword weights consistent over time (``engine.method.chain``; 0: eq 8 frame by frame).
+        the codeword weights consistent over time (``facetraj_engine.method.chain``; 0: eq 8 frame by frame).
     closure : after the smoothing, close the lips at the labelled /p b m/ and rest the face in
-        pauses (``engine.method.closure``, beyond the paper; the paper's tables run without it).
+        pauses (``facetraj_engine.method.closure``, beyond the paper; the paper's tables run without it).
     closure_taper_s : the closure's raised-cosine tapers outside each /p b m/.
     rest_pause_s, rest_taper_s : pauses longer than this rest the face; the tapers inside them.
     """
@@ -156,7 +156,7 @@ class EvalConfig:
     moving_fraction : "whole face" averages over the coordinates whose training standard deviation
         (head-normalised) is at least this fraction of the largest one.
     by_labels : the synthesis mode follows each utterance's labels, as in every command
-        (:func:`engine.method.modes.choose_mode`: acoustic-only without labels, robust with the
+        (:func:`facetraj_engine.method.modes.choose_mode`: acoustic-only without labels, robust with the
         model's cross-validated settings for labels that are not hand-checked); ``False``: each
         config's mode is used as it is (the paper's tables, ablations).
     keep : with ``by_labels``, the settings of the configs that the model's cross-validated ones

@@ -28,7 +28,7 @@ LABEL_KINDS = ("hand-checked", "aligned", "recognized")
 @dataclass(frozen=True)
 class Provenance:
     """How a set of phone labels was made; the record travels with them in their TextGrid
-    (``engine.labels.provenance``).
+    (``facetraj_engine.labels.provenance``).
 
     Attributes
     ----------
@@ -91,7 +91,7 @@ class Utterance:
     text : optional orthographic text.
     label_source : where ``phones`` came from: ``"file"`` (a label file), ``"aligned"`` (forced
         alignment of ``text``), ``"recognized"`` (phone recognition) or ``"none"``
-        (``engine.labels.alignment`` / ``engine.io.labelling``).
+        (``facetraj_engine.labels.alignment`` / ``facetraj_engine.io.labelling``).
     provenance : how ``phones`` were made (a label file records it; else hand-checked).
     confidence : per phone, how sure their maker was, in (0, 1] (NaN: no score); ``None`` for
         hand-checked labels.

@@ -3,7 +3,7 @@ files, each logged once.
 
 The command line prints ``str(err)`` and exits with status 2; the app shows it in a dialog. Every
 error here survives pickling (a worker process's error is rebuilt in the parent as it was raised,
-:mod:`engine.fanout`).
+:mod:`facetraj_engine.fanout`).
 
 A warning about a file (markers shorter than the audio, channels mixed down, ...) goes through
 :func:`warn_file`: logged the first time only, however often the file is read (a corpus command

@@ -11,7 +11,7 @@ bounded whatever the number of items (the corpus is read, analysed and let go on
 time). Either way a bad file gives the same outcome:
 
 - by default, the first item in order whose file is bad stops the work with its own
-  :class:`~engine.errors.FacetrajError` (``file: problem``; its ``item`` attribute names the
+  :class:`~facetraj_engine.errors.FacetrajError` (``file: problem``; its ``item`` attribute names the
   item), as the serial run does; the items still waiting are not started;
 - with a :class:`Skips` (the commands' ``--skip-bad``), the item is left out, its message kept,
   and the work goes on; the command ends with :meth:`Skips.summary` ("1 of 3 utterances skipped:
@@ -21,9 +21,9 @@ A worker's error comes back as it was raised (every facetraj error pickles, and 
 does not is replaced by a plain copy before it leaves the worker). A worker that dies (killed,
 out of memory, a crash in a file reader) fails the item it was working on, named, and only that
 item: another worker takes its place for the rest; the failure is a
-:class:`~engine.errors.FacetrajError` like a bad file's (stops the work, or with a
+:class:`~facetraj_engine.errors.FacetrajError` like a bad file's (stops the work, or with a
 :class:`Skips` is recorded there), never a traceback. A bug in ``fn`` (any other exception) is
-raised here as it is. The warnings about files a worker logs (``engine.errors.warn_file``) are
+raised here as it is. The warnings about files a worker logs (``facetraj_engine.errors.warn_file``) are
 sent to the parent, which logs each once.
 """
 
@@ -113,7 +113,7 @@ def portable(exc: BaseException) -> BaseException:
 
 
 #: called in the parent before worker processes fork: what every worker would otherwise load
-#: for itself (``engine.method.kernels`` loads the compiled kernels here), loaded once
+#: for itself (``facetraj_engine.method.kernels`` loads the compiled kernels here), loaded once
 _BEFORE_FORK: list[Callable[[], None]] = []
 
 
@@ -146,7 +146,7 @@ def fan_out(fn: Callable[[I], R], items: Sequence[I], workers: int = 1, *,
     """``(item, fn(item))`` for every item, computed in ``workers`` processes (forked; serially
     for 1, or where fork is unavailable), taken in order (``ordered``) or as they finish.
 
-    A :class:`~engine.errors.FacetrajError` of an item, or its worker's death, stops the work
+    A :class:`~facetraj_engine.errors.FacetrajError` of an item, or its worker's death, stops the work
     (raised, ``item`` set), or with ``skip`` leaves the item out (recorded there).
     ``progress(fraction, describe(item))`` as the items are taken, ``(1.0, "done")`` at the end.
     ``setup()`` is called once in every process that runs items (each worker; this one when

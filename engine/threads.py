@@ -123,7 +123,7 @@ def frame_spans(n_frames: int, threads: int | None = None) -> list[tuple[int, in
 def map_spans(fn: Callable[[int, int], T], n_frames: int, threads: int | None = None) -> list[T]:
     """``fn(start, stop)`` for each of :func:`frame_spans`, in threads when there are several;
     the results in span order, each span run in a copy of the caller's context (its
-    :func:`limit_frame_threads` and ``engine.method.kernels.use_kernels`` hold there). An
+    :func:`limit_frame_threads` and ``facetraj_engine.method.kernels.use_kernels`` hold there). An
     exception in a span is raised here. (The threads' matrix
     products are small: callers that run beside other work run BLAS on one thread, as the app,
     live mode and the evaluation do, :func:`one_blas_thread`.)

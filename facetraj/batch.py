@@ -2,8 +2,8 @@
 
 Every input goes through :func:`synthesize_file`, the one path of ``facetraj synth`` for a
 recording (its labels and mode by the same rules as one file,
-:func:`engine.method.recording.synthesize_recording`), in ``jobs`` worker processes that each
-hold the model (loaded once; forked workers share the parent's copy: :func:`engine.fanout.fan_out`,
+:func:`facetraj_engine.method.recording.synthesize_recording`), in ``jobs`` worker processes that each
+hold the model (loaded once; forked workers share the parent's copy: :func:`facetraj_engine.fanout.fan_out`,
 whose worker that dies fails the input it was on, and only that one). An input whose output
 exists is skipped unless ``overwrite`` (outputs are written whole or not at all, so an interrupted
 run resumes where it stopped); an input that fails is reported with its one-line reason and the
@@ -24,7 +24,7 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from engine.errors import FacetrajError, InputError
+from facetraj_engine.errors import FacetrajError, InputError
 
 log = logging.getLogger("facetraj")
 
@@ -39,8 +39,8 @@ _GLOB_CHARS = frozenset("*?[")
 @dataclass(frozen=True)
 class SynthJob:
     """What every input of a run shares: the synthesis settings and how outputs are written
-    (``request``: :class:`~engine.method.recording.LabelRequest`; ``explicit``, ``keep``: as
-    :func:`~engine.method.recording.synthesize_recording` takes them)."""
+    (``request``: :class:`~facetraj_engine.method.recording.LabelRequest`; ``explicit``, ``keep``: as
+    :func:`~facetraj_engine.method.recording.synthesize_recording` takes them)."""
 
     config: Any
     request: Any
@@ -48,7 +48,7 @@ class SynthJob:
     keep: tuple[str, ...] = ()
     overwrite: bool = False
     compress: bool = False
-    #: ``compiled`` or ``numpy`` (``engine.method.kernels``): chosen for the whole run
+    #: ``compiled`` or ``numpy`` (``facetraj_engine.method.kernels``): chosen for the whole run
     kernels: str = "compiled"
 
 
@@ -92,7 +92,7 @@ def collect_inputs(specs: Iterable[str]) -> list[Path]:
     """The recordings named by ``specs``, in order, each once: files, folders (their
     ``.wav``/``.flac`` files, sorted), globs (``**`` for sub-folders; audio files only) and list
     files (:data:`LIST_SUFFIXES`: one input a line, ``#`` comments)."""
-    from engine.io.audio import AUDIO_SUFFIXES
+    from facetraj_engine.io.audio import AUDIO_SUFFIXES
 
     found: list[Path] = []
     for spec in specs:
@@ -114,7 +114,7 @@ def collect_inputs(specs: Iterable[str]) -> list[Path]:
 
 
 def _list_file(path: Path) -> list[str]:
-    from engine.io.files import read_text
+    from facetraj_engine.io.files import read_text
 
     lines = (ln.split("#", 1)[0].strip() for ln in read_text(path, "list of inputs").splitlines())
     return [str(path.parent / ln) for ln in lines if ln]
@@ -138,11 +138,11 @@ def synthesize_file(model: Any, audio: Path, output: Path, job: SynthJob,
                     samples: tuple[Any, int] | None = None, early: Any = None) -> Any:
     """One recording to one trajectory file, as ``facetraj synth`` does for every input
     (``samples``, ``early``: its audio when read, its input LSFs being analysed, as
-    :func:`~engine.method.recording.synthesize_recording` takes them); returns the
-    :class:`~engine.method.recording.RecordingSynthesis` (logged)."""
-    from engine.io.export import write_trajectories
-    from engine.method.kernels import use_kernels
-    from engine.method.recording import synthesize_recording
+    :func:`~facetraj_engine.method.recording.synthesize_recording` takes them); returns the
+    :class:`~facetraj_engine.method.recording.RecordingSynthesis` (logged)."""
+    from facetraj_engine.io.export import write_trajectories
+    from facetraj_engine.method.kernels import use_kernels
+    from facetraj_engine.method.recording import synthesize_recording
 
     with use_kernels(job.kernels):
         done = synthesize_recording(model, audio, job.config, job.request, explicit=job.explicit,
@@ -162,13 +162,13 @@ def _worker_init(model_path: Path, job: SynthJob, one_thread: bool) -> None:
     """A worker process: the model loaded once (unless inherited from the parent), one BLAS
     thread (the products are small: more threads spin, measured 1.7x the CPU time on a batch),
     and one frame thread when the workers share the cores (``one_thread``)."""
-    from engine.threads import THREADS_ENV, one_blas_thread
+    from facetraj_engine.threads import THREADS_ENV, one_blas_thread
 
     one_blas_thread()
     if one_thread:
         os.environ[THREADS_ENV] = "1"                   # this process's frames on one thread
     if _WORKER.get("path") != model_path:
-        from engine.method.model import Model
+        from facetraj_engine.method.model import Model
 
         _WORKER.update(path=model_path, model=Model.load(model_path))
     _WORKER["job"] = job
@@ -184,7 +184,7 @@ def _worker_run(pair: tuple[Path, Path]) -> Outcome:
     except FacetrajError as exc:
         return Outcome(str(src), str(out), "failed", str(exc), time.perf_counter() - t0)
     except OSError as exc:
-        from engine.io.files import write_problem
+        from facetraj_engine.io.files import write_problem
 
         where = exc.filename or src
         return Outcome(str(src), str(out), "failed", f"{where}: {write_problem(exc)}",
@@ -205,11 +205,11 @@ def _worker_run(pair: tuple[Path, Path]) -> Outcome:
 
 def choose_kernels(job: SynthJob, inputs: Iterable[Path], workers: int = 1) -> SynthJob:
     """``job`` with the kernels that pay for themselves on ``inputs`` shared by ``workers``
-    processes (``engine.method.kernels.choice_for``): the prebuilt ones whenever they are there;
+    processes (``facetraj_engine.method.kernels.choice_for``): the prebuilt ones whenever they are there;
     else numba's, whose loading costs about half a second, paid before the workers fork, when
     they save it back on minutes of speech in each worker, the durations read from the files'
     headers only as far as needed (an unreadable one counts nothing: its synthesis says why)."""
-    from engine.method.kernels import PAYS_OFF_S, choice_for, ready_choice
+    from facetraj_engine.method.kernels import PAYS_OFF_S, choice_for, ready_choice
 
     mode = job.config.mode
     if ready_choice() == "compiled":                   # prebuilt (or loaded): nothing to count
@@ -236,18 +236,18 @@ def import_synthesis() -> None:
     import numpy.ma  # noqa: F401
     import soundfile  # noqa: F401
 
-    import engine.io.export
-    import engine.io.labelling
-    import engine.io.textgrid
-    import engine.method.recording  # noqa: F401
+    import facetraj_engine.io.export
+    import facetraj_engine.io.labelling
+    import facetraj_engine.io.textgrid
+    import facetraj_engine.method.recording  # noqa: F401
 
 
 def _preload(job: SynthJob, model: Any) -> None:
     """:func:`import_synthesis`, the engine's before-fork hooks run (the compiled kernels loaded
     when chosen) and the model's search layout made, once, before the workers fork (each
     worker's first input made that layout for itself: 1,700 page faults)."""
-    from engine.fanout import prepare_fork
-    from engine.method.kernels import use_kernels
+    from facetraj_engine.fanout import prepare_fork
+    from facetraj_engine.method.kernels import use_kernels
 
     import_synthesis()
     model.prepare_search()
@@ -262,8 +262,8 @@ def run_batch(model_path: Path, specs: Sequence[str], outdir: Path, fmt: str, jo
     """Synthesize every input of ``specs`` into ``outdir`` (made when missing) with ``jobs``
     worker processes; the outcomes in input order. The model is loaded (and checked) here once
     before any worker starts."""
-    from engine.fanout import Skips, fan_out
-    from engine.method.model import Model
+    from facetraj_engine.fanout import Skips, fan_out
+    from facetraj_engine.method.model import Model
 
     inputs = collect_inputs(specs)
     if not inputs:
@@ -304,7 +304,7 @@ def run_batch(model_path: Path, specs: Sequence[str], outdir: Path, fmt: str, jo
 def write_summary(outdir: Path, outcomes: Sequence[Outcome], settings: dict[str, Any],
                   seconds: float) -> Path:
     """The JSON summary beside the outputs: counts, settings and every input's outcome."""
-    from engine.io.files import write_json
+    from facetraj_engine.io.files import write_json
 
     counts = {s: sum(o.status == s for o in outcomes) for s in ("done", "skipped", "failed")}
     return write_json(outdir / SUMMARY_NAME, {
@@ -323,7 +323,7 @@ def summary_lines(outcomes: Sequence[Outcome]) -> list[str]:
 
 def default_jobs() -> int:
     """Worker processes by default: the cores this process may use."""
-    from engine.threads import usable_cores
+    from facetraj_engine.threads import usable_cores
 
     return usable_cores()
 

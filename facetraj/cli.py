@@ -12,8 +12,8 @@ import logging
 import sys
 from collections.abc import Sequence
 
-from engine.errors import FacetrajError
-from engine.io.files import write_problem
+from facetraj_engine.errors import FacetrajError
+from facetraj_engine.io.files import write_problem
 
 from .commands import align, corpus, evaluate, gui, live, render, synth, train
 from .options import SECONDS

@@ -38,17 +38,17 @@ def add_corpus_work_options(p: argparse.ArgumentParser, noun: str = "utterances"
 
 def jobs(args: argparse.Namespace, default: int | None = None) -> int:
     """The processes asked for: ``--jobs``, else ``default``, else every usable core."""
-    from engine.threads import usable_cores
+    from facetraj_engine.threads import usable_cores
 
     return args.jobs or default or usable_cores()
 
 
 def skips(args: argparse.Namespace, noun: str = "utterances"):
-    """An :class:`engine.fanout.Skips` to collect skipped items when ``--skip-bad`` was given,
+    """An :class:`facetraj_engine.fanout.Skips` to collect skipped items when ``--skip-bad`` was given,
     else ``None`` (a bad file stops the command)."""
     if not getattr(args, "skip_bad", False):
         return None
-    from engine.fanout import Skips
+    from facetraj_engine.fanout import Skips
 
     return Skips(noun)
 
@@ -57,7 +57,7 @@ def finish(skipped) -> int:
     """The end of a corpus-wide command: one line per kind of file warning with its count, the
     summary of what was skipped (printed even with ``-q``), and the exit status (0, or
     :data:`EXIT_INCOMPLETE` when something was skipped)."""
-    from engine.errors import file_warning_summary
+    from facetraj_engine.errors import file_warning_summary
 
     for line in file_warning_summary():
         log.warning("%s", line)

@@ -1,6 +1,6 @@
 """The training and synthesis options shared by several subcommands, the range-checked option
-types every subcommand uses, and the configurations (:class:`~engine.config.TrainConfig`,
-:class:`~engine.config.SynthConfig`) built from them.
+types every subcommand uses, and the configurations (:class:`~facetraj_engine.config.TrainConfig`,
+:class:`~facetraj_engine.config.SynthConfig`) built from them.
 
 A value out of range is refused by argparse with the valid range (exit status 2), e.g.
 ``argument -N/--n-context-phones: expected a whole number from 1 to 1000, got '0'``.
@@ -12,7 +12,7 @@ import argparse
 import math
 from collections.abc import Callable
 
-from engine.config import SynthConfig, TrainConfig
+from facetraj_engine.config import SynthConfig, TrainConfig
 
 ALL = -1
 

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from engine.io.audio import read_audio
-from engine.labels.alignment import align, read_dictionary, recognize
+from facetraj_engine.io.audio import read_audio
+from facetraj_engine.labels.alignment import align, read_dictionary, recognize
 
 SENTENCE = Path(__file__).resolve().parent.parent / "data_samples" / "s002.flac"
 

@@ -46,14 +46,14 @@ def toy_corpus_dir(tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="session")
 def toy_corpus(toy_corpus_dir):
-    from engine.io.corpus import load_corpus
+    from facetraj_engine.io.corpus import load_corpus
 
     return load_corpus(toy_corpus_dir)
 
 
 @pytest.fixture(scope="session")
 def toy_model(toy_corpus):
-    from engine.method.training import train
+    from facetraj_engine.method.training import train
 
     return train(toy_corpus)
 
@@ -70,7 +70,7 @@ def fuzz_workspace(tmp_path_factory, toy_corpus_dir, toy_model):
 
 @pytest.fixture(scope="session")
 def default_corpus():
-    from engine.io.corpus import load_corpus
+    from facetraj_engine.io.corpus import load_corpus
 
     assert (DEFAULT_CORPUS / "corpus.json").exists(), "the default corpus data_samples/ is missing"
     return load_corpus(DEFAULT_CORPUS)
@@ -79,7 +79,7 @@ def default_corpus():
 @pytest.fixture(scope="session")
 def default_model(default_corpus):
     """The default model, trained once per session into the (test) cache the app also reads."""
-    from app.cache import load_or_train
+    from facetraj_app.cache import load_or_train
 
     return load_or_train(default_corpus)
 

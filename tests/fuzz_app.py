@@ -25,7 +25,7 @@ SETTLE_S = 0.4
 
 
 class AppProbe:
-    """Opens files in a main window (``app.main_window.MainWindow``) and reports the outcome."""
+    """Opens files in a main window (``facetraj_app.main_window.MainWindow``) and reports the outcome."""
 
     def __init__(self, window):
         from PyQt6.QtCore import QTimer
@@ -132,8 +132,8 @@ def run_batch(corpus: str, model: str, actions: list[tuple[int, list[str]]], res
     os.environ.setdefault("QT_LOGGING_RULES", "qt.multimedia.*=false;qt.multimedia.ffmpeg=false")
     from PyQt6.QtWidgets import QApplication
 
-    from app.main import build_window
-    from engine.threads import one_blas_thread
+    from facetraj_app.main import build_window
+    from facetraj_engine.threads import one_blas_thread
 
     one_blas_thread()
     app = QApplication.instance() or QApplication(sys.argv[:1])

@@ -118,8 +118,8 @@ class Workspace:
 def make_workspace(root: Path, toy_dir: Path | None = None, model_path: Path | None = None
                    ) -> Workspace:
     """A small corpus (3 utterances of the toy corpus) and a model trained on it, in ``root``."""
-    from engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
-    from engine.io.labelfiles import read_labels
+    from facetraj_engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
+    from facetraj_engine.io.labelfiles import read_labels
 
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     if toy_dir is None:
@@ -138,7 +138,7 @@ def make_workspace(root: Path, toy_dir: Path | None = None, model_path: Path | N
     if model_path is not None:
         shutil.copy(model_path, model)
     else:
-        from engine.method.training import train
+        from facetraj_engine.method.training import train
 
         train(load_corpus(toy_dir)).save(model)
     lab = root / "toy030.lab"
@@ -606,7 +606,7 @@ def c3d_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
             rate = rng.choice([1e6, 0.001, 0.0, -60.0, float("nan"), 1e30, 59.9, 240.0])
             data, how = _c3d_rate(src, rate), f"{rate:g} Hz"
         elif kind == "frames":
-            from engine.io.markerfiles import read_c3d, write_c3d
+            from facetraj_engine.io.markerfiles import read_c3d, write_c3d
 
             m = read_c3d(ws.c3d)
             n = rng.choice([0, 1, 2, 3])
@@ -638,7 +638,7 @@ def c3d_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
 # --------------------------------------------------------------------------- TSV / EMA markers
 def marker_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
     """Marker tables (TSV/CSV) and MOCHA EMA text in place of the C3D, damaged as text."""
-    from engine.io.markerfiles import read_c3d, write_marker_tsv
+    from facetraj_engine.io.markerfiles import read_c3d, write_marker_tsv
 
     m = read_c3d(ws.c3d)
     while True:
@@ -841,12 +841,12 @@ def _spoil(rng: random.Random, corpus: Path, utt: str, command: str) -> str:
         victim.unlink()
         return f"{victim.name} missing"
     if kind == "short":
-        from engine.io.markerfiles import read_c3d, write_c3d
+        from facetraj_engine.io.markerfiles import read_c3d, write_c3d
 
         m = read_c3d(corpus / f"{utt}.c3d")
         write_c3d(corpus / f"{utt}.c3d", m.markers[: rng.choice([1, 2, 30])], m.rate, m.names)
         return f"{utt}.c3d short"
-    from engine.io.markerfiles import read_c3d, write_marker_tsv
+    from facetraj_engine.io.markerfiles import read_c3d, write_marker_tsv
 
     m = read_c3d(corpus / f"{utt}.c3d")
     (corpus / f"{utt}.c3d").unlink()
@@ -922,7 +922,7 @@ ALIEN_LABELS = ["zz", "Q\\", "\u014b\u030a", "AA9", "ph", "#1", "i::", "\u0251\u
 
 def _write_label_file(path: Path, segs: list, rate: int = 16000) -> None:
     if path.suffix == ".TextGrid":
-        from engine.io.labelfiles import write_textgrid
+        from facetraj_engine.io.labelfiles import write_textgrid
 
         write_textgrid(path, {"phones": segs}, segs[-1].end)
     elif path.suffix == ".phn":
@@ -937,8 +937,8 @@ def alphabet_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
     """The toy labels written in each alphabet (must synthesize), or with labels in no alphabet,
     alphabets mixed, case changed (refused or synthesized, never a traceback); given with
     --labels or found beside the audio; sometimes with --label-map (a file or an alphabet)."""
-    from engine.data import PhoneSegment
-    from engine.io.labelfiles import read_labels
+    from facetraj_engine.data import PhoneSegment
+    from facetraj_engine.io.labelfiles import read_labels
 
     segs = read_labels(ws.textgrid)
     while True:
@@ -983,7 +983,7 @@ def app_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
     """What the window opens: a damaged audio file, damaged labels (given, beside the audio, in
     another alphabet), a transcript beside the audio, a damaged model or corpus description, a
     damaged marker file of the utterance shown (tests/fuzz_app.py)."""
-    from engine.io.labelfiles import read_labels
+    from facetraj_engine.io.labelfiles import read_labels
 
     segs = read_labels(ws.textgrid)
     while True:
@@ -1009,7 +1009,7 @@ def app_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
             path.write_text(text)
             action = ["audio", str(audio), "" if kind == "beside" else str(path)]
         elif kind == "alphabet":
-            from engine.data import PhoneSegment
+            from facetraj_engine.data import PhoneSegment
 
             name = rng.choice(list(SPELLINGS))
             lab = [PhoneSegment(s.start, s.end, rng.choice(SPELLINGS[name][s.label])) for s in segs]
@@ -1157,7 +1157,7 @@ def run_in_process(case: Case) -> Outcome:
 
 def run_forked(case: Case, timeout: float = TIMEOUT_S, memory: int = MEMORY_LIMIT) -> Outcome:
     """Run a case in a forked child with an address-space limit and a timeout."""
-    from engine.fanout import prepare_fork
+    from facetraj_engine.fanout import prepare_fork
 
     err_path = case_workdir(case) / ".stderr"
     t0 = time.perf_counter()
@@ -1292,7 +1292,7 @@ def _app_batch(ws: Workspace, actions: list, results: Path, timeout: float
                ) -> tuple[int, int | None, float]:
     """Fork a child that runs ``actions`` in one window; its peak memory, exit status (None when
     killed for taking longer than ``timeout``) and seconds."""
-    from engine.fanout import prepare_fork
+    from facetraj_engine.fanout import prepare_fork
 
     t0 = time.perf_counter()
     prepare_fork()

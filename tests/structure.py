@@ -13,7 +13,7 @@ PACKAGES = ("engine", "app", "facetraj", "benchmarks")
 
 
 def module_name(path: Path) -> str:
-    """``engine/method/pipeline.py`` -> ``engine.method.pipeline`` (a package: its ``__init__``)."""
+    """``engine/method/pipeline.py`` -> ``facetraj_engine.method.pipeline`` (a package: its ``__init__``)."""
     parts = path.relative_to(ROOT).with_suffix("").parts
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
@@ -168,8 +168,8 @@ def mermaid(edges: list[Import] | None = None) -> str:
 
 
 def _box_order(box: str) -> tuple[int, str]:
-    order = ["benchmarks", "facetraj", "app", "engine.corpusgen", "engine.report", "engine.analysis",
-             "engine.evaluation", "engine.streaming", "engine.method", "engine.io", "engine.labels",
+    order = ["benchmarks", "facetraj", "app", "facetraj_engine.corpusgen", "facetraj_engine.report", "facetraj_engine.analysis",
+             "facetraj_engine.evaluation", "facetraj_engine.streaming", "facetraj_engine.method", "facetraj_engine.io", "facetraj_engine.labels",
              "engine.shared"]
     return (order.index(box) if box in order else len(order), box)
 

@@ -11,13 +11,13 @@ import numpy as np
 import pytest
 from conftest import DEFAULT_CORPUS, MOCHA
 
-from engine.data import PhoneSegment
-from engine.evaluation.label_accuracy import boundary_errors, merged, phone_error_rate, summarise
-from engine.io.audio import read_audio
-from engine.io.labelfiles import read_lab, read_textgrid, read_textgrid_tiers, recorded_provenance
-from engine.io.labelling import label_audio, label_corpus, labels_for_audio, relabelled
-from engine.labels.alignment import MissingWordsError, UnalignableError, align, recognize
-from engine.labels.labelmap import read_label_map
+from facetraj_engine.data import PhoneSegment
+from facetraj_engine.evaluation.label_accuracy import boundary_errors, merged, phone_error_rate, summarise
+from facetraj_engine.io.audio import read_audio
+from facetraj_engine.io.labelfiles import read_lab, read_textgrid, read_textgrid_tiers, recorded_provenance
+from facetraj_engine.io.labelling import label_audio, label_corpus, labels_for_audio, relabelled
+from facetraj_engine.labels.alignment import MissingWordsError, UnalignableError, align, recognize
+from facetraj_engine.labels.labelmap import read_label_map
 from facetraj.cli import main
 
 CLIP = DEFAULT_CORPUS / "s002.flac"        # "The boy enjoyed the noisy toy." 2.1 s
@@ -151,7 +151,7 @@ def test_label_cache(tmp_path, monkeypatch, clip):
     monkeypatch.setenv("FACETRAJ_CACHE_DIR", str(tmp_path))
     first = label_audio(audio, rate, "aligned", text)
     assert len(list((tmp_path / "labels").glob("labels-*.json"))) == 1
-    import engine.io.labelling as labelling
+    import facetraj_engine.io.labelling as labelling
 
     monkeypatch.setattr(labelling, "align", lambda *a, **k: pytest.fail("not cached"))
     again = label_audio(audio, rate, "aligned", text)
@@ -161,7 +161,7 @@ def test_label_cache(tmp_path, monkeypatch, clip):
 
 def test_relabelled_corpus(toy_corpus, monkeypatch, tmp_path):
     """Every utterance labelled; the relabelled corpus trains and evaluates like any corpus."""
-    from engine.labels.provenance import Labels
+    from facetraj_engine.labels.provenance import Labels
 
     calls = []
 
@@ -171,7 +171,7 @@ def test_relabelled_corpus(toy_corpus, monkeypatch, tmp_path):
         return Labels([PhoneSegment(0, dur / 2, "sil"), PhoneSegment(dur / 2, dur, "aa")],
                       source=method)
 
-    import engine.io.labelling as labelling
+    import facetraj_engine.io.labelling as labelling
 
     monkeypatch.setattr(labelling, "label_audio", fake)
     auto = label_corpus(toy_corpus, "aligned")
@@ -275,7 +275,7 @@ def test_synth_with_text_aligns_then_synthesizes_robustly(tmp_path, default_mode
         assert main(["synth", str(model), str(wav), "-o", str(tmp_path / "t.c3d")]) == 0
     assert "labels aligned from u.txt (PocketSphinx" in caplog.text
     assert "; robust mode: aligned labels are not hand-checked" in caplog.text
-    from engine.io.markerfiles import read_c3d
+    from facetraj_engine.io.markerfiles import read_c3d
 
     a, p, t = (read_c3d(tmp_path / f"{n}.c3d").markers for n in "apt")
     np.testing.assert_allclose(p, t)                        # same labels, same trajectories
@@ -309,7 +309,7 @@ def test_corpus_align_command(tmp_path, caplog):
 
 
 def test_report_section_renders_the_accuracy_table(clip, clip_aligned):
-    from engine.report.labels import render_section
+    from facetraj_engine.report.labels import render_section
 
     _, _, truth, _ = clip
     row = {"data": "clip (exact labels)", **summarise("aligned", [(truth, clip_aligned.phones)]).to_json()}

@@ -1,4 +1,4 @@
-"""Label files in other phone alphabets (engine.labels.alphabets): recognised and mapped onto
+"""Label files in other phone alphabets (facetraj_engine.labels.alphabets): recognised and mapped onto
 ARPAbet for synthesis and corpora; labels in no alphabet are an error naming them and the option
 that fixes it (--label-map)."""
 
@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 from conftest import MOCHA
 
-from engine.errors import InputError
-from engine.io.labelfiles import read_label_file, read_labels
-from engine.labels.alphabets import ALPHABETS, detect, to_arpabet
-from engine.labels.labelmap import read_label_map
+from facetraj_engine.errors import InputError
+from facetraj_engine.io.labelfiles import read_label_file, read_labels
+from facetraj_engine.labels.alphabets import ALPHABETS, detect, to_arpabet
+from facetraj_engine.labels.labelmap import read_label_map
 from facetraj.cli import main
 
 #: the toy corpus's phones written in each alphabet (silence as that alphabet writes it)
@@ -46,7 +46,7 @@ def test_each_alphabet_is_recognised(labels, name):
 
 
 def test_every_alphabet_maps_onto_arpabet_phones():
-    from engine.labels.phoneset import ARPABET, FALLBACK, SILENCE
+    from facetraj_engine.labels.phoneset import ARPABET, FALLBACK, SILENCE
 
     allowed = set(ARPABET) | {SILENCE} | set(FALLBACK)   # extended symbols fall back per model
     for a in ALPHABETS:
@@ -120,7 +120,7 @@ def test_named_alphabet_as_label_map():
 
 
 def test_corpus_labels_in_another_alphabet(toy_corpus_dir, tmp_path):
-    from engine.io.corpus import load_corpus
+    from facetraj_engine.io.corpus import load_corpus
 
     root = tmp_path / "c"
     shutil.copytree(toy_corpus_dir, root)
@@ -136,7 +136,7 @@ def test_corpus_labels_in_another_alphabet(toy_corpus_dir, tmp_path):
 
 
 def test_to_arpabet_leaves_arpabet_alone():
-    from engine.data import PhoneSegment
+    from facetraj_engine.data import PhoneSegment
 
     segs = [PhoneSegment(0, 1, "sil"), PhoneSegment(1, 2, "AH0"), PhoneSegment(2, 3, "ax")]
     assert to_arpabet(segs, "x.lab") == segs

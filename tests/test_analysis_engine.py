@@ -9,7 +9,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from engine.analysis.errors import (
+from facetraj_engine.analysis.errors import (
     SegmentError,
     analyse_utterance,
     error_report,
@@ -19,24 +19,24 @@ from engine.analysis.errors import (
     worst_segments,
     write_error_csv,
 )
-from engine.analysis.inspector import inspect_frame
-from engine.analysis.metrics import (
+from facetraj_engine.analysis.inspector import inspect_frame
+from facetraj_engine.analysis.metrics import (
     condition_name,
     sweep_curves,
     table2_rows,
     write_sweep_csv,
     write_table2_csv,
 )
-from engine.analysis.pc_modes import describe_mode, mode_displacement, mode_sd
-from engine.analysis.similarity import (
+from facetraj_engine.analysis.pc_modes import describe_mode, mode_displacement, mode_sd
+from facetraj_engine.analysis.similarity import (
     cluster_phones,
     dendrogram,
     similarity_in_order,
     write_similarity_csv,
 )
-from engine.data import PhoneSegment
-from engine.evaluation.scores import EvalResult, UtteranceScore, evaluate_utterance
-from engine.method.pipeline import synthesize
+from facetraj_engine.data import PhoneSegment
+from facetraj_engine.evaluation.scores import EvalResult, UtteranceScore, evaluate_utterance
+from facetraj_engine.method.pipeline import synthesize
 
 
 def score(split, smoothing, n, wf, lo, up, mode="phonetic", utt="u"):
@@ -180,7 +180,7 @@ def test_pc_modes(toy_model):
 
 
 def test_inspect_frame_acoustic_only(toy_model, toy_corpus):
-    from engine.config import SynthConfig
+    from facetraj_engine.config import SynthConfig
 
     utt = toy_corpus.utterance(toy_corpus.info.test[0])
     res = synthesize(toy_model, utt.audio, utt.sample_rate, None, SynthConfig(mode="acoustic"),
@@ -194,7 +194,7 @@ def test_inspect_frame_acoustic_only(toy_model, toy_corpus):
 def test_inspect_frame_robust(toy_model, toy_corpus):
     """Robust mode: each candidate's target cost, label cost and origin, and the frame's label
     confidence, as the synthesis computed them (repeats of eq 4's codewords left out)."""
-    from engine.config import SynthConfig
+    from facetraj_engine.config import SynthConfig
 
     utt = toy_corpus.utterance(toy_corpus.info.test[0])
     conf = np.full(len(utt.phones), 0.5)

@@ -22,15 +22,15 @@ pytest.importorskip("pyvistaqt")
 if not os.environ.get("DISPLAY"):
     pytest.skip("the GUI tests need an X display (run under xvfb-run)", allow_module_level=True)
 
-from engine.analysis.common import subset_corpus
-from engine.analysis.errors import error_report
-from engine.analysis.metrics import sweep_curves, table2_rows
-from engine.analysis.pc_modes import describe_mode
-from engine.analysis.similarity import cluster_phones
-from engine.config import SynthConfig
-from engine.data import PhoneSegment
-from engine.evaluation.scores import sweep_n, table2
-from engine.method.similarity import top_similar
+from facetraj_engine.analysis.common import subset_corpus
+from facetraj_engine.analysis.errors import error_report
+from facetraj_engine.analysis.metrics import sweep_curves, table2_rows
+from facetraj_engine.analysis.pc_modes import describe_mode
+from facetraj_engine.analysis.similarity import cluster_phones
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.data import PhoneSegment
+from facetraj_engine.evaluation.scores import sweep_n, table2
+from facetraj_engine.method.similarity import top_similar
 
 pytestmark = pytest.mark.gui
 WAIT_MS = 240_000   # a hang guard (a loaded machine is slow), not a speed limit
@@ -48,7 +48,7 @@ def model(default_model):
 
 @pytest.fixture(scope="module")
 def view(model, corpus):
-    from app.state import build_view
+    from facetraj_app.state import build_view
 
     utt = corpus.utterance(corpus.info.test[0])
     return build_view(model, utt, "test", SynthConfig())
@@ -60,7 +60,7 @@ def cell_values(table, col: int) -> list[float]:
 
 # ---------------------------------------------------------------------- similarity
 def test_similarity_view_shows_engine_matrix(qtbot, model, tmp_path):
-    from app.analysis.similarity_view import SimilarityView
+    from facetraj_app.analysis.similarity_view import SimilarityView
 
     w = SimilarityView(model)
     qtbot.addWidget(w)
@@ -96,7 +96,7 @@ def test_similarity_view_shows_engine_matrix(qtbot, model, tmp_path):
 
 # ---------------------------------------------------------------------- metrics
 def test_metrics_view_table2_and_sweep_match_engine(qtbot, model, corpus, tmp_path):
-    from app.analysis.metrics_view import MetricsView
+    from facetraj_app.analysis.metrics_view import MetricsView
 
     w = MetricsView(model, corpus)
     qtbot.addWidget(w)
@@ -118,7 +118,7 @@ def test_metrics_view_table2_and_sweep_match_engine(qtbot, model, corpus, tmp_pa
         assert [w.table.item(r, col).value for r in ours] == pytest.approx(
             [getattr(r, metric) for r in want])
     # each phonetic N = 3 row is followed by the paper's (Table 2 of the paper)
-    from engine.evaluation.paper import table2_value
+    from facetraj_engine.evaluation.paper import table2_value
     assert names[ours[0] + 1].strip() == "the paper, same condition"
     assert [w.table.item(ours[0] + 1, c).value for c in (1, 2, 3)] == pytest.approx(
         table2_value("train", "triangular"))
@@ -136,7 +136,7 @@ def test_metrics_view_table2_and_sweep_match_engine(qtbot, model, corpus, tmp_pa
 
 # ---------------------------------------------------------------------- PC modes
 def test_pc_slider_moves_points_by_eigenvector_times_value(qtbot, model):
-    from app.analysis.pc_modes import SLIDER_STEPS, PCModeExplorer
+    from facetraj_app.analysis.pc_modes import SLIDER_STEPS, PCModeExplorer
 
     w = PCModeExplorer(model)
     qtbot.addWidget(w)
@@ -180,7 +180,7 @@ def test_pc_slider_moves_points_by_eigenvector_times_value(qtbot, model):
 
 # ---------------------------------------------------------------------- inspector
 def test_inspector_weights_sum_to_one(qtbot, model, view):
-    from app.analysis.inspector import CodebookInspector
+    from facetraj_app.analysis.inspector import CodebookInspector
 
     w = CodebookInspector(model)
     qtbot.addWidget(w)
@@ -208,8 +208,8 @@ def test_inspector_weights_sum_to_one(qtbot, model, view):
 def test_inspector_robust_mode_explains_choice(qtbot, model, corpus, tmp_path):
     """Robust mode: the table gains target cost, label cost and origin columns, the label
     confidence is shown, and the numbers are the synthesis's."""
-    from app.analysis.inspector import CodebookInspector
-    from engine.method.pipeline import synthesize
+    from facetraj_app.analysis.inspector import CodebookInspector
+    from facetraj_engine.method.pipeline import synthesize
 
     utt = corpus.utterance(corpus.info.test[0])
     conf = np.full(len(utt.phones), 0.25)
@@ -238,7 +238,7 @@ def test_inspector_robust_mode_explains_choice(qtbot, model, corpus, tmp_path):
 
 
 def test_settings_panel_explains_modes_and_shows_tuned(qtbot):
-    from app.settings_panel import MODE_NOTES, SynthSettingsPanel
+    from facetraj_app.settings_panel import MODE_NOTES, SynthSettingsPanel
 
     def choose(key: str) -> None:                   # as a user does
         p.mode.setCurrentIndex(p.mode.findData(key))
@@ -279,7 +279,7 @@ def test_settings_panel_explains_modes_and_shows_tuned(qtbot):
 
 # ---------------------------------------------------------------------- errors
 def test_error_view_matches_engine_and_jumps(qtbot, model, corpus, view):
-    from app.analysis.errors_view import ErrorView, LipErrorPanel
+    from facetraj_app.analysis.errors_view import ErrorView, LipErrorPanel
 
     w = ErrorView(model, corpus)
     qtbot.addWidget(w)
@@ -382,7 +382,7 @@ def assert_chart_matches_table(w) -> None:
 def test_kinematics_landmarks_within_one_frame(qtbot, tmp_path):
     from praatio import textgrid
 
-    from app.analysis.kinematics_panels import KinematicsControls, LipMeasurePanel
+    from facetraj_app.analysis.kinematics_panels import KinematicsControls, LipMeasurePanel
 
     view, fake_model, truth = synthetic_view()
     w = KinematicsControls(fake_model)
@@ -423,7 +423,7 @@ def test_kinematics_landmarks_within_one_frame(qtbot, tmp_path):
 def test_kinematics_chart_without_original_and_in_a_narrow_dock(qtbot):
     from PyQt6.QtCore import Qt
 
-    from app.analysis.kinematics_panels import SIDE_BY_SIDE_WIDTH, KinematicsControls
+    from facetraj_app.analysis.kinematics_panels import SIDE_BY_SIDE_WIDTH, KinematicsControls
 
     view, fake_model, _truth = synthetic_view()
     w = KinematicsControls(fake_model)
@@ -448,8 +448,8 @@ def test_kinematics_chart_without_original_and_in_a_narrow_dock(qtbot):
 
 # ---------------------------------------------------------------------- in the main window
 def test_installed_in_main_window(qtbot, corpus, model):
-    from app.analysis import PANELS, VIEWS, install
-    from app.main_window import MainWindow
+    from facetraj_app.analysis import PANELS, VIEWS, install
+    from facetraj_app.main_window import MainWindow
 
     win = MainWindow(corpus.root, use_audio=False)
     qtbot.addWidget(win)
@@ -497,8 +497,8 @@ def test_export_buttons_write_or_report(qtbot, model, corpus, tmp_path, monkeypa
     dialog writes nothing, and a failure is shown in a message box instead of raised."""
     from PyQt6.QtWidgets import QFileDialog, QMessageBox
 
-    from app.analysis.metrics_view import MetricsView
-    from app.analysis.similarity_view import SimilarityView
+    from facetraj_app.analysis.metrics_view import MetricsView
+    from facetraj_app.analysis.similarity_view import SimilarityView
 
     chosen: list[str] = []
     monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (chosen.pop(0), ""))

@@ -22,11 +22,11 @@ from PyQt6.QtCore import QPoint, Qt
 from PyQt6.QtGui import QImage
 from PyQt6.QtWidgets import QFileDialog, QMessageBox
 
-from app import style
-from app.browser import normalise_text
-from app.main import build_window
-from app.main_window import DEFAULT_SENTENCE, MainWindow
-from engine.config import SynthConfig
+from facetraj_app import style
+from facetraj_app.browser import normalise_text
+from facetraj_app.main import build_window
+from facetraj_app.main_window import DEFAULT_SENTENCE, MainWindow
+from facetraj_engine.config import SynthConfig
 from facetraj.paths import default_corpus
 
 pytestmark = pytest.mark.gui
@@ -311,8 +311,8 @@ def test_corrupt_file_shows_error_and_app_keeps_working(window, qtbot, tmp_path,
     # original markers
     import shutil
 
-    from app.open_audio import SentenceDialog
-    from engine.io.corpus import audio_path
+    from facetraj_app.open_audio import SentenceDialog
+    from facetraj_engine.io.corpus import audio_path
 
     good = tmp_path / audio_path(win.corpus.root, win.corpus.info.test[-1]).name
     shutil.copy(audio_path(win.corpus.root, win.corpus.info.test[-1]), good)
@@ -338,10 +338,10 @@ def test_browser_scores_are_kept_per_settings(qtbot, toy_corpus, toy_model, monk
     the new settings' scores are computed (the old ones stay shown, greyed), and going back to
     earlier settings shows theirs at once with nothing computed (the sweep used to restart from
     nothing after every change); the browser's columns say what they hold."""
-    from app import correlations
-    from app.browser import UtteranceBrowser
-    from app.viewer_model import ViewerModel
-    from app.workers import Gate, TaskRunner
+    from facetraj_app import correlations
+    from facetraj_app.browser import UtteranceBrowser
+    from facetraj_app.viewer_model import ViewerModel
+    from facetraj_app.workers import Gate, TaskRunner
 
     browser = UtteranceBrowser()
     qtbot.addWidget(browser)

@@ -24,7 +24,7 @@ def workspace(fuzz_workspace):
 
 @pytest.fixture
 def probe(qtbot, workspace):
-    from app.main import build_window
+    from facetraj_app.main import build_window
 
     win = build_window(workspace.corpus, model=workspace.model, use_audio=False)
     qtbot.addWidget(win)
@@ -92,8 +92,8 @@ def test_audio_too_short_names_the_file(probe, workspace, tmp_path):
 def test_label_file_in_another_alphabet_opens(probe, workspace, tmp_path):
     from fuzzing import SPELLINGS, _write_label_file
 
-    from engine.data import PhoneSegment
-    from engine.io.labelfiles import read_labels
+    from facetraj_engine.data import PhoneSegment
+    from facetraj_engine.io.labelfiles import read_labels
 
     segs = [PhoneSegment(s.start, s.end, SPELLINGS["IPA"][s.label][0])
             for s in read_labels(workspace.textgrid)]

@@ -18,20 +18,20 @@ from alignment_cases import alignment_cases
 from conftest import edited_model_file
 from fuzzing import _c3d_rate
 
-from app.display import require_display
-from engine.config import SynthConfig
-from engine.data import PhoneSegment, Utterance
-from engine.errors import FILE_WARNINGS, FacetrajError
-from engine.fanout import fan_out
-from engine.io.audio import read_audio
-from engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
-from engine.io.files import atomic_write
-from engine.io.labelfiles import read_lab, read_label_file, read_labels, read_textgrid, validate_phones
-from engine.io.markerfiles import read_c3d, read_markers, read_mocha_ema, write_c3d
-from engine.labels.labelmap import read_label_map
-from engine.method.model import Model
-from engine.method.pipeline import synthesize
-from engine.method.training import MarkerSetup, train
+from facetraj_app.display import require_display
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.data import PhoneSegment, Utterance
+from facetraj_engine.errors import FILE_WARNINGS, FacetrajError
+from facetraj_engine.fanout import fan_out
+from facetraj_engine.io.audio import read_audio
+from facetraj_engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
+from facetraj_engine.io.files import atomic_write
+from facetraj_engine.io.labelfiles import read_lab, read_label_file, read_labels, read_textgrid, validate_phones
+from facetraj_engine.io.markerfiles import read_c3d, read_markers, read_mocha_ema, write_c3d
+from facetraj_engine.labels.labelmap import read_label_map
+from facetraj_engine.method.model import Model
+from facetraj_engine.method.pipeline import synthesize
+from facetraj_engine.method.training import MarkerSetup, train
 
 DOC = Path(__file__).resolve().parent.parent / "docs" / "bad-input.md"
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from engine.evaluation.baselines import (
+from facetraj_engine.evaluation.baselines import (
     Baselines,
     FrameData,
     evaluate_baselines,

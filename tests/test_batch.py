@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from conftest import DEFAULT_CORPUS
 
-from engine.io.markerfiles import read_marker_table
+from facetraj_engine.io.markerfiles import read_marker_table
 from facetraj.batch import SUMMARY_NAME, collect_inputs, is_batch, output_paths
 from facetraj.cli import main
 

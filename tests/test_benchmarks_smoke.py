@@ -46,7 +46,7 @@ def test_smoke_table(toy: Path, tmp_path: Path, capsys) -> None:
 def test_smoke_rows_positive_finite(toy: Path, monkeypatch) -> None:
     from benchmarks.__main__ import run_all
     from benchmarks.common import load_context
-    from engine.threads import THREADS_ENV
+    from facetraj_engine.threads import THREADS_ENV
 
     monkeypatch.setenv(THREADS_ENV, "2")
     ctx = load_context(toy, smoke=True)
@@ -116,7 +116,7 @@ def test_corpus_scaling_smoke(toy: Path, tmp_path: Path) -> None:
     run in child processes and measured from outside, and its section of the Markdown."""
     from benchmarks import corpus_scale
     from benchmarks.common import load_context
-    from engine.io.corpus import load_corpus
+    from facetraj_engine.io.corpus import load_corpus
 
     corpus = load_corpus(toy)
     twice = load_corpus(corpus_scale.repeat_corpus(corpus, tmp_path / "x2", 2))

@@ -1,4 +1,4 @@
-"""The chain over frames (engine.method.chain): forward-backward against every path enumerated,
+"""The chain over frames (facetraj_engine.method.chain): forward-backward against every path enumerated,
 beta = 0 is eq 8, and the robust mode with it on real synthesis."""
 
 from __future__ import annotations
@@ -7,10 +7,10 @@ import itertools
 
 import numpy as np
 
-from engine.config import SynthConfig
-from engine.data import Provenance
-from engine.method.chain import chain_marginals, chain_pcs, join_log_potentials, join_scale
-from engine.method.pipeline import synthesize
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.data import Provenance
+from facetraj_engine.method.chain import chain_marginals, chain_pcs, join_log_potentials, join_scale
+from facetraj_engine.method.pipeline import synthesize
 
 
 def brute_marginals(log_target: np.ndarray, log_join: np.ndarray) -> np.ndarray:

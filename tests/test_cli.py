@@ -6,7 +6,7 @@ import os
 import numpy as np
 import pytest
 
-from engine.io.markerfiles import read_c3d, read_marker_table
+from facetraj_engine.io.markerfiles import read_c3d, read_marker_table
 from facetraj.cli import main
 
 

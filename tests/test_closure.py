@@ -1,4 +1,4 @@
-"""The closure step's per-interval work (``engine.method.closure``): each interval and pause
+"""The closure step's per-interval work (``facetraj_engine.method.closure``): each interval and pause
 touches only its own frames, with results equal to the bit to the formula over every frame."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from engine.method.closure import ClosurePlan, ClosureStats, bump, close_lips, rest_in_pauses
+from facetraj_engine.method.closure import ClosurePlan, ClosureStats, bump, close_lips, rest_in_pauses
 
 
 def _close_lips_every_frame(pcs, times, plan, stats, a0, g, taper_s):

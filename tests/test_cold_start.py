@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engine.errors import InputError
-from engine.io import hash_memo
-from engine.io.corpus import load_corpus
+from facetraj_engine.errors import InputError
+from facetraj_engine.io import hash_memo
+from facetraj_engine.io.corpus import load_corpus
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -25,17 +25,17 @@ NOT_IN_FIRST_FRAME = (
     "scipy.spatial", "multiprocessing", "concurrent.futures.process",
     # numba: the first frame is synthesized by the prebuilt kernels (no numba), or where they
     # are missing by the numpy reference, numba's kernels loaded in the background afterwards
-    # (engine.method.kernels)
-    "numba", "engine.method.compiled_lsf", "engine.method.compiled_search",
-    "engine.method.training", "engine.labels.alignment", "engine.io.labelling", "engine.report",
-    # the analysis views' numbers (engine.analysis.lips, the lips at closure, is the 3-D view's:
+    # (facetraj_engine.method.kernels)
+    "numba", "facetraj_engine.method.compiled_lsf", "facetraj_engine.method.compiled_search",
+    "facetraj_engine.method.training", "facetraj_engine.labels.alignment", "facetraj_engine.io.labelling", "facetraj_engine.report",
+    # the analysis views' numbers (facetraj_engine.analysis.lips, the lips at closure, is the 3-D view's:
     # under a millisecond to import, its package's __init__ a docstring)
-    "engine.analysis.similarity", "engine.analysis.errors", "engine.analysis.metrics",
-    "engine.analysis.inspector", "engine.analysis.pc_modes", "engine.analysis.common",
-    "engine.evaluation.kinematics", "engine.evaluation.second_voice",
-    "app.gallery", "app.video", "app.report_figures", "app.analysis.figures",
-    "app.analysis.errors_view", "app.analysis.metrics_view", "app.analysis.pc_modes",
-    "app.analysis.inspector", "app.analysis.similarity_view", "app.analysis.kinematics_panels",
+    "facetraj_engine.analysis.similarity", "facetraj_engine.analysis.errors", "facetraj_engine.analysis.metrics",
+    "facetraj_engine.analysis.inspector", "facetraj_engine.analysis.pc_modes", "facetraj_engine.analysis.common",
+    "facetraj_engine.evaluation.kinematics", "facetraj_engine.evaluation.second_voice",
+    "facetraj_app.gallery", "facetraj_app.video", "facetraj_app.report_figures", "facetraj_app.analysis.figures",
+    "facetraj_app.analysis.errors_view", "facetraj_app.analysis.metrics_view", "facetraj_app.analysis.pc_modes",
+    "facetraj_app.analysis.inspector", "facetraj_app.analysis.similarity_view", "facetraj_app.analysis.kinematics_panels",
 )
 
 
@@ -45,7 +45,7 @@ def _loaded(modules: list[str]) -> list[str]:
 
 
 def test_app_window_module_imports_nothing_the_first_frame_does_not_use():
-    code = "import json, sys; import app.main_window; print(json.dumps(sorted(sys.modules)))"
+    code = "import json, sys; import facetraj_app.main_window; print(json.dumps(sorted(sys.modules)))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                          cwd=ROOT, env={"QT_QPA_PLATFORM": "offscreen", "PATH": ""})
     assert _loaded(json.loads(out.stdout)) == []
@@ -53,13 +53,13 @@ def test_app_window_module_imports_nothing_the_first_frame_does_not_use():
 
 FIRST_FRAME = """
 import json, os, sys
-import engine.io.corpus
+import facetraj_engine.io.corpus
 audio_reads = []
-read_audio = engine.io.corpus.read_audio
+read_audio = facetraj_engine.io.corpus.read_audio
 def counted(path, *args, **kwargs):
     audio_reads.append(os.path.basename(str(path)))
     return read_audio(path, *args, **kwargs)
-engine.io.corpus.read_audio = counted
+facetraj_engine.io.corpus.read_audio = counted
 from facetraj.cli import main
 rc = main(["-q", "gui", "data_samples", "--screenshot", sys.argv[1]])
 with open(sys.argv[2], "w") as fh:
@@ -88,7 +88,7 @@ def test_first_frame_imports_and_reads_only_what_it_shows(trained_cache, tmp_pat
 MATPLOTLIB_QUICKLY = """
 import inspect, json, sys
 import numpy as np
-from app.main import matplotlib_without_property_docs
+from facetraj_app.main import matplotlib_without_property_docs
 with matplotlib_without_property_docs():
     import matplotlib.artist
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -177,14 +177,14 @@ def test_an_unreadable_memo_costs_only_the_recomputation(corpus_copy, reads, mon
 def test_an_utterance_is_read_and_checked_when_it_is_used(corpus_copy, monkeypatch):
     """Opening a corpus reads its description only; a broken utterance is found (with its file
     named) when it is loaded, and the others still load."""
-    import engine.io.corpus
+    import facetraj_engine.io.corpus
 
     corpus = load_corpus(corpus_copy)
     bad, good = corpus.info.test[0], corpus.info.test[1]
     (corpus_copy / f"{bad}.c3d").write_bytes(b"not a c3d file")
     audio: list[str] = []
-    read_audio = engine.io.corpus.read_audio
-    monkeypatch.setattr(engine.io.corpus, "read_audio",
+    read_audio = facetraj_engine.io.corpus.read_audio
+    monkeypatch.setattr(facetraj_engine.io.corpus, "read_audio",
                         lambda path, *a, **k: audio.append(Path(path).stem) or read_audio(path, *a, **k))
     corpus = load_corpus(corpus_copy)
     assert audio == []
@@ -200,7 +200,7 @@ def test_an_utterance_is_read_and_checked_when_it_is_used(corpus_copy, monkeypat
 def test_spectrogram_equals_scipy(n, rate, offset):
     from scipy.signal import spectrogram as scipy_spectrogram
 
-    from app.timeline import spectrogram
+    from facetraj_app.timeline import spectrogram
 
     x = np.random.default_rng(n).standard_normal(n) + offset
     nper, hop = max(16, int(0.006 * rate)), max(1, int(0.002 * rate))
@@ -218,7 +218,7 @@ def test_spectrogram_equals_scipy(n, rate, offset):
 def test_convolve_nearest_equals_scipy(n, window):
     from scipy.ndimage import convolve1d
 
-    from engine.method.smoothing import convolve_nearest
+    from facetraj_engine.method.smoothing import convolve_nearest
 
     w = np.array(window)
     w = (w + w[::-1]) / 2                                    # symmetric, as the smoothings use
@@ -232,7 +232,7 @@ def test_convolve_nearest_equals_scipy(n, window):
 def test_not_a_knot_spline_equals_scipy(n_knots, spacing):
     from scipy.interpolate import CubicSpline
 
-    from engine.method.smoothing import not_a_knot_spline
+    from facetraj_engine.method.smoothing import not_a_knot_spline
 
     rng = np.random.default_rng(n_knots)
     knots = (np.arange(n_knots) * 6.0 if spacing == "even"
@@ -251,7 +251,7 @@ def test_spline_smooth_unchanged():
     from scipy.interpolate import CubicSpline
     from scipy.ndimage import convolve1d
 
-    from engine.method.smoothing import spline_smooth
+    from facetraj_engine.method.smoothing import spline_smooth
 
     x = np.cumsum(np.random.default_rng(5).standard_normal((203, 6)), axis=0)
     knots = np.append(np.arange(0, 203, 6), 202)

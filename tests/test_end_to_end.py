@@ -4,10 +4,10 @@ that hold on any corpus (lips follow speech, phonetic beats acoustic-only, train
 import numpy as np
 import pytest
 
-from engine.config import SynthConfig
-from engine.evaluation.scores import evaluate, speech_mask, trajectory_correlations
-from engine.method.model import Model
-from engine.method.pipeline import synthesize
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.evaluation.scores import evaluate, speech_mask, trajectory_correlations
+from facetraj_engine.method.model import Model
+from facetraj_engine.method.pipeline import synthesize
 
 
 def test_model_on_default_corpus(default_model, default_corpus):

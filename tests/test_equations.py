@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from engine.method.similarity import (
+from facetraj_engine.method.similarity import (
     context_similarity,
     context_weights,
     distance_scale,
@@ -14,7 +14,7 @@ from engine.method.similarity import (
     top_contexts,
     top_similar,
 )
-from engine.method.synthesis import (
+from facetraj_engine.method.synthesis import (
     approximate_lsf,
     codebook_weights,
     gamma_grid,
@@ -168,7 +168,7 @@ def test_nearest_codeword_prefilter():
 def test_grid_weights_equal_eq6_for_every_gamma():
     """The fast kernel of eq 6 on an evenly spaced gamma grid (two exponentials per codeword)
     against the reference softmax, for each gamma; an uneven grid takes the reference path."""
-    from engine.method.synthesis import codebook_weights, gamma_grid, grid_weights
+    from facetraj_engine.method.synthesis import codebook_weights, gamma_grid, grid_weights
 
     rng = np.random.default_rng(13)
     d = rng.gamma(2.0, 20.0, size=(50, 128))           # eq 5 distances of 128 candidates
@@ -185,7 +185,7 @@ def test_pruned_eq4_search_equals_scoring_every_context(count):
     """top_context_phones (pruned by the centre bound, all queries at once) returns exactly
     the full eq 4 ranking: the same contexts, scores and lower-index-first ties; phone 4 has
     fewer than 12 contexts at its best centre similarity (the unpruned path)."""
-    from engine.method.similarity import context_similarity, top_context_phones, top_contexts
+    from facetraj_engine.method.similarity import context_similarity, top_context_phones, top_contexts
 
     rng = np.random.default_rng(count)
     n_phones, context = 6, 3

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from engine.config import SynthConfig
-from engine.evaluation.scores import (
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.evaluation.scores import (
     EvalConfig,
     evaluate,
     moving_coordinates,
@@ -81,14 +81,14 @@ def test_median_filter_equals_scipy_medfilt(k, n):
     """scipy's values, in one chunk of windows and in several (a last part chunk)."""
     from scipy.signal import medfilt
 
-    from engine.method.speech import median_filter
+    from facetraj_engine.method.speech import median_filter
 
     x = np.random.default_rng(k).standard_normal(n) * 20 - 40      # an energy contour in dB
     np.testing.assert_array_equal(median_filter(x, k), medfilt(x, k))
 
 
 def test_median_filter_with_nan_is_nan_where_the_window_holds_it():
-    from engine.method.speech import median_filter
+    from facetraj_engine.method.speech import median_filter
 
     x = np.arange(9, dtype=float)
     x[4] = np.nan
@@ -103,7 +103,7 @@ def test_short_time_energy_equals_the_sum_over_windowed_frames(rate, n):
     """The block-product energy equals each frame's windowed sum of squares (the definition),
     in one chunk of blocks and in several (20 s; a chunk's last blocks half signal, half
     padding)."""
-    from engine.method.speech import short_time_energy_db
+    from facetraj_engine.method.speech import short_time_energy_db
 
     x = np.random.default_rng(n).standard_normal(n) * 0.1
     win, hop = int(round(0.02 * rate)), int(round(0.004 * rate))

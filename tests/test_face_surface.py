@@ -10,7 +10,7 @@ import pytest
 
 pytest.importorskip("pyvistaqt")
 
-from app.surface import face_triangles, lip_contours, unroll
+from facetraj_app.surface import face_triangles, lip_contours, unroll
 
 
 def _pieces(tri: np.ndarray) -> int:
@@ -104,7 +104,7 @@ def test_the_triangulation_is_stored_and_read_back(tmp_path, monkeypatch, defaul
     """stored_face_triangles: made once and kept in the cache folder; read back without
     triangulating; a damaged or foreign file is made again, a folder that cannot be written
     only costs the triangulation."""
-    from app import surface
+    from facetraj_app import surface
 
     monkeypatch.setenv("FACETRAJ_CACHE_DIR", str(tmp_path / "cache"))
     neutral = default_model.neutral_face()
@@ -149,8 +149,8 @@ def test_the_mouth_closes_when_the_lips_meet(face, boy):
     """At the /b/ of "boy" the lips' inner edges meet (the surface had a hole there: the markers
     sit on the outside of the lips, 11 mm apart at closure); at /oy/ they are apart by the
     aperture beyond the closed distance."""
-    from app.surface import Mouth
-    from engine.analysis.lips import closed_lips
+    from facetraj_app.surface import Mouth
+    from facetraj_engine.analysis.lips import closed_lips
 
     m, neutral, contours, tri = face
     closed = closed_lips(m)

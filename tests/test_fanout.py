@@ -1,4 +1,4 @@
-"""Work fanned out over processes (engine.fanout, the one fan-out of the project) and the
+"""Work fanned out over processes (facetraj_engine.fanout, the one fan-out of the project) and the
 corpus-wide commands, the synth batch and the corpus builder that use it: a bad file gives the
 serial run's one-line error with any number of jobs, or with --skip-bad is left out with a summary
 and exit status 3; a worker killed while on an item fails that item only, named; every facetraj
@@ -20,9 +20,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import engine
-from engine.errors import FILE_WARNINGS, FacetrajError, InputError, warn_file
-from engine.fanout import Skips, fan_out
+import facetraj_engine
+from facetraj_engine.errors import FILE_WARNINGS, FacetrajError, InputError, warn_file
+from facetraj_engine.fanout import Skips, fan_out
 from facetraj.cli import main
 
 
@@ -183,7 +183,7 @@ def test_file_warnings_of_workers_are_logged_once(caplog):
 @pytest.fixture
 def corpus_with_a_bad_file(tmp_path, toy_corpus_dir) -> Path:
     """Three utterances of the toy corpus (two train, one test); toy001's C3D truncated."""
-    from engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
+    from facetraj_engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
 
     root = tmp_path / "corpus"
     root.mkdir()
@@ -221,8 +221,8 @@ def _refused_alike(argv, capsys) -> None:
 
 
 def test_eval_and_sweep_with_a_bad_file(corpus_with_a_bad_file, toy_model, tmp_path, capsys):
-    from engine.evaluation.scores import evaluate
-    from engine.io.corpus import load_corpus
+    from facetraj_engine.evaluation.scores import evaluate
+    from facetraj_engine.io.corpus import load_corpus
 
     model = toy_model.save(tmp_path / "m.npz")
     root = corpus_with_a_bad_file
@@ -238,9 +238,9 @@ def test_eval_and_sweep_with_a_bad_file(corpus_with_a_bad_file, toy_model, tmp_p
 
 
 def test_train_with_a_bad_file(corpus_with_a_bad_file, tmp_path, capsys):
-    from engine.io.corpus import load_corpus
-    from engine.method.model import Model
-    from engine.method.training import train
+    from facetraj_engine.io.corpus import load_corpus
+    from facetraj_engine.method.model import Model
+    from facetraj_engine.method.training import train
 
     root = corpus_with_a_bad_file
     _refused_alike(["train", root, "-o", tmp_path / "m.npz"], capsys)
@@ -290,7 +290,7 @@ def test_warnings_once_per_file_and_once_per_corpus(corpus_with_a_bad_file, toy_
     """Markers shorter than the audio in two files: one warning per file, however often the
     report reads them (training, three evaluations, the sweep, the baselines, in two processes),
     and one line for the corpus with the count."""
-    from engine.io.markerfiles import read_c3d, write_c3d
+    from facetraj_engine.io.markerfiles import read_c3d, write_c3d
 
     root = corpus_with_a_bad_file
     shutil.copy(toy_corpus_dir / "toy001.c3d", root)            # toy001 good again
@@ -360,7 +360,7 @@ def test_a_worker_of_the_corpus_builder_killed_fails_its_utterance_only(tmp_path
     """The corpus builder fans out by the same fan-out (it used a process pool, broken whole by
     one dead worker): the other utterances are built, then the build stops naming the one that
     was not, and writes no corpus.json."""
-    from engine.corpusgen import build
+    from facetraj_engine.corpusgen import build
 
     def fake(utt_id, out_dir, seed, config):
         if utt_id == "s002":
@@ -456,7 +456,7 @@ def test_the_workers_run_at_most_ahead_items_beyond_the_caller(tmp_path, monkeyp
 def test_without_fork_the_items_run_here(monkeypatch):
     """Where ``fork`` is missing (Windows), the items run in this process, by the one rule
     ``can_fork``; the set-up too."""
-    from engine import fanout
+    from facetraj_engine import fanout
 
     monkeypatch.setattr(fanout, "can_fork", lambda: False)
     pids = _forks_noted(monkeypatch)

@@ -1,4 +1,4 @@
-"""``app.figure_canvas.BackgroundCanvas``: a draw that finishes after its canvas was deleted."""
+"""``facetraj_app.figure_canvas.BackgroundCanvas``: a draw that finishes after its canvas was deleted."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from matplotlib.figure import Figure
 from PyQt6 import sip
 from PyQt6.QtWidgets import QVBoxLayout, QWidget
 
-from app.figure_canvas import BackgroundCanvas
+from facetraj_app.figure_canvas import BackgroundCanvas
 
 pytestmark = pytest.mark.gui
 WAIT_MS = 60_000           # a hang guard, not a speed limit

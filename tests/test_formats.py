@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 import soundfile as sf
 
-from engine.data import PhoneSegment
-from engine.errors import InputError
-from engine.io.audio import read_audio, write_audio
-from engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
-from engine.io.files import atomic_write
-from engine.io.labelfiles import (
+from facetraj_engine.data import PhoneSegment
+from facetraj_engine.errors import InputError
+from facetraj_engine.io.audio import read_audio, write_audio
+from facetraj_engine.io.corpus import CorpusInfo, load_corpus, save_corpus_info
+from facetraj_engine.io.files import atomic_write
+from facetraj_engine.io.labelfiles import (
     read_lab,
     read_labels,
     read_phn,
@@ -19,7 +19,7 @@ from engine.io.labelfiles import (
     validate_phones,
     write_textgrid,
 )
-from engine.io.markerfiles import read_c3d, read_marker_table, write_c3d, write_marker_tsv
+from facetraj_engine.io.markerfiles import read_c3d, read_marker_table, write_c3d, write_marker_tsv
 
 
 def test_audio_round_trip_and_stereo_mixdown(tmp_path, caplog):

@@ -29,8 +29,8 @@ from fuzzing import (
     table,
 )
 
-from engine.errors import InputError
-from engine.io.files import atomic_write
+from facetraj_engine.errors import InputError
+from facetraj_engine.io.files import atomic_write
 from facetraj.cli import main
 
 N_CASES = 420
@@ -238,7 +238,7 @@ def test_transcript_not_utf8(workspace, tmp_path, capsys):
 
 
 def test_two_frame_c3d_in_the_test_split_evaluates(workspace, tmp_path, capsys):
-    from engine.io.markerfiles import read_c3d, write_c3d
+    from facetraj_engine.io.markerfiles import read_c3d, write_c3d
 
     corpus = _corpus_copy(workspace, tmp_path)
     m = read_c3d(corpus / "toy030.c3d")
@@ -322,10 +322,10 @@ def test_corpus_init_needs_overwrite(workspace, tmp_path, capsys):
 
 
 def test_train_checks_output_before_training(workspace, tmp_path, capsys, monkeypatch):
-    import engine.method.training
+    import facetraj_engine.method.training
 
     (tmp_path / "m.npz").write_bytes(b"mine")
-    monkeypatch.setattr(engine.method.training, "train", lambda *a, **k: pytest.fail("trained"))
+    monkeypatch.setattr(facetraj_engine.method.training, "train", lambda *a, **k: pytest.fail("trained"))
     refused(["train", workspace.corpus, "-o", tmp_path / "m.npz"], capsys, "already exists")
 
 
@@ -360,7 +360,7 @@ def test_sigterm_during_a_write_removes_the_part_file(tmp_path):
 
 
 def test_label_map_to_unknown_phone_blames_the_map(workspace, tmp_path, capsys):
-    from engine.io.labelfiles import read_labels
+    from facetraj_engine.io.labelfiles import read_labels
 
     first = next(s.label for s in read_labels(workspace.textgrid) if s.label != "sil")
     (tmp_path / "map.tsv").write_text(f"{first}\tzz\n")
@@ -412,7 +412,7 @@ def test_lab_with_an_inf_time(workspace, tmp_path, capsys):
 
 
 def test_marker_names_that_differ_are_named(workspace, tmp_path, capsys):
-    from engine.io.markerfiles import read_c3d, write_c3d
+    from facetraj_engine.io.markerfiles import read_c3d, write_c3d
 
     corpus = _corpus_copy(workspace, tmp_path)
     m = read_c3d(corpus / "toy030.c3d")
@@ -424,7 +424,7 @@ def test_marker_names_that_differ_are_named(workspace, tmp_path, capsys):
 def test_c3d_reader_advice_is_not_shown(workspace, tmp_path):
     """ezc3d's own refusal (a flag bit in the parameter section, found by the fuzz run) is shown
     without its advice to set ignoreBadFormatting, which a user cannot."""
-    from engine.io.markerfiles import read_c3d
+    from facetraj_engine.io.markerfiles import read_c3d
 
     data = bytearray(workspace.c3d.read_bytes())
     data[553] ^= 1
@@ -462,7 +462,7 @@ def test_audio_header_claiming_too_much_is_refused_before_allocating(workspace, 
     the samples the file holds."""
     from fuzzing import Case
 
-    from engine.io.audio import read_audio
+    from facetraj_engine.io.audio import read_audio
 
     x, rate = sf.read(workspace.wav)
     sf.write(tmp_path / "a.flac", x, rate)
@@ -483,7 +483,7 @@ def test_audio_header_claiming_too_much_is_refused_before_allocating(workspace, 
 
 def test_multichannel_audio_is_mixed_down_block_by_block(tmp_path, monkeypatch):
     """Mixed down as the mean of the channels, the same as all at once, over several blocks."""
-    import engine.io.audio as audio
+    import facetraj_engine.io.audio as audio
 
     rng = np.random.default_rng(4)
     x = rng.uniform(-0.5, 0.5, (50000, 3))
@@ -495,9 +495,9 @@ def test_multichannel_audio_is_mixed_down_block_by_block(tmp_path, monkeypatch):
 
 
 def test_oversized_text_and_est_headers_are_refused(tmp_path):
-    from engine.io.files import MAX_TEXT_BYTES
-    from engine.io.labelfiles import read_labels
-    from engine.io.markerfiles import read_mocha_ema
+    from facetraj_engine.io.files import MAX_TEXT_BYTES
+    from facetraj_engine.io.labelfiles import read_labels
+    from facetraj_engine.io.markerfiles import read_mocha_ema
 
     big = tmp_path / "big.lab"
     with open(big, "wb") as fh:

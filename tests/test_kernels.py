@@ -12,13 +12,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engine.config import SynthConfig
-from engine.method import aot, kernels, prebuilt
-from engine.method.kernels import kernel_choice, use_kernels
-from engine.method.lsf import lsf2poly, lsf_at, poly2lsf
-from engine.method.lsf_index import build_index
-from engine.method.pipeline import synthesize
-from engine.method.similarity import context_similarity, top_context_phones, top_contexts
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.method import aot, kernels, prebuilt
+from facetraj_engine.method.kernels import kernel_choice, use_kernels
+from facetraj_engine.method.lsf import lsf2poly, lsf_at, poly2lsf
+from facetraj_engine.method.lsf_index import build_index
+from facetraj_engine.method.pipeline import synthesize
+from facetraj_engine.method.similarity import context_similarity, top_context_phones, top_contexts
 
 ROOT = Path(__file__).resolve().parent.parent
 #: LSFs in radians: the reference polishes each root to a Newton step of 1e-9 (an error of order
@@ -29,9 +29,9 @@ LSF_ATOL = 1e-10
 @pytest.fixture(params=["compiled", "jit"])
 def kind(request):
     """The compiled kernels each comparison runs: the prebuilt extension (``make`` builds it:
-    ``python -m engine.method.aot``) and numba's just-in-time ones (an install without it)."""
+    ``python -m facetraj_engine.method.aot``) and numba's just-in-time ones (an install without it)."""
     if request.param == "compiled" and kernels.prebuilt() is None:
-        pytest.fail("the prebuilt kernels are missing or stale: python -m engine.method.aot")
+        pytest.fail("the prebuilt kernels are missing or stale: python -m facetraj_engine.method.aot")
     return request.param
 
 
@@ -50,7 +50,7 @@ def frame_times(audio: np.ndarray, rate: int, marker_rate: float = 60.0) -> np.n
 
 def test_the_compiled_kernels_load_here():
     """Both ways: the prebuilt extension (built by make) and numba's just-in-time kernels."""
-    assert kernels.prebuilt() is not None, "python -m engine.method.aot builds them"
+    assert kernels.prebuilt() is not None, "python -m facetraj_engine.method.aot builds them"
     assert kernels.warm_up()
     assert kernels.loaded()
     with use_kernels("jit"):
@@ -90,7 +90,7 @@ def test_lsf_analysis_equals_the_reference_on_edge_cases(rate, kind):
 def test_a_frame_the_grid_cannot_bracket_goes_to_the_reference(kind, monkeypatch):
     """Two LSFs closer than a grid cell (pi/128): the kernel flags the frame, the reference's
     eigenvalues solve it."""
-    from engine.method import lsf as lsf_module
+    from facetraj_engine.method import lsf as lsf_module
 
     lsf = np.linspace(0.2, 2.9, 18)
     lsf[5] = lsf[4] + 0.004
@@ -112,7 +112,7 @@ def test_a_frame_the_grid_cannot_bracket_goes_to_the_reference(kind, monkeypatch
         got = lsf_module.compiled_frame_lsf(kernels.compiled("compiled_lsf"), pad,
                                             np.array([2000]), np.hamming(400), 18)
     with use_kernels("numpy"):
-        from engine.method.lsf import lpc
+        from facetraj_engine.method.lsf import lpc
 
         ref = poly2lsf(lpc(pad[2000:2400] * np.hamming(400), 18))
     np.testing.assert_allclose(got, ref[None], rtol=0, atol=LSF_ATOL)
@@ -166,7 +166,7 @@ def test_lsf_index_search_small_and_exhaustive(kind):
 
 
 def test_eqs_5_to_8_equal_the_reference(default_model, default_corpus, kind):
-    from engine.method.synthesis import gamma_grid, weight_frames
+    from facetraj_engine.method.synthesis import gamma_grid, weight_frames
 
     m = default_model
     cb = m.codebook
@@ -187,7 +187,7 @@ def test_eqs_5_to_8_equal_the_reference(default_model, default_corpus, kind):
 def test_eqs_5_to_8_where_gammas_tie(toy_model, kind):
     """One codeword dominating: every gamma's error equal to rounding, so the kernel and the
     reference may choose different gammas; the weights and PCs agree to rounding."""
-    from engine.method.synthesis import gamma_grid, weight_frames
+    from facetraj_engine.method.synthesis import gamma_grid, weight_frames
 
     cb = toy_model.codebook
     rng = np.random.default_rng(1)
@@ -243,7 +243,7 @@ def test_a_kernel_module_that_fails_to_load_falls_back_to_numpy(monkeypatch, cap
 
 
 def test_numba_is_not_imported_by_the_engine_nor_the_command_line():
-    code = ("import json, sys; import engine.method.pipeline, engine.method.model, facetraj.cli; "
+    code = ("import json, sys; import facetraj_engine.method.pipeline, facetraj_engine.method.model, facetraj.cli; "
             "print(json.dumps(sorted(sys.modules)))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                          cwd=ROOT)
@@ -256,10 +256,10 @@ def test_a_synthesis_with_the_prebuilt_kernels_imports_no_numba(toy_model, tmp_p
     code = """
 import sys
 import numpy as np
-from engine.method import kernels
-from engine.method.model import Model
-from engine.config import SynthConfig
-from engine.method.pipeline import synthesize
+from facetraj_engine.method import kernels
+from facetraj_engine.method.model import Model
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.method.pipeline import synthesize
 model = Model.load(sys.argv[1])
 audio = np.random.default_rng(1).standard_normal(16000) * 0.1
 config = SynthConfig(mode="acoustic")
@@ -295,7 +295,7 @@ def test_prebuilt_kernels_missing_broken_or_stale_give_way_to_numba(monkeypatch,
 
 
 def test_the_build_runs_only_when_the_fingerprint_says_stale(monkeypatch):
-    """``python -m engine.method.aot`` (what ``make`` runs every time) builds nothing while the
+    """``python -m facetraj_engine.method.aot`` (what ``make`` runs every time) builds nothing while the
     extension is current, and builds when it is stale or ``--force`` is given."""
     built = []
     monkeypatch.setattr(aot, "build", lambda: built.append(1) or prebuilt.folder())
@@ -311,8 +311,8 @@ def test_a_read_only_install_does_not_crash():
     compile without their cache (in every process: seconds) and give the same LSFs."""
     code = """
 import numpy as np
-from engine.method.kernels import use_kernels
-from engine.method.lsf import lsf_at
+from facetraj_engine.method.kernels import use_kernels
+from facetraj_engine.method.lsf import lsf_at
 x = np.random.default_rng(0).standard_normal(8000)
 with use_kernels("jit"):
     fast = lsf_at(x, 16000, np.arange(10) / 60)
@@ -329,7 +329,7 @@ print(fast.shape, float(np.abs(fast - ref).max()) < 1e-10)
 
 
 def test_the_choice_holds_in_the_frame_threads():
-    from engine.threads import map_spans
+    from facetraj_engine.threads import map_spans
 
     with use_kernels("numpy"):
         assert map_spans(lambda a, b: kernel_choice(), 3000, 2) == ["numpy", "numpy"]
@@ -343,9 +343,9 @@ def test_a_live_stream_never_waits_for_the_kernels_to_load(toy_model, tmp_path):
     code = """
 import sys
 import numpy as np
-from engine.method import aot, kernels, prebuilt
-from engine.method.model import Model
-from engine.streaming.synthesizer import StreamingSynthesizer
+from facetraj_engine.method import aot, kernels, prebuilt
+from facetraj_engine.method.model import Model
+from facetraj_engine.streaming.synthesizer import StreamingSynthesizer
 model = Model.load(sys.argv[1])
 audio = np.random.default_rng(1).standard_normal(16000) * 0.1
 def stream(between):
@@ -376,8 +376,8 @@ def test_a_fork_waits_for_a_warm_up_under_way_in_another_thread(monkeypatch):
     no child inherits numba's locks held mid-compile."""
     import threading
 
-    from engine.fanout import prepare_fork
-    from engine.method import compiled_lsf
+    from facetraj_engine.fanout import prepare_fork
+    from facetraj_engine.method import compiled_lsf
 
     monkeypatch.setenv(kernels.KERNELS_ENV, "jit")      # numba's kernels, compiled when asked
     started, release = threading.Event(), threading.Event()

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from engine.data import PhoneSegment
-from engine.evaluation.kinematics import (
+from facetraj_engine.data import PhoneSegment
+from facetraj_engine.evaluation.kinematics import (
     LANDMARKS,
     Gesture,
     compare_landmarks,

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from engine.config import SynthConfig
-from engine.io.audio import read_audio
-from engine.io.markerfiles import read_marker_table
-from engine.method.pipeline import synthesize
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.io.audio import read_audio
+from facetraj_engine.io.markerfiles import read_marker_table
+from facetraj_engine.method.pipeline import synthesize
 from facetraj.cli import main
 
 
@@ -37,8 +37,8 @@ def test_live_from_file_writes_the_offline_synthesis(model_file, default_model, 
 
 def test_live_from_file_with_phones_writes_them_beside_the_take(model_file, default_model,
                                                                 default_corpus, tmp_path, capsys):
-    from engine.io.labelfiles import read_label_file
-    from engine.streaming.live import stream_file
+    from facetraj_engine.io.labelfiles import read_label_file
+    from facetraj_engine.streaming.live import stream_file
 
     wav = default_corpus.root / f"{default_corpus.info.test[1]}.flac"
     out = tmp_path / "take.tsv"

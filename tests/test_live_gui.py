@@ -11,14 +11,14 @@ pytest.importorskip("pyvistaqt")
 
 from screens import image_array, on_screen, place_in
 
-from app import live, style
-from app.main import build_window
-from app.plotter_widget import grab_with_3d
-from engine.config import SynthConfig
-from engine.errors import FacetrajError
-from engine.io.audio import read_audio
-from engine.io.markerfiles import read_c3d
-from engine.method.pipeline import synthesize
+from facetraj_app import live, style
+from facetraj_app.main import build_window
+from facetraj_app.plotter_widget import grab_with_3d
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.errors import FacetrajError
+from facetraj_engine.io.audio import read_audio
+from facetraj_engine.io.markerfiles import read_c3d
+from facetraj_engine.method.pipeline import synthesize
 from facetraj.cli import main
 
 
@@ -116,7 +116,7 @@ def test_live_screenshot_command_saves_the_face(default_model, tmp_path, default
     import subprocess
     import sys
 
-    from engine.io.corpus import audio_path
+    from facetraj_engine.io.corpus import audio_path
 
     model = default_model.save(tmp_path / "m.npz")
     out = tmp_path / "live.png"

@@ -12,11 +12,11 @@ pytest.importorskip("pytestqt")
 pytest.importorskip("pyvistaqt")
 pytest.importorskip("pocketsphinx")
 
-from app import live
-from app.live_input import InputLost, decode_pcm
-from app.live_phones import ACOUSTIC, PHONES
-from engine.io.audio import read_audio, write_audio
-from engine.io.labelfiles import read_label_file
+from facetraj_app import live
+from facetraj_app.live_input import InputLost, decode_pcm
+from facetraj_app.live_phones import ACOUSTIC, PHONES
+from facetraj_engine.io.audio import read_audio, write_audio
+from facetraj_engine.io.labelfiles import read_label_file
 
 
 @pytest.fixture
@@ -139,7 +139,7 @@ class _Device:
 
 
 def test_a_device_with_another_rate_records_in_its_own_format():
-    from app.live_input import capture_format
+    from facetraj_app.live_input import capture_format
 
     fmt = capture_format(_Device())
     assert (fmt.sampleRate(), fmt.channelCount(), fmt.sampleFormat().name) == (48000, 2, "Float")
@@ -148,7 +148,7 @@ def test_a_device_with_another_rate_records_in_its_own_format():
 def test_a_source_that_stops_with_an_error_is_a_lost_input():
     from PyQt6.QtMultimedia import QtAudio
 
-    from app.live_input import MicFeeder
+    from facetraj_app.live_input import MicFeeder
 
     class Source:
         def __init__(self):

@@ -1,4 +1,4 @@
-"""Live mode with phones (issue 27, engine.streaming): the streamed recognizer, the phonetic stream
+"""Live mode with phones (issue 27, facetraj_engine.streaming): the streamed recognizer, the phonetic stream
 against offline synthesis, the streamed closure step against the offline one, speech and pauses
 of a stream, the running voice match; a take's phones; long silence and clipping."""
 
@@ -10,18 +10,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engine.config import SynthConfig
-from engine.data import PhoneSegment
-from engine.labels.provenance import Labels
-from engine.method.closure import ClosurePlan, aperture_functional, close_lips, rest_in_pauses
-from engine.method.pipeline import synthesize
-from engine.method.speech import filtered_energy_db, pauses, speech_mask
-from engine.streaming.closure import ClosureStream, closure_moves, pause_runs, rest_weights
-from engine.streaming.live import LiveConfig, LiveStream, live_mode, stream_file
-from engine.streaming.phones import FrozenPhone, PhoneSnapshot, PhoneTrack
-from engine.streaming.phonetic import PhoneticSynthesizer, PhoneticTiming
-from engine.streaming.recognizer import CMN_INIT, RecognizerConfig, RunningCmn, StreamingRecognizer
-from engine.streaming.speech import SILENT, SPEECH, UNRANGED, SpeechStream
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.data import PhoneSegment
+from facetraj_engine.labels.provenance import Labels
+from facetraj_engine.method.closure import ClosurePlan, aperture_functional, close_lips, rest_in_pauses
+from facetraj_engine.method.pipeline import synthesize
+from facetraj_engine.method.speech import filtered_energy_db, pauses, speech_mask
+from facetraj_engine.streaming.closure import ClosureStream, closure_moves, pause_runs, rest_weights
+from facetraj_engine.streaming.live import LiveConfig, LiveStream, live_mode, stream_file
+from facetraj_engine.streaming.phones import FrozenPhone, PhoneSnapshot, PhoneTrack
+from facetraj_engine.streaming.phonetic import PhoneticSynthesizer, PhoneticTiming
+from facetraj_engine.streaming.recognizer import CMN_INIT, RecognizerConfig, RunningCmn, StreamingRecognizer
+from facetraj_engine.streaming.speech import SILENT, SPEECH, UNRANGED, SpeechStream
 
 pytest.importorskip("pocketsphinx")
 
@@ -82,7 +82,7 @@ def test_running_cepstral_mean_is_recovered_from_what_pocketsphinx_reports():
     # frames of cepstra [60, 1, ...] decoded after the mean was set to the initial one
     true = np.array([60.0, 1.0] + [0.0] * 11)
     reported = (500 * CMN_INIT + 20 * true) / 520           # PocketSphinx's sum over its count
-    from engine.streaming.recognizer import held_sum
+    from facetraj_engine.streaming.recognizer import held_sum
     np.testing.assert_allclose(held_sum(reported, CMN_INIT, 20) / 20, true, atol=1e-9)
     plain = RunningCmn(prior_frames=0, speech_share=None)
     plain.add(20 * true, 20)
@@ -90,8 +90,8 @@ def test_running_cepstral_mean_is_recovered_from_what_pocketsphinx_reports():
 
 
 def test_frame_cepstra_average_to_the_mean_offline_recognition_removes(utterance):
-    from engine.evaluation.live_eval import frame_cepstra
-    from engine.labels.alignment import allphone_decoder
+    from facetraj_engine.evaluation.live_eval import frame_cepstra
+    from facetraj_engine.labels.alignment import allphone_decoder
 
     audio, rate, _ = utterance
     assert rate == 16000
@@ -106,8 +106,8 @@ def test_frame_cepstra_average_to_the_mean_offline_recognition_removes(utterance
 
 
 def test_a_prior_of_some_frames_brings_the_running_mean_nearest_the_whole_mean(utterance):
-    from engine.evaluation.live_eval import frame_cepstra, prior_count_errors
-    from engine.streaming.recognizer import CMN_PRIOR_FRAMES
+    from facetraj_engine.evaluation.live_eval import frame_cepstra, prior_count_errors
+    from facetraj_engine.streaming.recognizer import CMN_PRIOR_FRAMES
 
     audio, rate, _ = utterance
     errors = prior_count_errors([frame_cepstra(audio, rate)], [0.0, CMN_PRIOR_FRAMES, 1000.0])
@@ -117,7 +117,7 @@ def test_a_prior_of_some_frames_brings_the_running_mean_nearest_the_whole_mean(u
 
 
 def test_streamed_phones_agree_with_themselves(utterance):
-    from engine.evaluation.live_eval import phone_agreement, streamed_phones
+    from facetraj_engine.evaluation.live_eval import phone_agreement, streamed_phones
 
     audio, rate, _ = utterance
     phones = streamed_phones(audio, rate)
@@ -270,8 +270,8 @@ def test_speech_stream_filters_the_energy_as_offline(utterance):
 
 
 def test_running_voice_ratio_approaches_the_offline_one(default_model, arctic_wav):
-    from engine.io.audio import read_audio
-    from engine.method.pipeline import input_voice_ratio
+    from facetraj_engine.io.audio import read_audio
+    from facetraj_engine.method.pipeline import input_voice_ratio
 
     audio, rate = read_audio(arctic_wav)
     stream = LiveStream(default_model, rate)
@@ -286,9 +286,9 @@ def test_running_voice_ratio_approaches_the_offline_one(default_model, arctic_wa
 
 # --------------------------------------------------------------------------- a take
 def test_a_file_through_live_mode_keeps_its_phones(default_model, arctic_wav, tmp_path):
-    from engine.io.audio import read_audio
-    from engine.io.labelfiles import read_label_file
-    from engine.io.labelling import write_labels
+    from facetraj_engine.io.audio import read_audio
+    from facetraj_engine.io.labelfiles import read_label_file
+    from facetraj_engine.io.labelling import write_labels
 
     audio, rate = read_audio(arctic_wav)
     take = stream_file(default_model, audio, rate, 0.01)
@@ -342,7 +342,7 @@ def test_a_minute_of_silence_or_clipping_streams_with_bounded_state(default_mode
 
 
 def test_a_device_at_44_1_khz_streams_with_phones(default_model, utterance):
-    from engine.method.lsf import resample_audio
+    from facetraj_engine.method.lsf import resample_audio
 
     audio, rate, _ = utterance
     a44 = resample_audio(audio, rate, 44100)
@@ -350,7 +350,7 @@ def test_a_device_at_44_1_khz_streams_with_phones(default_model, utterance):
     here = stream_file(default_model, audio, rate, 0.01)
     assert len(take.frames) == len(here.frames)
     # 44.1 kHz is resampled to 16 kHz for the recognizer: nearly the same phones, frame by frame
-    from engine.evaluation.live_eval import frame_labels
+    from facetraj_engine.evaluation.live_eval import frame_labels
 
     n = int(len(audio) / rate * 100)
     alike = np.mean(frame_labels(take.labels.phones, n) == frame_labels(here.labels.phones, n))

@@ -6,7 +6,7 @@ import pytest
 from scipy.linalg import solve_toeplitz
 from scipy.signal import lfilter
 
-from engine.method.lsf import analysis_frames, levinson, lpc, lsf2poly, lsf_at, poly2lsf
+from facetraj_engine.method.lsf import analysis_frames, levinson, lpc, lsf2poly, lsf_at, poly2lsf
 
 
 def _stable_poly(rng, order):
@@ -100,7 +100,7 @@ def test_resampling_to_16k():
 
 def _cheb_rows(a):
     """The Chebyshev rows poly2lsf solves (P and Q with the trivial roots divided out)."""
-    from engine.method.lsf import _sum_difference, lsf_chebyshev_series
+    from facetraj_engine.method.lsf import _sum_difference, lsf_chebyshev_series
 
     _, _, p_rows, q_rows = _sum_difference(a)
     return np.concatenate(lsf_chebyshev_series(p_rows, q_rows))
@@ -109,7 +109,7 @@ def _cheb_rows(a):
 def test_fast_root_kernel_equals_colleague_eigenvalues():
     """The grid + Newton kernel against its reference, the colleague-matrix eigenvalues, on
     random minimum-phase polynomials and on LPC of real-like frames (AR(2) noise)."""
-    from engine.method.lsf import chebyshev_real_roots, colleague_eigenvalues
+    from facetraj_engine.method.lsf import chebyshev_real_roots, colleague_eigenvalues
 
     rng = np.random.default_rng(11)
     polys = [_stable_poly(rng, 18) for _ in range(300)]
@@ -124,7 +124,7 @@ def test_fast_root_kernel_equals_colleague_eigenvalues():
 def test_close_lsf_pairs_fall_back_to_the_reference(monkeypatch):
     """A P root pair closer than a grid cell (pi/128) is not bracketed: the row is solved by the
     eigenvalues, so the LSFs still come back right; a row of well-separated LSFs does not."""
-    from engine.method import lsf as lsf_mod
+    from facetraj_engine.method import lsf as lsf_mod
 
     w = np.linspace(0.1, 3.0, 18)
     close = w.copy()
@@ -145,7 +145,7 @@ def test_close_lsf_pairs_fall_back_to_the_reference(monkeypatch):
 
 
 def test_autocorrelation_equals_the_direct_sums():
-    from engine.method.lsf import autocorrelation
+    from facetraj_engine.method.lsf import autocorrelation
 
     x = np.random.default_rng(12).standard_normal((5, 400))
     direct = np.array([[row[: 400 - k] @ row[k:] for k in range(19)] for row in x])
@@ -160,8 +160,8 @@ def test_the_peak_scaling_equals_scaling_the_signal_first(peak, rate, kernels):
     """``lsf_at`` brings the peak to [0.5, 1) by a power of 2; scaling up after the pre-emphasis
     (without a copy of the signal) gives the LSFs of the signal scaled first, to the bit, and huge
     samples do not overflow."""
-    from engine.method.kernels import use_kernels
-    from engine.method.lsf import resample_audio
+    from facetraj_engine.method.kernels import use_kernels
+    from facetraj_engine.method.lsf import resample_audio
 
     rng = np.random.default_rng(3)
     x = lfilter([1.0], [1.0, -1.6, 0.8], rng.standard_normal(rate // 2))

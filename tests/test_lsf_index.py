@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 from conftest import edited_model_file
 
-from engine.config import SynthConfig
-from engine.method.codebook import Codebook
-from engine.method.lsf_index import LsfIndex, build_index, kmeans
-from engine.method.model import Model
-from engine.method.pipeline import synthesize
-from engine.method.synthesis import perceptual_weights
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.method.codebook import Codebook
+from facetraj_engine.method.lsf_index import LsfIndex, build_index, kmeans
+from facetraj_engine.method.model import Model
+from facetraj_engine.method.pipeline import synthesize
+from facetraj_engine.method.synthesis import perceptual_weights
 from facetraj.cli import build_parser
 from facetraj.options import synth_config
 

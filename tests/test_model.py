@@ -7,13 +7,13 @@ import numpy as np
 import pytest
 from conftest import edited_model_file
 
-from engine.config import SynthConfig, TrainConfig
-from engine.data import PhoneSegment, Utterance
-from engine.errors import InputError, ModelFileError
-from engine.evaluation.scores import evaluate
-from engine.method.model import Model
-from engine.method.pipeline import resmooth, synthesize
-from engine.method.training import MarkerSetup, train
+from facetraj_engine.config import SynthConfig, TrainConfig
+from facetraj_engine.data import PhoneSegment, Utterance
+from facetraj_engine.errors import InputError, ModelFileError
+from facetraj_engine.evaluation.scores import evaluate
+from facetraj_engine.method.model import Model
+from facetraj_engine.method.pipeline import resmooth, synthesize
+from facetraj_engine.method.training import MarkerSetup, train
 
 
 def test_model_contents(toy_model, toy_corpus):
@@ -54,7 +54,7 @@ def test_save_load_round_trip_bit_for_bit(toy_model, tmp_path):
 
 
 def test_a_model_is_stored_uncompressed_and_a_compressed_one_still_loads(toy_model, tmp_path):
-    from engine.io.model_file import is_compressed
+    from facetraj_engine.io.model_file import is_compressed
 
     path = toy_model.save(tmp_path / "m.npz")
     with zipfile.ZipFile(path) as z:
@@ -71,8 +71,8 @@ def test_a_model_is_stored_uncompressed_and_a_compressed_one_still_loads(toy_mod
 
 def test_a_compressed_cached_model_is_stored_uncompressed_once(toy_model, toy_corpus, tmp_path,
                                                                 monkeypatch):
-    from app.cache import cached_model_path, load_or_train
-    from engine.io.model_file import is_compressed
+    from facetraj_app.cache import cached_model_path, load_or_train
+    from facetraj_engine.io.model_file import is_compressed
 
     monkeypatch.setenv("FACETRAJ_CACHE_DIR", str(tmp_path / "cache"))
     path = cached_model_path(toy_corpus)

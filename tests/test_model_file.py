@@ -1,4 +1,4 @@
-"""The model reader (engine.io.model_file): every array's data type, shape, values and
+"""The model reader (facetraj_engine.io.model_file): every array's data type, shape, values and
 cross-references are checked before anything uses the model; each check is tested here with a
 model file damaged in that one way."""
 
@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 from conftest import edited_model_file
 
-from engine.errors import ModelFileError
-from engine.method.model import Model
-from engine.method.pipeline import synthesize
+from facetraj_engine.errors import ModelFileError
+from facetraj_engine.method.model import Model
+from facetraj_engine.method.pipeline import synthesize
 
 
 @pytest.fixture(scope="module")
@@ -174,7 +174,7 @@ def test_other_number_types_are_read_as_the_method_computes(saved, tmp_path, toy
     assert m1.codebook.contexts.dtype == np.int64 and m1.codebook.lsf.dtype == np.float64
     utt = toy_corpus.utterance(toy_corpus.info.test[0])
     for mode in ("phonetic", "acoustic"):
-        from engine.config import SynthConfig
+        from facetraj_engine.config import SynthConfig
 
         cfg = SynthConfig(mode=mode)
         r0 = synthesize(m0, utt.audio, utt.sample_rate, utt.phones, cfg, n_frames=utt.n_frames)

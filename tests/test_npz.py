@@ -1,4 +1,4 @@
-"""``engine.io.npz.write_npz``: numpy's ``.npz`` without numpy's copies."""
+"""``facetraj_engine.io.npz.write_npz``: numpy's ``.npz`` without numpy's copies."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import os
 import numpy as np
 import pytest
 
-from engine.io.npz import write_npz
+from facetraj_engine.io.npz import write_npz
 
 
 def _arrays() -> dict[str, np.ndarray]:
@@ -42,7 +42,7 @@ def test_python_objects_are_refused() -> None:
 
 
 def test_a_file_on_disk_has_numpys_bytes_and_ends_where_they_end(tmp_path) -> None:
-    """Written to a file, its disk blocks given first (``engine.io.files.preallocated``, sized
+    """Written to a file, its disk blocks given first (``facetraj_engine.io.files.preallocated``, sized
     by a guess): the same bytes as in memory, the file cut where the archive ends, for a guess
     above the size (large arrays) and below it (many empty ones)."""
     for arrays in (_arrays(), {f"e{k}": np.zeros(0) for k in range(40)}):
@@ -56,7 +56,7 @@ def test_a_file_on_disk_has_numpys_bytes_and_ends_where_they_end(tmp_path) -> No
 def test_preallocated_gives_the_blocks_before_the_writes(tmp_path) -> None:
     """Where the system has fallocate, the blocks exist before a byte is written (ext4 then has
     nothing to write out when a rename replaces a file); the file is cut where writing stopped."""
-    from engine.io.files import _fallocate, preallocated
+    from facetraj_engine.io.files import _fallocate, preallocated
 
     path = tmp_path / "x.bin"
     with open(path, "wb") as handle, preallocated(handle, 1 << 20):
@@ -73,7 +73,7 @@ def test_preallocated_gives_the_blocks_before_the_writes(tmp_path) -> None:
 
 def test_preallocated_leaves_a_pipe_and_memory_as_they_are() -> None:
     """Nothing to give blocks to: no fallocate, and no truncate (a pipe cannot be cut)."""
-    from engine.io.files import preallocated
+    from facetraj_engine.io.files import preallocated
 
     read, write = os.pipe()
     with open(write, "wb") as handle, preallocated(handle, 1 << 16):

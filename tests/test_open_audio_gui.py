@@ -19,8 +19,8 @@ if not os.environ.get("DISPLAY"):
 
 from PyQt6.QtWidgets import QDialog, QFileDialog, QMessageBox
 
-from app.main import build_window
-from app.open_audio import MissingWordsDialog, SentenceDialog
+from facetraj_app.main import build_window
+from facetraj_app.open_audio import MissingWordsDialog, SentenceDialog
 from facetraj.paths import default_corpus
 
 pytestmark = pytest.mark.gui
@@ -153,8 +153,8 @@ def test_recordings_from_the_command_line_open_one_after_another(qtbot, trained_
     """``facetraj gui FOLDER`` (a folder of recordings without face data): each recording is
     synthesized with the default corpus's model, its phones recognized (nothing beside it), the
     one after the other; an unreadable file is reported and skipped."""
-    from app.recordings import RecordingQueue, recordings_in
-    from engine.errors import InputError
+    from facetraj_app.recordings import RecordingQueue, recordings_in
+    from facetraj_engine.errors import InputError
 
     folder = tmp_path / "talker"
     folder.mkdir()
@@ -190,7 +190,7 @@ def test_the_search_shown_is_the_search_used_for_each_label_choice(window, qtbot
     the title names it and where the labels came from; choosing the search shown does nothing,
     choosing another is obeyed (the panel read "phonetic" for aligned labels while the synthesis
     was robust, and "robust" for no labels while it was acoustic-only)."""
-    from app.provenance import search_key, search_title
+    from facetraj_app.provenance import search_key, search_title
 
     win = window
     stem = tmp_path / "boy"

@@ -8,9 +8,9 @@ import warnings
 import numpy as np
 import pytest
 
-from engine.io.export import write_trajectories
-from engine.io.markerfiles import read_c3d, read_marker_table, write_c3d, write_marker_tsv
-from engine.io.numtext import fixed_point_lines
+from facetraj_engine.io.export import write_trajectories
+from facetraj_engine.io.markerfiles import read_c3d, read_marker_table, write_c3d, write_marker_tsv
+from facetraj_engine.io.numtext import fixed_point_lines
 
 NAMES = [f"M{i}" for i in range(7)]
 
@@ -59,7 +59,7 @@ def _c3d_frame_by_frame(path, markers, rate, integer, names=NAMES):
     """``write_c3d`` as it was: every frame handed to ``c3d.Writer`` (the reference)."""
     import c3d
 
-    from engine.io.markerfiles import C3D_INT_SCALE
+    from facetraj_engine.io.markerfiles import C3D_INT_SCALE
 
     finite = np.isfinite(markers).all(axis=2)
     if integer:
@@ -105,7 +105,7 @@ def test_c3d_layout_is_the_c3d_packages_for_every_size(tmp_path, frames, points,
 
 
 def test_c3d_refuses_more_points_than_it_can_name(tmp_path):
-    from engine.errors import InputError
+    from facetraj_engine.errors import InputError
 
     names = [f"P{i}" for i in range(256)]
     with pytest.raises(InputError, match="1 to 255 points"):

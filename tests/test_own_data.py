@@ -7,13 +7,13 @@ import numpy as np
 import pytest
 from conftest import MOCHA
 
-from engine.config import SynthConfig
-from engine.errors import InputError
-from engine.io.corpus import init_corpus, load_corpus
-from engine.io.markerfiles import MOCHA_COILS, read_markers, read_mocha_ema, write_c3d
-from engine.labels.labelmap import MOCHA_TO_ARPABET, read_label_map
-from engine.method.pipeline import synthesize
-from engine.method.training import train
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.errors import InputError
+from facetraj_engine.io.corpus import init_corpus, load_corpus
+from facetraj_engine.io.markerfiles import MOCHA_COILS, read_markers, read_mocha_ema, write_c3d
+from facetraj_engine.labels.labelmap import MOCHA_TO_ARPABET, read_label_map
+from facetraj_engine.method.pipeline import synthesize
+from facetraj_engine.method.training import train
 
 needs_mocha = pytest.mark.skipif(not (MOCHA / "fsew0_001.ema").exists(),
                                  reason="the MOCHA sample ../shared/data/mocha_fsew0_001 is absent")
@@ -113,7 +113,7 @@ def test_marker_set_mismatch_and_resampling(tmp_path, toy_corpus_dir):
         (tmp_path / f"u.{ext}").write_bytes((toy_corpus_dir / f"{utt.name}.{ext}").read_bytes())
     write_c3d(tmp_path / "u.c3d", utt.markers[:, :11], 60.0, utt.marker_names[:11])
     info = corpus.info
-    from engine.io.corpus import CorpusInfo, save_corpus_info
+    from facetraj_engine.io.corpus import CorpusInfo, save_corpus_info
 
     save_corpus_info(tmp_path, CorpusInfo(**{**info.__dict__, "train": ["u"], "test": []}))
     with pytest.raises(InputError, match="u.c3d: marker set differs"):

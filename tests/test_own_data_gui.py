@@ -17,16 +17,16 @@ if not (MOCHA / "fsew0_001.ema").exists():
 
 from PyQt6.QtWidgets import QMessageBox
 
-from app.main import build_window
-from app.own_data import (
+from facetraj_app.main import build_window
+from facetraj_app.own_data import (
     ImportDialog,
     default_label_map,
     export_figure,
     export_trajectories,
     guess_roles,
 )
-from engine.io.corpus import load_corpus
-from engine.io.markerfiles import read_c3d, read_marker_table
+from facetraj_engine.io.corpus import load_corpus
+from facetraj_engine.io.markerfiles import read_c3d, read_marker_table
 
 pytestmark = pytest.mark.gui
 WAIT_MS = 240_000   # a hang guard (a loaded machine is slow), not a speed limit

@@ -13,7 +13,7 @@ pytest.importorskip("pytestqt")
 
 from PyQt6.QtCore import QEvent, QObject, pyqtSignal
 
-from app.playback import MAX_WAIT, PlaybackScheduler
+from facetraj_app.playback import MAX_WAIT, PlaybackScheduler
 
 RATE = 60.0
 
@@ -158,7 +158,7 @@ gui = pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X displ
 
 @pytest.fixture
 def window(qtbot, trained_cache):
-    from app.main import build_window
+    from facetraj_app.main import build_window
     from facetraj.paths import default_corpus
 
     win = build_window(default_corpus(), use_audio=False)
@@ -211,7 +211,7 @@ def test_playback_blits_the_cursor_without_redrawing_the_panels(window, qtbot, m
 def test_the_cursor_is_drawn_in_every_panel_at_its_time(window):
     from matplotlib.colors import to_rgb
 
-    from app.style import CURSOR_COLOR
+    from facetraj_app.style import CURSOR_COLOR
 
     timeline = window.timeline
     t = 0.37 * window.view.duration
@@ -299,7 +299,7 @@ def test_a_new_scene_renders_once(window):
 def test_a_frame_update_moves_the_points_in_place_with_one_render(window, qtbot):
     from PyQt6.QtWidgets import QApplication
 
-    from app.plotter_widget import is_native
+    from facetraj_app.plotter_widget import is_native
 
     win = window
     face = win.face
@@ -411,7 +411,7 @@ def test_the_time_read_out_does_not_lay_the_window_out_again(window):
 @pytest.mark.gui
 def test_both_plotter_widgets_draw_the_same_face(qtbot, default_model):
     """The native-window plotter (X11) and pyvistaqt's QOpenGLWidget one render the same image."""
-    from app.view3d import FaceView
+    from facetraj_app.view3d import FaceView
 
     images = []
     for native in (True, False):

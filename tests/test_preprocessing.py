@@ -3,14 +3,14 @@
 import numpy as np
 import pytest
 
-from engine.data import PhoneSegment
-from engine.errors import InputError
-from engine.labels.phoneset import map_labels, normalise_label
-from engine.method.codebook import codeword_times, interpolate_frames
-from engine.method.context import context_ids
-from engine.method.markers import fill_gaps, kabsch, reference_pose, remove_head_motion
-from engine.method.pca import fit_pca
-from engine.method.smoothing import smooth, spline_smooth, triangular_smooth, triangular_window
+from facetraj_engine.data import PhoneSegment
+from facetraj_engine.errors import InputError
+from facetraj_engine.labels.phoneset import map_labels, normalise_label
+from facetraj_engine.method.codebook import codeword_times, interpolate_frames
+from facetraj_engine.method.context import context_ids
+from facetraj_engine.method.markers import fill_gaps, kabsch, reference_pose, remove_head_motion
+from facetraj_engine.method.pca import fit_pca
+from facetraj_engine.method.smoothing import smooth, spline_smooth, triangular_smooth, triangular_window
 
 
 def _rotation(rng):

@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engine.data import PhoneSegment, Provenance
-from engine.io.labelfiles import read_label_file, read_textgrid_tiers, recorded_provenance
-from engine.io.labelling import write_labels
-from engine.labels.provenance import Labels, labels_from_tiers, parse_provenance, provenance_text
+from facetraj_engine.data import PhoneSegment, Provenance
+from facetraj_engine.io.labelfiles import read_label_file, read_textgrid_tiers, recorded_provenance
+from facetraj_engine.io.labelling import write_labels
+from facetraj_engine.labels.provenance import Labels, labels_from_tiers, parse_provenance, provenance_text
 
 PRAAT = shutil.which("praat")
 PHONES = [PhoneSegment(0.0, 0.2, "sil"), PhoneSegment(0.2, 0.31, "b"),

@@ -1,4 +1,4 @@
-"""``engine.method.recording``: a recording's input LSFs analysed early (``EarlyLsf``), beside
+"""``facetraj_engine.method.recording``: a recording's input LSFs analysed early (``EarlyLsf``), beside
 the reading of the model's arrays and the labels, give the synthesis of the line-by-line path."""
 
 from __future__ import annotations
@@ -8,10 +8,10 @@ import dataclasses
 import numpy as np
 import pytest
 
-from engine.io.audio import read_audio
-from engine.method.model import Model
-from engine.method.pipeline import frame_count
-from engine.method.recording import EarlyLsf, LabelRequest, synthesize_recording
+from facetraj_engine.io.audio import read_audio
+from facetraj_engine.method.model import Model
+from facetraj_engine.method.pipeline import frame_count
+from facetraj_engine.method.recording import EarlyLsf, LabelRequest, synthesize_recording
 
 
 @pytest.fixture(scope="module")
@@ -52,7 +52,7 @@ def test_a_model_of_other_settings_gets_none(model_file, toy_corpus_dir):
 
 
 def test_an_analysis_that_fails_gives_none(model_file, toy_corpus_dir, monkeypatch):
-    import engine.method.recording as recording
+    import facetraj_engine.method.recording as recording
 
     def broken(*args, **kwargs):
         raise MemoryError("no room")
@@ -65,7 +65,7 @@ def test_an_analysis_that_fails_gives_none(model_file, toy_corpus_dir, monkeypat
 
 
 def test_settings_of_a_bad_model_file_are_refused_naming_it(model_file, tmp_path):
-    from engine.errors import ModelFileError
+    from facetraj_engine.errors import ModelFileError
 
     cut = tmp_path / "cut.npz"
     cut.write_bytes(model_file.read_bytes()[:5000])

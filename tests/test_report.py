@@ -1,4 +1,4 @@
-"""The results report (issue 7): ``app.report_figures.make_report`` on a small toy corpus writes
+"""The results report (issue 7): ``facetraj_app.report_figures.make_report`` on a small toy corpus writes
 every section, the JSON of all numbers and non-blank figures."""
 
 from __future__ import annotations
@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 from toycorpus import build_toy_corpus
 
-from engine.evaluation.paper import FIGURE4_TEXT, PAPER_TABLE2, paper_table1
-from engine.method.similarity import SimilarRow
-from engine.report import find_utterance, table1_agreement
+from facetraj_engine.evaluation.paper import FIGURE4_TEXT, PAPER_TABLE2, paper_table1
+from facetraj_engine.method.similarity import SimilarRow
+from facetraj_engine.report import find_utterance, table1_agreement
 
 SECTIONS = (
     "## Table 2: correlation, original vs synthesized (N = 3)",
@@ -28,7 +28,7 @@ SECTIONS = (
 @pytest.fixture(scope="module")
 def small_corpus(tmp_path_factory) -> Path:
     root = build_toy_corpus(tmp_path_factory.mktemp("toy-report"), n_train=8, n_test=3, seed=3)
-    from engine.io.corpus import load_corpus
+    from facetraj_engine.io.corpus import load_corpus
 
     test_id = load_corpus(root).info.test[1]
     (root / f"{test_id}.txt").write_text(FIGURE4_TEXT + ".\n", encoding="utf-8")
@@ -37,7 +37,7 @@ def small_corpus(tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="module")
 def report(small_corpus, tmp_path_factory) -> Path:
-    from app.report_figures import make_report
+    from facetraj_app.report_figures import make_report
 
     out = tmp_path_factory.mktemp("docs")
     seen = []
@@ -101,7 +101,7 @@ def test_only_report_files_are_written(report: Path) -> None:
 
 
 def test_find_utterance_and_paper_tables(small_corpus: Path) -> None:
-    from engine.io.corpus import load_corpus
+    from facetraj_engine.io.corpus import load_corpus
 
     corpus = load_corpus(small_corpus)
     assert find_utterance(corpus) == (corpus.info.test[1], "test")
@@ -118,8 +118,8 @@ def test_find_utterance_and_paper_tables(small_corpus: Path) -> None:
 
 
 def test_engine_report_does_not_plot() -> None:
-    import engine.report
+    import facetraj_engine.report
 
-    for path in Path(engine.report.__file__).parent.glob("*.py"):
+    for path in Path(facetraj_engine.report.__file__).parent.glob("*.py"):
         src = path.read_text()
         assert "import matplotlib" not in src and "from matplotlib" not in src, path  # pure engine

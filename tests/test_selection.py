@@ -1,4 +1,4 @@
-"""The robust mode (issue 16, engine.method.selection): each new equation on a hand-checked example, the
+"""The robust mode (issue 16, facetraj_engine.method.selection): each new equation on a hand-checked example, the
 fast kernels against plain loops, the mode rule, and the model file keeping its new parts."""
 
 from __future__ import annotations
@@ -7,13 +7,13 @@ import numpy as np
 import pytest
 from conftest import edited_model_file
 
-from engine.config import SynthConfig
-from engine.data import PhoneSegment, Provenance
-from engine.method.kernels import use_kernels
-from engine.method.model import Model
-from engine.method.modes import choose_mode
-from engine.method.pipeline import frame_confidence, synthesize
-from engine.method.selection import (
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.data import PhoneSegment, Provenance
+from facetraj_engine.method.kernels import use_kernels
+from facetraj_engine.method.model import Model
+from facetraj_engine.method.modes import choose_mode
+from facetraj_engine.method.pipeline import frame_confidence, synthesize
+from facetraj_engine.method.selection import (
     candidate_union,
     context_distances,
     context_frames,
@@ -22,7 +22,7 @@ from engine.method.selection import (
     robust_frames,
     weight_costs,
 )
-from engine.method.synthesis import gamma_grid, perceptual_weights, weight_frames
+from facetraj_engine.method.synthesis import gamma_grid, perceptual_weights, weight_frames
 
 
 def test_mean_normalise_hand_checked():

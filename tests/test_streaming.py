@@ -1,17 +1,17 @@
-"""Streaming synthesis (engine.streaming) equals offline synthesis; its parts equal their batch
-forms; the speaker warp (engine.method.speaker)."""
+"""Streaming synthesis (facetraj_engine.streaming) equals offline synthesis; its parts equal their batch
+forms; the speaker warp (facetraj_engine.method.speaker)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from engine.config import SynthConfig
-from engine.method.lsf import ResampleStream, analysis_frames, frame_lsf, lsf_at, preemphasize, resample_audio
-from engine.method.pipeline import synthesize
-from engine.method.smoothing import TriangularStream, triangular_smooth
-from engine.method.speaker import choose_warp, warp_lsf
-from engine.streaming.synthesizer import StreamConfig, StreamingSynthesizer, stream_synthesize
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.method.lsf import ResampleStream, analysis_frames, frame_lsf, lsf_at, preemphasize, resample_audio
+from facetraj_engine.method.pipeline import synthesize
+from facetraj_engine.method.smoothing import TriangularStream, triangular_smooth
+from facetraj_engine.method.speaker import choose_warp, warp_lsf
+from facetraj_engine.streaming.synthesizer import StreamConfig, StreamingSynthesizer, stream_synthesize
 
 ACOUSTIC = SynthConfig(mode="acoustic", closure=False)   # live mode has no closure step yet
 

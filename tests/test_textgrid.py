@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from praatio import textgrid as ptg
 
-from engine.errors import InputError
-from engine.io.labelfiles import read_textgrid_tiers
-from engine.io.textgrid import TextGridSyntaxError, parse_textgrid
+from facetraj_engine.errors import InputError
+from facetraj_engine.io.labelfiles import read_textgrid_tiers
+from facetraj_engine.io.textgrid import TextGridSyntaxError, parse_textgrid
 
 LABELS = ["sil", "", 'say "ah"', "é ʃ ŋ", "a = b : [1]", "two\nlines", "12.5", "<exists>"]
 

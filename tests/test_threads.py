@@ -1,4 +1,4 @@
-"""Synthesis split between frame threads (engine.threads): the same result as one thread, to
+"""Synthesis split between frame threads (facetraj_engine.threads): the same result as one thread, to
 rounding (BLAS's matrix products may add a row's terms in another order for another number of
 rows), in every mode that splits its frames; the thread-count rule; the evaluation on one thread."""
 
@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from engine.config import SynthConfig
-from engine.method.pipeline import synthesize
-from engine.threads import (
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.method.pipeline import synthesize
+from facetraj_engine.threads import (
     THREADS_ENV,
     frame_spans,
     frame_threads,
@@ -31,7 +31,7 @@ SHORT = 120          # frames: 2 s
 @pytest.fixture
 def short_spans(monkeypatch):
     """Spans of 2 s, so that a few seconds of speech split between threads."""
-    from engine import threads
+    from facetraj_engine import threads
 
     monkeypatch.setattr(threads, "MIN_FRAMES_PER_THREAD", SHORT)
 
@@ -96,8 +96,8 @@ def test_an_error_in_a_span_reaches_the_caller(short_spans):
 def test_evaluation_synthesizes_on_one_frame_thread(default_model, default_corpus, monkeypatch):
     """evaluate() scores are independent of its worker processes to the bit: each utterance is
     synthesized on one frame thread, whatever the process would use."""
-    from engine.evaluation.scores import evaluate
-    from engine.method import pipeline
+    from facetraj_engine.evaluation.scores import evaluate
+    from facetraj_engine.method import pipeline
 
     seen = []
     real = pipeline.frame_threads
@@ -118,7 +118,7 @@ def test_evaluation_synthesizes_on_one_frame_thread(default_model, default_corpu
 def test_beside_runs_in_a_thread_of_its_own_and_gives_its_result_or_its_error():
     import threading
 
-    from engine.threads import beside, limit_frame_threads
+    from facetraj_engine.threads import beside, limit_frame_threads
 
     where = beside(lambda: threading.current_thread().name)
     assert where() == "facetraj-beside"
@@ -140,7 +140,7 @@ def test_the_phonetic_synthesis_with_its_voice_match_beside_equals_one_in_line(t
                                                                                 toy_corpus):
     """The voice match is computed beside eqs 4-8 in the phonetic mode: the same synthesis and
     the same voice match as with one thread, where it is computed in line."""
-    from engine.data import PhoneSegment
+    from facetraj_engine.data import PhoneSegment
 
     utt = toy_corpus.utterance(toy_corpus.info.test[0])
     span = len(utt.audio) / utt.sample_rate

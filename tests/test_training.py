@@ -11,12 +11,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import pytest
 
-from engine.data import PhoneSegment
-from engine.io.corpus import Corpus
-from engine.method.closure import ClosureGather, closure_part, regression_direction
-from engine.method.moments import Moments
-from engine.method.pca import fit_pca, pca_of
-from engine.method.training import train
+from facetraj_engine.data import PhoneSegment
+from facetraj_engine.io.corpus import Corpus
+from facetraj_engine.method.closure import ClosureGather, closure_part, regression_direction
+from facetraj_engine.method.moments import Moments
+from facetraj_engine.method.pca import fit_pca, pca_of
+from facetraj_engine.method.training import train
 
 
 def _every_frame(model, corpus) -> np.ndarray:
@@ -153,7 +153,7 @@ def test_the_neutral_pose_in_blocks_is_the_pose_of_all_frames_at_once():
     """``reference_pose`` fits a block of frames at a time (what it holds stays the same whatever
     the corpus's length) and sums the aligned frames one after the other: the same bits as the
     mean of every frame aligned at once."""
-    from engine.method.markers import kabsch, reference_pose
+    from facetraj_engine.method.markers import kabsch, reference_pose
 
     rng = np.random.default_rng(11)
     pose = rng.normal(0, 30, (4, 3))

@@ -1,5 +1,5 @@
-"""Cross-validation of the robust mode's settings on the training split only (engine.evaluation.tuning), and
-the evaluation with automatic labels (engine.evaluation.label_eval) on its own numbers."""
+"""Cross-validation of the robust mode's settings on the training split only (facetraj_engine.evaluation.tuning), and
+the evaluation with automatic labels (facetraj_engine.evaluation.label_eval) on its own numbers."""
 
 from __future__ import annotations
 
@@ -10,12 +10,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from engine.config import SynthConfig
-from engine.errors import InputError
-from engine.evaluation.label_eval import LabelEval, evaluate_kind, format_markdown
-from engine.evaluation.scores import UtteranceScore
-from engine.evaluation.tuning import LIMITS, coordinate_search, cross_validate, fold_ids
-from engine.method.modes import tuned_config
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.errors import InputError
+from facetraj_engine.evaluation.label_eval import LabelEval, evaluate_kind, format_markdown
+from facetraj_engine.evaluation.scores import UtteranceScore
+from facetraj_engine.evaluation.tuning import LIMITS, coordinate_search, cross_validate, fold_ids
+from facetraj_engine.method.modes import tuned_config
 from facetraj.cli import main
 
 
@@ -103,7 +103,7 @@ def test_evaluate_kind_on_toy_corpus(toy_corpus, toy_model):
 
 
 def test_label_eval_file_round_trip(tmp_path):
-    from engine.evaluation.label_eval import read_label_eval, write_label_eval
+    from facetraj_engine.evaluation.label_eval import read_label_eval, write_label_eval
 
     assert read_label_eval(tmp_path / "absent.json") is None
     res = LabelEval(scores={"recognized": [_score("robust", 0.7), _score("phonetic", 0.5)]},

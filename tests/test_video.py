@@ -25,7 +25,7 @@ def test_video_from_corpus_utterance(toy_corpus_dir, tmp_path, capsys):
     assert "Video: h264" in info and "Audio: aac" in info and "640x320" in info
     dur = next(ln for ln in info.splitlines() if "Duration" in ln)
     _h, _m, s = dur.split("Duration:")[1].split(",")[0].strip().split(":")
-    from engine.io.corpus import load_corpus
+    from facetraj_engine.io.corpus import load_corpus
 
     utt = load_corpus(toy_corpus_dir).utterance("toy030")
     assert float(s) == pytest.approx(utt.duration, abs=0.15)
@@ -65,11 +65,11 @@ def _colour_pixels(img, box, hex_colour, tol=40):
 def test_video_frame_has_legend_surface_and_phone_tier_inside(default_model, default_corpus, size):
     """A rendered frame: the legend and the phone tier lie inside the frame and show what they
     should (the legend's colours, phone labels inside the tier); the face surface is drawn."""
-    from app.style import ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
-    from app.video import VideoFrames, VideoSettings
-    from engine.config import SynthConfig
-    from engine.method.modes import choose_mode
-    from engine.method.pipeline import synthesize
+    from facetraj_app.style import ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
+    from facetraj_app.video import VideoFrames, VideoSettings
+    from facetraj_engine.config import SynthConfig
+    from facetraj_engine.method.modes import choose_mode
+    from facetraj_engine.method.pipeline import synthesize
 
     utt = default_corpus.utterance(default_corpus.info.test[0])
     res = synthesize(default_model, utt.audio, utt.sample_rate, utt.phones,

@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pytest
 
-from app.viewer_model import SynthRequest, ViewerModel, correlation_sweep, load_model, read_texts
-from engine.data import Provenance
-from engine.errors import FacetrajError, InputError
+from facetraj_app.viewer_model import SynthRequest, ViewerModel, correlation_sweep, load_model, read_texts
+from facetraj_engine.data import Provenance
+from facetraj_engine.errors import FacetrajError, InputError
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -28,7 +28,7 @@ def state(toy_corpus, toy_model) -> ViewerModel:
 
 
 def test_viewer_model_imports_no_gui_library():
-    code = ("import sys, app.viewer_model, app.state; "
+    code = ("import sys, facetraj_app.viewer_model, facetraj_app.state; "
             "bad = [m for m in sys.modules if m.split('.')[0] in ('PyQt6', 'pyvista', 'pyvistaqt', "
             "'matplotlib')]; print(bad); sys.exit(1 if bad else 0)")
     proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True)
@@ -122,8 +122,8 @@ def test_choosing_the_search_shown_is_explicit_and_the_title_names_the_search_us
     choice from then on, with no synthesis to redo; choosing phonetic where robust is shown is
     obeyed although the settings already asked for phonetic. The title and status line say the
     search the synthesis used and where the labels came from."""
-    from app.provenance import LabelOrigin
-    from app.viewer_model import view_summary, view_title
+    from facetraj_app.provenance import LabelOrigin
+    from facetraj_app.viewer_model import view_summary, view_title
 
     utt = toy_corpus.utterance(toy_corpus.info.test[0])
     name = state.add_external(replace(utt, markers=None, label_source="aligned", text="a b c",
@@ -158,9 +158,9 @@ def test_choosing_the_search_shown_is_explicit_and_the_title_names_the_search_us
 def test_provenance_doctests():
     import doctest
 
-    import app.provenance
+    import facetraj_app.provenance
 
-    assert doctest.testmod(app.provenance).failed == 0
+    assert doctest.testmod(facetraj_app.provenance).failed == 0
 
 
 def test_frame_and_phone_arithmetic(state, toy_corpus):
@@ -227,7 +227,7 @@ def test_load_model_checks_the_marker_set(toy_corpus, toy_model, tmp_path):
 
 
 def test_gate_wakes_its_waiter_without_polling():
-    from app.workers import Gate
+    from facetraj_app.workers import Gate
 
     gate = Gate(is_open=False)
     result: list[bool] = []

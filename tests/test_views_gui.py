@@ -20,9 +20,9 @@ from PyQt6.QtGui import QImage
 from PyQt6.QtWidgets import QAbstractButton, QSlider
 from screens import Heartbeat, image_array, on_screen, place_in
 
-from app.analysis import PANELS, VIEWS
-from app.figure_canvas import BackgroundCanvas
-from app.main import build_window
+from facetraj_app.analysis import PANELS, VIEWS
+from facetraj_app.figure_canvas import BackgroundCanvas
+from facetraj_app.main import build_window
 from facetraj.paths import default_corpus
 
 pytestmark = pytest.mark.gui
@@ -167,7 +167,7 @@ def test_the_face_shows_the_mouth_closed_at_a_b_and_the_lip_panels_where_closed_
     front: between the lip centre markers the picture is skin at the /b/ (the surface had a hole
     there) and the dark mouth at the /oy/ after it; the lip panels draw the talker's closed lip
     positions as a reference line."""
-    from app import style
+    from facetraj_app import style
 
     win = window
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):

@@ -1,5 +1,5 @@
-"""The second voice (engine.evaluation.second_voice) and acoustic-only synthesis from it with and
-without speaker normalisation (engine.evaluation.voice_eval, issue 13)."""
+"""The second voice (facetraj_engine.evaluation.second_voice) and acoustic-only synthesis from it with and
+without speaker normalisation (facetraj_engine.evaluation.voice_eval, issue 13)."""
 
 from __future__ import annotations
 
@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 from scipy.signal import lfilter
 
-from engine.errors import InputError
-from engine.evaluation.scores import METRICS
-from engine.evaluation.second_voice import (
+from facetraj_engine.errors import InputError
+from facetraj_engine.evaluation.scores import METRICS
+from facetraj_engine.evaluation.second_voice import (
     VoiceSpec,
     all_pole_filter,
     f0_track,
@@ -23,7 +23,7 @@ from engine.evaluation.second_voice import (
     second_voice,
     voice_ratios,
 )
-from engine.evaluation.voice_eval import (
+from facetraj_engine.evaluation.voice_eval import (
     NORMALISATIONS,
     VOICES,
     condition,
@@ -32,7 +32,7 @@ from engine.evaluation.voice_eval import (
     read_voice_eval,
     write_voice_eval,
 )
-from engine.method.speaker import warp_grid
+from facetraj_engine.method.speaker import warp_grid
 
 RATE = 16000
 
@@ -156,7 +156,7 @@ def test_evaluation_on_the_toy_corpus(toy_voice_eval):
 
 
 def test_file_round_trip_and_report_section(toy_voice_eval, tmp_path):
-    from engine.report.markdown import second_voice_section
+    from facetraj_engine.report.markdown import second_voice_section
 
     assert read_voice_eval(tmp_path / "absent.json") is None
     back = read_voice_eval(write_voice_eval(tmp_path / "voice_eval.json", toy_voice_eval))

@@ -12,7 +12,7 @@ pytest.importorskip("pytestqt")
 
 from PyQt6.QtCore import QObject
 
-from app.workers import Gate, TaskRunner
+from facetraj_app.workers import Gate, TaskRunner
 
 pytestmark = pytest.mark.gui
 

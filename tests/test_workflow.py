@@ -7,8 +7,8 @@ from __future__ import annotations
 import logging
 import shutil
 
-from engine.io.labelfiles import recorded_provenance
-from engine.method.model import Model
+from facetraj_engine.io.labelfiles import recorded_provenance
+from facetraj_engine.method.model import Model
 from facetraj.cli import main
 
 

@@ -13,11 +13,11 @@ import numpy as np
 from scipy.ndimage import gaussian_filter1d
 from scipy.signal import lfilter
 
-from engine.data import PhoneSegment
-from engine.io.audio import write_audio
-from engine.io.corpus import CorpusInfo, save_corpus_info
-from engine.io.labelfiles import write_textgrid
-from engine.io.markerfiles import write_c3d
+from facetraj_engine.data import PhoneSegment
+from facetraj_engine.io.audio import write_audio
+from facetraj_engine.io.corpus import CorpusInfo, save_corpus_info
+from facetraj_engine.io.labelfiles import write_textgrid
+from facetraj_engine.io.markerfiles import write_c3d
 
 RATE = 16000
 FPS = 60.0

@@ -4,7 +4,7 @@
 ``app/main_window.py``): one "Analysis" menu entry per view, each opening a dock on first use, and
 checkable entries for the time-aligned panels (lip aperture, width, protrusion, tangential
 velocity with landmarks, lip error). Views are rebuilt when a new model is loaded. Every number
-shown comes from the engine (``engine.analysis``, ``engine.evaluation.kinematics`` and the modules they use).
+shown comes from the engine (``facetraj_engine.analysis``, ``facetraj_engine.evaluation.kinematics`` and the modules they use).
 
 Each view is also a standalone widget taking ``(model[, corpus], window=None)``.
 """

@@ -24,8 +24,8 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from app.figure_canvas import BackgroundCanvas
-from app.workers import TaskRunner
+from facetraj_app.figure_canvas import BackgroundCanvas
+from facetraj_app.workers import TaskRunner
 
 log = logging.getLogger(__name__)
 

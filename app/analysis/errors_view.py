@@ -1,6 +1,6 @@
 """Error analysis: which phones synthesize worst, which utterances, which segments.
 
-The view runs :func:`engine.analysis.errors.error_report` in a background worker and shows correlation
+The view runs :func:`facetraj_engine.analysis.errors.error_report` in a background worker and shows correlation
 and RMS lip error per phone, a sortable per-utterance list and the worst segments; a click on an
 utterance or a segment jumps there (utterance and time). :class:`LipErrorPanel` adds
 ``|original - synthesized|`` of the lips to the time-aligned stack with the worst segments of
@@ -31,9 +31,9 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from app.style import ORIGINAL_COLOR, SYNTH_COLOR
-from engine.analysis.common import subset_corpus
-from engine.analysis.errors import (
+from facetraj_app.style import ORIGINAL_COLOR, SYNTH_COLOR
+from facetraj_engine.analysis.common import subset_corpus
+from facetraj_engine.analysis.errors import (
     ErrorReport,
     error_report,
     lip_error,
@@ -41,8 +41,8 @@ from engine.analysis.errors import (
     worst_segments,
     write_error_csv,
 )
-from engine.io.corpus import Corpus
-from engine.method.model import Model
+from facetraj_engine.io.corpus import Corpus
+from facetraj_engine.method.model import Model
 
 from .common import (
     Canvas,

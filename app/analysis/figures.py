@@ -1,6 +1,6 @@
 """Screenshots of the analysis views for ``docs/analysis.md`` (run under a display, e.g. Xvfb):
 
-    xvfb-run -a -s "-screen 0 1600x1200x24" python -m app.analysis.figures data_samples docs/figures
+    xvfb-run -a -s "-screen 0 1600x1200x24" python -m facetraj_app.analysis.figures data_samples docs/figures
 
 Writes ``analysis_<view>.png`` for every view and ``analysis_window.png`` (the main window with the
 kinematics and lip error panels in the time-aligned stack).
@@ -17,8 +17,8 @@ from pathlib import Path
 from PyQt6.QtCore import QEventLoop, QTimer
 from PyQt6.QtWidgets import QApplication, QWidget
 
-from app.figure_canvas import BackgroundCanvas
-from app.plotter_widget import grab_with_3d
+from facetraj_app.figure_canvas import BackgroundCanvas
+from facetraj_app.plotter_widget import grab_with_3d
 
 log = logging.getLogger(__name__)
 
@@ -103,8 +103,8 @@ def make_figures(corpus_dir: Path, out: Path, per_split: int = 6,
                  only: set[str] | None = None) -> list[Path]:
     """Open the main window on ``corpus_dir`` with the analysis views and save their screenshots
     (``only``: just these views, e.g. ``{"errors"}``; ``"window"`` is the panel stack)."""
-    from app.main_window import MainWindow
-    from engine.io.corpus import load_corpus
+    from facetraj_app.main_window import MainWindow
+    from facetraj_engine.io.corpus import load_corpus
 
     from . import install
 

@@ -3,10 +3,10 @@
 The current phone and its context-phone, the top-N context-phones chosen with their n_j scores
 (eq 4), the 5N candidate codewords with their distances d_i (eq 5) and weights v_i (eq 6), the
 chosen gamma, and the input LSF vector w against its approximation w-hat (eq 7). In the robust
-mode (``engine.method.selection``) each candidate also shows why it was chosen: its target cost (eq 5
+mode (``facetraj_engine.method.selection``) each candidate also shows why it was chosen: its target cost (eq 5
 with acoustic context), its label cost (kappa times the label's confidence, when eq 4 did not
 choose it) and whether eq 4 chose it; the frame's label confidence is shown above. Every number is
-from :func:`engine.analysis.inspector.inspect_frame`.
+from :func:`facetraj_engine.analysis.inspector.inspect_frame`.
 """
 
 from __future__ import annotations
@@ -26,10 +26,10 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from app.style import ORIGINAL_COLOR, SYNTH_COLOR
-from engine.analysis.inspector import FrameInspection, inspect_frame
-from engine.method.model import Model
-from engine.method.pipeline import Synthesis
+from facetraj_app.style import ORIGINAL_COLOR, SYNTH_COLOR
+from facetraj_engine.analysis.inspector import FrameInspection, inspect_frame
+from facetraj_engine.method.model import Model
+from facetraj_engine.method.pipeline import Synthesis
 
 from .common import Canvas, NumberItem, fill_table, heat_item, text_item
 

@@ -33,9 +33,9 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from app.style import CLOSED_COLOR, ORIGINAL_COLOR, SYNTH_COLOR
-from engine.analysis.lips import ClosedLips
-from engine.evaluation.kinematics import (
+from facetraj_app.style import CLOSED_COLOR, ORIGINAL_COLOR, SYNTH_COLOR
+from facetraj_engine.analysis.lips import ClosedLips
+from facetraj_engine.evaluation.kinematics import (
     LABIAL_PHONES,
     LANDMARKS,
     GestureMeasurement,
@@ -47,7 +47,7 @@ from engine.evaluation.kinematics import (
     write_landmarks_textgrid,
     write_landmarks_tsv,
 )
-from engine.method.model import Model
+from facetraj_engine.method.model import Model
 
 from .common import Canvas, NumberItem, export_with_dialog, fill_table, text_item
 

@@ -27,8 +27,8 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from engine.analysis.common import subset_corpus
-from engine.analysis.metrics import (
+from facetraj_engine.analysis.common import subset_corpus
+from facetraj_engine.analysis.metrics import (
     SweepCurve,
     Table2Row,
     sweep_curves,
@@ -36,10 +36,10 @@ from engine.analysis.metrics import (
     write_sweep_csv,
     write_table2_csv,
 )
-from engine.evaluation.paper import TABLE2_N, table2_value
-from engine.evaluation.scores import METRICS, EvalResult, sweep_n, table2
-from engine.io.corpus import Corpus
-from engine.method.model import Model
+from facetraj_engine.evaluation.paper import TABLE2_N, table2_value
+from facetraj_engine.evaluation.scores import METRICS, EvalResult, sweep_n, table2
+from facetraj_engine.io.corpus import Corpus
+from facetraj_engine.method.model import Model
 
 from .common import (
     Canvas,

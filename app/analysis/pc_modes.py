@@ -31,12 +31,12 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from app.plotter_widget import make_plotter
-from app.style import BACKGROUND, SYNTH_COLOR
-from app.surface import lip_contours, stored_face_triangles
-from app.view3d import MarkerSet
-from engine.analysis.pc_modes import describe_mode, mode_displacement, mode_sd, variance_shares
-from engine.method.model import Model
+from facetraj_app.plotter_widget import make_plotter
+from facetraj_app.style import BACKGROUND, SYNTH_COLOR
+from facetraj_app.surface import lip_contours, stored_face_triangles
+from facetraj_app.view3d import MarkerSet
+from facetraj_engine.analysis.pc_modes import describe_mode, mode_displacement, mode_sd, variance_shares
+from facetraj_engine.method.model import Model
 
 from ..workers import one_per_pass
 from .common import Canvas, vertical_split

@@ -29,9 +29,9 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from engine.evaluation.paper import paper_table1
-from engine.method.model import Model
-from engine.method.similarity import top_similar
+from facetraj_engine.evaluation.paper import paper_table1
+from facetraj_engine.method.model import Model
+from facetraj_engine.method.similarity import top_similar
 
 from .common import (
     Canvas,
@@ -44,7 +44,7 @@ from .common import (
 )
 
 if TYPE_CHECKING:
-    from engine.analysis.similarity import Dendrogram, PhoneClustering
+    from facetraj_engine.analysis.similarity import Dendrogram, PhoneClustering
 
 log = logging.getLogger(__name__)
 
@@ -52,7 +52,7 @@ log = logging.getLogger(__name__)
 def clustering_of(model: Model) -> tuple[PhoneClustering, Dendrogram]:
     """The phones' clustering and its dendrogram (slow the first time: scipy's clustering is
     imported; run in a worker)."""
-    from engine.analysis.similarity import cluster_phones, dendrogram
+    from facetraj_engine.analysis.similarity import cluster_phones, dendrogram
 
     clustering = cluster_phones(model)
     return clustering, dendrogram(clustering)
@@ -152,7 +152,7 @@ class SimilarityView(QWidget):
     def refresh(self) -> None:
         if self.clustering is None:
             return
-        from engine.analysis.similarity import similarity_in_order
+        from facetraj_engine.analysis.similarity import similarity_in_order
 
         nu = float(self.nu.value())
         self.matrix = similarity_in_order(self.model, nu, self.clustering.order)
@@ -191,7 +191,7 @@ class SimilarityView(QWidget):
 
     # ------------------------------------------------------------------ export
     def export_csv(self, path: str | Path) -> Path:
-        from engine.analysis.similarity import write_similarity_csv
+        from facetraj_engine.analysis.similarity import write_similarity_csv
 
         if self.clustering is None:
             raise ValueError("the phones are still being clustered")

@@ -17,11 +17,11 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import mannwhitneyu
 
-from engine.config import SynthConfig
-from engine.evaluation.closure_eval import arctic_references
-from engine.io.corpus import load_corpus
-from engine.method.pipeline import synthesize
-from engine.method.training import train
+from facetraj_engine.config import SynthConfig
+from facetraj_engine.evaluation.closure_eval import arctic_references
+from facetraj_engine.io.corpus import load_corpus
+from facetraj_engine.method.pipeline import synthesize
+from facetraj_engine.method.training import train
 
 BILABIALS = ("p", "b", "m")
 

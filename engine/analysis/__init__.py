@@ -4,7 +4,7 @@ module per view (mirroring ``app/analysis/``):
 * :mod:`.similarity` (``similarity_view``): phones ordered by hierarchical clustering of the eq 2
   distances (visemes group), the dendrogram, the similarity matrix (eq 3) as CSV;
 * :mod:`.metrics` (``metrics_view``): Table 2 and the N sweep (Figure 5) as rows and CSV, from an
-  :class:`~engine.evaluation.scores.EvalResult`;
+  :class:`~facetraj_engine.evaluation.scores.EvalResult`;
 * :mod:`.errors` (``errors_view``): per-frame lip error, per-phone correlation and RMS error,
   per-utterance errors, worst segments;
 * :mod:`.inspector` (``inspector``): the codebook inspector, everything eqs 4-8 did at one frame;
@@ -14,7 +14,7 @@ module per view (mirroring ``app/analysis/``):
   mouth shuts and the panels draw their "closed" line;
 * :mod:`.common`: the CSV writer and the quick-look corpus subset they share.
 
-The kinematics panels' numbers are in :mod:`engine.evaluation.kinematics`. Pure numpy/scipy; every number
+The kinematics panels' numbers are in :mod:`facetraj_engine.evaluation.kinematics`. Pure numpy/scipy; every number
 the app shows is computed here or in the other engine modules. Import from the modules, e.g.
-``from engine.analysis.similarity import cluster_phones``.
+``from facetraj_engine.analysis.similarity import cluster_phones``.
 """

@@ -26,7 +26,7 @@ class CodewordRow:
     time: float             # its time in that utterance (s)
     distance: float         # d_i (eq 5)
     weight: float           # v_i (eq 6)
-    target_cost: float = float("nan")   # robust mode: eq 5 with acoustic context (engine.method.selection)
+    target_cost: float = float("nan")   # robust mode: eq 5 with acoustic context (facetraj_engine.method.selection)
     label_cost: float = float("nan")    # robust mode: kappa * confidence if eq 4 did not choose it
     from_labels: bool = True            # chosen by eq 4 (always, in phonetic mode)
 

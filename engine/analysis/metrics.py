@@ -1,5 +1,5 @@
 """The metrics view's numbers: the paper's Table 2 and the N sweep (Figure 5) as rows and CSV,
-from an :class:`~engine.evaluation.scores.EvalResult`."""
+from an :class:`~facetraj_engine.evaluation.scores.EvalResult`."""
 
 from __future__ import annotations
 
@@ -34,7 +34,7 @@ def condition_name(split: str, smoothing: str, mode: str = "phonetic", n: int | 
 @dataclass(kw_only=True)
 class Table2Row(ConditionScores):
     """One row of Table 2: the condition, its three mean correlations (the fields of
-    :class:`~engine.evaluation.scores.ConditionScores`), a row ``name`` and the number of utterances."""
+    :class:`~facetraj_engine.evaluation.scores.ConditionScores`), a row ``name`` and the number of utterances."""
 
     name: str
     utterances: int
@@ -77,7 +77,7 @@ class SweepCurve:
 
 
 def sweep_curves(result: EvalResult, smoothing: str = "triangular") -> list[SweepCurve]:
-    """The N sweep per split from a :func:`~engine.evaluation.scores.sweep_n` result."""
+    """The N sweep per split from a :func:`~facetraj_engine.evaluation.scores.sweep_n` result."""
     out = []
     for split in ("train", "test"):
         ns = sorted({s.n_context_phones for s in result.scores

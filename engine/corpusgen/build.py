@@ -191,7 +191,7 @@ def check_phone_coverage(counts: Counter, minimum: int = MIN_PHONE_COUNT) -> lis
 def _build_all(ids: list[str], root: Path, seed: int, config: CorpusConfig, workers: int,
                progress: Progress | None) -> dict[str, UtteranceResult]:
     """Every utterance of ``ids`` built into ``root`` in ``workers`` processes
-    (:func:`engine.fanout.fan_out`). A worker that dies fails its utterance only: the others are
+    (:func:`facetraj_engine.fanout.fan_out`). A worker that dies fails its utterance only: the others are
     built, then the build stops with an error naming the ones that were not."""
     results: dict[str, UtteranceResult] = {}
     failed = Skips("utterances", verb="not built")
@@ -214,7 +214,7 @@ def build_corpus(out_dir: str | os.PathLike[str], n_sentences: int = DEFAULT_SEN
 
     ``progress(fraction, message)`` is called before synthesis and after each utterance (the
     engine's progress convention). ``workers`` processes (default: the number of CPUs; forked by
-    :func:`engine.fanout.fan_out`) synthesize in parallel; every utterance comes out the same
+    :func:`facetraj_engine.fanout.fan_out`) synthesize in parallel; every utterance comes out the same
     bits however many. Returns the corpus description.
     """
     config = config or CorpusConfig()
@@ -253,7 +253,7 @@ def build_corpus(out_dir: str | os.PathLike[str], n_sentences: int = DEFAULT_SEN
         fixed_markers=list(FIXED_MARKERS), upper_lip=UPPER_LIP, lower_lip=LOWER_LIP,
         train=train, test=test, lip_corners=list(LIP_CORNERS),
         name="facetraj synthetic (VocalTractLab JD3)",
-        description=(f"Synthetic audio-visual corpus built by engine.corpusgen (seed {seed}, "
+        description=(f"Synthetic audio-visual corpus built by facetraj_engine.corpusgen (seed {seed}, "
                      f"{n_sentences} sentences): speech from the VocalTractLab articulatory "
                      f"synthesizer (speaker JD3), 54 face markers driven by its jaw and lip "
                      f"articulators, with head motion, marker noise and {n_drops} short marker "

@@ -9,8 +9,8 @@
 - ``kinematics``: lip kinematics and gesture landmarks;
 - ``paper``: the paper's own numbers (Tables 1-2, Figure 4's sentence).
 
-Imports ``engine.method``, ``engine.streaming`` and below; ``engine.analysis`` and
-``engine.report`` build on it.
+Imports ``facetraj_engine.method``, ``facetraj_engine.streaming`` and below; ``facetraj_engine.analysis`` and
+``facetraj_engine.report`` build on it.
 """
 
 from .. import lazy_exports

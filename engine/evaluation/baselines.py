@@ -1,6 +1,6 @@
 """Two simple baselines to put the paper's method in perspective (issue 7), scored exactly like
-Table 2 (:func:`~engine.evaluation.scores.trajectory_correlations` on
-:func:`~engine.evaluation.scores.speech_mask` frames, the same smoothing).
+Table 2 (:func:`~facetraj_engine.evaluation.scores.trajectory_correlations` on
+:func:`~facetraj_engine.evaluation.scores.speech_mask` frames, the same smoothing).
 
 * **Viseme lookup**: every frame gets the mean PC vector of its phone (the eq 1 idea applied
   directly, no acoustics, no context): what the phone labels alone explain.
@@ -8,7 +8,7 @@ Table 2 (:func:`~engine.evaluation.scores.trajectory_correlations` on
   paper's own features, ~180 ms of context, no labels), by ridge regression; the regularisation
   is chosen on held-out *training* utterances, never on the test split.
 
-Both work on the 60 Hz marker frames: LSFs from :func:`engine.method.lsf.lsf_at` with the model's
+Both work on the 60 Hz marker frames: LSFs from :func:`facetraj_engine.method.lsf.lsf_at` with the model's
 analysis settings, PCs from the model's normalisation and PCA. Both are fitted from sufficient
 statistics given one training utterance at a time (:class:`BaselineGather`: the phones' sums, the
 moments of ``[features, PCs]``), so that a corpus is streamed through them. numpy only.

@@ -4,7 +4,7 @@ The lip aperture is the upper-lip centre's y minus the lower-lip centre's y (the
 ``upper_lip`` and ``lower_lip`` markers, head frame, mm). For each /p b m/ segment of the
 reference labels, the smallest aperture inside it; a closure counts when that minimum is within
 ``tol`` (1 mm) of the talker's closed aperture -- for a synthesized face the training talker's
-(:attr:`engine.method.closure.ClosureStats.closed`). Beside it, so that lips shut all the time
+(:attr:`facetraj_engine.method.closure.ClosureStats.closed`). Beside it, so that lips shut all the time
 cannot pass: the median over vowels of each vowel's largest aperture, and the median over pauses
 (silences over 150 ms) of each pause's median aperture.
 """

@@ -1,11 +1,11 @@
 """Lips that close, measured for the report (issue 25): the closure of every synthesis mode and
 label source on the default corpus's held-out sentences (with their correlations) and on real
 voices the model was not trained on (CMU ARCTIC sentences, speech only), each synthesized the way
-the commands do it (:func:`engine.method.recording.synthesize_recording` is ``facetraj synth``;
-:func:`engine.streaming.live.stream_file` is ``facetraj live --from-file``, with phones
+the commands do it (:func:`facetraj_engine.method.recording.synthesize_recording` is ``facetraj synth``;
+:func:`facetraj_engine.streaming.live.stream_file` is ``facetraj live --from-file``, with phones
 recognized as they are spoken or ``--acoustic-only``).
 
-The measure is :mod:`engine.evaluation.closure`: /p b m/ within 1 mm of the training talker's
+The measure is :mod:`facetraj_engine.evaluation.closure`: /p b m/ within 1 mm of the training talker's
 closed aperture, the median minimum at /p b m/, the median vowel maximum and the median pause
 aperture. On the corpus the reference labels are its exact ones; on the ARCTIC sentences, their
 transcripts aligned, whatever labels the synthesis itself was given.

@@ -1,16 +1,16 @@
 """Evaluation with automatic labels (issue 16): every mode and baseline on held-out sentences,
 trained and tested with the corpus's exact labels, or with labels from the aligner or the
-recognizer (``engine.io.labelling``) -- the setting of a real user, who has no hand-checked labels.
+recognizer (``facetraj_engine.io.labelling``) -- the setting of a real user, who has no hand-checked labels.
 
 For each label kind: a model trained on the training split with those labels; its robust-mode
-settings cross-validated on the training split (``engine.evaluation.tuning``); then on the test split, with
+settings cross-validated on the training split (``facetraj_engine.evaluation.tuning``); then on the test split, with
 the same kind of labels, the paper's phonetic mode (N = 3), acoustic-only (default index search),
-the robust mode, and the two baselines of ``engine.evaluation.baselines`` (viseme lookup, ridge regression),
+the robust mode, and the two baselines of ``facetraj_engine.evaluation.baselines`` (viseme lookup, ridge regression),
 all scored as Table 2 (triangular smoothing, speech frames); and ``default``, what the documented
 workflow does (``corpus align``, ``corpus init``, ``train``, ``eval``): the mode by the one rule
-(:func:`engine.method.modes.choose_mode`), with every default of synthesis (the chain, the label
+(:func:`facetraj_engine.method.modes.choose_mode`), with every default of synthesis (the chain, the label
 weight by voice, the closure step). The same test sentences spoken by a second voice
-(:mod:`engine.evaluation.second_voice`; for automatic labels, labelled from its own audio) are
+(:mod:`facetraj_engine.evaluation.second_voice`; for automatic labels, labelled from its own audio) are
 scored too, under ``"<kind>, second voice"``.
 """
 
@@ -39,7 +39,7 @@ from .tuning import cross_validate
 
 log = logging.getLogger(__name__)
 
-#: The file of a saved evaluation, beside the report (``engine.report``).
+#: The file of a saved evaluation, beside the report (``facetraj_engine.report``).
 LABEL_EVAL_FILE = "label_eval.json"
 #: Label kinds: the corpus's own (exact) labels, and the two automatic ones.
 LABEL_KINDS = ("exact", "aligned", "recognized")
@@ -231,7 +231,7 @@ def evaluate_labels(corpus: Corpus, kinds: Sequence[str] = LABEL_KINDS,
 
 
 def write_label_eval(path: str | os.PathLike[str], result: LabelEval) -> Path:
-    """Save ``result`` as JSON (read by the report generator, ``engine.report``)."""
+    """Save ``result`` as JSON (read by the report generator, ``facetraj_engine.report``)."""
     return write_json(path, result.to_json())
 
 
@@ -254,15 +254,15 @@ def format_markdown(result: LabelEval) -> str:
     """The results.md section: one table per label kind and a plain recommendation."""
     lines = ["Held-out (test) sentences only. Exact labels are the corpus's own; aligned labels come "
              "from PocketSphinx forced alignment of each sentence's text, recognized ones from its "
-             "phone recognizer without text (`engine.io.labelling`, cached). For each kind of labels "
+             "phone recognizer without text (`facetraj_engine.io.labelling`, cached). For each kind of labels "
              "the model is trained on the training split labelled the same way, the robust mode's "
-             "settings are cross-validated on the training split (`engine.evaluation.tuning`), and every "
+             "settings are cross-validated on the training split (`facetraj_engine.evaluation.tuning`), and every "
              "method is scored on the test split as in Table 2 (triangular smoothing, speech "
              "frames), mean ± one standard deviation over utterances (the corpus has one speaker, "
              "so the spread is over utterances). *Second voice*: the same test sentences spoken by "
-             "a voice with a shorter vocal tract and a higher pitch (`engine.evaluation.second_voice`, "
+             "a voice with a shorter vocal tract and a higher pitch (`facetraj_engine.evaluation.second_voice`, "
              "the same timing, so the same markers), its automatic labels made from its own audio, "
-             "synthesized with the same model. Computed by `engine.evaluation.label_eval` "
+             "synthesized with the same model. Computed by `facetraj_engine.evaluation.label_eval` "
              "(`facetraj report --automatic-labels`)."]
     for kind in result.scores:
         lines += ["", f"**{kind.title()} labels** (train and test labelled the same way)", "",

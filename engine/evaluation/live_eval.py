@@ -5,7 +5,7 @@ Offline, ``facetraj synth speech.wav`` recognizes the phones of the whole record
 cepstral mean, the phone sequence re-aligned), synthesizes in the robust mode with the voice
 ratio of the whole recording and applies the closure step with every frame known. Live mode
 (``facetraj live --from-file``) has the audio up to each frame's time plus its lookahead. The
-comparison takes both through the measure of :mod:`engine.evaluation.closure` against the
+comparison takes both through the measure of :mod:`facetraj_engine.evaluation.closure` against the
 reference phones (the transcripts aligned), and compares them directly: the lip aperture frame by
 frame, the recognized phones 10 ms frame by 10 ms frame, and which reference /p b m/ each
 recognizer found (a recognized /p b m/ overlapping it).
@@ -133,7 +133,7 @@ def phone_agreement(recordings: Mapping[str, tuple[np.ndarray, int]],
     """The share of offline recognition's speech frames (10 ms, not ``sil``) that the streamed
     recognizer (``config``, each recording a fresh stream in 10 ms blocks) labels alike, pooled
     over ``recordings`` (name: audio, rate); ``offline`` gives recognition's phones when already
-    known (:func:`engine.labels.alignment.recognize` otherwise)."""
+    known (:func:`facetraj_engine.labels.alignment.recognize` otherwise)."""
     alike = speech = 0
     for name, (audio, rate) in recordings.items():
         ref = offline[name] if offline is not None else recognize(audio, rate).phones
@@ -160,7 +160,7 @@ class _BlockLog(RunningCmn):
 def frame_cepstra(audio: np.ndarray, rate: int) -> np.ndarray:
     """The 13 cepstra of each 10 ms frame the streamed recognizer decodes from ``audio``
     (frames x 13): its running mean set after every frame, each frame's cepstra recovered from
-    the mean PocketSphinx reports (:func:`engine.streaming.recognizer.held_sum`)."""
+    the mean PocketSphinx reports (:func:`facetraj_engine.streaming.recognizer.held_sum`)."""
     log = _BlockLog()
     rec = StreamingRecognizer(rate, RecognizerConfig(cmn_every=1), cmn=log)
     step = max(1, int(round(FRAME_S * rate)))

@@ -200,11 +200,11 @@ def evaluate(model: Model, corpus: Corpus, splits: Iterable[str] = ("train", "te
     """Score every utterance of ``splits`` under each synthesis config (Table 2 and more).
 
     With ``workers > 1`` the utterances are scored in that many processes
-    (:func:`engine.fanout.fan_out`: forked, so the model is shared, not copied through pickle);
+    (:func:`facetraj_engine.fanout.fan_out`: forked, so the model is shared, not copied through pickle);
     each utterance is independent, and the scores come back in corpus order, equal to the serial
-    run's. BLAS runs on one thread either way (:mod:`engine.threads`): the processes share the
+    run's. BLAS runs on one thread either way (:mod:`facetraj_engine.threads`): the processes share the
     cores, and the serial run computes the same sums in the same order; and each utterance is
-    synthesized on one frame thread (:func:`engine.threads.limit_frame_threads`), in the serial
+    synthesized on one frame thread (:func:`facetraj_engine.threads.limit_frame_threads`), in the serial
     run too, so that the scores do not depend on ``workers`` even at rounding level.
 
     An utterance with a bad file stops the evaluation with that file's error, whatever

@@ -14,7 +14,7 @@ and vowel); at the top of the band it returns to the identity so that the map st
 ``(0, nyquist)``. Finally the level is matched to the original's short-time level (so silence
 stays silence and the speech/silence detection sees the same frames).
 
-The normaliser (``engine.method.speaker``) warps LSFs by one factor below a knee; this voice's map has
+The normaliser (``facetraj_engine.method.speaker``) warps LSFs by one factor below a knee; this voice's map has
 factors that change with frequency, so it is not one of the normaliser's own warps.
 """
 
@@ -63,7 +63,7 @@ def check_audio(audio: np.ndarray, what: str = "audio", min_samples: int = 2) ->
     >>> check_audio([0.0, float("nan")])
     Traceback (most recent call last):
     ...
-    engine.errors.InputError: audio: the audio has 1 sample that is not a finite number (NaN or inf)
+    facetraj_engine.errors.InputError: audio: the audio has 1 sample that is not a finite number (NaN or inf)
     """
     x = np.asarray(audio, dtype=np.float64)
     if x.ndim != 1:
@@ -126,7 +126,7 @@ def warp_poles(a: np.ndarray, warp, rate: float) -> np.ndarray:
 
 def frame_lpc(x: np.ndarray, rate: float, order: int, hop: int, window: int) -> np.ndarray:
     """LPC polynomials ``(K, order + 1)`` of Hann-windowed frames centred every ``hop`` samples
-    (frame k at sample ``k hop``; zero outside the signal), by :func:`engine.method.lsf.lpc`."""
+    (frame k at sample ``k hop``; zero outside the signal), by :func:`facetraj_engine.method.lsf.lpc`."""
     n_frames = len(x) // hop + 1
     pad = np.concatenate([np.zeros(window // 2), x, np.zeros(window)])
     idx = np.arange(n_frames)[:, None] * hop + np.arange(window)[None, :]

@@ -1,6 +1,6 @@
 """Cross-validated synthesis settings (issues 16, 24): the robust mode's N, label weight,
 acoustic candidates and gamma's range, and the smoothing width, chosen on the *training* split
-only (never the test split) and stored in the model (:attr:`engine.method.model.Model.tuned`).
+only (never the test split) and stored in the model (:attr:`facetraj_engine.method.model.Model.tuned`).
 
 K folds of the training utterances: a model trained on K-1 folds synthesizes (up to
 ``max_per_fold`` utterances of) the held-out fold; a setting's score is the mean correlation

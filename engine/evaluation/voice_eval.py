@@ -2,7 +2,7 @@
 normalisation (issue 13).
 
 The model is trained on the training split (the training voice). Each test sentence is then
-spoken by a second voice (``engine.evaluation.second_voice``: the same recording with a shorter vocal tract's
+spoken by a second voice (``facetraj_engine.evaluation.second_voice``: the same recording with a shorter vocal tract's
 formants and a higher pitch, timing unchanged, so the original face markers still line up) and
 synthesized acoustic-only (the default index search) with the input LSFs left alone
 (``speaker_warp = 1.0``), warped by a factor chosen per utterance (``speaker_warp = None``), or
@@ -34,7 +34,7 @@ from .second_voice import VoiceSpec, median_ratios, second_voice, voice_ratios
 
 log = logging.getLogger(__name__)
 
-#: The file of a saved evaluation, beside the report (``engine.report``).
+#: The file of a saved evaluation, beside the report (``facetraj_engine.report``).
 VOICE_EVAL_FILE = "voice_eval.json"
 #: The voices: the corpus's own (training) voice and the second voice made from it.
 VOICES = ("training", "second")
@@ -67,8 +67,8 @@ class VoiceEval:
     ----------
     scores : condition (:func:`condition`) -> per-utterance scores.
     warps : condition -> utterance -> the warp factor applied.
-    voice : the second voice: ``spec`` (:class:`~engine.evaluation.second_voice.VoiceSpec` as a dict) and
-        ``ratios``, the median over test utterances of :func:`~engine.evaluation.second_voice.voice_ratios`.
+    voice : the second voice: ``spec`` (:class:`~facetraj_engine.evaluation.second_voice.VoiceSpec` as a dict) and
+        ``ratios``, the median over test utterances of :func:`~facetraj_engine.evaluation.second_voice.voice_ratios`.
     """
 
     scores: dict[str, list[UtteranceScore]] = field(default_factory=dict)
@@ -162,7 +162,7 @@ def evaluate_voices(corpus: Corpus, model: Model | None = None, spec: VoiceSpec 
 
 
 def write_voice_eval(path: str | os.PathLike[str], result: VoiceEval) -> Path:
-    """Save ``result`` as JSON (read by the report generator, ``engine.report``)."""
+    """Save ``result`` as JSON (read by the report generator, ``facetraj_engine.report``)."""
     return write_json(path, result.to_json())
 
 
@@ -182,7 +182,7 @@ def voice_paragraph(result: VoiceEval) -> str:
     spec, r = result.voice.get("spec", {}), result.voice.get("ratios", {})
     text = ("**The second voice.** VocalTractLab could not make it (changing the JD3 speaker's "
             "anatomy crashed it or froze the vocal tract in one shape), so it is made from each "
-            "test recording by signal processing (`engine.evaluation.second_voice.second_voice`): LPC "
+            "test recording by signal processing (`facetraj_engine.evaluation.second_voice.second_voice`): LPC "
             "analysis-synthesis every 5 ms, the formants (LPC pole frequencies) moved by a "
             "nonuniform map, as Fant's female/male scale factors are ")
     if spec:
@@ -275,6 +275,6 @@ def format_markdown(result: VoiceEval) -> str:
              "with a warp chosen per utterance and with one warp chosen per voice "
              "(`engine/method/speaker.py`), scored as in Table 2 (triangular smoothing, speech frames of "
              "the original recording), mean ± one standard deviation over utterances. Computed "
-             "by `engine.evaluation.voice_eval` (`facetraj report --second-voice`).")
+             "by `facetraj_engine.evaluation.voice_eval` (`facetraj report --second-voice`).")
     return "\n\n".join([intro, voice_paragraph(result), "\n".join(table_lines(result)),
                         warps_paragraph(result), verdict_paragraph(result)])

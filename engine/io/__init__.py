@@ -10,7 +10,7 @@
 - ``labelling``: which labels an input gets (a file, an aligned transcript, recognition), cached;
 - ``export``: trajectories out as C3D, TSV/CSV or NPZ.
 
-Imports the shared modules and ``engine.labels``; never ``engine.method`` or above.
+Imports the shared modules and ``facetraj_engine.labels``; never ``facetraj_engine.method`` or above.
 """
 
 from .. import lazy_exports

@@ -10,7 +10,7 @@ words 11-12 the frame rate. The parameter section (byte 3 of its first block: th
 data inside its entry), reads the point count, frame count and rate from the header and the
 POINT / ANALOG parameters, and checks that the samples they ask for fit in the file and that the
 rate is sane. A damaged file is refused in microseconds instead of making the reader allocate
-gigabytes. Raises :class:`~engine.errors.InputError` naming the file.
+gigabytes. Raises :class:`~facetraj_engine.errors.InputError` naming the file.
 """
 
 from __future__ import annotations

@@ -49,7 +49,7 @@ class CorpusInfo:
         description) mapping the labels onto ARPAbet when utterances are loaded.
     label_provenance : how label files without a record of their own (any file facetraj did not
         write) were made: ``hand-checked`` (the default), ``aligned`` or ``recognized``
-        (``engine.labels.provenance``).
+        (``facetraj_engine.labels.provenance``).
     data_dir : where the utterance files are, relative to the description's folder (``""``: the
         same folder). Lets a description point at a read-only folder of someone else's data.
     dimensions : 3, or 2 for midsagittal data (x = 0 for every marker).
@@ -285,7 +285,7 @@ class Corpus:
     def fingerprint(self) -> str:
         """A hash of the description and every data file (names and contents), for caching
         models; computed once per corpus object, and known from the files' stamps alone when
-        they are unchanged since an earlier computation (:mod:`engine.io.hash_memo`)."""
+        they are unchanged since an earlier computation (:mod:`facetraj_engine.io.hash_memo`)."""
         if "fingerprint" not in self._memo:
             description = json.dumps(self.info.to_json(), sort_keys=True)
             files = [p for p in sorted(self.data_root.iterdir())
@@ -337,7 +337,7 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
     .phn file) and markers (C3D, TSV/CSV or MOCHA EMA, resampled to the corpus rate).
 
     Labels are mapped onto ARPAbet with ``label_map``, or without one from the alphabet they are
-    in (:func:`engine.labels.alphabets.to_arpabet`: labels in none is an error naming them).
+    in (:func:`facetraj_engine.labels.alphabets.to_arpabet`: labels in none is an error naming them).
     Markers shorter than the audio are padded with NaN (a warning); longer ones are cut at the
     audio's end.
     """

@@ -20,7 +20,7 @@ def write_trajectories(path: str | os.PathLike[str], markers: np.ndarray, rate: 
                        compress: bool = False) -> Path:
     """Write ``(T, M, 3)`` trajectories (``rate`` frames per second, marker ``names``, head frame)
     as C3D, TSV/CSV or NPZ (by the suffix). The NPZ also holds ``arrays`` (for a synthesis, its
-    :meth:`~engine.method.pipeline.Synthesis.arrays`: times, smoothed and raw PCs, gamma, input LSF
+    :meth:`~facetraj_engine.method.pipeline.Synthesis.arrays`: times, smoothed and raw PCs, gamma, input LSF
     and settings), and says ``which`` trajectories it holds (synthesized or original).
 
     The NPZ is stored uncompressed unless ``compress``: on 60 s of synthesized speech, deflate

@@ -43,7 +43,7 @@ def write_problem(exc: OSError) -> str:
 
 def check_output_path(path: str | os.PathLike[str], overwrite: bool = True) -> Path:
     """Refuse an output path that cannot be written, before any work is done: an existing file
-    without ``overwrite`` (:class:`~engine.errors.OutputExistsError`), a folder at the path, a
+    without ``overwrite`` (:class:`~facetraj_engine.errors.OutputExistsError`), a folder at the path, a
     parent that is a regular file, a name too long, a folder we may not write in.
     Raises :class:`InputError` naming the path; returns it as a :class:`Path`."""
     path = Path(path)
@@ -101,7 +101,7 @@ def atomic_write(path: str | os.PathLike[str], overwrite: bool = True) -> Iterat
 
     The file gets the mode of the file it replaces, or the user's umask for a new one. The
     temporary file is removed when the block fails, on Ctrl-C and on SIGTERM. Raises
-    :class:`~engine.errors.OutputExistsError` when ``path`` exists and ``overwrite`` is false, and
+    :class:`~facetraj_engine.errors.OutputExistsError` when ``path`` exists and ``overwrite`` is false, and
     :class:`InputError` naming ``path`` when it cannot be written (see :func:`check_output_path`).
 
     Examples

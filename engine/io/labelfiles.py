@@ -20,7 +20,7 @@ LABEL_SUFFIXES = (".textgrid", ".lab", ".phn")
 
 def read_textgrid_tiers(path: str | os.PathLike[str]) -> dict[str, list[PhoneSegment]]:
     """Read every interval tier of a Praat TextGrid (long or short text form,
-    :mod:`engine.io.textgrid`); intervals out of order or overlapping are refused."""
+    :mod:`facetraj_engine.io.textgrid`); intervals out of order or overlapping are refused."""
     path = Path(path)
     try:
         parsed = parse_textgrid(read_text(path))
@@ -178,9 +178,9 @@ def read_label_file(path: str | os.PathLike[str], rate: int, duration: float,
                     declared: str | None = None, detect_alphabet: bool = True) -> Labels:
     """The labels of a label file, checked against the audio's ``duration``: its phones, a
     TextGrid's ``words`` tier, and where they came from (the record a TextGrid written by
-    facetraj holds, :func:`engine.labels.provenance.labels_from_tiers`; else ``declared``,
+    facetraj holds, :func:`facetraj_engine.labels.provenance.labels_from_tiers`; else ``declared``,
     hand-checked by default). The phones are mapped onto ARPAbet from the alphabet they are in
-    (:func:`engine.labels.alphabets.to_arpabet`) unless ``detect_alphabet`` is off (a label map
+    (:func:`facetraj_engine.labels.alphabets.to_arpabet`) unless ``detect_alphabet`` is off (a label map
     given by the user maps them later)."""
     path = Path(path)
     if path.suffix.lower() != ".textgrid":

@@ -3,14 +3,14 @@
 - :func:`labels_for_audio` is THE rule for where the labels of an audio file come from, used by
   the command line and the app: a label file given, else a sentence given (aligned), else
   recognition asked for, else a label file beside the audio (same stem), else a ``.txt``
-  transcript beside it (aligned), else none -- and then :func:`engine.method.modes.choose_mode` switches
+  transcript beside it (aligned), else none -- and then :func:`facetraj_engine.method.modes.choose_mode` switches
   to acoustic-only synthesis.
 - :func:`label_audio` labels one recording by ``"aligned"`` (from its text) or ``"recognized"``,
-  through a cache outside the repository (``engine.io.cachedir``), keyed by the audio's content, the
+  through a cache outside the repository (``facetraj_engine.io.cachedir``), keyed by the audio's content, the
   method, the text, extra pronunciations and the PocketSphinx version.
-- :func:`label_corpus` labels every utterance of a :class:`~engine.io.corpus.Corpus`;
+- :func:`label_corpus` labels every utterance of a :class:`~facetraj_engine.io.corpus.Corpus`;
   :func:`relabelled` gives a corpus whose utterances carry those labels, which
-  :func:`engine.method.training.train` and :func:`engine.evaluation.scores.evaluate` take as they are (the
+  :func:`facetraj_engine.method.training.train` and :func:`facetraj_engine.evaluation.scores.evaluate` take as they are (the
   paper trained and tested on aligner labels, section 3).
 """
 
@@ -128,7 +128,7 @@ def labels_for_audio(audio_path: str | os.PathLike[str], audio: np.ndarray, rate
     5. a ``.txt`` beside the audio -> aligned;
     6. otherwise, with ``fallback``, recognized (synthesis: on every voice measured the robust mode
        with recognized labels beats acoustic-only, and only labels can close the lips), when
-       recognition fails or without ``fallback`` ``None``: :func:`engine.method.modes.choose_mode`
+       recognition fails or without ``fallback`` ``None``: :func:`facetraj_engine.method.modes.choose_mode`
        then synthesizes acoustic-only.
 
     A label file's provenance is the record it holds (a TextGrid facetraj wrote), else
@@ -136,7 +136,7 @@ def labels_for_audio(audio_path: str | os.PathLike[str], audio: np.ndarray, rate
 
     The choice is logged. Errors of alignment (missing words, text that does not fit) propagate.
     A label file's alphabet is recognised and mapped onto ARPAbet unless ``detect_alphabet`` is
-    off (:func:`engine.io.labelfiles.read_label_file`).
+    off (:func:`facetraj_engine.io.labelfiles.read_label_file`).
     """
     duration = len(audio) / float(rate)
     if labels is not None:
@@ -323,7 +323,7 @@ def label_folder(folder: str | os.PathLike[str], method: str = "aligned",
     (``method="aligned"``; recognized where the transcript is missing or does not align), or
     recognized for all (``"recognized"``). Existing TextGrids are kept unless ``overwrite``.
 
-    The recordings are labelled in ``workers`` processes (:func:`engine.fanout.fan_out`). A
+    The recordings are labelled in ``workers`` processes (:func:`facetraj_engine.fanout.fan_out`). A
     recording that cannot be labelled (a bad audio file or transcript, silence) stops the work
     with its error, the TextGrids already written staying; with ``skip`` it is left out, recorded
     there and in ``failed``."""

@@ -1,4 +1,4 @@
-"""Reading a model file safely: the ``.npz`` archive of :meth:`engine.method.model.Model.save`, checked
+"""Reading a model file safely: the ``.npz`` archive of :meth:`facetraj_engine.method.model.Model.save`, checked
 before anything is trusted.
 
 Every zip member's compression method and size, and every array's ``.npy`` header (dtype, shape)
@@ -8,7 +8,7 @@ returned as int64 and float64 whatever the file stored), shape (against the meta
 other arrays), values (finite; LSFs in (0, pi) and in order, phone tokens ending after they
 start, orthonormal PCs, variances not negative, distances a distance matrix) and
 cross-references (marker, phone and utterance indices within their lists; the LSF index a
-partition of the codebook). Any problem is a :class:`~engine.errors.ModelFileError` naming the
+partition of the codebook). Any problem is a :class:`~facetraj_engine.errors.ModelFileError` naming the
 file, before anything uses the model.
 """
 

@@ -2,7 +2,7 @@
 every array (``numpy.lib.format.write_array`` writes to a zip member through ``tobytes``: 6.4 MB
 of copies for a 60 s synthesis, 3 of its 7 ms; issue 28). Models and trajectories are saved
 this way (numbers and text only: nothing is pickled), their disk blocks given before the bytes
-are written (:func:`engine.io.files.preallocated`)."""
+are written (:func:`facetraj_engine.io.files.preallocated`)."""
 
 from __future__ import annotations
 

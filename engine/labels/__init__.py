@@ -6,8 +6,8 @@
 - ``labelmap``: label maps onto ARPAbet (a user's map file, or an alphabet by name);
 - ``alignment``: forced alignment of a transcript and phone recognition, with a score per phone.
 
-Imports only the shared modules (``engine.data``, ``engine.errors``): reading label files and
-deciding which labels an input gets is ``engine.io`` (``labelfiles``, ``labelling``).
+Imports only the shared modules (``facetraj_engine.data``, ``facetraj_engine.errors``): reading label files and
+deciding which labels an input gets is ``facetraj_engine.io`` (``labelfiles``, ``labelling``).
 """
 
 from .. import lazy_exports

@@ -51,7 +51,7 @@ UNALIGNABLE_MARGIN = 12.0
 #: issue 25): on six real CMU ARCTIC sentences it finds 11 of 13 /p b m/ (lw 0.5-1: 7, 2: 9,
 #: 6.5: 9; 3 false /p b m/ of 15 found), on the real MOCHA-TIMIT sample the phone error rate is
 #: the same at lw 2-4 (42.9 %); on the synthetic default corpus it finds fewer (14 of 35 against
-#: 20), where synthesis trusts recognized bilabials least (engine.method.closure).
+#: 20), where synthesis trusts recognized bilabials least (facetraj_engine.method.closure).
 ALLPHONE_SETTINGS = {"lw": 4.0, "pip": 0.3, "beam": 1e-20, "pbeam": 1e-20}
 
 
@@ -309,7 +309,7 @@ def _mean_score(labels: Labels) -> float:
 # --------------------------------------------------------------------------- recognition
 def allphone_decoder():
     """A PocketSphinx decoder of the all-phone search (:data:`ALLPHONE_SETTINGS`, 16 kHz): the one
-    recognition uses, offline here and streamed in live mode (``engine.streaming.recognizer``)."""
+    recognition uses, offline here and streamed in live mode (``facetraj_engine.streaming.recognizer``)."""
     lm = os.path.join(_pocketsphinx().get_model_path(), "en-us", "en-us-phone.lm.bin")
     return _decoder(allphone=lm, **ALLPHONE_SETTINGS)
 

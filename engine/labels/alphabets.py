@@ -13,7 +13,7 @@ silently dropped: a phone the synthesis does not know cannot be placed.
 Each table maps a symbol onto the nearest of the 39 CMU phones (General American), as the MOCHA
 map does: British vowels without an American twin to their nearest, centring diphthongs to their
 first element, the flap to ``dx`` and the glottal stop to ``q`` (which
-:func:`engine.labels.phoneset.map_labels` then maps onto the model's ``t`` unless it knows them).
+:func:`facetraj_engine.labels.phoneset.map_labels` then maps onto the model's ``t`` unless it knows them).
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ how sure their maker was, and the record of it that travels with them in a TextG
 Labels are made three ways: checked by a person (``hand-checked``: the paper's labels, and any
 label file facetraj did not write, unless the user says otherwise), aligned from a transcript
 (``aligned``, PocketSphinx) or recognized from speech alone (``recognized``). Automatic labels
-carry a confidence per phone in (0, 1] (:attr:`engine.labels.provenance.Labels.confidence`).
+carry a confidence per phone in (0, 1] (:attr:`facetraj_engine.labels.provenance.Labels.confidence`).
 
 In a TextGrid the record is two extra interval tiers that Praat opens, shows and saves like any
 other (tested through Praat itself):
@@ -63,7 +63,7 @@ class Labels:
     text : the sentence aligned (normalised), else ``""``.
     provenance : how the phones were made: by default ``aligned`` or ``recognized`` for those
         sources, hand-checked for a file (a TextGrid written by facetraj records its own,
-        :func:`engine.io.labelfiles.read_label_file`).
+        :func:`facetraj_engine.io.labelfiles.read_label_file`).
     """
 
     phones: list[PhoneSegment]
@@ -102,7 +102,7 @@ class Labels:
 
     def tiers(self) -> dict[str, list[PhoneSegment]]:
         """The TextGrid tiers: ``words`` (when any), ``phones``, and for labels that are not
-        hand-checked their record (``engine.labels.provenance``): ``provenance`` and
+        hand-checked their record (``facetraj_engine.labels.provenance``): ``provenance`` and
         ``confidence``."""
         tiers = {"words": list(self.words)} if self.words else {}
         tiers["phones"] = list(self.phones)

@@ -13,8 +13,8 @@ the LSF index (acoustic-only) or both (``selection``, the robust mode beyond the
 Equation modules are plain array functions, each naming its equation, with doctests; fast
 kernels (``compiled_lsf``, ``compiled_search``, ``compiled_weights``; ``kernels`` chooses them,
 ``aot`` builds them at install, ``prebuilt`` loads those) are tested against the reference
-formula. Imports shared modules, ``engine.labels`` and ``engine.io``; never
-``engine.evaluation`` or above.
+formula. Imports shared modules, ``facetraj_engine.labels`` and ``facetraj_engine.io``; never
+``facetraj_engine.evaluation`` or above.
 """
 
 from .. import lazy_exports

@@ -6,10 +6,10 @@
 The extension holds the same functions compiled from the same source by the same compiler as
 the just-in-time kernels, for this machine's processor; it is used only while it matches its
 source: ``prebuilt.fingerprint`` is compiled into it (``built_from``) and checked when
-:mod:`engine.method.prebuilt` loads it. A missing or stale extension falls back to numba's
-just-in-time kernels (:mod:`engine.method.kernels`).
+:mod:`facetraj_engine.method.prebuilt` loads it. A missing or stale extension falls back to numba's
+just-in-time kernels (:mod:`facetraj_engine.method.kernels`).
 
-Built by ``python -m engine.method.aot`` (``make`` does it after installing) into this folder, or
+Built by ``python -m facetraj_engine.method.aot`` (``make`` does it after installing) into this folder, or
 into ``$FACETRAJ_KERNELS_DIR`` where it is looked for too (a read-only install).
 """
 
@@ -98,10 +98,10 @@ def _constant(value: int):
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m engine.method.aot [--check] [--force] [--into DIR]``: build the extension
+    """``python -m facetraj_engine.method.aot [--check] [--force] [--into DIR]``: build the extension
     unless it is there and current (``--force``: build anyway), or only say whether it is
     (``--check``: exit 0) or not (exit 1)."""
-    parser = argparse.ArgumentParser(prog="python -m engine.method.aot", description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m facetraj_engine.method.aot", description=__doc__.split("\n\n")[0])
     parser.add_argument("--check", action="store_true", help="only say whether it is current")
     parser.add_argument("--force", action="store_true", help="build even when it is current")
     parser.add_argument("--into", type=Path, help=f"the folder (default: ${DIR_ENV} or {HERE})")

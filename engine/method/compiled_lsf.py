@@ -1,6 +1,6 @@
 """The LSF analysis (paper section 2.1) compiled by numba, frame by frame in one loop: Hamming
 window, autocorrelation, Levinson-Durbin (LPC) and the LSF roots of the sum and difference
-polynomials. The reference is ``engine.method.lsf`` (``analysis_frames``, ``lpc``,
+polynomials. The reference is ``facetraj_engine.method.lsf`` (``analysis_frames``, ``lpc``,
 ``poly2lsf``): the same formulas, tested equal to it to rounding (``tests/test_kernels.py``).
 
 The reference computes the autocorrelation through an FFT, the root bracketing grid by a matrix
@@ -9,7 +9,7 @@ the roots, polished by the same Newton iteration to the same tolerance, by about
 frame whose roots cannot all be bracketed on the grid (two closer than pi/128) or polished is
 flagged, and its LSFs are computed by the reference (its colleague-matrix eigenvalues).
 
-Imported only through :mod:`engine.method.kernels` (it imports numba).
+Imported only through :mod:`facetraj_engine.method.kernels` (it imports numba).
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The acoustic-only candidate search compiled by numba: the LSF index's search for the codewords
 nearest by eq 5, frame by frame in one loop. The reference is
-``engine.method.lsf_index.LsfIndex.nearest``: the same distances, in the same float32, tested
+``facetraj_engine.method.lsf_index.LsfIndex.nearest``: the same distances, in the same float32, tested
 to choose the same codewords (``tests/test_kernels.py``).
 
 Per frame: eq 5's weights ``h``, the weighted absolute distance to every cell centroid, the
@@ -11,7 +11,7 @@ product, this kernel in LSF order: the two differ by float32 rounding, so a code
 edge of the ``count`` chosen can differ when two distances are equal to float32 rounding (no
 frame of 60 s of the default corpus's test speech).
 
-Imported only through :mod:`engine.method.kernels` (it imports numba).
+Imported only through :mod:`facetraj_engine.method.kernels` (it imports numba).
 """
 
 from __future__ import annotations

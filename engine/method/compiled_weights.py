@@ -1,12 +1,12 @@
 """Eqs 5-8 (paper section 2.3) compiled by numba, frame by frame in one loop: eq 5's weighted
 distances to the frame's candidate codewords, eq 6's weights on every gamma of an evenly spaced
 grid, eq 7's approximated LSFs and their error, the gamma of least error, and eq 8's PC vector.
-The reference is ``engine.method.synthesis.weight_frames`` (with ``grid_weights``): the same
+The reference is ``facetraj_engine.method.synthesis.weight_frames`` (with ``grid_weights``): the same
 formulas, its matrix products here sums in index order, so the results equal it to rounding
 (``tests/test_kernels.py``). Used for a few candidates per frame only (the phonetic mode's):
 on the acoustic-only 128 numpy's vectorised ``exp`` and BLAS products are faster.
 
-Imported only through :mod:`engine.method.kernels` (it imports numba).
+Imported only through :mod:`facetraj_engine.method.kernels` (it imports numba).
 """
 
 from __future__ import annotations

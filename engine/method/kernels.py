@@ -1,12 +1,12 @@
 """Which implementation runs the per-frame hot paths of synthesis: the compiled kernels
-(``engine.method.compiled_lsf``, ``compiled_search``, ``compiled_weights``) or the numpy
-reference (``engine.method.lsf``, ``engine.method.lsf_index``, ``engine.method.synthesis``).
+(``facetraj_engine.method.compiled_lsf``, ``compiled_search``, ``compiled_weights``) or the numpy
+reference (``facetraj_engine.method.lsf``, ``facetraj_engine.method.lsf_index``, ``facetraj_engine.method.synthesis``).
 
 The numpy functions are the reference: each compiled kernel computes the same formula, frame by
 frame in one loop, and is tested equal to it to rounding (``tests/test_kernels.py``). The
 kernels come two ways, the same source compiled by numba either way:
 
-- prebuilt (:mod:`engine.method.aot` builds them, :mod:`engine.method.prebuilt` loads them):
+- prebuilt (:mod:`facetraj_engine.method.aot` builds them, :mod:`facetraj_engine.method.prebuilt` loads them):
   compiled at install into an extension that loads in about 2 ms without numba; used whenever
   it is built and current;
 - just in time: numba imported when a kernel is first asked for, never by importing the engine
@@ -154,7 +154,7 @@ def jit(fn=None, **flags):
 
 
 def _load(name: str) -> ModuleType | None:
-    """``engine.method.<name>`` imported (numba with it) once; ``None`` when it cannot be."""
+    """``facetraj_engine.method.<name>`` imported (numba with it) once; ``None`` when it cannot be."""
     with _lock:
         if name not in _loaded:
             try:
@@ -168,7 +168,7 @@ def _load(name: str) -> ModuleType | None:
 
 
 def prebuilt() -> ModuleType | None:
-    """The prebuilt kernels (:func:`engine.method.prebuilt.load`, looked for once), or ``None``."""
+    """The prebuilt kernels (:func:`facetraj_engine.method.prebuilt.load`, looked for once), or ``None``."""
     with _lock:
         if not _prebuilt:
             from .prebuilt import load
@@ -221,7 +221,7 @@ def warm_up() -> bool:
 
 
 def _before_fork() -> None:
-    """Worker processes about to fork (``engine.fanout``): the compiled kernels loaded here
+    """Worker processes about to fork (``facetraj_engine.fanout``): the compiled kernels loaded here
     once, when chosen, rather than in every worker (half a second of CPU each); a warm-up under
     way in another thread (the app's, in the background) finishes first either way, so that no
     child inherits numba half-way through compiling (its locks held by a thread it has not)."""

@@ -474,7 +474,7 @@ def frame_lsf(frames: np.ndarray, order: int) -> np.ndarray:
 
 def compiled_frame_lsf(kernel, pad: np.ndarray, starts: np.ndarray, window: np.ndarray,
                        order: int) -> np.ndarray:
-    """The compiled analysis (``kernel.lsf_frames``, ``engine.method.compiled_lsf``) of the frames
+    """The compiled analysis (``kernel.lsf_frames``, ``facetraj_engine.method.compiled_lsf``) of the frames
     ``pad[s:s + n] * window`` with this module's root grid and tolerances; the frames it flags
     (roots the grid cannot bracket) solved by :func:`poly2lsf` from their LPC polynomials."""
     xg, basis = root_grid(order // 2, ROOT_GRID)
@@ -492,9 +492,9 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     """LSF vectors ``(len(times), order)`` from 25 ms Hamming frames centred on ``times``.
 
     The audio is resampled to ``audio_rate`` first (the paper analyses 16 kHz speech). The frames
-    are analysed by the compiled kernel (``engine.method.compiled_lsf``, equal to this module's
-    functions to rounding) unless :mod:`engine.method.kernels` chooses numpy, in ``threads`` spans
-    at once (``None``: :func:`engine.threads.frame_threads`).
+    are analysed by the compiled kernel (``facetraj_engine.method.compiled_lsf``, equal to this module's
+    functions to rounding) unless :mod:`facetraj_engine.method.kernels` chooses numpy, in ``threads`` spans
+    at once (``None``: :func:`facetraj_engine.threads.frame_threads`).
     The LSFs equal one thread's to rounding: BLAS's matrix products (autocorrelation lags, the
     root bracketing grid) may add a row's terms in another order for another number of rows.
 

@@ -149,8 +149,8 @@ class LsfIndex:
         float32 (half the memory traffic of the search's largest arrays; the distances only rank
         the codewords: eqs 5-8 are computed again in float64 on the ``count`` found). ``grouped``
         may pass :meth:`grouped` of ``cb_lsf``, computed once. The compiled kernel
-        (``engine.method.compiled_search``) runs this search frame by frame unless
-        :mod:`engine.method.kernels` chooses numpy.
+        (``facetraj_engine.method.compiled_search``) runs this search frame by frame unless
+        :mod:`facetraj_engine.method.kernels` chooses numpy.
 
         Examples
         --------

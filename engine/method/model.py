@@ -1,7 +1,7 @@
 """The trained model: marker normalisation, PCA, codebook and similarity matrix, and its file
 (one ``.npz`` with a JSON metadata entry, never pickle).
 
-Training is :func:`engine.method.training.train`; synthesis :func:`engine.method.pipeline.synthesize`.
+Training is :func:`facetraj_engine.method.training.train`; synthesis :func:`facetraj_engine.method.pipeline.synthesize`.
 """
 
 from __future__ import annotations
@@ -58,13 +58,13 @@ class Model:
     lsf_mean : ``(P,)`` the training speaker's mean codeword LSF (the robust mode's speaker mean
         normalisation); older model files have none and it is computed from the codebook.
     tuned : the synthesis settings chosen by cross-validation on the training split
-        (:func:`engine.evaluation.tuning.cross_validate`: ``{"settings": {...}, "scores": [...]}``), or empty.
+        (:func:`facetraj_engine.evaluation.tuning.cross_validate`: ``{"settings": {...}, "scores": [...]}``), or empty.
     trained_labels : how the training utterances' labels were made: utterances per kind
-        (``{"hand-checked": 186}``; ``engine.data.Provenance``); empty in older model files.
+        (``{"hand-checked": 186}``; ``facetraj_engine.data.Provenance``); empty in older model files.
     closure : the training talker's closed lip aperture, closing direction and rest face
-        (:mod:`engine.method.closure`); ``None`` in older model files (no closure step).
+        (:mod:`facetraj_engine.method.closure`); ``None`` in older model files (no closure step).
     voice_distance : ``D0``, the training voice's distance to its own codebook
-        (:mod:`engine.method.voice_match`); NaN in older model files.
+        (:mod:`facetraj_engine.method.voice_match`); NaN in older model files.
     """
 
     config: TrainConfig
@@ -93,7 +93,7 @@ class Model:
     # ------------------------------------------------------------------ derived quantities
     @cached_property
     def join_scale(self) -> float:
-        """``s^2`` of the chain's join cost (:func:`engine.method.chain.join_scale`), from the
+        """``s^2`` of the chain's join cost (:func:`facetraj_engine.method.chain.join_scale`), from the
         codebook."""
         cb = self.codebook
         return join_scale(cb.pcs, cb.token_start, cb.token_end, cb.n_per_phone, self.marker_rate)
@@ -142,11 +142,11 @@ class Model:
     def input_lsf(self, audio: np.ndarray, sample_rate: int, times: np.ndarray,
                   threads: int | None = 1) -> np.ndarray:
         """The input LSF vectors w (eq 5) at ``times``, analysed as in training, ``(T, P)``, in
-        ``threads`` spans of frames (``None``: :func:`engine.threads.frame_threads`)."""
+        ``threads`` spans of frames (``None``: :func:`facetraj_engine.threads.frame_threads`)."""
         return analysed_lsf(self.config, audio, sample_rate, times, threads)
 
     def lsf_index(self) -> LsfIndex:
-        """The coarse LSF index of the codebook (``engine.method.lsf_index``), built here and kept if the
+        """The coarse LSF index of the codebook (``facetraj_engine.method.lsf_index``), built here and kept if the
         model has none or has one for a codebook of another size."""
         if self.index is None or self.index.n_codewords != self.codebook.lsf.shape[0]:
             self.index = build_index(self.codebook.lsf, self.config.index_cells)
@@ -239,7 +239,7 @@ class Model:
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> Model:
         """Read a model written by :meth:`save`; a wrong, truncated, damaged or newer file is
-        refused (:func:`engine.io.model_file.read_model_file` checks every entry first)."""
+        refused (:func:`facetraj_engine.io.model_file.read_model_file` checks every entry first)."""
         path = Path(path)
         meta, a = read_model_file(path, MODEL_VERSION, MODEL_FORMAT)
         try:

@@ -2,11 +2,11 @@
 
 The paper's phonetic mode (section 2.3, eq 4) trusts its labels fully: right for hand-checked
 labels, wrong for labels from an aligner or a recognizer, whose errors it copies into the face.
-So the mode follows the labels' provenance (``engine.labels.provenance``):
+So the mode follows the labels' provenance (``facetraj_engine.labels.provenance``):
 
 - no labels: acoustic-only (the paper's "5N replaced with the whole codebook");
 - hand-checked labels: the paper's phonetic mode;
-- aligned or recognized labels: the robust mode (``engine.method.selection``), each phone's label
+- aligned or recognized labels: the robust mode (``facetraj_engine.method.selection``), each phone's label
   counting as much as its maker trusted it, with the settings cross-validated at training
   (:func:`tuned_config`, ``facetraj train``);
 - a mode the user chose explicitly is kept (acoustic-only when there are no labels at all).

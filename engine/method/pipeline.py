@@ -1,9 +1,9 @@
 """The synthesis pipeline (paper section 2.3): input LSFs, the candidate codewords of each frame
 (eq 4 in phonetic mode, the LSF index in acoustic-only mode, both in the robust mode), eqs 5-8
-(``engine.method.synthesis``; ``engine.method.selection`` for the robust mode), smoothing, and the PCs back to
+(``facetraj_engine.method.synthesis``; ``facetraj_engine.method.selection`` for the robust mode), smoothing, and the PCs back to
 face points.
 
-Which mode the labels allow is :func:`engine.method.modes.choose_mode`, the one rule.
+Which mode the labels allow is :func:`facetraj_engine.method.modes.choose_mode`, the one rule.
 """
 
 from __future__ import annotations
@@ -61,7 +61,7 @@ class Synthesis:
     segments : per input phone, the chosen context-phones (phonetic mode), else empty.
     frame_segment : ``(T,)`` index into ``segments`` (phonetic mode), else -1.
     warp : the speaker warp factor applied to the input LSFs (``config.speaker_warp``).
-    closure : where the closure step acted (:mod:`engine.method.closure`), ``None`` when off.
+    closure : where the closure step acted (:mod:`facetraj_engine.method.closure`), ``None`` when off.
     voice_match : the input's voice match (:func:`input_voice_match`) when the synthesis needed
         it (the robust mode, recognized labels), else NaN.
     """
@@ -81,7 +81,7 @@ class Synthesis:
 
     def arrays(self) -> dict[str, np.ndarray]:
         """What an ``.npz`` output keeps of the synthesis beside its markers
-        (:func:`engine.io.export.write_trajectories`)."""
+        (:func:`facetraj_engine.io.export.write_trajectories`)."""
         return {"times": self.times, "pcs": self.pcs, "raw_pcs": self.raw_pcs,
                 "gamma": self.frames.gamma, "lsf": self.lsf,
                 "config": np.array(json.dumps(self.config.to_dict()))}
@@ -120,12 +120,12 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     and per frame eqs 5-8 over their 5N codewords. Otherwise (acoustic-only) eqs 5-8 over the
     ``config.acoustic_prefilter`` codewords nearest to each frame, found through the model's LSF
     index (``acoustic_probe`` cells), or over the whole codebook as the paper does
-    (``acoustic_prefilter=None``). With ``mode="robust"`` (``engine.method.selection``): eq 4's
+    (``acoustic_prefilter=None``). With ``mode="robust"`` (``facetraj_engine.method.selection``): eq 4's
     codewords and the ``robust_candidates`` acoustically nearest together, the target cost eq 5
     with acoustic context plus ``label_weight`` times the label's ``confidence`` (one value in
-    [0, 1] per phone, e.g. :attr:`engine.labels.provenance.Labels.confidence`; ``None``: 1,
+    [0, 1] per phone, e.g. :attr:`facetraj_engine.labels.provenance.Labels.confidence`; ``None``: 1,
     hand-checked) for codewords eq 4 did not choose. Then smoothing; with ``config.closure`` the
-    lips close at the labelled /p b m/ and the face rests in pauses (:mod:`engine.method.closure`,
+    lips close at the labelled /p b m/ and the face rests in pauses (:mod:`facetraj_engine.method.closure`,
     trusting each label as its ``provenance`` says: ``None``, hand-checked); and the PCs back to
     ``(T, M, 3)`` markers.
 
@@ -226,10 +226,10 @@ def _eq4(model: Model, segs: list[PhoneSegment], times: np.ndarray, config: Synt
 def robust_weights(model: Model, w: np.ndarray, candidates: np.ndarray, conf: np.ndarray,
                    config: SynthConfig, scale: float = 1.0, w_ctx: np.ndarray | None = None
                    ) -> FrameWeights:
-    """The robust mode's eqs 5-8 (``engine.method.selection``), its label weight times
+    """The robust mode's eqs 5-8 (``facetraj_engine.method.selection``), its label weight times
     ``scale`` (the voice's distance ratio: eq 5's distances grow with it); ``w_ctx``: the input
     frames at :func:`context_offsets` when ``w`` is part of a longer input (a stream). The chain
-    over frames (``engine.method.chain``) is :func:`synthesize`'s, on the whole input."""
+    over frames (``facetraj_engine.method.chain``) is :func:`synthesize`'s, on the whole input."""
     cb = model.codebook
     near = model.lsf_index().nearest(w, cb.lsf, config.robust_candidates, config.acoustic_probe or 8)
     return robust_frames(w, candidates, near, conf, cb.lsf, cb.pcs, _gammas(config),
@@ -285,9 +285,9 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
                  match: float, config: SynthConfig, filtered: np.ndarray | None = None
                  ) -> ClosurePlan | None:
     """Where the closure step acts (``None``: off, or a model file without its statistics): the
-    labelled /p b m/, trusted as :func:`~engine.method.closure.closure_strengths` says (for
+    labelled /p b m/, trusted as :func:`~facetraj_engine.method.closure.closure_strengths` says (for
     recognized labels by the voice ``match``; NaN: unknown, untrusted), and the pauses by
-    energy (``filtered``: :func:`~engine.method.speech.filtered_energy_db` of the audio, when
+    energy (``filtered``: :func:`~facetraj_engine.method.speech.filtered_energy_db` of the audio, when
     already computed)."""
     if not config.closure or model.closure is None:
         return None
@@ -301,7 +301,7 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
 
 
 class SpeechEnergy:
-    """An input's filtered short-time energy (:func:`~engine.method.speech.filtered_energy_db`:
+    """An input's filtered short-time energy (:func:`~facetraj_engine.method.speech.filtered_energy_db`:
     its speech frames and pauses), computed when first asked, once for every step that asks."""
 
     def __init__(self, audio: np.ndarray, sample_rate: int):
@@ -318,7 +318,7 @@ def _voice_ratio_of(model: Model, energy: SpeechEnergy, times: np.ndarray, w: np
     """What gives the input's voice distance ratio when the synthesis weighs by it (the robust
     mode's label weight, the closure step's trust in recognized labels) or it is ``wanted``,
     else NaN (not computed). In the phonetic mode eqs 4-8 do not use it: it is computed beside
-    them (:func:`engine.threads.beside`; its energy, index layout and search let go of the
+    them (:func:`facetraj_engine.threads.beside`; its energy, index layout and search let go of the
     interpreter lock), else here."""
     recognized = provenance is not None and provenance.kind == "recognized"
     if not (wanted or (config.mode == "robust" and config.label_weight_by_voice) or
@@ -338,7 +338,7 @@ def _voice_ratio_of(model: Model, energy: SpeechEnergy, times: np.ndarray, w: np
 def input_voice_ratio(model: Model, audio: np.ndarray, sample_rate: int,
                       times: np.ndarray | None = None, w: np.ndarray | None = None,
                       filtered: np.ndarray | None = None) -> float:
-    """``D / D0`` (:mod:`engine.method.voice_match`): how far an input's voice is from the
+    """``D / D0`` (:mod:`facetraj_engine.method.voice_match`): how far an input's voice is from the
     codebook's, relative to the training voice's own figure, from the audio alone (its LSFs ``w``
     at ``times`` and its filtered energy when already computed; NaN for a model file without
     ``D0``)."""
@@ -355,13 +355,13 @@ def input_voice_ratio(model: Model, audio: np.ndarray, sample_rate: int,
 def input_voice_match(model: Model, audio: np.ndarray, sample_rate: int,
                       times: np.ndarray | None = None, w: np.ndarray | None = None) -> float:
     """The voice match in [0, 1] of an input (:func:`input_voice_ratio` through
-    :func:`engine.method.voice_match.voice_match`)."""
+    :func:`facetraj_engine.method.voice_match.voice_match`)."""
     return voice_match(input_voice_ratio(model, audio, sample_rate, times, w), 1.0)
 
 
 def normalise_speaker(model: Model, w: np.ndarray, config: SynthConfig) -> tuple[np.ndarray, float]:
     """The input LSFs ``w`` warped by ``config.speaker_warp`` (chosen here for these frames when
-    it is ``None``), and the warp factor (``engine.method.speaker``)."""
+    it is ``None``), and the warp factor (``facetraj_engine.method.speaker``)."""
     alpha = config.speaker_warp
     if alpha is None:
         alpha = choose_warp(w, model.codebook.lsf)
@@ -374,7 +374,7 @@ def acoustic_candidates(model: Model, w: np.ndarray, config: SynthConfig,
     """Acoustic-only candidates ``(T, I)`` of frames ``w``: the ``config.acoustic_prefilter``
     codewords nearest by eq 5 through the model's LSF index (``acoustic_probe`` cells), or exactly,
     or every codeword (``acoustic_prefilter=None``, as the paper does). ``grouped``: the index's
-    :meth:`~engine.method.lsf_index.LsfIndex.grouped` codebook, when the caller keeps it."""
+    :meth:`~facetraj_engine.method.lsf_index.LsfIndex.grouped` codebook, when the caller keeps it."""
     cb = model.codebook
     if config.acoustic_prefilter is not None and config.acoustic_probe is not None:
         return model.lsf_index().nearest(w, cb.lsf, config.acoustic_prefilter,

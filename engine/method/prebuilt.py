@@ -1,10 +1,10 @@
-"""The compiled kernels prebuilt at install (:mod:`engine.method.aot` builds them): where the
+"""The compiled kernels prebuilt at install (:mod:`facetraj_engine.method.aot` builds them): where the
 extension is, what it must have been built from, and loading it without numba.
 
 The extension is used only while it matches its source: :func:`fingerprint` (the kernel modules,
 the ``lsf`` module whose constants they compile in, the builder, the processor) is compiled into
 it (``built_from``) and checked at load. A missing, broken or stale extension gives ``None``
-(logged), and :mod:`engine.method.kernels` uses numba's just-in-time kernels.
+(logged), and :mod:`facetraj_engine.method.kernels` uses numba's just-in-time kernels.
 """
 
 from __future__ import annotations
@@ -78,7 +78,7 @@ def load() -> ModuleType | None:
     (logged: the just-in-time kernels are used)."""
     path = _path()
     if path is None:
-        log.debug("no prebuilt kernels in %s (python -m engine.method.aot builds them)", folder())
+        log.debug("no prebuilt kernels in %s (python -m facetraj_engine.method.aot builds them)", folder())
         return None
     try:
         spec = importlib.util.spec_from_file_location(MODULE, path)
@@ -86,11 +86,11 @@ def load() -> ModuleType | None:
         spec.loader.exec_module(module)
         built_from = module.built_from()
     except Exception as exc:                   # a broken file: the just-in-time kernels run
-        log.warning("prebuilt kernels %s unusable (%s); rebuild with python -m engine.method.aot",
+        log.warning("prebuilt kernels %s unusable (%s); rebuild with python -m facetraj_engine.method.aot",
                     path, exc)
         return None
     if built_from != fingerprint():
         log.warning("prebuilt kernels %s are stale (their source, or the processor, changed); "
-                    "rebuild with python -m engine.method.aot", path)
+                    "rebuild with python -m facetraj_engine.method.aot", path)
         return None
     return module

@@ -1,7 +1,7 @@
 """A recording in, a face out: what ``facetraj synth`` (one file or a batch) and the app do with
-an audio file -- the rule for where its labels come from (:func:`engine.io.labelling.
-labels_for_audio`), the rule for the mode (:func:`engine.method.modes.choose_mode`), synthesis
-(:func:`engine.method.pipeline.synthesize`), and the input's voice match, in one place."""
+an audio file -- the rule for where its labels come from (:func:`facetraj_engine.io.labelling.
+labels_for_audio`), the rule for the mode (:func:`facetraj_engine.method.modes.choose_mode`), synthesis
+(:func:`facetraj_engine.method.pipeline.synthesize`), and the input's voice match, in one place."""
 
 from __future__ import annotations
 
@@ -46,7 +46,7 @@ class LabelRequest:
 @dataclass
 class RecordingSynthesis:
     """The face of one recording, with its labels, why its mode was chosen, and its voice match
-    (:mod:`engine.method.voice_match`, NaN for a model file without the figure)."""
+    (:mod:`facetraj_engine.method.voice_match`, NaN for a model file without the figure)."""
 
     synthesis: Synthesis
     labels: Labels | None
@@ -62,7 +62,7 @@ class RecordingSynthesis:
 
 
 class EarlyLsf:
-    """A recording's input LSFs (eq 5's w), analysed beside other work (:func:`engine.threads.
+    """A recording's input LSFs (eq 5's w), analysed beside other work (:func:`facetraj_engine.threads.
     beside`) from the moment the model file's settings (its checked metadata,
     :meth:`Model.read_settings`) and the audio are read, while the caller reads the model's
     arrays and the labels: the compiled analysis lets go of the interpreter lock, so on a 60 s

@@ -126,7 +126,7 @@ def label_penalty(from_labels: np.ndarray, confidence: np.ndarray, kappa: float)
 
 @dataclass
 class RobustFrames(FrameWeights):
-    """:class:`~engine.method.synthesis.FrameWeights` of the robust mode, with why each candidate got its
+    """:class:`~facetraj_engine.method.synthesis.FrameWeights` of the robust mode, with why each candidate got its
     weight: ``acoustic_cost`` (eq 5 with context), ``label_cost`` (:func:`label_penalty`),
     ``from_labels`` (chosen by eq 4) and ``confidence`` ``(T,)`` (the frame's label confidence).
     Entries that do not count (repeats) have infinite cost and weight 0."""
@@ -142,7 +142,7 @@ def weight_costs(w: np.ndarray, candidates: np.ndarray, cost: np.ndarray, cb_lsf
     """Eqs 6-8 over a given target cost instead of eq 5's distance: ``v_i = softmax(-gamma
     cost_i)``, gamma searched on ``gammas`` to minimise ``sum_k h_k |w_k - w-hat_k|`` (eq 7's
     criterion), ``p-hat = sum_i v_i F_i``. With ``cost`` = eq 5's distances this is
-    :func:`engine.method.synthesis.weight_frames` (the test checks it).
+    :func:`facetraj_engine.method.synthesis.weight_frames` (the test checks it).
     """
     h = perceptual_weights(w)
     cand_lsf = cb_lsf[candidates]                                           # (T, I, P)

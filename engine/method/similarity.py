@@ -164,9 +164,9 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     ``count``-th best score of each query (a partition) and a sort of the few scores reaching it.
     The result, including the lower-index-first tie order, is that of the full computation
     (tested). With a context (``context >= 1``) the contexts that can win are found by groups
-    of the same centre and first neighbours (:mod:`engine.method.context_index`): their number
+    of the same centre and first neighbours (:mod:`facetraj_engine.method.context_index`): their number
     stops growing with the corpus, where the contexts of a centre phone grow with it. The
-    compiled kernel (``engine.method.compiled_search``), when :mod:`engine.method.kernels`
+    compiled kernel (``facetraj_engine.method.compiled_search``), when :mod:`facetraj_engine.method.kernels`
     gives it, finds the same contexts per centre phone and scores them with the same additions,
     query by query, keeping each query's best ``count`` as it goes: it is used while the
     codebook holds fewer than :data:`GROUPS_FROM` contexts a group (it is then the faster,

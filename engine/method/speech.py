@@ -1,6 +1,6 @@
 """Speech and pauses by energy (paper section 3): short-time energy, a 112 ms median filter and a
 threshold between the utterance's floor and peak. The evaluation scores speech frames only; the
-closure step (:mod:`engine.method.closure`) rests the face in the long pauses."""
+closure step (:mod:`facetraj_engine.method.closure`) rests the face in the long pauses."""
 
 from __future__ import annotations
 

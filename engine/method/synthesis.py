@@ -165,8 +165,8 @@ def weight_frames(w: np.ndarray, candidates: np.ndarray, cb_lsf: np.ndarray, cb_
     (acoustic-only full search), whose codebook is not gathered per frame and eqs 7-8 are plain
     matrix products. Codewords are gathered with ``np.take`` (a third of the time of indexing).
     A few candidates per frame (:data:`COMPILED_MAX_CANDIDATES`: the phonetic mode's 5N) on an
-    evenly spaced gamma grid go to the compiled kernel (``engine.method.compiled_weights``,
-    equal to this to rounding) unless :mod:`engine.method.kernels` chooses numpy.
+    evenly spaced gamma grid go to the compiled kernel (``facetraj_engine.method.compiled_weights``,
+    equal to this to rounding) unless :mod:`facetraj_engine.method.kernels` chooses numpy.
     """
     n_frames = w.shape[0]
     n_cand = candidates.shape[1]

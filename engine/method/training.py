@@ -2,17 +2,17 @@
 PCA, the audio-visual codebook, the phone means and distances of eqs 1-2, and the LSF index.
 
 The corpus is streamed: each utterance is read, analysed and let go in turn (in ``workers``
-processes, :func:`engine.fanout.fan_out`), so that only what the model keeps grows with the
+processes, :func:`facetraj_engine.fanout.fan_out`), so that only what the model keeps grows with the
 corpus (the codewords, the PCA's moments, the closure statistics). The steps that need every
 frame come from sufficient statistics gathered an utterance at a time, in three passes over the
-utterances (:mod:`engine.method.training_set`):
+utterances (:mod:`facetraj_engine.method.training_set`):
 
 1. every utterance loaded whole: its labels checked, its marker gaps filled, every fifth frame
    of its fixed markers kept (the neutral pose, :func:`reference_pose`), its codewords' LSF
    vectors computed (they need the audio, not the PCA);
 2. its markers read again and moved into the head frame of that pose: the count, mean and
-   scatter matrix of its complete frames, merged in order (:class:`~engine.method.moments.Moments`),
-   whose eigenvectors are the PCA (:func:`~engine.method.pca.pca_of`);
+   scatter matrix of its complete frames, merged in order (:class:`~facetraj_engine.method.moments.Moments`),
+   whose eigenvectors are the PCA (:func:`~facetraj_engine.method.pca.pca_of`);
 3. its markers read a third time: their PCs, the codewords' PC vectors, its share of the
    closure statistics; and the audio of the few utterances the voice reference ``D0`` is
    measured on.
@@ -303,7 +303,7 @@ def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = 
           skip: Skips | None = None) -> Model:
     """Train a model (paper sections 2.1-2.2) on utterances with markers and phone labels.
 
-    Given a :class:`~engine.io.corpus.Corpus`, its ``train`` split is used and the marker roles come
+    Given a :class:`~facetraj_engine.io.corpus.Corpus`, its ``train`` split is used and the marker roles come
     from ``corpus.json``; otherwise pass ``setup``.
 
     Steps: gap filling; head-motion removal against a Procrustes-mean neutral pose of the fixed
@@ -311,7 +311,7 @@ def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = 
     means and distances; the coarse LSF index of acoustic-only synthesis.
 
     The corpus is streamed (the module's docstring), in ``workers`` processes
-    (:func:`engine.fanout.fan_out`; the model equals the serial run's). A bad file stops training
+    (:func:`facetraj_engine.fanout.fan_out`; the model equals the serial run's). A bad file stops training
     with its error, or with ``skip`` its utterance is left out (``--skip-bad``).
     """
     config = config or TrainConfig()

@@ -1,7 +1,7 @@
 """The training utterances as training reads them: one at a time, by index, from a corpus folder
 or from utterances in memory, never all at once.
 
-Training (:mod:`engine.method.training`) passes over them three times, as the paper's steps
+Training (:mod:`facetraj_engine.method.training`) passes over them three times, as the paper's steps
 need the results of the steps before over the whole set (section 2.1: the neutral head pose
 before head-motion removal, the PCA of every head-normalised frame before the codewords' PC
 vectors). The first pass loads every utterance whole; the later ones read its markers alone
@@ -48,7 +48,7 @@ class TrainingSet:
     @classmethod
     def of(cls, utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None
            ) -> TrainingSet:
-        """A :class:`~engine.io.corpus.Corpus`'s ``train`` split, with its ``corpus.json`` roles
+        """A :class:`~facetraj_engine.io.corpus.Corpus`'s ``train`` split, with its ``corpus.json`` roles
         unless ``setup`` is given; or utterances in memory, with ``setup`` (required), the marker
         set of the first one that has markers."""
         if isinstance(utterances, Corpus):

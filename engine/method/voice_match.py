@@ -9,7 +9,7 @@ linear in log distance between. Measured: the training voice's held-out sentence
 0.86-1.27 ``D0``, six real CMU ARCTIC sentences by two other talkers at 3.5-4.8 ``D0``.
 
 Synthesis trusts recognized labels more where the voice matches less (the recognizer was trained
-on many real voices; the codebook on one): :func:`engine.method.closure.closure_strengths`.
+on many real voices; the codebook on one): :func:`facetraj_engine.method.closure.closure_strengths`.
 """
 
 from __future__ import annotations

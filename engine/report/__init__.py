@@ -4,7 +4,7 @@ split, the paper's numbers beside ours and a discussion of the differences.
 
 Pure engine: no plotting here. :func:`write_report` computes everything
 (:func:`~.compute.compute_report`), calls an optional ``figures`` callable to draw the figures
-(``app.report_figures`` does it with matplotlib) and writes ``results.md`` and ``results.json``.
+(``facetraj_app.report_figures`` does it with matplotlib) and writes ``results.md`` and ``results.json``.
 
 * :mod:`.rows`: the typed rows (one method's correlations, the N sweep, Table 1's agreement, the
   corpus and model summaries) and the functions that build them from scores;
@@ -15,7 +15,7 @@ Pure engine: no plotting here. :func:`write_report` computes everything
 * :mod:`.markdown`: one function per section of ``results.md``;
 * :mod:`.text`: how numbers are written.
 
-The paper's own numbers (Tables 1 and 2, Figure 4's sentence) are in :mod:`engine.evaluation.paper`.
+The paper's own numbers (Tables 1 and 2, Figure 4's sentence) are in :mod:`facetraj_engine.evaluation.paper`.
 """
 
 from __future__ import annotations

@@ -185,7 +185,7 @@ def model_summary(model: Model, baselines: Baselines) -> ModelSummary:
 
 def _automatic_labels(corpus: Corpus, model: Model, comparisons: list[ComparisonRow],
                       progress: Progress) -> dict:
-    """The automatic-label section (``engine.report.labels``), with the MOCHA-TIMIT sample in
+    """The automatic-label section (``facetraj_engine.report.labels``), with the MOCHA-TIMIT sample in
     ``../shared`` beside the repository when it is there."""
     from .labels import MOCHA_SAMPLE, label_section
 

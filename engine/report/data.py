@@ -78,7 +78,7 @@ class ReportData:
     comparisons : one row per method, split and smoothing.
     sweep : the N sweep (Figure 5, triangular).
     figure4 : the Figure-4 example (``None`` when the corpus has no test utterance).
-    labels : the automatic-label section (``engine.report.labels.label_section``), ``None``
+    labels : the automatic-label section (``facetraj_engine.report.labels.label_section``), ``None``
         when the corpus has no transcripts.
     figures : figure name -> path relative to the report folder (filled by the figures callable).
     timings : seconds per stage.
@@ -96,9 +96,9 @@ class ReportData:
     timings: dict[str, float] = field(default_factory=dict)
     figures: dict[str, str] = field(default_factory=dict)
     created: str = ""
-    label_eval: LabelEval | None = None    # every mode with automatic labels (engine.evaluation.label_eval)
-    voice_eval: VoiceEval | None = None    # acoustic-only from a second voice (engine.evaluation.voice_eval)
-    closure_eval: dict | None = None       # lips that close (engine.evaluation.closure_eval)
+    label_eval: LabelEval | None = None    # every mode with automatic labels (facetraj_engine.evaluation.label_eval)
+    voice_eval: VoiceEval | None = None    # acoustic-only from a second voice (facetraj_engine.evaluation.voice_eval)
+    closure_eval: dict | None = None       # lips that close (facetraj_engine.evaluation.closure_eval)
 
     def row(self, mode: str, split: str = "test", smoothing: str = "triangular") -> ComparisonRow | None:
         """The comparison row of one mode (``phonetic``, ``acoustic``, ``acoustic-indexed``,

@@ -1,5 +1,5 @@
 """The report's section on automatic phone labels: their accuracy against hand and exact labels
-(:mod:`engine.evaluation.label_accuracy`) and Table 2 with aligned and recognized labels."""
+(:mod:`facetraj_engine.evaluation.label_accuracy`) and Table 2 with aligned and recognized labels."""
 
 from __future__ import annotations
 

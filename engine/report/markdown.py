@@ -170,7 +170,7 @@ def discussion_section(data: ReportData) -> list[str]:
 
 
 def automatic_labels_section(data: ReportData) -> list[str]:
-    """Every mode and baseline under exact, aligned and recognized labels (``engine.evaluation.label_eval``),
+    """Every mode and baseline under exact, aligned and recognized labels (``facetraj_engine.evaluation.label_eval``),
     when an evaluation was saved beside the report; else nothing."""
     if data.label_eval is None:
         return []
@@ -180,7 +180,7 @@ def automatic_labels_section(data: ReportData) -> list[str]:
 
 def second_voice_section(data: ReportData) -> list[str]:
     """Acoustic-only synthesis from a voice other than the training voice, with and without
-    speaker normalisation (``engine.evaluation.voice_eval``), when an evaluation was saved beside the report;
+    speaker normalisation (``facetraj_engine.evaluation.voice_eval``), when an evaluation was saved beside the report;
     else nothing."""
     if data.voice_eval is None:
         return []
@@ -189,7 +189,7 @@ def second_voice_section(data: ReportData) -> list[str]:
 
 
 def closure_section(data: ReportData) -> list[str]:
-    """Lips that close, per mode and label source (``engine.evaluation.closure_eval``), when an
+    """Lips that close, per mode and label source (``facetraj_engine.evaluation.closure_eval``), when an
     evaluation was saved beside the report; else nothing."""
     return [] if data.closure_eval is None else closure_markdown(data.closure_eval)
 

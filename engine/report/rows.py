@@ -16,7 +16,7 @@ from ..method.similarity import SimilarRow
 @dataclass(kw_only=True)
 class ComparisonRow(ConditionScores):
     """One method's correlations on one split and smoothing: the means over utterances (the fields
-    of :class:`~engine.evaluation.scores.ConditionScores`), their standard deviations over utterances
+    of :class:`~facetraj_engine.evaluation.scores.ConditionScores`), their standard deviations over utterances
     (NaN under two utterances), the utterance count ``n`` and the ``method`` as the report names it.
     """
 

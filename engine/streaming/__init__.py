@@ -4,7 +4,7 @@ Acoustic-only, equal to the offline synthesis of the same audio (``synthesizer``
 ``tests/test_streaming.py``); with phones recognized as they are spoken (``live``: the
 ``recognizer`` beside the ``phonetic`` synthesizer, the ``closure`` step streamed; issue 27).
 
-Imports ``engine.method`` and below.
+Imports ``facetraj_engine.method`` and below.
 """
 
 from .. import lazy_exports

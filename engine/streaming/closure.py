@@ -1,7 +1,7 @@
 """The closure step on a stream (live mode, issue 27): lips that close at the settled /p b m/,
 and a face that rests in pauses, as far as a frame's emission time lets them be known.
 
-Offline (:mod:`engine.method.closure`), the lips at /p b m/ segment j move by
+Offline (:mod:`facetraj_engine.method.closure`), the lips at /p b m/ segment j move by
 ``c_j = s_j min(0, closed - m_j)`` along the closing direction, ``m_j`` the smallest aperture of
 the segment's frames, flat over the segment with raised-cosine tapers outside it; and the face
 blends to the rest face inside pauses. A stream emits frame t before the frames after it are
@@ -27,7 +27,7 @@ def closure_moves(aperture: np.ndarray, times: np.ndarray, intervals: np.ndarray
                   strengths: np.ndarray, closed: float, taper_s: float, seen: np.ndarray,
                   at: np.ndarray | None = None, clamp: bool = False) -> np.ndarray:
     """Per frame t, the aperture move ``c(t)`` (mm, at most 0) of
-    :func:`engine.method.closure.close_lips`, each segment's minimum taken over its frames up to
+    :func:`facetraj_engine.method.closure.close_lips`, each segment's minimum taken over its frames up to
     ``seen[t]`` (frame t's own aperture when none of them is): the move the step makes when frame
     t is emitted. ``at``: the frames to compute (default all); the result is one move per frame
     of ``at``. With ``clamp``, no frame is moved past the closed aperture (offline a frame can be,
@@ -59,7 +59,7 @@ def closure_moves(aperture: np.ndarray, times: np.ndarray, intervals: np.ndarray
 
 
 def rest_weights(times: np.ndarray, pauses: np.ndarray, taper_s: float) -> np.ndarray:
-    """Per frame, how far the face rests (:func:`engine.method.closure.rest_in_pauses`'s
+    """Per frame, how far the face rests (:func:`facetraj_engine.method.closure.rest_in_pauses`'s
     weight): 1 inside a pause, raised-cosine tapers inside it, 0 outside; a pause without an end
     (``inf``) has no closing taper.
 
@@ -73,8 +73,8 @@ def rest_weights(times: np.ndarray, pauses: np.ndarray, taper_s: float) -> np.nd
 
 
 def pause_runs(decisions: np.ndarray, times: np.ndarray, min_s: float) -> np.ndarray:
-    """``(J, 2)`` pauses among the frames decided so far (:mod:`engine.streaming.speech`): runs
-    of silent frames longer than ``min_s`` as :func:`engine.method.speech.pauses` finds them; a
+    """``(J, 2)`` pauses among the frames decided so far (:mod:`facetraj_engine.streaming.speech`): runs
+    of silent frames longer than ``min_s`` as :func:`facetraj_engine.method.speech.pauses` finds them; a
     run reaching the last decided frame has not ended (``inf``) and counts once it is longer than
     ``min_s``.
 

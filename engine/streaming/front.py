@@ -1,8 +1,8 @@
 """The input LSFs of a stream (paper section 2.3's first step, on audio blocks as they arrive).
 
-The same computation as :meth:`engine.method.model.Model.input_lsf` (resampling to the model's
+The same computation as :meth:`facetraj_engine.method.model.Model.input_lsf` (resampling to the model's
 rate, pre-emphasis, 25 ms Hamming windows centred on the marker frames, LPC, LSFs), with the state
-carried between blocks: the resampler's filter memory (``engine.method.lsf.ResampleStream``), the
+carried between blocks: the resampler's filter memory (``facetraj_engine.method.lsf.ResampleStream``), the
 last sample for the pre-emphasis and the analysis samples not yet used by a frame. Frame t's
 window is complete half a window (12.5 ms) after its time, plus the resampler's few samples.
 """

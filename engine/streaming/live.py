@@ -1,9 +1,9 @@
 """Live mode's stream (issue 27): the recognizer beside the synthesizer, one take at a time.
 
 :class:`LiveStream` is what ``facetraj live`` (with or without its window) and the Live window
-run: with phones (the default, "phones + acoustics"), a :class:`~engine.streaming.recognizer.
-StreamingRecognizer` and a :class:`~engine.streaming.phonetic.PhoneticSynthesizer` fed the same
-blocks; acoustic-only, the paper's search as before (:class:`~engine.streaming.synthesizer.
+run: with phones (the default, "phones + acoustics"), a :class:`~facetraj_engine.streaming.recognizer.
+StreamingRecognizer` and a :class:`~facetraj_engine.streaming.phonetic.PhoneticSynthesizer` fed the same
+blocks; acoustic-only, the paper's search as before (:class:`~facetraj_engine.streaming.synthesizer.
 StreamingSynthesizer`, frames in batches of ``LIVE_BATCH_FRAMES``).
 
 The recognizer runs in the caller's thread (``threaded=False``: each block is recognized before
@@ -65,9 +65,9 @@ class LiveConfig:
 
 def live_mode(config: SynthConfig, model: Model, phones: bool = True) -> ModeChoice:
     """The synthesis settings of a take: with phones, those the mode rule
-    (:func:`engine.method.modes.choose_mode`) gives recognized labels -- the robust mode with the
+    (:func:`facetraj_engine.method.modes.choose_mode`) gives recognized labels -- the robust mode with the
     model's cross-validated settings, and the closure step, but not the chain over frames
-    (``engine.method.chain``: its forward-backward needs the whole input); acoustic-only, the
+    (``facetraj_engine.method.chain``: its forward-backward needs the whole input); acoustic-only, the
     paper's search without it (as ``facetraj live`` was)."""
     if not phones:
         return ModeChoice(config.with_(mode="acoustic", closure=False), "acoustic-only, chosen")
@@ -250,7 +250,7 @@ class LiveStream:
 
     def labels(self, duration: float) -> Labels | None:
         """The take's recognized phones as :class:`Labels` covering ``[0, duration]``, their
-        confidence the stability of each (``engine.streaming.phones``), their provenance
+        confidence the stability of each (``facetraj_engine.streaming.phones``), their provenance
         ``recognized`` by the streamed search; ``None`` acoustic-only."""
         if self.recognizer is None:
             return None

@@ -3,19 +3,19 @@ mode over recognized phones, then the closure step -- on audio blocks as they ar
 
 Per frame t (at ``t / marker_rate``), in order:
 
-1. its input LSFs (``engine.streaming.front``), and those of the robust mode's acoustic context
+1. its input LSFs (``facetraj_engine.streaming.front``), and those of the robust mode's acoustic context
    (frames t +- 3);
 2. **its phone**: frame t waits until the recognizer has settled the phone at its time
-   (``engine.streaming.recognizer``), but never longer than ``wait_s`` of audio after it; a
+   (``facetraj_engine.streaming.recognizer``), but never longer than ``wait_s`` of audio after it; a
    settled phone makes it a robust-mode frame (eq 4's codewords of that phone in its context --
    the phones settled so far, silence after them -- and the acoustically nearest ones, the label
    weighed by the phone's confidence and the running voice ratio,
-   :func:`engine.method.pipeline.robust_weights`); without one it is an acoustic-only frame, as
-   in ``facetraj live`` before (:func:`engine.method.pipeline.acoustic_candidates`);
+   :func:`facetraj_engine.method.pipeline.robust_weights`); without one it is an acoustic-only frame, as
+   in ``facetraj live`` before (:func:`facetraj_engine.method.pipeline.acoustic_candidates`);
 3. frames are analysed ``batch`` at a time, smoothed by the triangular window (3 frames later);
-4. the closure step (``engine.streaming.closure``): the lips close at the settled /p b m/ (trusted
-   as far as the running voice match is low, :func:`engine.method.closure.closure_strengths`),
-   the face rests in the pauses found by energy (``engine.streaming.speech``), ``hold`` frames
+4. the closure step (``facetraj_engine.streaming.closure``): the lips close at the settled /p b m/ (trusted
+   as far as the running voice match is low, :func:`facetraj_engine.method.closure.closure_strengths`),
+   the face rests in the pauses found by energy (``facetraj_engine.streaming.speech``), ``hold`` frames
    later.
 
 So a frame is emitted at most ``lookahead_s`` after its time: ``max(wait_s, the LSF context)`` +
@@ -57,7 +57,7 @@ VOICE_BATCH = 30
 
 
 class PhoneSource(Protocol):
-    """Where the settled phones come from (a :class:`engine.streaming.phones.PhoneTrack`, or a
+    """Where the settled phones come from (a :class:`facetraj_engine.streaming.phones.PhoneTrack`, or a
     recognizer running in another thread)."""
 
     @property
@@ -84,7 +84,7 @@ class PhoneticTiming:
 class ContextCodewords:
     """Eq 4's candidate codewords of context-phones (rows ``[l_C .. l_1, c, r_1 .. r_C]`` of the
     model's phone ids), each context-phone's computed once: a stream meets the same one batch
-    after batch (:func:`engine.method.similarity.top_context_phones`, as offline)."""
+    after batch (:func:`facetraj_engine.method.similarity.top_context_phones`, as offline)."""
 
     def __init__(self, model: Model, config: SynthConfig):
         self.model, self.config = model, config
@@ -292,10 +292,10 @@ class PhoneticSynthesizer:
 
 def recognized_silence(snap: PhoneSnapshot, times: np.ndarray) -> np.ndarray:
     """Whether the settled phone at each of ``times`` is silence (times not settled: no). Before
-    a stream's energy has spanned its range (:mod:`engine.streaming.speech`: the silence before
+    a stream's energy has spanned its range (:mod:`facetraj_engine.streaming.speech`: the silence before
     the first words), the recognizer says where the pauses are.
 
-    >>> from engine.data import PhoneSegment
+    >>> from facetraj_engine.data import PhoneSegment
     >>> snap = PhoneSnapshot([PhoneSegment(0, .3, "sil"), PhoneSegment(.3, .4, "b")],
     ...                      np.ones(2), 0.4)
     >>> recognized_silence(snap, np.array([0.1, 0.35, 0.5])).tolist()

@@ -1,10 +1,10 @@
 """Streaming phone recognition (live mode, issue 27): PocketSphinx's all-phone search fed as the
 audio arrives, its partial hypotheses settled into phones with a confidence.
 
-The search is offline recognition's (:func:`engine.labels.alignment.allphone_decoder`, the same
+The search is offline recognition's (:func:`facetraj_engine.labels.alignment.allphone_decoder`, the same
 settings), fed in 10 ms steps; every ``partial_every`` steps its partial hypothesis (the best
 path's phone segments so far) is observed, and the frames ``settle_s`` behind the decoder's front
-are frozen (:class:`engine.streaming.phones.PhoneTrack`): the phones synthesis may use. The steps
+are frozen (:class:`facetraj_engine.streaming.phones.PhoneTrack`): the phones synthesis may use. The steps
 are the same whatever the size of the blocks fed, so the phones are too.
 
 Two things differ from offline recognition, both measured on the CMU ARCTIC samples:
@@ -15,7 +15,7 @@ Two things differ from offline recognition, both measured on the CMU ARCTIC samp
   (c0 = 54-60 on the ARCTIC samples). :class:`RunningCmn` estimates the mean from the frames so far
   and sets it every 5 frames, PocketSphinx's initial mean counting as :data:`CMN_PRIOR_FRAMES`
   frames (the count whose running mean is nearest the whole-utterance mean on PocketSphinx's own
-  test recordings: :func:`engine.evaluation.live_eval.prior_count_errors`).
+  test recordings: :func:`facetraj_engine.evaluation.live_eval.prior_count_errors`).
 * **Utterances.** The search's history grows with the utterance and each partial hypothesis is a
   back-trace over all of it, so the decoder starts a new utterance at the settled frame when the
   settled phones end in a pause (``restart_silence_s``) or the utterance reaches
@@ -114,7 +114,7 @@ class RunningCmn:
     ``MIN_RANGE_C0``, or with ``speech_share=None``); the initial mean counts as ``prior_frames``
     frames (:data:`CMN_PRIOR_FRAMES`, a MAP-style prior). Only the last ``MAX_BLOCKS`` blocks
     count. Measured against offline recognition's phones (10 ms speech frames labelled alike,
-    :func:`engine.evaluation.live_eval.phone_agreement`) on the default corpus's 94 test
+    :func:`facetraj_engine.evaluation.live_eval.phone_agreement`) on the default corpus's 94 test
     sentences and 7 real ones (the ARCTIC and MOCHA samples), the prior worth 40 frames: these
     weighed means 65.0 % and 74.5 % (63.8 % and 72.9 % worth 20), the plain running mean 65.0 %
     and 75.8 %, PocketSphinx's own live mean 61.3 % and 61.1 %; live closure on the ARCTIC

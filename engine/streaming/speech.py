@@ -1,9 +1,9 @@
 """Speech and pauses of a stream, by energy (live mode, issue 27): what
-:func:`engine.method.speech.speech_mask` and :func:`~engine.method.speech.pauses` compute on a
+:func:`facetraj_engine.method.speech.speech_mask` and :func:`~facetraj_engine.method.speech.pauses` compute on a
 whole recording, computed as the audio arrives.
 
 The same short-time energy (20 ms Hamming window, 4 ms hop) and 112 ms median filter (its values
-equal :func:`engine.method.speech.filtered_energy_db`'s, tested); a marker frame's value is known
+equal :func:`facetraj_engine.method.speech.filtered_energy_db`'s, tested); a marker frame's value is known
 66 ms after its time (half the filter and half the window). What a stream cannot know is the
 recording's floor and peak (its 5th and 99th energy percentiles): the threshold uses those of the
 filtered energy so far (at most the last ``HISTORY_S``), and until the energy has spanned

@@ -1,10 +1,10 @@
 """Streaming acoustic-only synthesis: audio blocks in, face frames out as soon as they are determined.
 
-The same computation as :func:`engine.method.pipeline.synthesize` in acoustic-only mode (paper section
+The same computation as :func:`facetraj_engine.method.pipeline.synthesize` in acoustic-only mode (paper section
 2.3: input LSFs, the LSF-index search, eqs 5-8, the triangular smoothing), with the state carried
-between blocks: the resampler's filter memory (``engine.method.lsf.ResampleStream``), the last sample
+between blocks: the resampler's filter memory (``facetraj_engine.method.lsf.ResampleStream``), the last sample
 for the pre-emphasis, the analysis samples not yet used by a frame, and the smoother's last raw
-frames (``engine.method.smoothing.TriangularStream``). Frame t (at ``t / marker_rate``) is emitted once
+frames (``facetraj_engine.method.smoothing.TriangularStream``). Frame t (at ``t / marker_rate``) is emitted once
 the audio up to ``t / marker_rate + lookahead_s`` has arrived: half the analysis window (12.5 ms),
 the resampler's few samples and the smoothing window's second half (3 frames, 50 ms, at 60 Hz),
 plus up to ``batch_frames - 1`` frames when frames are analysed in batches (live mode: 3).

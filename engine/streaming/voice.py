@@ -1,13 +1,13 @@
 """The voice match of a stream, measured as it runs (live mode, issue 27).
 
-Offline, :func:`engine.method.pipeline.input_voice_ratio` takes the median, over (at most 400
+Offline, :func:`facetraj_engine.method.pipeline.input_voice_ratio` takes the median, over (at most 400
 evenly spaced) speech frames of the whole recording, of eq 5's distance to the nearest codeword,
-over the training voice's own figure ``D0`` (:mod:`engine.method.voice_match`). A stream has the
+over the training voice's own figure ``D0`` (:mod:`facetraj_engine.method.voice_match`). A stream has the
 frames so far: :class:`RunningVoice` keeps the distances of the last ``MAX_FRAMES`` speech frames
 (6.7 s of speech) and gives their median ratio once ``MIN_FRAMES`` have been heard. It is live
 mode's one running adaptation: the robust mode's label weight grows with the ratio
 (``SynthConfig.label_weight_by_voice``) and recognized /p b m/ close as far as the voice does not
-match (:func:`engine.method.closure.closure_strengths`).
+match (:func:`facetraj_engine.method.closure.closure_strengths`).
 
 Until the voice has been measured, live mode takes it for an unmatched voice (``PRIOR_MATCH``):
 a person at a microphone is not the training voice, which is synthetic (the ARCTIC talkers are at
@@ -61,12 +61,12 @@ class RunningVoice:
 
     @property
     def match(self) -> float:
-        """The voice match in [0, 1] (:func:`engine.method.voice_match.voice_match`), or
+        """The voice match in [0, 1] (:func:`facetraj_engine.method.voice_match.voice_match`), or
         ``PRIOR_MATCH`` while the ratio is unknown."""
         r = self.ratio
         return voice_match(r, 1.0) if np.isfinite(r) else PRIOR_MATCH
 
     def weight_scale(self, by_voice: bool = True) -> float:
         """The factor of the robust mode's label weight
-        (:func:`engine.method.voice_match.label_weight_scale` of the running ratio)."""
+        (:func:`facetraj_engine.method.voice_match.label_weight_scale` of the running ratio)."""
         return label_weight_scale(self.ratio, by_voice)

@@ -7,7 +7,7 @@ import argparse
 import logging
 from pathlib import Path
 
-from engine.errors import FacetrajError
+from facetraj_engine.errors import FacetrajError
 
 from ..corpus_work import add_corpus_work_options, finish, jobs, skips
 from ..options import FRACTION, RATE, integer
@@ -19,7 +19,7 @@ log = logging.getLogger("facetraj")
 
 def cmd_corpus_build(args: argparse.Namespace) -> int:
     try:
-        from engine.corpusgen.build import build_corpus
+        from facetraj_engine.corpusgen.build import build_corpus
     except ImportError as exc:
         raise FacetrajError(f"the corpus generator is not available ({exc}); "
                             "install it with: pip install -e '.[corpus]'") from exc
@@ -34,7 +34,7 @@ def cmd_corpus_build(args: argparse.Namespace) -> int:
 
 
 def cmd_corpus_init(args: argparse.Namespace) -> int:
-    from engine.io.corpus import init_corpus, label_kinds, load_corpus
+    from facetraj_engine.io.corpus import init_corpus, label_kinds, load_corpus
 
     out, info = init_corpus(args.data_dir, args.output, args.fixed, args.upper_lip,
                             args.lower_lip, args.lip_corners, args.label_map or "", args.rate,
@@ -52,14 +52,14 @@ def cmd_corpus_init(args: argparse.Namespace) -> int:
 
 
 def cmd_corpus_show(args: argparse.Namespace) -> int:
-    from engine.io.corpus import load_corpus
+    from facetraj_engine.io.corpus import load_corpus
 
     corpus = load_corpus(args.corpus)
     info = corpus.info
     print(f"{info.name or corpus.root.name}: {len(info.train)} train, {len(info.test)} test, "
           f"{len(info.marker_names)} markers at {info.marker_rate:g} Hz ({info.dimensions}-D)")
     print(f"fixed: {' '.join(info.fixed_markers)}; lips: {info.upper_lip} / {info.lower_lip}")
-    from engine.fanout import fan_out
+    from facetraj_engine.fanout import fan_out
 
     skipped = skips(args)
     for split in ("train", "test"):
@@ -70,13 +70,13 @@ def cmd_corpus_show(args: argparse.Namespace) -> int:
 
 
 def cmd_corpus_align(args: argparse.Namespace) -> int:
-    from engine.io.labelling import label_folder
+    from facetraj_engine.io.labelling import label_folder
 
     from .align import extra_dictionary
 
     folder = args.folder
     if folder.is_file() or (folder / "corpus.json").is_file():
-        from engine.io.corpus import load_corpus
+        from facetraj_engine.io.corpus import load_corpus
 
         folder = load_corpus(folder).data_root
     skipped = skips(args, "recordings")

@@ -14,7 +14,7 @@ from ..options import POSITIVE, TOP_N, add_synth_options, integer, synth_config
 from ..progress import TerminalProgress
 
 if TYPE_CHECKING:
-    from engine.config import EvalConfig
+    from facetraj_engine.config import EvalConfig
 
 log = logging.getLogger("facetraj")
 
@@ -22,9 +22,9 @@ log = logging.getLogger("facetraj")
 def mode_rule(args: argparse.Namespace, model, corpus, splits) -> EvalConfig:
     """The evaluation settings of ``eval`` and ``sweep``: without ``--mode`` each utterance's mode
     follows its labels, as in ``synth`` (logged with the reason, for the first utterance)."""
-    from engine.config import EvalConfig
-    from engine.errors import FacetrajError
-    from engine.method.modes import TUNED_FIELDS, choose_mode
+    from facetraj_engine.config import EvalConfig
+    from facetraj_engine.errors import FacetrajError
+    from facetraj_engine.method.modes import TUNED_FIELDS, choose_mode
 
     explicit = getattr(args, "mode", None) is not None
     keep = tuple(f for f in TUNED_FIELDS if getattr(args, f, None) is not None)
@@ -50,9 +50,9 @@ def log_modes(res) -> None:
 
 
 def cmd_eval(args: argparse.Namespace) -> int:
-    from engine.evaluation.scores import evaluate, format_table2
-    from engine.io.corpus import load_corpus
-    from engine.method.model import Model
+    from facetraj_engine.evaluation.scores import evaluate, format_table2
+    from facetraj_engine.io.corpus import load_corpus
+    from facetraj_engine.method.model import Model
 
     model = Model.load(args.model)
     corpus = load_corpus(args.corpus)
@@ -70,9 +70,9 @@ def cmd_eval(args: argparse.Namespace) -> int:
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from engine.evaluation.scores import sweep_n
-    from engine.io.corpus import load_corpus
-    from engine.method.model import Model
+    from facetraj_engine.evaluation.scores import sweep_n
+    from facetraj_engine.io.corpus import load_corpus
+    from facetraj_engine.method.model import Model
 
     model = Model.load(args.model)
     corpus = load_corpus(args.corpus)
@@ -93,8 +93,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def cmd_similarity(args: argparse.Namespace) -> int:
-    from engine.method.model import Model
-    from engine.method.similarity import format_table1, top_similar
+    from facetraj_engine.method.model import Model
+    from facetraj_engine.method.similarity import format_table1, top_similar
 
     model = Model.load(args.model)
     s = model.similarity(args.nu)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from engine.errors import FacetrajError
+from facetraj_engine.errors import FacetrajError
 
 from ..options import SECONDS
 from ..paths import default_corpus
@@ -13,8 +13,8 @@ from ..paths import default_corpus
 
 def cmd_gui(args: argparse.Namespace) -> int:
     try:
-        from app.main import run_app
-        from app.recordings import recordings_in
+        from facetraj_app.main import run_app
+        from facetraj_app.recordings import recordings_in
     except ImportError as exc:
         raise FacetrajError(f"the app cannot start: {exc}") from exc
     recordings = recordings_in(args.corpus) if args.corpus is not None else []

@@ -1,5 +1,5 @@
 """``facetraj live``: the face follows a microphone, or a file played through the same streaming
-path (``engine.streaming.live``: phones recognized as they are spoken, the robust mode and the
+path (``facetraj_engine.streaming.live``: phones recognized as they are spoken, the robust mode and the
 closure step; ``--acoustic-only``: the paper's acoustic search alone).
 
 * ``facetraj live``: the app's Live mode (input device, level meter, scrolling lip panels and
@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from engine.errors import FacetrajError
+from facetraj_engine.errors import FacetrajError
 
 from ..options import count_or_all, real, synth_config
 from ..paths import default_corpus
@@ -28,19 +28,19 @@ log = logging.getLogger("facetraj")
 
 def load_model(args: argparse.Namespace):
     """The model of ``--model``, or the default corpus's (trained and cached on first use)."""
-    from engine.method.model import Model
+    from facetraj_engine.method.model import Model
 
     if args.model is not None:
         return Model.load(args.model)
-    from app.cache import load_or_train
-    from engine.io.corpus import load_corpus
+    from facetraj_app.cache import load_or_train
+    from facetraj_engine.io.corpus import load_corpus
 
     return load_or_train(load_corpus(args.corpus or default_corpus()))
 
 
 def live_config(args: argparse.Namespace):
     """The synthesis settings of a stream (its mode follows ``--acoustic-only``:
-    :func:`engine.streaming.live.live_mode`), ``--warp`` as the speaker warp."""
+    :func:`facetraj_engine.streaming.live.live_mode`), ``--warp`` as the speaker warp."""
     cfg = synth_config(args)
     if args.smoothing == "spline":
         raise FacetrajError("live mode smooths with the triangular window or not at all "
@@ -53,10 +53,10 @@ def live_config(args: argparse.Namespace):
 
 def write_take(args: argparse.Namespace, model, audio: np.ndarray, rate: int, cfg) -> Path:
     """Stream ``--from-file`` and write the take to ``-o`` (its phones to a TextGrid beside it)."""
-    from engine.io.export import write_trajectories
-    from engine.io.labelling import write_labels
-    from engine.streaming.live import LiveConfig, stream_file
-    from engine.threads import one_blas_thread
+    from facetraj_engine.io.export import write_trajectories
+    from facetraj_engine.io.labelling import write_labels
+    from facetraj_engine.streaming.live import LiveConfig, stream_file
+    from facetraj_engine.threads import one_blas_thread
 
     textgrid = args.output.with_suffix(".TextGrid")
     if not args.acoustic_only and textgrid.exists() and not args.overwrite:
@@ -81,7 +81,7 @@ def write_take(args: argparse.Namespace, model, audio: np.ndarray, rate: int, cf
 
 
 def cmd_live(args: argparse.Namespace) -> int:
-    from engine.io.audio import read_audio
+    from facetraj_engine.io.audio import read_audio
 
     cfg = live_config(args)
     if args.output is not None:
@@ -94,7 +94,7 @@ def cmd_live(args: argparse.Namespace) -> int:
         print(write_take(args, load_model(args), audio, rate, cfg))
         return 0
     try:
-        from app.live import run_live
+        from facetraj_app.live import run_live
     except ImportError as exc:
         raise FacetrajError(f"the app cannot start: {exc}") from exc
     return run_live(model_loader=lambda: load_model(args), config=cfg, from_file=args.from_file,
@@ -121,7 +121,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="the paper's acoustic search alone, without recognizing the phones "
                         "(lower latency; the lips of a new voice do not close)")
     p.add_argument("--warp", type=real(0.5, 2.0), default=1.0, metavar="ALPHA",
-                   help="with --acoustic-only: speaker warp of the input LSFs (engine.method.speaker; "
+                   help="with --acoustic-only: speaker warp of the input LSFs (facetraj_engine.method.speaker; "
                         "1 = none, below 1 for a shorter vocal tract than the training voice)")
     p.add_argument("--screenshot", metavar="OUT.png", help=argparse.SUPPRESS)
     p.add_argument("--quit-after", type=real(0, 1e6, lo_open=True), metavar="S",

@@ -7,7 +7,7 @@ import argparse
 import logging
 from pathlib import Path
 
-from engine.errors import FacetrajError
+from facetraj_engine.errors import FacetrajError
 
 from ..corpus_work import add_corpus_work_options, finish, jobs, skips
 from ..options import FPS, add_synth_options, integer, synth_config, video_size
@@ -18,19 +18,19 @@ log = logging.getLogger("facetraj")
 
 
 def cmd_video(args: argparse.Namespace) -> int:
-    from engine.method.model import Model
-    from engine.method.modes import choose_mode
-    from engine.method.pipeline import synthesize
+    from facetraj_engine.method.model import Model
+    from facetraj_engine.method.modes import choose_mode
+    from facetraj_engine.method.pipeline import synthesize
 
     try:
-        from app.video import VideoSettings, render_video
+        from facetraj_app.video import VideoSettings, render_video
     except ImportError as exc:
         raise FacetrajError(f"video export needs the app's packages: {exc}") from exc
     model = Model.load(args.model)
     original = None
     title = ""
     if args.corpus:
-        from engine.io.corpus import load_corpus
+        from facetraj_engine.io.corpus import load_corpus
 
         if not args.utterance:
             raise FacetrajError("give --utterance ID with --corpus")
@@ -40,8 +40,8 @@ def cmd_video(args: argparse.Namespace) -> int:
         original = model.normalise_markers(utt.markers) if utt.markers is not None else None
         title, source = utt.text or utt.name, utt.name
     elif args.audio:
-        from engine.io.audio import read_audio
-        from engine.io.labelfiles import read_label_file
+        from facetraj_engine.io.audio import read_audio
+        from facetraj_engine.io.labelfiles import read_label_file
 
         audio, rate = read_audio(args.audio)
         labels = read_label_file(args.labels, rate, len(audio) / rate) if args.labels else None
@@ -65,38 +65,38 @@ def cmd_video(args: argparse.Namespace) -> int:
 
 
 def cmd_report(args: argparse.Namespace) -> int:
-    from engine.method.model import Model
+    from facetraj_engine.method.model import Model
 
     try:
-        from app.report_figures import make_report
+        from facetraj_app.report_figures import make_report
     except ImportError as exc:
         raise FacetrajError(f"the report's figures need matplotlib: {exc}") from exc
     model = Model.load(args.model) if args.model else None
     if args.automatic_labels:
-        from engine.evaluation.label_eval import LABEL_EVAL_FILE, evaluate_labels, write_label_eval
-        from engine.io.corpus import load_corpus
+        from facetraj_engine.evaluation.label_eval import LABEL_EVAL_FILE, evaluate_labels, write_label_eval
+        from facetraj_engine.io.corpus import load_corpus
 
         args.output.mkdir(parents=True, exist_ok=True)
         result = evaluate_labels(load_corpus(args.corpus or default_corpus()),
                                  progress=TerminalProgress("automatic labels"))
         write_label_eval(args.output / LABEL_EVAL_FILE, result)
     if args.second_voice:
-        from engine.evaluation.voice_eval import VOICE_EVAL_FILE, evaluate_voices, write_voice_eval
-        from engine.io.corpus import load_corpus
+        from facetraj_engine.evaluation.voice_eval import VOICE_EVAL_FILE, evaluate_voices, write_voice_eval
+        from facetraj_engine.io.corpus import load_corpus
 
         args.output.mkdir(parents=True, exist_ok=True)
         voices = evaluate_voices(load_corpus(args.corpus or default_corpus()), model=model,
                                  progress=TerminalProgress("second voice"))
         write_voice_eval(args.output / VOICE_EVAL_FILE, voices)
     if args.closure:
-        from engine.evaluation.closure_eval import (
+        from facetraj_engine.evaluation.closure_eval import (
             ARCTIC_DIR,
             CLOSURE_EVAL_FILE,
             evaluate_closure,
             write_closure_eval,
         )
-        from engine.io.corpus import load_corpus
-        from engine.method.training import train
+        from facetraj_engine.io.corpus import load_corpus
+        from facetraj_engine.method.training import train
 
         corpus = load_corpus(args.corpus or default_corpus())
         args.output.mkdir(parents=True, exist_ok=True)

@@ -16,8 +16,8 @@ log = logging.getLogger("facetraj")
 
 
 def _job(args: argparse.Namespace):
-    from engine.method.modes import TUNED_FIELDS
-    from engine.method.recording import LabelRequest
+    from facetraj_engine.method.modes import TUNED_FIELDS
+    from facetraj_engine.method.recording import LabelRequest
 
     from ..batch import SynthJob
 
@@ -34,9 +34,9 @@ def cmd_synth(args: argparse.Namespace) -> int:
 
     if is_batch(args.inputs, args.output):
         return _cmd_batch(args)
-    from engine.io.files import check_output_path
-    from engine.method.model import Model
-    from engine.method.recording import EarlyLsf
+    from facetraj_engine.io.files import check_output_path
+    from facetraj_engine.method.model import Model
+    from facetraj_engine.method.recording import EarlyLsf
 
     from ..batch import choose_kernels, synthesize_file
 
@@ -53,7 +53,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
 
 
 def _cmd_batch(args: argparse.Namespace) -> int:
-    from engine.errors import InputError
+    from facetraj_engine.errors import InputError
 
     from .. import batch
     from ..progress import TerminalProgress

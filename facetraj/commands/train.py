@@ -14,9 +14,9 @@ log = logging.getLogger("facetraj")
 
 
 def cmd_train(args: argparse.Namespace) -> int:
-    from engine.io.corpus import load_corpus
-    from engine.io.files import check_output_path
-    from engine.method.training import train
+    from facetraj_engine.io.corpus import load_corpus
+    from facetraj_engine.io.files import check_output_path
+    from facetraj_engine.method.training import train
 
     check_output_path(args.output, args.overwrite)  # before training, not after
     corpus = load_corpus(args.corpus)
@@ -25,7 +25,7 @@ def cmd_train(args: argparse.Namespace) -> int:
                   workers=jobs(args), skip=skipped)
     folds = tune_folds(args, model.trained_labels)
     if folds:
-        from engine.evaluation.tuning import cross_validate
+        from facetraj_engine.evaluation.tuning import cross_validate
 
         tuning = cross_validate(corpus.without(skipped.bad if skipped else ()), train_config(args),
                                 folds=folds,
