@@ -1,6 +1,7 @@
 """``python -m benchmarks [--smoke] [--corpus DIR] [--out FILE] [--only GROUP ...]``
 
-Runs the training, synthesis, scaling and phone-labelling benchmarks (and the app playback benchmark,
+Runs the training, synthesis, scaling, corpus scaling and phone-labelling benchmarks (and the app
+playback benchmark,
 ``benchmarks/playback.py``, when it exists and a display is available), prints one table and
 writes it, with the machine described, to ``docs/benchmarks.md``.
 
@@ -23,7 +24,7 @@ from pathlib import Path
 
 from facetraj_engine.threads import limit_frame_threads, one_blas_thread
 
-from . import cli, labels, live, scaling, startup, synth, train
+from . import cli, corpus_scale, labels, live, scaling, startup, synth, train
 from .common import (
     REPO,
     BenchContext,
@@ -38,7 +39,8 @@ from .common import (
 
 log = logging.getLogger("benchmarks")
 
-GROUPS = ("train", "synth", "cli", "scaling", "eval", "labels", "playback", "startup", "live")
+GROUPS = ("train", "synth", "cli", "scaling", "corpus", "eval", "labels", "playback", "startup",
+          "live")
 DEFAULT_OUT = REPO / "docs" / "benchmarks.md"
 #: hand-written profile notes (per stage, before and after a change), copied into the Markdown
 NOTES = REPO / "benchmarks" / "profile_notes.md"
@@ -92,6 +94,8 @@ def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS, factors: Sequence[i
     if "scaling" in only:
         with limit_frame_threads(1):              # how the search grows, on one core
             rows += scaling.run(ctx, factors, prefilters)
+    if "corpus" in only:                          # the real commands on a corpus 1, 4, 16 times
+        rows += corpus_scale.run(ctx)
     if "eval" in only:
         rows += startup.evaluation(ctx)
     if "labels" in only:
@@ -151,6 +155,7 @@ def write_markdown(path: Path, rows: Sequence[BenchRow], ctx: BenchContext, elap
         *([f"- {r.name}: {r.cell()} {r.unit} (aim {r.aim}): **{r.verdict()}**"
            for r in rows if r.ok is not None] or ["- not judged (smoke size)"]),
         "",
+        *corpus_scale.section(rows),
         *(["## Where synthesis spends its time (cProfile, own time)", ""] if prof else []),
         *[line for name, top in (prof or {}).items() for line in (
             f"{name}:", "", "| function | s | share |", "|---|---:|---:|",

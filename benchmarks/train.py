@@ -5,9 +5,10 @@ the codebook.
 
 The split is measured inside one ``train()`` call by wrapping the engine's own functions as
 ``facetraj_engine.method.training`` calls them (``lsf_at``; ``fill_gaps``, ``reference_pose``,
-``remove_head_motion``; ``fit_pca``); the codebook time is the remainder (context-phones, codeword
-times, PC interpolation, eqs 1-2). Peak memory is measured in a second call under
-``tracemalloc`` (numpy reports its buffers to it), so that tracing does not slow the timed run.
+``remove_head_motion``; ``pca_of``, the PCA of the merged moments); the codebook time is the
+remainder (context-phones, codeword times, PC interpolation, eqs 1-2). Peak memory is measured
+in a second call under ``tracemalloc`` (numpy reports its buffers to it), so that tracing does
+not slow the timed run.
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ log = logging.getLogger(__name__)
 STAGES: dict[str, tuple[str, ...]] = {
     "lsf": ("lsf_at",),
     "normalisation": ("fill_gaps", "reference_pose", "remove_head_motion"),
-    "pca": ("fit_pca",),
+    "pca": ("pca_of",),
 }
 
 TRAIN_AIM_S = 30.0
@@ -95,7 +96,7 @@ def run(ctx: BenchContext) -> list[BenchRow]:
                  note=f"{n_cw} codeword LSF vectors"),
         BenchRow("train", "marker normalisation (fill_gaps, reference_pose, remove_head_motion)",
                  norm, "s"),
-        BenchRow("train", "PCA (fit_pca)", pca, "s",
+        BenchRow("train", "PCA (pca_of)", pca, "s",
                  note=f"{model.pca.n_components} PCs of {model.n_markers * 3} coordinates"),
         BenchRow("train", "codebook: contexts, PC codewords, eqs 1-2 (rest of train())", rest, "s",
                  note=f"{model.codebook.n_contexts} context-phones"),

@@ -1,23 +1,30 @@
-"""Work fanned out over processes, one item (an utterance, a recording) at a time, with the
-serial run's errors.
+"""Work fanned out over processes, one item (an utterance, a recording, a sentence to build) at
+a time: the one fan-out of the project (the corpus commands, ``facetraj synth``'s batch, the
+corpus builder).
 
 :func:`fan_out` runs ``fn(item)`` for every item, serially or in worker processes (forked, so
-that the model and the corpus are inherited, not pickled). Either way a bad file gives the same
-outcome:
+that the model and the corpus are inherited, not pickled), and yields ``(item, result)`` as the
+caller takes them: in the items' order (``ordered``, the default: the same sums in the same
+order whatever the number of workers) or as they finish. It is a stream: the workers run at most
+``ahead`` items beyond the last one the caller has taken, so that what waits to be taken stays
+bounded whatever the number of items (the corpus is read, analysed and let go one item at a
+time). Either way a bad file gives the same outcome:
 
 - by default, the first item in order whose file is bad stops the work with its own
   :class:`~facetraj_engine.errors.FacetrajError` (``file: problem``; its ``item`` attribute names the
-  item), as the serial run does; the items still waiting are cancelled;
+  item), as the serial run does; the items still waiting are not started;
 - with a :class:`Skips` (the commands' ``--skip-bad``), the item is left out, its message kept,
   and the work goes on; the command ends with :meth:`Skips.summary` ("1 of 3 utterances skipped:
   ...") and exit status 3 (its result is incomplete).
 
 A worker's error comes back as it was raised (every facetraj error pickles, and anything that
-does not is replaced by a plain copy before it leaves the worker); a worker that dies (killed,
-out of memory, a crash in a file reader) is an error naming the item it was working on (with a
-:class:`Skips`, that item is skipped), never a traceback. :func:`forked_map` is the worker
-processes under both this and ``facetraj synth``'s batch. The warnings about files a worker
-logs (``facetraj_engine.errors.warn_file``) are sent to the parent, which logs each once.
+does not is replaced by a plain copy before it leaves the worker). A worker that dies (killed,
+out of memory, a crash in a file reader) fails the item it was working on, named, and only that
+item: another worker takes its place for the rest; the failure is a
+:class:`~facetraj_engine.errors.FacetrajError` like a bad file's (stops the work, or with a
+:class:`Skips` is recorded there), never a traceback. A bug in ``fn`` (any other exception) is
+raised here as it is. The warnings about files a worker logs (``facetraj_engine.errors.warn_file``) are
+sent to the parent, which logs each once.
 """
 
 from __future__ import annotations
@@ -42,12 +49,16 @@ log = logging.getLogger(__name__)
 I = TypeVar("I", bound=Hashable)
 R = TypeVar("R")
 
+#: items a worker may run ahead of the last one taken, per worker (:func:`fan_out`'s ``ahead``)
+AHEAD_PER_WORKER = 4
+
 
 @dataclass
 class Skips:
     """Items left out because their files were bad (``--skip-bad``): item -> message; and every
     item tried, for the count. One object may follow several passes over the same items (the
-    report trains, then evaluates three times): each item counts once.
+    report trains, then evaluates three times): each item counts once. ``verb`` says what
+    happened to them (``facetraj synth``'s batch: ``failed``).
 
     >>> s = Skips("utterances")
     >>> s.tried.update(["a", "b", "c"]); s.add("b", InputError("b.c3d", "not a C3D file"))
@@ -58,11 +69,12 @@ class Skips:
     noun: str = "utterances"
     bad: dict[Any, str] = field(default_factory=dict)
     tried: set = field(default_factory=set)
+    verb: str = "skipped"
 
     def add(self, item: Any, exc: BaseException) -> None:
         if item not in self.bad:
             self.bad[item] = str(exc)
-            log.warning("skipped: %s", exc)
+            log.warning("%s: %s", self.verb, exc)
 
     def __bool__(self) -> bool:
         """True when something was skipped."""
@@ -70,7 +82,7 @@ class Skips:
 
     def summary(self) -> str:
         """``"k of n <noun> skipped: <message>"`` (one message per line when several)."""
-        head = f"{len(self.bad)} of {len(self.tried | set(self.bad))} {self.noun} skipped"
+        head = f"{len(self.bad)} of {len(self.tried | set(self.bad))} {self.noun} {self.verb}"
         if len(self.bad) == 1:
             return f"{head}: {next(iter(self.bad.values()))}"
         return head + ":" + "".join(f"\n  {msg}" for msg in self.bad.values())
@@ -100,23 +112,72 @@ def portable(exc: BaseException) -> BaseException:
         return RuntimeError(f"{type(exc).__name__}: {exc}")
 
 
-#: called in the parent before worker processes fork: what every worker would otherwise load
-#: for itself (``facetraj_engine.method.kernels`` loads the compiled kernels here), loaded once
-_BEFORE_FORK: list[Callable[[], None]] = []
+def can_fork() -> bool:
+    """Whether :func:`fan_out` can run workers here (``fork`` exists: not on Windows); where it
+    cannot, the work runs in this process."""
+    return hasattr(os, "fork")
 
 
-def before_fork(fn: Callable[[], None]) -> None:
-    """Have ``fn()`` called in the parent before :func:`fan_out` forks its workers (once per
-    registration, whatever the number of calls)."""
-    if fn not in _BEFORE_FORK:
-        _BEFORE_FORK.append(fn)
+# --------------------------------------------------------------------------- the one entry
+def fan_out(fn: Callable[[I], R], items: Sequence[I], workers: int = 1, *,
+            skip: Skips | None = None, progress: Progress | None = None,
+            describe: Callable[[I], str] = str, ordered: bool = True,
+            setup: Callable[[], None] | None = None, ahead: int | None = None
+            ) -> Iterator[tuple[I, R]]:
+    """``(item, fn(item))`` for every item, computed in ``workers`` processes (forked; serially
+    for 1, or where fork is unavailable), taken in order (``ordered``) or as they finish.
+
+    A :class:`~facetraj_engine.errors.FacetrajError` of an item, or its worker's death, stops the work
+    (raised, ``item`` set), or with ``skip`` leaves the item out (recorded there).
+    ``progress(fraction, describe(item))`` as the items are taken, ``(1.0, "done")`` at the end.
+    ``setup()`` is called once in every process that runs items (each worker; this one when
+    serial). The workers run at most ``ahead`` items (default :data:`AHEAD_PER_WORKER` per
+    worker) beyond the last one taken. A generator: nothing runs until the first is asked for,
+    and closing it early starts no further item."""
+    items = list(items)
+    if skip is not None:
+        skip.tried.update(items)
+    workers = max(1, min(workers, len(items)))
+    if workers > 1 and can_fork():
+        runs = _in_processes(fn, items, workers, ordered, setup,
+                             ahead or AHEAD_PER_WORKER * workers)
+    else:
+        runs = _here(fn, items, setup)
+    try:
+        for k, (i, done) in enumerate(runs):
+            item = items[i]
+            if progress:
+                progress(k / len(items), describe(item))
+            if isinstance(done, _Died):
+                done = _Done(error=FacetrajError(
+                    f"a worker process stopped unexpectedly ({done.how()}: out of memory, or a "
+                    f"crash in a file reader) while working on {describe(item)}; run with "
+                    f"--jobs 1 to see why"))
+            FILE_WARNINGS.merge(done.warnings)
+            if done.error is not None:
+                if skip is None:
+                    done.error.item = item          # what --skip-bad would have left out
+                    raise done.error
+                skip.add(item, done.error)
+                continue
+            yield item, done.result
+    finally:
+        runs.close()                                # the workers stopped and reaped, now
+    if progress:
+        progress(1.0, "done")
 
 
-def prepare_fork() -> None:
-    """Run the :func:`before_fork` hooks: call it right before any ``fork`` (``fan_out`` does):
-    no thread is then half-way through loading what a child would inherit locked."""
-    for prepare in _BEFORE_FORK:
-        prepare()
+def _here(fn: Callable[[Any], Any], items: list, setup: Callable[[], None] | None
+          ) -> Iterator[tuple[int, _Done]]:
+    """The items run in this process, one at a time as they are asked for; their file warnings
+    logged as they are raised."""
+    if setup is not None:
+        setup()
+    for i, item in enumerate(items):
+        try:
+            yield i, _Done(result=fn(item))
+        except FacetrajError as exc:
+            yield i, _Done(error=exc)
 
 
 # --------------------------------------------------------------------------- worker processes
@@ -124,12 +185,14 @@ def prepare_fork() -> None:
 # they share, runs ``fn`` on it and sends the result back through its own pipe; the parent only
 # reads. With a pool that hands items out itself (``concurrent.futures``) a worker waits for the
 # parent's thread between items, and where the workers fill the cores that thread waits for a
-# core (benchmarks/profile_notes.md measures it).
+# core (benchmarks/profile_notes.md). A semaphore of ``ahead`` slots bounds the items taken and
+# not yet handed to the caller: a worker takes a slot before an item, the parent gives it back
+# when the caller has taken that item.
 _LENGTH = struct.Struct("<Q")
 
 
 @dataclass
-class WorkerDied:
+class _Died:
     """The result of an item whose worker stopped while working on it: ``status`` is what
     ``os.waitstatus_to_exitcode`` gave (a negative signal number when killed)."""
 
@@ -139,14 +202,10 @@ class WorkerDied:
         return f"killed by signal {-self.status}" if self.status < 0 else \
             f"exit status {self.status}"
 
-    def describe(self) -> str:
-        return f"the worker process stopped while working on it ({self.how()}: out of memory, " \
-               f"or a crash in a file reader)"
-
 
 class _Raised:
-    """What a worker sends when ``fn`` raised: the exception (made picklable), re-raised in the
-    parent."""
+    """What a worker sends when ``fn`` raised a bug: the exception (made picklable), re-raised
+    in the parent."""
 
     def __init__(self, exc: BaseException):
         self.exc = exc
@@ -159,29 +218,47 @@ def _send(fd: int, message: Any) -> None:
         view = view[os.write(fd, view):]
 
 
-def _child(fn: Callable[[Any], Any], items: Sequence[Any], counter, fd: int,
-           initializer: Callable[..., None] | None, initargs: tuple) -> None:
-    """A worker's life: set up, then items taken from ``counter`` until none is left."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)       # the parent stops the work (module doc)
+def _run_one(fn: Callable[[Any], Any], item: Any) -> _Done | _Raised:
+    """``fn(item)`` in a worker: its result, or its facetraj error, and the file warnings it
+    raised; a bug is sent as it is (raised in the parent), after its traceback."""
+    mark = FILE_WARNINGS.mark()
+    try:
+        with limit_frame_threads(1):    # one process per core already
+            done = _Done(result=fn(item))
+    except FacetrajError as exc:
+        done = _Done(error=portable(exc))  # type: ignore[arg-type]
+    except BaseException as exc:                   # a bug in fn: the parent raises it
+        traceback.print_exc()                      # its traceback, where it happened
+        return _Raised(portable(exc))
+    done.warnings = FILE_WARNINGS.since(mark)
+    return done
+
+
+def _child(fn: Callable[[Any], Any], items: Sequence[Any], shared: tuple, fd: int,
+           setup: Callable[[], None] | None) -> None:
+    """A worker's life: set up, then items taken from the shared counter (a slot first) until
+    none is left."""
+    counter, slots = shared
+    signal.signal(signal.SIGINT, signal.SIG_IGN)       # the parent stops the work
     code = 0
     try:
-        if initializer is not None:
-            initializer(*initargs)
+        one_blas_thread()                              # the processes share the cores
+        FILE_WARNINGS.quiet = True                     # the parent logs them
+        if setup is not None:
+            setup()
         while True:
+            slots.acquire()
             with counter.get_lock():
                 i = counter.value
                 if i >= len(items):
                     break
                 counter.value = i + 1
             _send(fd, ("take", i))
-            try:
-                result = fn(items[i])
-            except BaseException as exc:               # a bug in fn: the parent raises it
-                traceback.print_exc()                  # its traceback, where it happened
-                _send(fd, ("done", i, _Raised(portable(exc))))
+            done = _run_one(fn, items[i])
+            _send(fd, ("done", i, done))
+            if isinstance(done, _Raised):
                 code = 1
                 break
-            _send(fd, ("done", i, result))
     except BaseException:
         traceback.print_exc()
         code = 1
@@ -196,6 +273,7 @@ class _Worker:
         self.pid, self.fd = pid, fd
         self.buffer = bytearray()
         self.working: int | None = None
+        self.done = 0
 
     def messages(self, data: bytes) -> Iterator[tuple]:
         self.buffer += data
@@ -208,76 +286,78 @@ class _Worker:
             yield message
 
 
-def can_fork() -> bool:
-    """Whether :func:`forked_map` can run here (``fork`` exists: not on Windows); where it
-    cannot, the work runs in this process."""
-    return hasattr(os, "fork")
+class _Processes:
+    """The forked workers of one :func:`fan_out`, read by the parent: :meth:`finished` gives
+    ``(index, _Done | _Died)`` as the workers finish items; :meth:`taken` gives a slot back."""
 
+    def __init__(self, fn: Callable[[Any], Any], items: Sequence[Any], workers: int,
+                 setup: Callable[[], None] | None, ahead: int):
+        import multiprocessing as mp
 
-def forked_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int,
-               initializer: Callable[..., None] | None = None, initargs: tuple = ()
-               ) -> Iterator[tuple[int, Any]]:
-    """``(index, fn(items[index]))`` for every item, as the ``workers`` forked children finish
-    them (each set up once by ``initializer(*initargs)``); ``(index, WorkerDied)`` for an item
-    whose worker died. An exception ``fn`` raises is raised here. Closing the iterator early
-    (``break``, an error) lets the items in work finish and takes no more."""
-    import multiprocessing as mp
+        ctx = mp.get_context("fork")
+        self.fn, self.items, self.setup, self.workers = fn, items, setup, workers
+        self.shared = (ctx.Value("q", 0), ctx.Semaphore(max(ahead, workers)))
+        self.running: dict[int, _Worker] = {}
+        self.sel = selectors.DefaultSelector()
 
-    counter = mp.get_context("fork").Value("q", 0)
-    running: dict[int, _Worker] = {}
-    sel = selectors.DefaultSelector()
-    left = len(items)
-
-    def spawn() -> None:
-        prepare_fork()
+    def spawn(self) -> None:
         r, w = os.pipe()
         pid = os.fork()
         if pid == 0:                                   # the child: never returns
             os.close(r)
-            for other in running.values():
+            for other in self.running.values():
                 os.close(other.fd)
-            _child(fn, items, counter, w, initializer, initargs)
+            _child(self.fn, self.items, self.shared, w, self.setup)
         os.close(w)
-        running[r] = _Worker(pid, r)
-        sel.register(r, selectors.EVENT_READ)
+        self.running[r] = _Worker(pid, r)
+        self.sel.register(r, selectors.EVENT_READ)
 
-    try:
-        for _ in range(max(1, min(workers, len(items)))):
-            spawn()
-        while running:
-            for key, _ in sel.select():
-                worker = running[key.fd]
+    def taken(self) -> None:
+        """The caller has taken an item: a worker may start another."""
+        self.shared[1].release()
+
+    def finished(self) -> Iterator[tuple[int, Any]]:
+        for _ in range(self.workers):
+            self.spawn()
+        while self.running:
+            for key, _ in self.sel.select():
+                worker = self.running[key.fd]
                 data = os.read(key.fd, 1 << 16)
                 for message in worker.messages(data):
                     if message[0] == "take":
                         worker.working = message[1]
                         continue
-                    _, i, result = message
-                    worker.working, left = None, left - 1
-                    if isinstance(result, _Raised):
-                        raise result.exc
-                    yield i, result
-                if data:
-                    continue
-                sel.unregister(key.fd)                  # end of pipe: the worker is gone
-                os.close(key.fd)
-                del running[key.fd]
-                _, status = os.waitpid(worker.pid, 0)
-                code = os.waitstatus_to_exitcode(status)
-                if worker.working is not None:
-                    left -= 1
-                    yield worker.working, WorkerDied(code)
-                    if counter.value < len(items):      # another in its place
-                        spawn()
-                elif code != 0:                         # before its first item: its set-up
-                    raise FacetrajError(f"a worker process stopped as it was set up "
-                                        f"({WorkerDied(code).how()}); run with --jobs 1 to see why")
-        if left > 0:
-            raise RuntimeError(f"{left} items were neither done nor reported")
-    finally:
+                    _, i, done = message
+                    worker.working, worker.done = None, worker.done + 1
+                    if isinstance(done, _Raised):
+                        raise done.exc
+                    yield i, done
+                if not data:                           # end of pipe: the worker is gone
+                    yield from self._gone(key.fd, worker)
+
+    def _gone(self, fd: int, worker: _Worker) -> Iterator[tuple[int, _Died]]:
+        """A worker's pipe closed: reaped; the item it was on failed, another in its place."""
+        self.sel.unregister(fd)
+        os.close(fd)
+        del self.running[fd]
+        _, status = os.waitpid(worker.pid, 0)
+        code = os.waitstatus_to_exitcode(status)
+        if code != 0 and worker.working is None and not worker.done:    # in its set-up
+            raise FacetrajError(f"a worker process stopped as it was set up "
+                                f"({_Died(code).how()}); run with --jobs 1 to see why")
+        if code != 0 and self.shared[0].value < len(self.items):
+            self.spawn()
+        if worker.working is not None:
+            yield worker.working, _Died(code)
+
+    def close(self) -> None:
+        """Take no more items, let the ones in work finish, reap every worker."""
+        counter, slots = self.shared
         with counter.get_lock():
-            counter.value = len(items)                  # take nothing more
-        for worker in running.values():                 # the items in work finish
+            counter.value = len(self.items)
+        for _ in range(len(self.running)):
+            slots.release()                            # a worker waiting for a slot: it stops
+        for worker in self.running.values():
             try:
                 while os.read(worker.fd, 1 << 16):
                     pass
@@ -285,85 +365,31 @@ def forked_map(fn: Callable[[Any], Any], items: Sequence[Any], workers: int,
                 pass
             os.close(worker.fd)
             os.waitpid(worker.pid, 0)
-        sel.close()
+        self.running.clear()
+        self.sel.close()
 
 
-def _worker_setup() -> None:
-    """A corpus command's worker process: the processes share the cores (``facetraj_engine.threads``),
-    and the parent logs the file warnings."""
-    one_blas_thread()
-    FILE_WARNINGS.quiet = True
-
-
-def _run_one(fn: Callable[[Any], Any], item: Any) -> _Done:
-    """``fn(item)`` in a worker: its result, or its facetraj error, and the file warnings it
-    raised; a bug is raised as it is (``forked_map`` sends it to the parent)."""
-    mark = FILE_WARNINGS.mark()
-    try:
-        with limit_frame_threads(1):    # one process per core already
-            done = _Done(result=fn(item))
-    except FacetrajError as exc:
-        done = _Done(error=portable(exc))  # type: ignore[arg-type]
-    done.warnings = FILE_WARNINGS.since(mark)
-    return done
-
-
-def fan_out(fn: Callable[[I], R], items: Sequence[I], workers: int = 1, *,
-            skip: Skips | None = None, progress: Progress | None = None,
-            describe: Callable[[I], str] = str) -> list[tuple[I, R]]:
-    """``(item, fn(item))`` for every item, in order, computed in ``workers`` processes (forked;
-    serially for 1, or where fork is unavailable). A :class:`~facetraj_engine.errors.FacetrajError` of an
-    item stops the work (raised as it is), or with ``skip`` leaves the item out (recorded there).
-    ``progress(fraction, describe(item))`` as the items are taken in order."""
-    items = list(items)
-    if skip is not None:
-        skip.tried.update(items)
-    workers = max(1, min(workers, len(items)))
-    if workers > 1 and can_fork():
-        return _in_processes(fn, items, workers, skip, progress, describe)
-    out: list[tuple[I, R]] = []
-    for k, item in enumerate(items):
-        if progress:
-            progress(k / len(items), describe(item))
-        try:
-            out.append((item, fn(item)))
-        except FacetrajError as exc:
-            if skip is None:
-                exc.item = item         # what --skip-bad would have left out
-                raise
-            skip.add(item, exc)
-    if progress:
-        progress(1.0, "done")
-    return out
-
-
-def _in_processes(fn: Callable[[I], R], items: list[I], workers: int, skip: Skips | None,
-                  progress: Progress | None, describe: Callable[[I], str]) -> list[tuple[I, R]]:
-    """:func:`fan_out` in forked workers (:func:`forked_map`), the results taken in order."""
-    import functools
-
-    out: list[tuple[I, R]] = []
+def _in_processes(fn: Callable[[Any], Any], items: list, workers: int, ordered: bool,
+                  setup: Callable[[], None] | None, ahead: int
+                  ) -> Iterator[tuple[int, _Done | _Died]]:
+    """The items run in ``workers`` forked processes; ``(index, outcome)`` in order, or as they
+    finish; a slot given back as each is handed on."""
+    procs = _Processes(fn, items, workers, setup, ahead)
     waiting: dict[int, Any] = {}
     k = 0
-    for i, done in forked_map(functools.partial(_run_one, fn), items, workers, _worker_setup):
-        waiting[i] = done
-        while k in waiting:
-            done, item = waiting.pop(k), items[k]
-            if progress:
-                progress(k / len(items), describe(item))
-            k += 1
-            if isinstance(done, WorkerDied):
-                done = _Done(error=FacetrajError(
-                    f"a worker process stopped unexpectedly (out of memory, or a crash in a file "
-                    f"reader) while working on {describe(item)}; run with --jobs 1 to see why"))
-            FILE_WARNINGS.merge(done.warnings)
-            if done.error is not None:
-                if skip is None:
-                    done.error.item = item
-                    raise done.error
-                skip.add(item, done.error)
+    try:
+        for i, done in procs.finished():
+            if not ordered:
+                yield i, done
+                procs.taken()
+                k += 1
                 continue
-            out.append((item, done.result))
-    if progress:
-        progress(1.0, "done")
-    return out
+            waiting[i] = done
+            while k in waiting:
+                yield k, waiting.pop(k)
+                procs.taken()
+                k += 1
+        if k < len(items):
+            raise RuntimeError(f"{len(items) - k} items were neither done nor reported")
+    finally:
+        procs.close()

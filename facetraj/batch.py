@@ -3,7 +3,8 @@
 Every input goes through :func:`synthesize_file`, the one path of ``facetraj synth`` for a
 recording (its labels and mode by the same rules as one file,
 :func:`facetraj_engine.workflow.recording.synthesize_recording`), in ``jobs`` worker processes that each
-hold the model (loaded once; forked workers share the parent's copy). An input whose output
+hold the model (loaded once; forked workers share the parent's copy: :func:`facetraj_engine.fanout.fan_out`,
+whose worker that dies fails the input it was on, and only that one). An input whose output
 exists is skipped unless ``overwrite`` (outputs are written whole or not at all, so an interrupted
 run resumes where it stopped); an input that fails is reported with its one-line reason and the
 others go on. The summary (done / skipped / failed, with each reason) is printed, and written as
@@ -12,12 +13,13 @@ JSON beside the outputs (:data:`SUMMARY_NAME`).
 
 from __future__ import annotations
 
+import functools
 import glob
 import logging
 import math
 import os
 import time
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -227,26 +229,6 @@ def import_synthesis() -> None:
     import facetraj_engine.workflow.recording  # noqa: F401
 
 
-# --------------------------------------------------------------------------- fan-out
-def fan_out(fn: Callable[[Any], Any], items: Sequence[Any], workers: int,
-            initializer: Callable[..., None], initargs: tuple) -> Iterator[tuple[Any, Any]]:
-    """``(item, fn(item))`` for every item, as they finish: in this process when ``workers`` is
-    1 or fork is missing (``facetraj_engine.fanout.can_fork``), else in that many forked processes
-    (``facetraj_engine.fanout.forked_map``: the parent's modules and model are shared, not loaded again),
-    each set up once by ``initializer``; an item whose worker died comes with an
-    ``facetraj_engine.fanout.WorkerDied``. ``fn`` must not raise (its errors are results)."""
-    from facetraj_engine.fanout import can_fork, forked_map
-
-    if workers <= 1 or len(items) <= 1 or not can_fork():
-        initializer(*initargs)
-        for item in items:
-            yield item, fn(item)
-        return
-
-    for i, result in forked_map(fn, items, workers, initializer, initargs):
-        yield items[i], result
-
-
 # --------------------------------------------------------------------------- the run
 def run_batch(model_path: Path, specs: Sequence[str], outdir: Path, fmt: str, job: SynthJob,
               jobs: int, progress: Callable[[float, str], None] | None = None
@@ -254,7 +236,7 @@ def run_batch(model_path: Path, specs: Sequence[str], outdir: Path, fmt: str, jo
     """Synthesize every input of ``specs`` into ``outdir`` (made when missing) with ``jobs``
     worker processes; the outcomes in input order. The model is loaded (and checked) here once
     before any worker starts."""
-    from facetraj_engine.fanout import WorkerDied
+    from facetraj_engine.fanout import Skips, fan_out
     from facetraj_engine.method.model import Model
 
     inputs = collect_inputs(specs)
@@ -278,17 +260,18 @@ def run_batch(model_path: Path, specs: Sequence[str], outdir: Path, fmt: str, jo
         import_synthesis()
     _WORKER.update(path=model_path, model=model)          # shared by forked workers
     t0 = time.perf_counter()
-    results = fan_out(_worker_run, todo, workers, _worker_init, (model_path, job, workers > 1))
-    for k, ((src, out), outcome) in enumerate(results, 1):
-        if isinstance(outcome, WorkerDied):         # a crash in a file reader, out of memory
-            outcome = Outcome(str(src), str(out), "failed", f"{src}: {outcome.describe()}")
+    died = Skips("inputs", verb="failed")         # a worker that died: its input failed
+    for _, outcome in fan_out(_worker_run, todo, workers, skip=died, progress=progress,
+                              describe=lambda pair: str(pair[0]), ordered=False,
+                              setup=functools.partial(_worker_init, model_path, job, workers > 1)):
         outcomes[Path(outcome.input)] = outcome
         if outcome.status == "failed":
             log.info("%s", outcome.reason)          # and in the summary at the end
         elif "line" in outcome.details:             # here, above the bar: not from a worker
             log.info("%s", outcome.details["line"])
-        if progress:
-            progress(k / len(todo), Path(outcome.input).name)
+    for src, out in todo:
+        if (src, out) in died.bad:
+            outcomes[src] = Outcome(str(src), str(out), "failed", died.bad[(src, out)])
     log.info("%d inputs in %.1f s", len(todo), time.perf_counter() - t0)
     return [outcomes[p] for p in inputs]
 

@@ -23,12 +23,12 @@ EXIT_INCOMPLETE = 3
 
 
 def add_corpus_work_options(p: argparse.ArgumentParser, noun: str = "utterances",
-                            jobs_default: str = "every core", jobs: bool = True) -> None:
+                            jobs: bool = True) -> None:
     """``--jobs/-j N`` (unless ``jobs`` is off) and ``--skip-bad`` (``noun``: what the command
     works through)."""
     if jobs:
         p.add_argument("--jobs", "-j", type=integer(1, 256), metavar="N",
-                       help=f"{noun} processed in N processes (default: {jobs_default})")
+                       help=f"{noun} processed in N processes (default: every core)")
     p.add_argument("--skip-bad", action="store_true",
                    help=f"leave out {noun} whose files are bad and go on: the command ends with "
                         f"a summary ('2 of 280 {noun} skipped: FILE: PROBLEM') and exit status 3, "

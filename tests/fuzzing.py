@@ -1319,11 +1319,8 @@ def run_in_process(case: Case) -> Outcome:
 
 def run_forked(case: Case, timeout: float = TIMEOUT_S, memory: int = MEMORY_LIMIT) -> Outcome:
     """Run a case in a forked child with an address-space limit and a timeout."""
-    from facetraj_engine.fanout import prepare_fork
-
     err_path = case_workdir(case) / ".stderr"
     t0 = time.perf_counter()
-    prepare_fork()            # as facetraj forks: nothing half-loaded in another thread
     at_fork = vm_rss()
     pid = os.fork()
     if pid == 0:  # the child: never returns
@@ -1454,10 +1451,7 @@ def _app_batch(ws: Workspace, actions: list, results: Path, timeout: float
                ) -> tuple[int, int | None, float]:
     """Fork a child that runs ``actions`` in one window; its peak memory, exit status (None when
     killed for taking longer than ``timeout``) and seconds."""
-    from facetraj_engine.fanout import prepare_fork
-
     t0 = time.perf_counter()
-    prepare_fork()
     pid = os.fork()
     if pid == 0:
         code = 1

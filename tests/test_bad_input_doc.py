@@ -355,7 +355,7 @@ def corpus_command_cases(f: BadInputs) -> dict[str, Callable[[], object]]:
         lambda: _cli(["eval", str(f.model.save(f.tmp / "m.npz")), str(f.small_corpus()), "-j", "2"]),
     "bad files left out with `--skip-bad`": lambda: _cli(
         ["eval", str(f.model.save(f.tmp / "m.npz")), str(f.small_corpus()), "-j", "2", "--skip-bad"]),
-    "a worker process that dies (killed, out of memory)": lambda: fan_out(_exit_on_b, "abc", 2),
+    "a worker process that dies (killed, out of memory)": lambda: list(fan_out(_exit_on_b, "abc", 2)),
     "the same problem in many files of a corpus": lambda: _cli(
         ["eval", str(f.model.save(f.tmp / "m.npz")), str(f.small_corpus(short=("toy000", "toy030")))]),
     "a label file in another phone alphabet (TIMIT, MOCHA-TIMIT, SAMPA, X-SAMPA, IPA)": lambda:

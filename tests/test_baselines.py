@@ -107,3 +107,28 @@ def test_baselines_on_toy_corpus(toy_model, toy_corpus):
     # the toy's faces follow its phones: the viseme lookup must track them well
     vis = [s.whole_face for s in scores if s.mode == "viseme" and s.split == "test"]
     assert np.mean(vis) > 0.8
+
+
+def test_baselines_fitted_an_utterance_at_a_time_equal_the_fit_of_every_frame(toy_model,
+                                                                              toy_corpus):
+    """The report streams the training utterances into the fit (issue 41): the viseme table and
+    its fallback are the bits of the lookup of every frame at once; the ridge regression from the
+    merged moments is the closed form on every frame at once to rounding."""
+    frames = [frame_data(toy_model, toy_corpus.utterance(u), keep_original=False)
+              for u in toy_corpus.info.train]
+    assert frames[0].original.size == 0
+    pcs = np.concatenate([fd.pcs for fd in frames])
+    phone = np.concatenate([fd.phone for fd in frames])
+    streamed = fit_baselines(toy_model, iter(frames), len(frames))
+    whole = fit_viseme(pcs, phone, len(toy_model.phones))
+    np.testing.assert_array_equal(streamed.viseme.table, whole.table)
+    np.testing.assert_array_equal(streamed.viseme.fallback, whole.fallback)
+    ok = np.isfinite(pcs).all(axis=1)
+    x = np.concatenate([stack_context(fd.lsf, 5) for fd in frames])[ok]
+    y = pcs[ok]
+    scale = np.where(x.std(axis=0) > 0, x.std(axis=0), 1.0)
+    xs = (x - x.mean(axis=0)) / scale
+    lam = streamed.ridge.lam
+    coef = np.linalg.solve(xs.T @ xs + lam * np.eye(xs.shape[1]), xs.T @ (y - y.mean(axis=0)))
+    np.testing.assert_allclose(streamed.ridge.coef, coef, rtol=1e-8, atol=1e-10)
+    np.testing.assert_allclose(streamed.ridge.predict(x), xs @ coef + y.mean(axis=0), atol=1e-9)

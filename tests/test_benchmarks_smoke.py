@@ -28,7 +28,7 @@ def test_smoke_table(toy: Path, tmp_path: Path, capsys) -> None:
     for needle in ("## Machine", "CPU:", "numpy:", "| group | benchmark |"):
         assert needle in text
     expected = [
-        "LSF extraction (lsf_at)", "PCA (fit_pca)", "train() total",
+        "LSF extraction (lsf_at)", "PCA (pca_of)", "train() total",
         "train() peak traced memory (tracemalloc)",
         "phonetic, 1 s input", "phonetic, 2 s input", "acoustic, 1 s input", "acoustic, 2 s input",
         "LSF index build (k-means), codebook x4",
@@ -108,3 +108,27 @@ def test_smoke_command_rows(toy: Path) -> None:
         assert any(n.startswith(want) for n in names), want
     for r in rows:
         assert math.isfinite(r.value) and r.value > 0 and r.ok is None, r
+
+
+def test_corpus_scaling_smoke(toy: Path, tmp_path: Path) -> None:
+    """The corpus scaling benchmark (issue 41): the corpus repeated under new names (links to the
+    same files, a corpus.json listing both splits repeated), the real `facetraj train` and `eval`
+    run in child processes and measured from outside, and its section of the Markdown."""
+    from benchmarks import corpus_scale
+    from benchmarks.common import load_context
+    from facetraj_engine.io.corpus import load_corpus
+
+    corpus = load_corpus(toy)
+    twice = load_corpus(corpus_scale.repeat_corpus(corpus, tmp_path / "x2", 2))
+    assert twice.info.train == corpus.info.train + [f"{u}_r01" for u in corpus.info.train]
+    assert (tmp_path / "x2" / f"{corpus.info.test[0]}_r01.wav").resolve() == \
+        (toy / f"{corpus.info.test[0]}.wav").resolve()
+    rows = corpus_scale.run(load_context(toy, smoke=True))
+    names = {r.name: r for r in rows}
+    for command in ("train", "eval"):
+        for f in corpus_scale.SMOKE_FACTORS:
+            assert names[f"{command} x{f}: time"].value > 0
+            assert 30 < names[f"{command} x{f}: peak memory"].value < 2048
+        assert math.isfinite(names[f"{command}: time growth exponent"].value)
+    section = "\n".join(corpus_scale.section(rows))
+    assert "| x2 |" in section and "### Past one machine" in section

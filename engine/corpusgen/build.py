@@ -8,19 +8,20 @@ same as in a full build.
 
 from __future__ import annotations
 
+import functools
 import logging
-import multiprocessing
 import os
 import re
 import time
 from collections import Counter
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ..data import PhoneSegment
+from ..errors import FacetrajError
+from ..fanout import Skips, fan_out
 from ..io.audio import write_audio
 from ..io.corpus import CorpusInfo, save_corpus_info
 from ..io.labelfiles import write_textgrid
@@ -182,13 +183,27 @@ def _lexicon() -> dict:
     return _LEXICON
 
 
-def _worker(utt_id: str, out_dir: str, seed: int, config: CorpusConfig) -> UtteranceResult:
-    return build_utterance(utt_id, out_dir, seed, config)
-
-
 def check_phone_coverage(counts: Counter, minimum: int = MIN_PHONE_COUNT) -> list[str]:
     """ARPAbet phones seen fewer than ``minimum`` times."""
     return [p for p in ARPABET if counts.get(p, 0) < minimum]
+
+
+def _build_all(ids: list[str], root: Path, seed: int, config: CorpusConfig, workers: int,
+               progress: Progress | None) -> dict[str, UtteranceResult]:
+    """Every utterance of ``ids`` built into ``root`` in ``workers`` processes
+    (:func:`facetraj_engine.fanout.fan_out`). A worker that dies fails its utterance only: the others are
+    built, then the build stops with an error naming the ones that were not."""
+    results: dict[str, UtteranceResult] = {}
+    failed = Skips("utterances", verb="not built")
+    build = functools.partial(build_utterance, out_dir=root, seed=seed, config=config)
+    for utt_id, res in fan_out(build, ids, workers, skip=failed, progress=progress,
+                               ordered=False):
+        results[utt_id] = res
+        log.info("%s done (%.1f s audio, %.1f s)", res.utt_id, res.duration, res.seconds)
+    if failed:
+        raise FacetrajError(f"{root}: {failed.summary()} (the other utterances are built; "
+                            f"corpus.json is not written)")
+    return results
 
 
 def build_corpus(out_dir: str | os.PathLike[str], n_sentences: int = DEFAULT_SENTENCES,
@@ -198,8 +213,9 @@ def build_corpus(out_dir: str | os.PathLike[str], n_sentences: int = DEFAULT_SEN
     """Build the corpus into ``out_dir`` (``corpus.json`` + four files per sentence).
 
     ``progress(fraction, message)`` is called before synthesis and after each utterance (the
-    engine's progress convention). ``workers`` processes
-    (default: the number of CPUs) synthesize in parallel. Returns the corpus description.
+    engine's progress convention). ``workers`` processes (default: the number of CPUs; forked by
+    :func:`facetraj_engine.fanout.fan_out`) synthesize in parallel; every utterance comes out the same
+    bits however many. Returns the corpus description.
     """
     config = config or CorpusConfig()
     if not 1 <= n_sentences <= len(SENTENCES):
@@ -221,23 +237,7 @@ def build_corpus(out_dir: str | os.PathLike[str], n_sentences: int = DEFAULT_SEN
         m = re.fullmatch(r"(s\d{3,})\.(flac|wav|TextGrid|c3d|txt)", p.name)
         if m and m.group(1) not in keep:
             p.unlink()
-    results: dict[str, UtteranceResult] = {}
-    n_workers = workers or os.cpu_count() or 1
-    if n_workers == 1:
-        for k, u in enumerate(ids):
-            results[u] = build_utterance(u, root, seed, config)
-            if progress:
-                progress((k + 1) / len(ids), u)
-    else:
-        ctx = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(n_workers, mp_context=ctx) as pool:
-            futures = {pool.submit(_worker, u, str(root), seed, config): u for u in ids}
-            for k, fut in enumerate(as_completed(futures)):
-                res = fut.result()
-                results[res.utt_id] = res
-                log.info("%s done (%.1f s audio, %.1f s)", res.utt_id, res.duration, res.seconds)
-                if progress:
-                    progress((k + 1) / len(ids), res.utt_id)
+    results = _build_all(ids, root, seed, config, workers or os.cpu_count() or 1, progress)
     train_counts: Counter = Counter()
     for u in train:
         train_counts.update(results[u].phone_counts)

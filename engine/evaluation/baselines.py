@@ -9,13 +9,15 @@ Table 2 (:func:`~facetraj_engine.evaluation.scores.trajectory_correlations` on
   is chosen on held-out *training* utterances, never on the test split.
 
 Both work on the 60 Hz marker frames: LSFs from :func:`facetraj_engine.method.lsf.lsf_at` with the model's
-analysis settings, PCs from the model's normalisation and PCA. numpy only.
+analysis settings, PCs from the model's normalisation and PCA. Both are fitted from sufficient
+statistics given one training utterance at a time (:class:`BaselineGather`: the phones' sums, the
+moments of ``[features, PCs]``), so that a corpus is streamed through them. numpy only.
 """
 
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,6 +27,7 @@ from ..data import Utterance
 from ..labels.phoneset import normalise_label
 from ..method.context import segment_index
 from ..method.model import Model
+from ..method.moments import Moments
 from ..method.smoothing import smooth
 from .scores import UtteranceScore, speech_mask, trajectory_correlations
 
@@ -68,15 +71,18 @@ def frame_phone_ids(model: Model, utt: Utterance, times: np.ndarray) -> np.ndarr
     return ids[segment_index(utt.phones, times)]
 
 
-def frame_data(model: Model, utt: Utterance, eval_config: EvalConfig | None = None) -> FrameData:
-    """Features, targets and the speech mask of one utterance with markers."""
+def frame_data(model: Model, utt: Utterance, eval_config: EvalConfig | None = None,
+               keep_original: bool = True) -> FrameData:
+    """Features, targets and the speech mask of one utterance with markers (without
+    ``keep_original``, its ``original`` markers are left empty: fitting does not need them)."""
     if utt.markers is None:
         raise ValueError(f"{utt.name}: no markers")
     times = utt.frame_times()
     lsf = model.input_lsf(utt.audio, utt.sample_rate, times)
     original = model.normalise_markers(utt.markers)
     pcs = model.to_pcs(original)
-    return FrameData(utt.name, lsf, pcs, frame_phone_ids(model, utt, times), original,
+    return FrameData(utt.name, lsf, pcs, frame_phone_ids(model, utt, times),
+                     original if keep_original else np.zeros((0, *original.shape[1:])),
                      speech_mask(utt.audio, utt.sample_rate, times, eval_config))
 
 
@@ -106,6 +112,35 @@ class VisemeLookup:
         return out
 
 
+class VisemeGather:
+    """:func:`fit_viseme` an utterance's frames at a time (in order): each phone's sum and count,
+    and the running sum of every finite row, added row after row as of all frames at once (the
+    same bits)."""
+
+    def __init__(self, n_phones: int):
+        self.n_phones = n_phones
+        self.sums: np.ndarray | None = None
+        self.counts = np.zeros(n_phones)
+        self.total: np.ndarray | None = None
+        self.n = 0
+
+    def add(self, pcs: np.ndarray, phone: np.ndarray) -> None:
+        pcs = np.asarray(pcs, dtype=np.float64)
+        phone = np.asarray(phone, dtype=np.int64)
+        if self.sums is None:
+            self.sums, self.total = np.zeros((self.n_phones, pcs.shape[1])), np.zeros(pcs.shape[1])
+        ok = np.isfinite(pcs).all(axis=1)
+        self.total = np.add.reduce(np.concatenate([self.total[None], pcs[ok]]), axis=0)
+        self.n += int(ok.sum())
+        sel = ok & (phone >= 0)
+        np.add.at(self.sums, phone[sel], pcs[sel])
+        self.counts += np.bincount(phone[sel], minlength=self.n_phones)
+
+    def lookup(self) -> VisemeLookup:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return VisemeLookup(self.sums / self.counts[:, None], self.total / self.n)
+
+
 def fit_viseme(pcs: np.ndarray, phone: np.ndarray, n_phones: int) -> VisemeLookup:
     """Mean of the finite PC rows of each phone id (eq 1 over frames); ids < 0 only count in the
     fallback mean.
@@ -116,17 +151,9 @@ def fit_viseme(pcs: np.ndarray, phone: np.ndarray, n_phones: int) -> VisemeLooku
     >>> v.table.ravel().tolist()[:2], v.predict(np.array([1, 2, -1])).ravel().tolist()
     ([2.0, 10.0], [10.0, 4.666666666666667, 4.666666666666667])
     """
-    pcs = np.asarray(pcs, dtype=np.float64)
-    phone = np.asarray(phone, dtype=np.int64)
-    ok = np.isfinite(pcs).all(axis=1)
-    fallback = pcs[ok].mean(axis=0)
-    sel = ok & (phone >= 0)
-    sums = np.zeros((n_phones, pcs.shape[1]))
-    np.add.at(sums, phone[sel], pcs[sel])
-    counts = np.bincount(phone[sel], minlength=n_phones).astype(float)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        table = sums / counts[:, None]
-    return VisemeLookup(table, fallback)
+    gather = VisemeGather(n_phones)
+    gather.add(pcs, phone)
+    return gather.lookup()
 
 
 # ---------------------------------------------------------------------- ridge regression
@@ -180,31 +207,75 @@ def fit_ridge(x: np.ndarray, y: np.ndarray, lam: float) -> RidgeRegression:
     [1.0, 2.0, 3.0]
     """
     x = np.asarray(x, dtype=np.float64)
-    y = np.asarray(y, dtype=np.float64)
-    x_mean = x.mean(axis=0)
-    x_scale = x.std(axis=0)
+    return ridge_of(Moments.of(np.hstack([x, np.asarray(y, dtype=np.float64)])), x.shape[1], lam)
+
+
+def ridge_of(moments: Moments, n_features: int, lam: float) -> RidgeRegression:
+    """:func:`fit_ridge` from the moments of the rows ``[x, y]`` (``x`` their first
+    ``n_features`` columns): ``Xs'Xs`` and ``Xs'(y - mean y)`` are their scatter's blocks over the
+    features' standard deviations, so that the frames need not be held; ``lam = 0``: the
+    minimum-norm least-squares solution."""
+    p = n_features
+    sxx, sxy = moments.scatter[:p, :p], moments.scatter[:p, p:]
+    x_scale = moments.std()[:p]
     x_scale = np.where(x_scale > 0, x_scale, 1.0)
-    xs = (x - x_mean) / x_scale
-    y_mean = y.mean(axis=0)
-    gram = xs.T @ xs
+    gram = sxx / np.outer(x_scale, x_scale)
     gram[np.diag_indices_from(gram)] += lam
-    if lam > 0:
-        coef = np.linalg.solve(gram, xs.T @ (y - y_mean))
-    else:  # least squares, minimum norm (constant features get 0)
-        coef = np.linalg.lstsq(xs, y - y_mean, rcond=None)[0]
-    return RidgeRegression(x_mean, x_scale, y_mean, coef, float(lam))
+    rhs = sxy / x_scale[:, None]
+    coef = np.linalg.solve(gram, rhs) if lam > 0 else np.linalg.lstsq(gram, rhs, rcond=None)[0]
+    return RidgeRegression(moments.mean[:p], x_scale, moments.mean[p:], coef, float(lam))
 
 
-def _design(frames: Sequence[FrameData], k: int) -> tuple[np.ndarray, np.ndarray]:
-    xs, ys = [], []
-    for fd in frames:
-        ok = np.isfinite(fd.pcs).all(axis=1)
-        xs.append(stack_context(fd.lsf, k)[ok])
-        ys.append(fd.pcs[ok])
-    return np.concatenate(xs), np.concatenate(ys)
+def _design(fd: FrameData, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """One utterance's stacked features and targets, on its frames with complete markers."""
+    ok = np.isfinite(fd.pcs).all(axis=1)
+    return stack_context(fd.lsf, k)[ok], fd.pcs[ok]
 
 
-def fit_ridge_baseline(frames: Sequence[FrameData], k: int = RIDGE_CONTEXT,
+class RidgeGather:
+    """:func:`fit_ridge_baseline` an utterance at a time, in order, ``n_utterances`` in all: the
+    moments of the fitting part (the first ones), then, as the held-out ones arrive (the fitting
+    part complete by then), each penalty's squared error on them; the refit on all from the
+    moments merged."""
+
+    def __init__(self, n_utterances: int, k: int = RIDGE_CONTEXT,
+                 lambdas: Sequence[float] = RIDGE_LAMBDAS, holdout: float = 0.2):
+        self.k, self.lambdas = k, list(lambdas)
+        n_hold = int(round(holdout * n_utterances)) if n_utterances >= 5 else 0
+        self.n_fit = n_utterances - n_hold if n_hold and len(self.lambdas) > 1 else n_utterances
+        self.fit: Moments | None = None
+        self.held: Moments | None = None
+        self.trials: list[RidgeRegression] = []
+        self.errors = np.zeros(len(self.lambdas))
+        self.values = 0
+        self.seen = 0
+        self.n_features = 0
+
+    def add(self, fd: FrameData) -> None:
+        x, y = _design(fd, self.k)
+        m = Moments.of(np.hstack([x, y]))
+        self.seen, self.n_features = self.seen + 1, x.shape[1]
+        if self.seen <= self.n_fit:
+            self.fit = m if self.fit is None else self.fit.merged(m)
+            return
+        if not self.trials:
+            self.trials = [ridge_of(self.fit, x.shape[1], lam * self.fit.n) for lam in self.lambdas]
+        self.errors += [float(((r.predict(x) - y) ** 2).sum()) for r in self.trials]
+        self.values += y.size
+        self.held = m if self.held is None else self.held.merged(m)
+
+    def ridge(self) -> RidgeRegression:
+        best = self.lambdas[0]
+        if self.trials:
+            mse = self.errors / max(self.values, 1)
+            best = self.lambdas[int(np.argmin(mse))]
+            log.info("ridge baseline: validation MSE %s -> lambda %g",
+                     ", ".join(f"{e:.4g}" for e in mse), best)
+        every = self.fit if self.held is None else self.fit.merged(self.held)
+        return ridge_of(every, self.n_features, best * every.n)
+
+
+def fit_ridge_baseline(frames: Iterable[FrameData], k: int = RIDGE_CONTEXT,
                        lambdas: Sequence[float] = RIDGE_LAMBDAS,
                        holdout: float = 0.2) -> RidgeRegression:
     """The ridge baseline on training utterances.
@@ -214,20 +285,10 @@ def fit_ridge_baseline(frames: Sequence[FrameData], k: int = RIDGE_CONTEXT,
     refitted on all of them.
     """
     frames = list(frames)
-    n_hold = int(round(holdout * len(frames))) if len(frames) >= 5 else 0
-    best = lambdas[0]
-    if n_hold and len(lambdas) > 1:
-        x_fit, y_fit = _design(frames[:-n_hold], k)
-        x_val, y_val = _design(frames[-n_hold:], k)
-        errors = []
-        for lam in lambdas:
-            r = fit_ridge(x_fit, y_fit, lam * len(x_fit))
-            errors.append(float(((r.predict(x_val) - y_val) ** 2).mean()))
-        best = lambdas[int(np.argmin(errors))]
-        log.info("ridge baseline: validation MSE %s -> lambda %g",
-                 ", ".join(f"{e:.4g}" for e in errors), best)
-    x, y = _design(frames, k)
-    return fit_ridge(x, y, best * len(x))
+    gather = RidgeGather(len(frames), k, lambdas, holdout)
+    for fd in frames:
+        gather.add(fd)
+    return gather.ridge()
 
 
 # ---------------------------------------------------------------------- scoring
@@ -248,11 +309,33 @@ class Baselines:
         raise ValueError(f"unknown baseline {name!r} (viseme or ridge)")
 
 
-def fit_baselines(model: Model, train_frames: Sequence[FrameData]) -> Baselines:
-    """Fit the viseme lookup and the ridge regression on the training frames."""
-    pcs = np.concatenate([fd.pcs for fd in train_frames])
-    phone = np.concatenate([fd.phone for fd in train_frames])
-    return Baselines(fit_viseme(pcs, phone, len(model.phones)), fit_ridge_baseline(train_frames))
+class BaselineGather:
+    """Both baselines fitted from ``n_utterances`` training utterances' frames given one at a
+    time, in order, and let go (:class:`VisemeGather`, :class:`RidgeGather`)."""
+
+    def __init__(self, model: Model, n_utterances: int):
+        self.viseme = VisemeGather(len(model.phones))
+        self.ridge = RidgeGather(n_utterances)
+
+    def add(self, fd: FrameData) -> None:
+        self.viseme.add(fd.pcs, fd.phone)
+        self.ridge.add(fd)
+
+    def baselines(self) -> Baselines:
+        return Baselines(self.viseme.lookup(), self.ridge.ridge())
+
+
+def fit_baselines(model: Model, train_frames: Iterable[FrameData],
+                  n_utterances: int | None = None) -> Baselines:
+    """Fit the viseme lookup and the ridge regression on the training frames (a sequence, or an
+    iterable of ``n_utterances``: each utterance's frames let go once added)."""
+    if n_utterances is None:
+        train_frames = list(train_frames)
+        n_utterances = len(train_frames)
+    gather = BaselineGather(model, n_utterances)
+    for fd in train_frames:
+        gather.add(fd)
+    return gather.baselines()
 
 
 def score_baseline(model: Model, fd: FrameData, pcs: np.ndarray, split: str, name: str,
@@ -278,10 +361,20 @@ def evaluate_baselines(model: Model, baselines: Baselines,
     out = []
     for split, fds in frames.items():
         for fd in fds:
-            for name in names:
-                pcs = baselines.predict(name, fd)
-                out.extend(score_baseline(model, fd, pcs, split, name, sm, eval_config)
-                           for sm in smoothings)
+            out.extend(score_baselines(model, baselines, fd, split, smoothings, names, eval_config))
     if progress:
         progress(1.0, "baselines done")
+    return out
+
+
+def score_baselines(model: Model, baselines: Baselines, fd: FrameData, split: str,
+                    smoothings: Sequence[str] = ("triangular", "spline"),
+                    names: Sequence[str] = ("viseme", "ridge"),
+                    eval_config: EvalConfig | None = None) -> list[UtteranceScore]:
+    """One utterance's scores of every baseline x smoothing."""
+    out = []
+    for name in names:
+        pcs = baselines.predict(name, fd)
+        out.extend(score_baseline(model, fd, pcs, split, name, sm, eval_config)
+                   for sm in smoothings)
     return out

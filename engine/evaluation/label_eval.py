@@ -34,7 +34,7 @@ from ..method.model import Model
 from ..method.modes import choose_mode, tuned_config
 from ..method.pipeline import synthesize
 from ..method.training import train
-from .baselines import evaluate_baselines, fit_baselines, frame_data
+from .baselines import fit_baselines, frame_data, score_baselines
 from .scores import METRICS, UtteranceScore, evaluate_utterance, speech_mask
 from .second_voice import second_voice
 from .tuning import cross_validate
@@ -135,16 +135,17 @@ def evaluate_kind(corpus: Corpus, kind: str, train_config: TrainConfig | None = 
     if max_test is not None and len(test) > max_test:
         test = [test[int(i)] for i in np.linspace(0, len(test) - 1, max_test)]
     scores: list[UtteranceScore] = []
-    train_frames = [frame_data(model, lab.utterance(u)) for u in lab.info.train]
-    baselines = fit_baselines(model, train_frames)
-    test_frames = []
+    baselines = fit_baselines(model, (frame_data(model, lab.utterance(u), keep_original=False)
+                                      for u in lab.info.train), len(lab.info.train))
+    baseline_scores: list[UtteranceScore] = []
     for j, utt_id in enumerate(test):
         if progress:
             progress(j / max(len(test), 1), f"{kind}: {utt_id}")
         utt = lab.utterance(utt_id)
         scores.extend(score_methods(model, utt, configs))
-        test_frames.append(frame_data(model, utt))
-    scores.extend(evaluate_baselines(model, baselines, {"test": test_frames}, ("triangular",)))
+        baseline_scores.extend(score_baselines(model, baselines, frame_data(model, utt), "test",
+                                               ("triangular",)))
+    scores.extend(baseline_scores)
     if second:
         return scores, tuning, second_voice_scores(model, lab, kind, test, progress)
     return scores, tuning

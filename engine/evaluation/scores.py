@@ -222,7 +222,7 @@ def evaluate(model: Model, corpus: Corpus, splits: Iterable[str] = ("train", "te
     with one_blas_thread(), limit_frame_threads(1):
         done = fan_out(score, list(split_of), workers, skip=skip, progress=progress,
                        describe=lambda u: f"{split_of[u]}: {u}")
-    return EvalResult([s for _, scores in done for s in scores])
+        return EvalResult([s for _, scores in done for s in scores])
 
 
 def table2(model: Model, corpus: Corpus, acoustic: bool = True,

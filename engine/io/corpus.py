@@ -296,6 +296,14 @@ class Corpus:
         """Load one utterance, with labels checked against the audio and markers against the info."""
         return load_utterance(self.data_root, utt_id, self.info, self.label_map())
 
+    def markers(self, utt_id: str, n_frames: int) -> np.ndarray:
+        """One utterance's markers alone, as :meth:`utterance` gives them for its ``n_frames``
+        marker frames of audio (:func:`fitted_frames`): what training reads again, after a first
+        pass that loaded the whole utterance, instead of holding every utterance's markers."""
+        mdata = read_markers(marker_path(self.data_root, utt_id), self.info.marker_rate,
+                             self.info.channel_names or None)
+        return fitted_frames(mdata.markers, n_frames)
+
     def utterances(self, split: str = "all") -> Iterator[Utterance]:
         """Iterate over ``train``, ``test`` or ``all`` utterances."""
         ids = {"train": self.info.train, "test": self.info.test, "all": self.info.ids}[split]
@@ -345,6 +353,19 @@ def load_corpus(root: str | os.PathLike[str]) -> Corpus:
         raise InputError(_json_path(root), f"its data folder {corpus.info.data_dir!r} "
                                            f"({corpus.data_root}) is not a folder")
     return corpus
+
+
+def fitted_frames(markers: np.ndarray, n_frames: int) -> np.ndarray:
+    """``markers`` ``(T, M, 3)`` cut or padded with NaN (unseen) to ``n_frames`` frames: those of
+    the utterance's audio.
+
+    >>> fitted_frames(np.zeros((2, 1, 3)), 3)[:, 0, 0].tolist()
+    [0.0, 0.0, nan]
+    """
+    if markers.shape[0] < n_frames:
+        pad = np.full((n_frames - markers.shape[0], *markers.shape[1:]), np.nan)
+        markers = np.concatenate([markers, pad])
+    return markers[:n_frames]
 
 
 def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
@@ -406,10 +427,7 @@ def _fit_to_audio(mpath: Path, markers: np.ndarray, marker_rate: float, duration
         warn_file(log, mpath, "markers shorter than the audio (later frames are treated as unseen)",
                   f"markers end at {(markers.shape[0] - 1) / marker_rate:.2f} s but the audio "
                   f"at {duration:.2f} s; later frames are treated as unseen")
-    if markers.shape[0] < n_audio:
-        pad = np.full((n_audio - markers.shape[0], *markers.shape[1:]), np.nan)
-        markers = np.concatenate([markers, pad])
-    markers = markers[:n_audio]
+    markers = fitted_frames(markers, n_audio)
     seen = marker_coverage(markers)
     if seen < 0.5:
         warn_file(log, mpath, "markers mostly missing (frames with gaps are left out)",

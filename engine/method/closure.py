@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..data import PhoneSegment
+from .moments import Moments
 from .pca import PCA
 
 #: The phones whose lips close.
@@ -87,36 +88,101 @@ def regression_direction(pcs: np.ndarray, aperture: np.ndarray) -> np.ndarray:
     >>> regression_direction(p, 3.0 + p @ np.array([1.0, 0.0])).tolist()
     [1.0, 2.0]
     """
-    ok = np.isfinite(pcs).all(axis=1) & np.isfinite(aperture)
-    p = pcs[ok] - pcs[ok].mean(axis=0)
-    a = aperture[ok] - aperture[ok].mean()
-    return p.T @ a / (a @ a)
+    return _direction(_joint_moments(np.asarray(pcs, dtype=np.float64),
+                                     np.asarray(aperture, dtype=np.float64)))
+
+
+def _joint_moments(p: np.ndarray, a: np.ndarray) -> Moments:
+    """The moments of the rows ``[p, a]`` where both are finite."""
+    ok = np.isfinite(p).all(axis=1) & np.isfinite(a)
+    return Moments.of(np.column_stack([p[ok], a[ok]]))
+
+
+def _direction(joint: Moments) -> np.ndarray:
+    """``cov(p, a) / var(a)`` from the moments of ``[p, a]``."""
+    return joint.scatter[:-1, -1] / joint.scatter[-1, -1]
+
+
+@dataclass
+class ClosurePart:
+    """One training utterance's share of :class:`ClosureStats`: the aperture's minimum in each
+    /p b m/, its PC rows in pauses over ``pause_s`` (finite ones), the moments of ``[p, a]`` over
+    its frames; and for the fallbacks of a corpus without pauses or without /p b m/, its PCs and
+    apertures (only when it has none itself)."""
+
+    minima: list[float]
+    rest: np.ndarray
+    joint: Moments
+    pcs: np.ndarray | None = None
+    apertures: np.ndarray | None = None
+
+
+def closure_part(pcs: np.ndarray, segs: Sequence[PhoneSegment], rate: float, a0: float,
+                 g: np.ndarray, pause_s: float = 0.15) -> ClosurePart:
+    """The :class:`ClosurePart` of one utterance's PCs ``(T, K)`` (NaN where a marker was unseen)
+    and its phone labels."""
+    p = np.asarray(pcs, dtype=np.float64)
+    a = a0 + p @ g
+    t = np.arange(len(p)) / rate
+    minima, rest = [], []
+    for s in segs:
+        idx = np.flatnonzero((t >= s.start) & (t < s.end))
+        if idx.size == 0 or not np.isfinite(a[idx]).any():
+            continue
+        if s.label in BILABIALS:
+            minima.append(float(np.nanmin(a[idx])))
+        elif s.label == "sil" and s.end - s.start > pause_s:
+            rest.append(p[idx])
+    rows = np.concatenate(rest) if rest else np.zeros((0, p.shape[1]))
+    return ClosurePart(minima, rows[np.isfinite(rows).all(axis=1)], _joint_moments(p, a),
+                       None if rest else p, None if minima else a)
+
+
+class ClosureGather:
+    """:class:`ClosureStats` gathered one utterance's :class:`ClosurePart` at a time (in order):
+    the minima and pause rows kept (their medians need them all), the regression from merged
+    moments; every utterance's PCs and apertures only while no pause (no /p b m/) has been seen,
+    for the fallbacks."""
+
+    def __init__(self, n_pcs: int):
+        self.minima: list[float] = []
+        self.rest: list[np.ndarray] = []
+        self.joint = Moments.empty(n_pcs + 1)
+        self.all_pcs: list[np.ndarray] = []
+        self.all_apertures: list[np.ndarray] = []
+
+    def add(self, part: ClosurePart) -> None:
+        self.minima += part.minima
+        if part.minima:
+            self.all_apertures = []
+        elif not self.minima:
+            self.all_apertures.append(part.apertures)
+        if len(part.rest):
+            self.rest.append(part.rest)
+            self.all_pcs = []
+        elif not self.rest:
+            self.all_pcs.append(part.pcs)
+        self.joint = self.joint.merged(part.joint)
+
+    def stats(self) -> ClosureStats:
+        """The statistics of every utterance added."""
+        rows = np.concatenate(self.rest) if self.rest else np.concatenate(self.all_pcs)
+        rows = rows[np.isfinite(rows).all(axis=1)]
+        closed = (float(np.median(self.minima)) if self.minima else
+                  float(np.nanpercentile(np.concatenate(self.all_apertures), 10)))
+        return ClosureStats(closed, _direction(self.joint), np.median(rows, axis=0))
 
 
 def closure_stats(pcs: Sequence[np.ndarray], phones: Sequence[Sequence[PhoneSegment]],
                   rate: float, a0: float, g: np.ndarray, pause_s: float = 0.15) -> ClosureStats:
     """:class:`ClosureStats` from the training utterances' PCs (``(T, K)`` each, NaN where a
-    marker was unseen) and their phone labels."""
-    minima, rest, all_p = [], [], []
+    marker was unseen) and their phone labels: the median aperture minimum over /p b m/ (else
+    the aperture's 10th percentile), the regression direction, the median face of long pauses
+    (else of every frame)."""
+    gather = ClosureGather(len(g))
     for p, segs in zip(pcs, phones, strict=True):
-        p = np.asarray(p, dtype=np.float64)
-        a = a0 + p @ g
-        t = np.arange(len(p)) / rate
-        all_p.append(p)
-        for s in segs:
-            idx = np.flatnonzero((t >= s.start) & (t < s.end))
-            if idx.size == 0 or not np.isfinite(a[idx]).any():
-                continue
-            if s.label in BILABIALS:
-                minima.append(float(np.nanmin(a[idx])))
-            elif s.label == "sil" and s.end - s.start > pause_s:
-                rest.append(p[idx])
-    p = np.concatenate(all_p)
-    direction = regression_direction(p, a0 + p @ g)
-    rows = np.concatenate(rest) if rest else p
-    rows = rows[np.isfinite(rows).all(axis=1)]
-    closed = float(np.median(minima)) if minima else float(np.nanpercentile(a0 + p @ g, 10))
-    return ClosureStats(closed, direction, np.median(rows, axis=0))
+        gather.add(closure_part(p, segs, rate, a0, g, pause_s))
+    return gather.stats()
 
 
 # --------------------------------------------------------------------------- where and how much

@@ -8,6 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .heap import give_back
+
 
 def codeword_times(start: np.ndarray, end: np.ndarray, n: int = 5,
                    placement: str = "centres") -> np.ndarray:
@@ -91,18 +93,22 @@ class Codebook:
         return np.repeat(self.centre, self.n_per_phone)
 
 
-def concatenate(parts: list[Codebook]) -> Codebook:
-    """Join codebooks built per utterance."""
+def concatenate(parts: list[Codebook], release: bool = False) -> Codebook:
+    """Join codebooks built per utterance. With ``release`` the parts' arrays are let go field by
+    field as they are joined (training's parts: the peak is the joined codebook and one field of
+    the parts, not the codebook twice)."""
     if not parts:
         raise ValueError("no codebook entries: the training data has no usable phone tokens")
-    return Codebook(
-        contexts=np.concatenate([p.contexts for p in parts]),
-        lsf=np.concatenate([p.lsf for p in parts]),
-        pcs=np.concatenate([p.pcs for p in parts]),
-        token_utt=np.concatenate([p.token_utt for p in parts]),
-        token_start=np.concatenate([p.token_start for p in parts]),
-        token_end=np.concatenate([p.token_end for p in parts]),
-        n_per_phone=parts[0].n_per_phone,
-        lsf_context=(np.concatenate([p.lsf_context for p in parts])
-                     if all(p.lsf_context is not None for p in parts) else None),
-    )
+    joined: dict[str, np.ndarray | None] = {}
+    for name in ("contexts", "lsf", "pcs", "token_utt", "token_start", "token_end",
+                 "lsf_context"):
+        arrays = [getattr(p, name) for p in parts]
+        if release:
+            for part in parts:
+                setattr(part, name, None)
+        joined[name] = (np.concatenate(arrays) if all(a is not None for a in arrays)
+                        else None)
+        del arrays
+        if release:
+            give_back()                            # the parts' small arrays, freed
+    return Codebook(**joined, n_per_phone=parts[0].n_per_phone)

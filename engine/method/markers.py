@@ -113,11 +113,14 @@ def remove_head_motion(markers: np.ndarray, fixed: np.ndarray, reference: np.nda
     return out
 
 
-def reference_pose(frames: np.ndarray, fixed: np.ndarray, iterations: int = 3) -> np.ndarray:
+def reference_pose(frames: np.ndarray, fixed: np.ndarray, iterations: int = 3,
+                   block: int = 8192) -> np.ndarray:
     """Neutral pose of the fixed markers: a generalised Procrustes mean of ``frames`` ``(T, M, 3)``.
 
-    Starts from the first complete frame and re-fits every frame to the running mean. No fixed
-    markers (data already head-corrected): an empty pose.
+    Starts from the first complete frame and re-fits every frame to the running mean, ``block``
+    frames at a time (what a fit holds stays the same whatever the corpus's length); the mean
+    is their sum taken frame after frame, the bits of the mean of all at once. No fixed markers
+    (data already head-corrected): an empty pose.
     """
     if len(fixed) == 0:
         return np.zeros((0, 3))
@@ -127,7 +130,11 @@ def reference_pose(frames: np.ndarray, fixed: np.ndarray, iterations: int = 3) -
         raise ValueError("no frame has all fixed markers visible")
     ref = src[0]
     for _ in range(iterations):
-        rot, trans = kabsch(src, np.broadcast_to(ref, src.shape))
-        aligned = np.einsum("tij,tmj->tmi", rot, src) + trans[:, None, :]
-        ref = aligned.mean(axis=0)
+        total = np.zeros_like(ref)
+        for a in range(0, len(src), block):
+            part = src[a:a + block]
+            rot, trans = kabsch(part, np.broadcast_to(ref, part.shape))
+            aligned = np.einsum("tij,tmj->tmi", rot, part) + trans[:, None, :]
+            total = np.add.reduce(np.concatenate([total[None], aligned]), axis=0)
+        ref = total / len(src)
     return ref

@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .moments import Moments
+
 
 @dataclass
 class PCA:
@@ -46,7 +48,7 @@ class PCA:
 
 
 def fit_pca(x: np.ndarray, n_components: int | None = 20, variance_target: float = 0.99) -> PCA:
-    """PCA of rows of ``x`` (``(T, D)``) by SVD.
+    """PCA of the rows of ``x`` (``(T, D)``): :func:`pca_of` their :class:`Moments`.
 
     Keeps ``n_components``, or when it is ``None`` the smallest count whose cumulative explained
     variance reaches ``variance_target``. With ``n_components = D`` reconstruction is exact.
@@ -59,18 +61,19 @@ def fit_pca(x: np.ndarray, n_components: int | None = 20, variance_target: float
     >>> p.n_components, bool(np.allclose(np.abs(p.components[0]), [1, 0], atol=0.01))
     (1, True)
     """
-    x = np.asarray(x, dtype=np.float64)
-    mean = x.mean(axis=0)
-    centred = x - mean
-    if len(x) >= 2 * x.shape[1]:
-        # tall data (frames >> 3M coordinates): eigen-decomposition of the D x D scatter matrix,
-        # much cheaper than the SVD of the T x D data, same components and variances
-        ev, vec = np.linalg.eigh(centred.T @ centred)
-        ev, vec = np.clip(ev[::-1], 0.0, None), vec[:, ::-1]
-        s, vt = np.sqrt(ev), vec.T
-    else:
-        _, s, vt = np.linalg.svd(centred, full_matrices=False)
-    var = s**2 / max(len(x) - 1, 1)
+    return pca_of(Moments.of(x), n_components, variance_target)
+
+
+def pca_of(moments: Moments, n_components: int | None = 20, variance_target: float = 0.99) -> PCA:
+    """The PCA of the rows whose count, mean and scatter matrix are ``moments`` (gathered an
+    utterance at a time in training): the eigen-decomposition of the ``D x D`` scatter matrix,
+    whose eigenvectors are the right singular vectors of the centred rows and whose eigenvalues
+    their squared singular values. ``n_components`` and ``variance_target`` as in
+    :func:`fit_pca`."""
+    ev, vec = np.linalg.eigh(moments.scatter)
+    ev, vec = np.clip(ev[::-1], 0.0, None), vec[:, ::-1]
+    vt = vec.T
+    var = ev / max(moments.n - 1, 1)
     total = float(var.sum())
     if n_components is None:
         cum = np.cumsum(var) / total
@@ -82,4 +85,4 @@ def fit_pca(x: np.ndarray, n_components: int | None = 20, variance_target: float
     # a sign convention so that a component's largest loading is positive (stable across runs)
     signs = np.sign(comps[np.arange(k), np.abs(comps).argmax(axis=1)])
     comps *= signs[:, None]
-    return PCA(mean=mean, components=comps, variances=var[:k], total_variance=total)
+    return PCA(mean=moments.mean, components=comps, variances=var[:k], total_variance=total)

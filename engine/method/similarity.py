@@ -9,6 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .context_index import context_index
+
 
 def phone_means(pcs: np.ndarray, phone_of: np.ndarray, n_phones: int) -> np.ndarray:
     """Eq 1: ``m_k = (1/T_k) sum_t P_kt``, the mean PC vector of each phone.
@@ -155,7 +157,9 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     :func:`context_similarity`'s order, so the scores are its scores to the bit; then the
     ``count``-th best score of each query (a partition) and a sort of the few scores reaching it.
     The result, including the lower-index-first tie order, is that of the full computation
-    (tested).
+    (tested). With a context (``context >= 1``) the contexts that can win are found by groups
+    of the same centre and first neighbours (:mod:`facetraj_engine.method.context_index`): their
+    number stops growing with the corpus, where the contexts of a centre phone grow with it.
 
     Returns ``(top, scores)``, both ``(Q, count)``.
 
@@ -173,6 +177,10 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     count = min(count, n_cb)
     cols = np.arange(full - c, full + c + 1)
     tables = context_weights(c, xi)[:, None, None] * s                       # (2c+1) x n x n
+    if n_q > 0 and c >= 1:                        # the contexts that can win, by groups
+        rest = 2.0 * sum(xi ** (-i) for i in range(2, c + 1))
+        rows, cand = context_index(codebook, n_ph).candidates(q, s, xi ** -1.0, bound, rest, count)
+        return _best(q, codebook, rows, cand, tables, cols, count)
     # the contexts that can win, per distinct query centre u: cand_all[u_start[u]:][:u_size[u]]
     centres, inverse = np.unique(q[:, full], return_inverse=True)
     sim = s[centres][:, codebook[:, full]]                                  # (U, L)
@@ -182,22 +190,31 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     u_size = np.count_nonzero(keep, axis=1)
     u_start = np.cumsum(u_size) - u_size
     cand_all = np.nonzero(keep)[1]
-    # every (query, context) pair, query by query: pair p is query rows[p] and context cand[p]
     sizes = u_size[inverse]
-    ends = np.cumsum(sizes)
-    starts = ends - sizes
     rows = np.repeat(np.arange(n_q), sizes)
-    place = np.arange(ends[-1]) - np.repeat(starts, sizes)                  # within its query
+    place = np.arange(sizes.sum()) - np.repeat(np.cumsum(sizes) - sizes, sizes)
     cand = cand_all[np.repeat(u_start[inverse], sizes) + place]
-    # eq 4's terms xi^-i S[query phone, context phone], added column by column
-    tables = tables.ravel()
+    return _best(q, codebook, rows, cand, tables, cols, count)
+
+
+def _best(q: np.ndarray, codebook: np.ndarray, rows: np.ndarray, cand: np.ndarray,
+          tables: np.ndarray, cols: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """The ``count`` best of each query among the (query ``rows[p]``, context ``cand[p]``) pairs
+    (by query, each query's in increasing context order): eq 4's terms ``xi^-i S`` looked up in
+    ``tables`` and added column by column, as :func:`context_similarity` adds them (its scores
+    to the bit), then the ``count``-th best score of each query (a partition) and a sort of the
+    few scores reaching it (ties: lower index first)."""
+    n_q, n_ph = q.shape[0], tables.shape[1]
+    sizes = np.bincount(rows, minlength=n_q)
+    starts = np.cumsum(sizes) - sizes
+    place = np.arange(len(rows)) - np.repeat(starts, sizes)                 # within its query
+    flat = tables.ravel()
     at = np.take(q.T[cols] * n_ph + (np.arange(len(cols)) * n_ph * n_ph)[:, None], rows, axis=1)
     at += np.take(codebook.T[cols], cand, axis=1)
-    terms = tables.take(at)
+    terms = flat.take(at)
     n = terms[0].copy()
     for term in terms[1:]:
         n += term
-    # the count best of each query: its count-th best score, then the few pairs reaching it
     width = int(sizes.max())
     grid = np.full((n_q, width), -np.inf)
     grid.ravel()[rows * width + place] = n

@@ -1,13 +1,36 @@
-"""Training (paper sections 2.1-2.2), step by step: load the training set, remove head motion,
+"""Training (paper sections 2.1-2.2), step by step: the training set read, head motion removed,
 PCA, the audio-visual codebook, the phone means and distances of eqs 1-2, and the LSF index.
+
+The corpus is streamed: each utterance is read, analysed and let go in turn (in ``workers``
+processes, :func:`facetraj_engine.fanout.fan_out`), so that only what the model keeps grows with the
+corpus (the codewords, the PCA's moments, the closure statistics). The steps that need every
+frame come from sufficient statistics gathered an utterance at a time, in passes over the
+utterances (:mod:`facetraj_engine.method.training_set`):
+
+1. every utterance loaded whole: its labels checked, its marker gaps filled, every fifth frame
+   of its fixed markers kept (the neutral pose, :func:`reference_pose`), its codewords' LSF
+   vectors computed (they need the audio, not the PCA);
+2. its markers read again and moved into the head frame of that pose: the count, mean and
+   scatter matrix of its complete frames, merged in order (:class:`~facetraj_engine.method.moments.Moments`),
+   whose eigenvectors are the PCA (:func:`~facetraj_engine.method.pca.pca_of`);
+3. its markers read a third time: their PCs, the codewords' PC vectors, its share of the
+   closure statistics; and the audio of the few utterances the voice reference ``D0`` is
+   measured on;
+4. the audio of (up to :data:`DETECTOR_UTTERANCES`) utterances read again, for the
+   bilabial-closure detector's frames (its logistic fit needs them all at once: a bounded
+   sample of a long corpus).
+
+The model equals the one of all frames at once to rounding (the PCA to about 1e-12), and the
+same bits whatever ``workers``: every sum is merged in the utterances' order.
 """
 
 from __future__ import annotations
 
 import logging
 from collections import Counter
-from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -19,7 +42,8 @@ from ..io.corpus import Corpus
 from ..io.labelfiles import validate_phones
 from ..labels.phoneset import SILENCE, apply_label_map
 from ..progress import Progress, no_progress
-from .closure import ClosureStats, aperture_functional, closure_stats
+from ..threads import one_blas_thread
+from .closure import ClosureGather, ClosurePart, aperture_functional, closure_part
 from .closure_detector import ClosureDetector, bilabial_frames, train_detector, utterance_inputs
 from .closure_search import left_out_rows
 from .codebook import Codebook, codeword_times, concatenate, interpolate_frames
@@ -27,23 +51,26 @@ from .context import context_ids
 from .lsf import lsf_at
 from .lsf_index import build_index
 from .markers import fill_gaps, reference_pose, remove_head_motion
-from .model import Model
-from .pca import PCA, fit_pca
+from .model import Model, analysed_lsf
+from .moments import Moments
+from .pca import PCA, pca_of
 from .similarity import distance_scale, phone_distances, phone_means
 from .speech import speech_mask
+from .training_set import MarkerSetup, TrainingSet
 from .voice_match import training_voice_distance
 
 log = logging.getLogger(__name__)
 
+#: every how many frames the fixed markers are kept for the neutral pose (paper 2.1)
+POSE_STEP = 5
+#: the training utterances ``D0`` is measured on (evenly spaced), and speech frames of each
+VOICE_UTTERANCES, VOICE_FRAMES = 40, 60
+#: the training utterances the bilabial-closure detector is fitted on (evenly spaced): every one
+#: of a corpus up to this many (the default corpus trains on 186), a bounded sample of a longer
+#: one, so that what the fit holds stops growing with the corpus
+DETECTOR_UTTERANCES = 400
 
-@dataclass
-class MarkerSetup:
-    """Which markers are which, for training on utterances outside a corpus folder."""
-
-    fixed: list[str]
-    upper_lip: str
-    lower_lip: str
-    lip_corners: list[str] = field(default_factory=list)
+__all__ = ["MarkerSetup", "marker_roles", "train"]
 
 
 @dataclass
@@ -56,6 +83,86 @@ class _MarkerRoles:
     lip_corners: list[int]
 
 
+def marker_roles(names: Sequence[str], setup: MarkerSetup) -> _MarkerRoles:
+    """The indices of ``setup``'s markers in ``names``; an unknown name is an :class:`InputError`."""
+    index = {n: i for i, n in enumerate(names)}
+    try:
+        return _MarkerRoles(np.array([index[n] for n in setup.fixed], dtype=int), index[setup.upper_lip],
+                            index[setup.lower_lip], [index[n] for n in setup.lip_corners])
+    except KeyError as exc:
+        raise InputError(None, f"marker {exc} is not in the marker set") from exc
+
+
+@dataclass
+class _Passes:
+    """What the three passes share: the training set, the settings, the marker roles, the
+    worker processes and the progress range of each pass."""
+
+    source: TrainingSet
+    config: TrainConfig
+    roles: _MarkerRoles
+    label_map: Mapping[str, str] | None
+    workers: int
+    progress: Progress
+
+    def fan_out(self, fn: Callable[[int], Any], names: Sequence[str], lo: float, hi: float,
+                what: str, skip: Skips | None = None) -> Iterator[tuple[int, Any]]:
+        """``(j, fn(j))`` for the utterances ``j`` named ``names[j]``, in order, in the worker
+        processes, progress from ``lo`` to ``hi``. With ``skip``, those left out are recorded
+        there by name."""
+        local = Skips(skip.noun) if skip is not None else None
+        yield from fan_out(fn, range(len(names)), self.workers, skip=local,
+                           progress=lambda f, m: self.progress(lo + (hi - lo) * f, m),
+                           describe=lambda j: f"{what}: {names[j]}")
+        if skip is not None:
+            skip.tried.update(names)
+            skip.bad.update({names[j]: message for j, message in local.bad.items()})
+
+    def normalised(self, markers: np.ndarray, reference: np.ndarray) -> np.ndarray:
+        """Gap filling and head-motion removal (paper 2.1), ``(T, M, 3)`` in the head frame."""
+        filled, _ = fill_gaps(markers, self.source.marker_rate, self.config.max_gap_s)
+        return remove_head_motion(filled, self.roles.fixed, reference)
+
+
+# --------------------------------------------------------------------------- pass 1: reading
+@dataclass
+class _Segments:
+    """Phone segments held as three arrays (a few bytes a phone, not a Python object each)."""
+
+    starts: np.ndarray
+    ends: np.ndarray
+    labels: np.ndarray
+
+    @classmethod
+    def of(cls, segs: Sequence[PhoneSegment]) -> _Segments:
+        return cls(np.array([s.start for s in segs], dtype=np.float64),
+                   np.array([s.end for s in segs], dtype=np.float64),
+                   np.array([s.label for s in segs], dtype=str))
+
+    def segments(self) -> list[PhoneSegment]:
+        return [PhoneSegment(float(a), float(b), str(lab))
+                for a, b, lab in zip(self.starts, self.ends, self.labels, strict=True)]
+
+
+@dataclass
+class _Read:
+    """Pass 1's result for one utterance: what the later passes and the model need of it."""
+
+    name: str
+    n_frames: int
+    phones: _Segments                   # as labelled: the phone set, the closure statistics
+    tokens: _Segments                   # checked and tidied: the codebook's phone tokens
+    kind: str
+    pose: np.ndarray                    # every POSE_STEP-th frame of the fixed markers, filled
+    lsf: np.ndarray | None = None       # the codewords' LSF vectors
+    lsf_context: np.ndarray | None = None
+
+    def times(self, config: TrainConfig) -> np.ndarray:
+        """The codeword times ``(tokens, n)``."""
+        return codeword_times(self.tokens.starts, self.tokens.ends, config.codewords_per_phone,
+                              config.placement)
+
+
 def _check_utterance(utt: Utterance, names: Sequence[str]) -> None:
     if utt.markers is None:
         raise InputError(utt.name, "the utterance has no marker data to train on")
@@ -66,114 +173,139 @@ def _check_utterance(utt: Utterance, names: Sequence[str]) -> None:
         raise InputError(utt.name, "only one marker frame")
 
 
-def load_training_set(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None,
-                      progress: Progress, workers: int = 1, skip: Skips | None = None
-                      ) -> tuple[list[Utterance], MarkerSetup, str]:
-    """The training utterances, their marker roles and the corpus fingerprint ("" outside a
-    corpus). A :class:`~facetraj_engine.io.corpus.Corpus` gives its ``train`` split (read in ``workers``
-    processes) and its ``corpus.json`` roles. An utterance with a bad file stops training with its
-    error, or with ``skip`` is left out (recorded there)."""
-    fingerprint = ""
-    if isinstance(utterances, Corpus):
-        corpus = utterances
-        info = corpus.info
-        setup = setup or MarkerSetup(info.fixed_markers, info.upper_lip, info.lower_lip,
-                                     info.lip_corners)
-        fingerprint = corpus.fingerprint()
-        done = fan_out(corpus.utterance, list(info.train), workers, skip=skip,
-                       progress=lambda f, m: progress(0.3 * f, m), describe=lambda u: f"loading {u}")
-        loaded = [utt for _, utt in done]
-    else:
-        loaded = list(utterances)
-    if setup is None:
-        raise ValueError("pass a MarkerSetup (fixed markers and lips) when not training on a Corpus")
-    checked: list[Utterance] = []
-    for utt in loaded:
-        try:
-            _check_utterance(utt, checked[0].marker_names if checked else utt.marker_names)
-        except InputError as exc:
-            if skip is None:
-                raise
-            skip.add(utt.name, exc)
-            continue
-        checked.append(utt)
-    if not checked:
-        raise InputError(None, "no training utterances" + (" left (every one was skipped)"
-                                                           if loaded or skip else ""))
-    return checked, setup, fingerprint
+def _read(p: _Passes, k: int) -> _Read:
+    """Pass 1 on utterance ``k``: loaded and checked, its fixed markers sampled for the neutral
+    pose, its codewords' LSF vectors (at ``codewords_per_phone`` times per phone)."""
+    config, utt = p.config, p.source.utterance(k)
+    _check_utterance(utt, p.source.marker_names)
+    segments = validate_phones(utt.phones, utt.duration, utt.name)
+    filled, valid = fill_gaps(utt.markers, p.source.marker_rate, config.max_gap_s)
+    if (~valid).any():
+        warn_file(log, utt.name, "frames with marker gaps left out",
+                  f"{(~valid).sum()} frames with gaps over {config.max_gap_s * 1000:.0f} ms "
+                  f"left out", logging.INFO)
+    read = _Read(utt.name, utt.n_frames, _Segments.of(utt.phones), _Segments.of(segments),
+                 utt.provenance.kind, filled[::POSE_STEP][:, p.roles.fixed])
+    times = read.times(config).ravel()
+    read.lsf = lsf_at(utt.audio, utt.sample_rate, times, config.lpc_order, config.window_s,
+                      config.audio_rate, config.preemphasis)
+    if config.lsf_context_frames > 0:
+        off = config.lsf_context_frames / p.source.marker_rate
+        read.lsf_context = np.stack([lsf_at(utt.audio, utt.sample_rate,
+                                             np.clip(times + o, 0, None), config.lpc_order,
+                                             config.window_s, config.audio_rate,
+                                             config.preemphasis) for o in (-off, off)], axis=1)
+    return read
 
 
-def marker_roles(names: Sequence[str], setup: MarkerSetup) -> _MarkerRoles:
-    """The indices of ``setup``'s markers in ``names``; an unknown name is an :class:`InputError`."""
-    index = {n: i for i, n in enumerate(names)}
-    try:
-        return _MarkerRoles(np.array([index[n] for n in setup.fixed]), index[setup.upper_lip],
-                            index[setup.lower_lip], [index[n] for n in setup.lip_corners])
-    except KeyError as exc:
-        raise InputError(None, f"marker {exc} is not in the marker set") from exc
+def _read_all(p: _Passes, skip: Skips | None) -> tuple[list[int], list[_Read]]:
+    """Pass 1 over every utterance: the indices kept (a bad file stops training with its error,
+    or with ``skip`` its utterance is left out) and what was read of each."""
+    kept, reads = [], []
+    for k, read in p.fan_out(lambda k: _read(p, k), p.source.names, 0.0, 0.45, "reading", skip):
+        kept.append(k)
+        reads.append(read)
+    if not reads:
+        raise InputError(None, "no training utterances" + (
+            " left (every one was skipped)" if len(p.source) or skip else ""))
+    return kept, reads
 
 
-def normalise_head(loaded: Sequence[Utterance], fixed: np.ndarray, rate: float,
-                   config: TrainConfig) -> tuple[list[np.ndarray], np.ndarray]:
-    """Gap filling and head-motion removal (paper 2.1): every utterance's ``(T, M, 3)`` markers in
-    the head frame of a Procrustes-mean neutral pose of the fixed markers, and that pose."""
-    filled = []
-    for utt in loaded:
-        f, valid = fill_gaps(utt.markers, rate, config.max_gap_s)
-        if (~valid).any():
-            warn_file(log, utt.name, "frames with marker gaps left out",
-                      f"{(~valid).sum()} frames with gaps over {config.max_gap_s * 1000:.0f} ms "
-                      f"left out", logging.INFO)
-        filled.append(f)
-    sample = np.concatenate([f[::5] for f in filled])
-    reference = reference_pose(sample, fixed)
-    return [remove_head_motion(f, fixed, reference) for f in filled], reference
+# --------------------------------------------------------------------------- pass 2: the PCA
+def _face_pca(p: _Passes, kept: Sequence[int], reads: Sequence[_Read], reference: np.ndarray
+              ) -> tuple[PCA, np.ndarray]:
+    """The PCA of the complete head-normalised marker vectors and each coordinate's std, from
+    their moments gathered an utterance at a time."""
+    def moments(j: int) -> Moments:
+        normed = p.normalised(p.source.markers(kept[j], reads[j].n_frames), reference)
+        flat = normed.reshape(normed.shape[0], -1)
+        return Moments.of(flat[np.isfinite(flat).all(axis=1)])
 
-
-def fit_face_pca(normed: Sequence[np.ndarray], config: TrainConfig) -> tuple[PCA, np.ndarray]:
-    """The PCA of the complete head-normalised marker vectors and each coordinate's std."""
-    flat = np.concatenate([n.reshape(n.shape[0], -1) for n in normed])
-    flat = flat[np.isfinite(flat).all(axis=1)]
-    if len(flat) < 2:
+    total = Moments.empty(3 * len(p.source.marker_names))
+    for _, m in p.fan_out(moments, [r.name for r in reads], 0.45, 0.6, "PCA"):
+        total = total.merged(m)
+    if total.n < 2:
         raise InputError(None, "no complete marker frames to train on")
-    pca = fit_pca(flat, config.n_components, config.variance_target)
+    pca = pca_of(total, p.config.n_components, p.config.variance_target)
     log.info("PCA: %d components explain %.2f %% of the variance", pca.n_components,
              100 * pca.explained_ratio.sum())
-    return pca, flat.std(axis=0)
+    return pca, total.std()
 
 
-def codebook_part(utt: Utterance, normed: np.ndarray, k: int, pca: PCA, pid: Mapping[str, int],
-                  rate: float, config: TrainConfig,
-                  label_map: Mapping[str, str] | None) -> Codebook:
-    """One utterance's context-phones and their codewords (LSF and PC vectors at
-    ``codewords_per_phone`` times per phone); tokens without complete marker data left out."""
-    phones = validate_phones(utt.phones, utt.duration, utt.name)
-    ids_ = [pid[apply_label_map(s.label, label_map)] for s in phones]
-    ctx = context_ids(ids_, config.context, pid[SILENCE])
-    starts = np.array([s.start for s in phones])
-    ends = np.array([s.end for s in phones])
-    times = codeword_times(starts, ends, config.codewords_per_phone, config.placement)
-    pcs_frames = pca.transform(normed.reshape(normed.shape[0], -1))  # NaN rows stay NaN
-    cw_pcs = interpolate_frames(pcs_frames, rate, times.ravel())
-    cw_lsf = lsf_at(utt.audio, utt.sample_rate, times.ravel(), config.lpc_order,
-                    config.window_s, config.audio_rate, config.preemphasis)
-    ctx_lsf = None
-    if config.lsf_context_frames > 0:
-        off = config.lsf_context_frames / rate
-        ctx_lsf = np.stack([lsf_at(utt.audio, utt.sample_rate, np.clip(times.ravel() + o, 0, None),
-                                   config.lpc_order, config.window_s, config.audio_rate,
-                                   config.preemphasis) for o in (-off, off)], axis=1)
+# --------------------------------------------------------------------------- pass 3: codewords
+@dataclass
+class _Codewords:
+    """Pass 3's result for one utterance: its codewords' PC vectors and which tokens have
+    complete marker data, its share of the closure statistics, and (for the few utterances
+    ``D0`` is measured on) the LSF vectors of its speech frames."""
+
+    pcs: np.ndarray
+    ok: np.ndarray
+    closure: ClosurePart
+    voice: np.ndarray | None = None
+
+
+def _codewords(p: _Passes, k: int, read: _Read, reference: np.ndarray, pca: PCA,
+               aperture: tuple[float, np.ndarray], voice: bool) -> _Codewords:
+    """Pass 3 on utterance ``k``: PC vectors at the codeword times (tokens without complete
+    marker data left out), its closure statistics, and its voice frames when ``voice``."""
+    config, rate = p.config, p.source.marker_rate
+    utt = p.source.utterance(k) if voice else None
+    markers = utt.markers if utt is not None else p.source.markers(k, read.n_frames)
+    normed = p.normalised(markers, reference)
+    pcs = pca.transform(normed.reshape(normed.shape[0], -1))       # NaN rows stay NaN
+    times = read.times(config)
+    cw_pcs = interpolate_frames(pcs, rate, times.ravel())
     n = config.codewords_per_phone
     ok = np.isfinite(cw_pcs).all(axis=1).reshape(-1, n).all(axis=1)
     ok &= times[:, -1] <= (normed.shape[0] - 1) / rate + 0.5 / rate
     if (~ok).any():
-        warn_file(log, utt.name, "phone tokens without complete marker data left out",
+        warn_file(log, read.name, "phone tokens without complete marker data left out",
                   f"{(~ok).sum()} phone tokens without complete marker data left out", logging.INFO)
-    keep = np.repeat(ok, n)
-    return Codebook(ctx[ok], cw_lsf[keep], cw_pcs[keep], np.full(ok.sum(), k), starts[ok],
-                    ends[ok], n, None if ctx_lsf is None else ctx_lsf[keep])
+    part = closure_part(pcs, read.phones.segments(), rate, *aperture)
+    return _Codewords(cw_pcs[np.repeat(ok, n)], ok, part,
+                      _voice_frames(config, utt) if utt is not None else None)
 
 
+def _voice_frames(config: TrainConfig, utt: Utterance) -> np.ndarray:
+    """The LSF vectors of (up to :data:`VOICE_FRAMES` evenly spaced) speech frames of ``utt``."""
+    times = utt.frame_times()
+    keep = np.flatnonzero(speech_mask(utt.audio, utt.sample_rate, times))
+    if keep.size:
+        keep = keep[np.linspace(0, keep.size - 1, min(keep.size, VOICE_FRAMES)).astype(int)]
+    return analysed_lsf(config, utt.audio, utt.sample_rate, times[keep])
+
+
+def _codebook(p: _Passes, kept: Sequence[int], reads: Sequence[_Read], reference: np.ndarray,
+              pca: PCA, pid: Mapping[str, int], closure: ClosureGather, voice: Sequence[int]
+              ) -> tuple[Codebook, dict[int, np.ndarray]]:
+    """Pass 3 over every utterance: the codebook (context-phones, LSF and PC codewords), the
+    closure statistics gathered into ``closure``, and the voice frames of utterances ``voice``
+    (positions in ``kept``)."""
+    aperture = aperture_functional(pca, p.roles.upper_lip, p.roles.lower_lip)
+    picked = set(voice)
+    config, n = p.config, p.config.codewords_per_phone
+    parts, frames = [], {}
+
+    def work(j: int) -> _Codewords:
+        return _codewords(p, kept[j], reads[j], reference, pca, aperture, j in picked)
+
+    for j, done in p.fan_out(work, [r.name for r in reads], 0.6, 0.9, "codebook"):
+        read = reads[j]
+        ids = [pid[apply_label_map(str(lab), p.label_map)] for lab in read.tokens.labels]
+        ctx = context_ids(ids, config.context, pid[SILENCE])
+        keep, ok = np.repeat(done.ok, n), done.ok
+        parts.append(Codebook(ctx[ok], read.lsf[keep], done.pcs, np.full(ok.sum(), j),
+                              read.tokens.starts[ok], read.tokens.ends[ok], n,
+                              None if read.lsf_context is None else read.lsf_context[keep]))
+        read.lsf = read.lsf_context = None                      # held by the part now
+        closure.add(done.closure)
+        if done.voice is not None:
+            frames[j] = done.voice
+    return concatenate(parts, release=True), frames
+
+
+# --------------------------------------------------------------------------- the whole
 def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = None,
           config: TrainConfig | None = None, progress: Progress | None = None,
           label_map: Mapping[str, str] | None = None, workers: int = 1,
@@ -187,97 +319,91 @@ def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = 
     markers; PCA; context-phones; LSF and PC vectors at 5 codeword times per phone; eq 1-2 phone
     means and distances; the coarse LSF index of acoustic-only synthesis.
 
-    The utterances are read, and their codewords computed, in ``workers`` processes
+    The corpus is streamed (the module's docstring), in ``workers`` processes
     (:func:`facetraj_engine.fanout.fan_out`; the model equals the serial run's). A bad file stops training
     with its error, or with ``skip`` its utterance is left out (``--skip-bad``).
     """
     config = config or TrainConfig()
     progress = progress or no_progress
-    loaded, setup, fingerprint = load_training_set(utterances, setup, progress, workers, skip)
-    names = list(loaded[0].marker_names)
-    rate = float(loaded[0].marker_rate)
-    roles = marker_roles(names, setup)
-
-    progress(0.3, "removing head motion")
-    normed, reference = normalise_head(loaded, roles.fixed, rate, config)
-    progress(0.4, "PCA")
-    pca, coord_std = fit_face_pca(normed, config)
-
-    phone_set = sorted({SILENCE} | {apply_label_map(s.label, label_map)
-                                    for utt in loaded for s in utt.phones})
-    pid = {p: i for i, p in enumerate(phone_set)}
-    parts = fan_out(lambda k: codebook_part(loaded[k], normed[k], k, pca, pid, rate, config,
-                                            label_map),
-                    range(len(loaded)), workers, progress=lambda f, m: progress(0.45 + 0.5 * f, m),
-                    describe=lambda k: f"codebook: {loaded[k].name}")
-    cb = concatenate([part for _, part in parts])
+    source = TrainingSet.of(utterances, setup)
+    if not len(source):
+        raise InputError(None, "no training utterances")
+    roles = marker_roles(source.marker_names, source.setup)
+    p = _Passes(source, config, roles, label_map, workers, progress)
+    with one_blas_thread():          # as in the workers: the same sums whatever ``workers``
+        kept, reads = _read_all(p, skip)
+        progress(0.45, "neutral pose")
+        reference = reference_pose(np.concatenate([r.pose for r in reads]),
+                                   np.arange(len(roles.fixed)))
+        for r in reads:
+            r.pose = np.zeros(0)
+        pca, coord_std = _face_pca(p, kept, reads, reference)
+        phone_set = sorted({SILENCE} | {apply_label_map(str(lab), label_map)
+                                        for r in reads for lab in set(r.phones.labels)})
+        pid = {ph: i for i, ph in enumerate(phone_set)}
+        voice = _voice_picks(len(reads))
+        closure = ClosureGather(pca.n_components)
+        cb, frames = _codebook(p, kept, reads, reference, pca, pid, closure, voice)
 
     # eqs 1-2 on the codeword PC vectors grouped by centre phone
     means = phone_means(cb.pcs, cb.codeword_phone(), len(phone_set))
     dist = phone_distances(means)
-    scale = distance_scale(dist, config.distance_scale)
-    progress(0.95, "LSF index")
-    index = build_index(cb.lsf, config.index_cells)
-    model = Model(config=config, phones=phone_set, marker_names=names, marker_rate=rate,
-                  fixed=roles.fixed, reference=reference, upper_lip=roles.upper_lip,
-                  lower_lip=roles.lower_lip, pca=pca, codebook=cb, means=means, distances=dist,
-                  scale=scale, coord_std=coord_std, lip_corners=roles.lip_corners,
-                  train_utterances=[u.name for u in loaded], corpus_fingerprint=fingerprint,
-                  index=index, trained_labels=dict(Counter(u.provenance.kind for u in loaded)))
-    progress(0.97, "closure and voice statistics")
-    model.closure = closure_part(model, loaded, normed)
-    model.voice_distance = voice_part(model, loaded)
+    progress(0.9, "LSF index")
+    model = Model(config=config, phones=phone_set, marker_names=list(source.marker_names),
+                  marker_rate=source.marker_rate, fixed=roles.fixed, reference=reference,
+                  upper_lip=roles.upper_lip, lower_lip=roles.lower_lip, pca=pca, codebook=cb,
+                  means=means, distances=dist, scale=distance_scale(dist, config.distance_scale),
+                  coord_std=coord_std, lip_corners=roles.lip_corners,
+                  train_utterances=[r.name for r in reads],
+                  corpus_fingerprint=source.fingerprint,
+                  index=build_index(cb.lsf, config.index_cells),
+                  trained_labels=dict(Counter(r.kind for r in reads)))
+    progress(0.95, "closure and voice statistics")
+    model.closure = closure.stats()
+    position = np.full(len(reads), -1)
+    position[voice] = np.arange(len(voice))
+    owner = position[cb.token_utt[np.arange(len(cb.lsf)) // cb.n_per_phone]]   # in lsf's order
+    lsf = [frames[j] for j in voice]
+    model.voice_distance = training_voice_distance(lsf, [np.ones(len(w), bool) for w in lsf],
+                                                   owner, cb.lsf, workers)
     if config.closure_detector:
-        progress(0.98, "closure detector")
-        model.detector = detector_part(model, loaded, label_map)
+        with one_blas_thread():
+            model.detector = _detector(p, kept, reads, model)
     progress(1.0, "done")
     return model
 
 
-def closure_part(model: Model, loaded: Sequence[Utterance], normed: Sequence[np.ndarray]
-                 ) -> ClosureStats:
-    """The closure step's statistics (:mod:`facetraj_engine.method.closure`) of the training talker."""
-    a0, g = aperture_functional(model.pca, model.upper_lip, model.lower_lip)
-    pcs = [model.to_pcs(n) for n in normed]
-    return closure_stats(pcs, [u.phones for u in loaded], model.marker_rate, a0, g)
+def _evenly(n: int, most: int) -> list[int]:
+    """Up to ``most`` of ``range(n)``, evenly spaced (all of them when ``n <= most``)."""
+    return [int(j) for j in np.unique(np.linspace(0, n - 1, min(n, most)).astype(int))]
 
 
-def detector_part(model: Model, loaded: Sequence[Utterance],
-                  label_map: Mapping[str, str] | None = None) -> ClosureDetector | None:
-    """The bilabial-closure detector (:mod:`facetraj_engine.method.closure_detector`) of the
-    training utterances' marker frames, their /p b m/ labels as targets; its second part with the
-    acoustic search's opinion, each utterance searched without its own codewords
-    (:mod:`facetraj_engine.method.closure_search`)."""
-    lsf, energy, targets, search = [], [], [], []
-    for k, utt in enumerate(loaded):
+def _voice_picks(n: int) -> list[int]:
+    """The (up to :data:`VOICE_UTTERANCES`, evenly spaced) utterances ``D0`` is measured on."""
+    return _evenly(n, VOICE_UTTERANCES)
+
+
+# --------------------------------------------------------------------------- pass 4: the detector
+def _detector(p: _Passes, kept: Sequence[int], reads: Sequence[_Read], model: Model
+              ) -> ClosureDetector | None:
+    """The bilabial-closure detector (:mod:`facetraj_engine.method.closure_detector`), fitted on
+    the marker frames of (up to :data:`DETECTOR_UTTERANCES`, evenly spaced) training utterances,
+    their /p b m/ labels as targets; its second part with the acoustic search's opinion, each
+    utterance searched without its own codewords (:mod:`facetraj_engine.method.closure_search`).
+    A fourth pass: each utterance read again."""
+    picks = _evenly(len(reads), DETECTOR_UTTERANCES)
+
+    def work(i: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        j = picks[i]
+        utt = p.source.utterance(kept[j])
         times = utt.frame_times()
-        w, e = utterance_inputs(model.config, utt.audio, utt.sample_rate, times)
-        phones = [PhoneSegment(s.start, s.end, apply_label_map(s.label, label_map))
+        w, e = utterance_inputs(p.config, utt.audio, utt.sample_rate, times)
+        phones = [PhoneSegment(s.start, s.end, apply_label_map(s.label, p.label_map))
                   for s in utt.phones]
-        lsf.append(w)
-        energy.append(e)
-        targets.append(bilabial_frames(phones, times))
-        search.append(left_out_rows(model, w, k))
-    return train_detector(lsf, energy, targets, ridge=model.config.closure_detector_ridge,
+        return w, e, bilabial_frames(phones, times), left_out_rows(model, w, j)
+
+    parts = [part for _, part in p.fan_out(work, [reads[j].name for j in picks], 0.96, 1.0,
+                                           "closure detector")]
+    lsf, energy, targets, search = (list(x) for x in zip(*parts, strict=True))
+    return train_detector(lsf, energy, targets, ridge=p.config.closure_detector_ridge,
                           search=search)
-
-
-def voice_part(model: Model, loaded: Sequence[Utterance], utterances: int = 40,
-               frames: int = 60) -> float:
-    """``D0`` of :mod:`facetraj_engine.method.voice_match` on (up to ``utterances`` evenly spaced)
-    training utterances, ``frames`` speech frames each."""
-    pick = np.unique(np.linspace(0, len(loaded) - 1, min(len(loaded), utterances)).astype(int))
-    position = np.full(len(loaded), -1)
-    position[pick] = np.arange(len(pick))
-    cb = model.codebook
-    owner = position[cb.token_utt[np.arange(len(cb.lsf)) // cb.n_per_phone]]   # in lsf's order
-    lsf, speech = [], []
-    for k in pick:
-        utt = loaded[k]
-        times = utt.frame_times()
-        mask = speech_mask(utt.audio, utt.sample_rate, times)
-        keep = np.flatnonzero(mask)
-        keep = keep[np.linspace(0, keep.size - 1, min(keep.size, frames)).astype(int)] if keep.size else keep
-        lsf.append(model.input_lsf(utt.audio, utt.sample_rate, times[keep]))
-        speech.append(np.ones(keep.size, bool))
-    return training_voice_distance(lsf, speech, owner, cb.lsf)

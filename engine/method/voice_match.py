@@ -19,6 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..config import SynthConfig
+from ..fanout import fan_out
 from .lsf_index import LsfIndex
 from .synthesis import lsf_distances, perceptual_weights
 
@@ -30,9 +31,10 @@ MAX_FRAMES = 400
 
 
 def nearest_distances(w: np.ndarray, cb_lsf: np.ndarray, exclude: np.ndarray | None = None,
-                      chunk: int = 128) -> np.ndarray:
+                      chunk: int = 128, block: int = 512) -> np.ndarray:
     """Per frame of ``w`` ``(T, P)``, eq 5's distance to the nearest codeword (exact search;
-    ``exclude`` ``(5L,)`` bool: codewords left out).
+    ``exclude`` ``(5L,)`` bool: codewords left out), ``chunk`` frames against ``block`` codewords
+    at a time: the differences held at once stay a few MB whatever the codebook's size.
 
     >>> L = np.array([[0.5, 1.0, 2.0], [0.6, 1.0, 2.0]])
     >>> nearest_distances(np.array([[0.6, 1.0, 2.0]]), L).tolist()
@@ -45,9 +47,11 @@ def nearest_distances(w: np.ndarray, cb_lsf: np.ndarray, exclude: np.ndarray | N
     codewords = cb_lsf if exclude is None else cb_lsf[~np.asarray(exclude, bool)]
     if len(codewords) == 0:
         return np.full(len(w), np.nan)
-    out = np.empty(len(w))
+    out = np.full(len(w), np.inf)
     for a in range(0, len(w), chunk):
-        out[a:a + chunk] = lsf_distances(w[a:a + chunk], codewords[None], h[a:a + chunk]).min(axis=1)
+        for b in range(0, len(codewords), block):
+            near = lsf_distances(w[a:a + chunk], codewords[None, b:b + block], h[a:a + chunk])
+            np.minimum(out[a:a + chunk], near.min(axis=1), out=out[a:a + chunk])
     return out
 
 
@@ -76,12 +80,15 @@ def indexed_distances(w: np.ndarray, cb_lsf: np.ndarray, index: LsfIndex) -> np.
 
 
 def training_voice_distance(lsf: Sequence[np.ndarray], speech: Sequence[np.ndarray],
-                            codeword_utterance: np.ndarray, cb_lsf: np.ndarray) -> float:
+                            codeword_utterance: np.ndarray, cb_lsf: np.ndarray,
+                            workers: int = 1) -> float:
     """``D0``: the median over training utterances of :func:`voice_distance`, each with its own
     codewords left out (``codeword_utterance`` ``(5L,)``: the index, in ``lsf``'s order, of the
-    utterance each codeword comes from)."""
-    d = [voice_distance(w, sp, cb_lsf, exclude=codeword_utterance == k)
-         for k, (w, sp) in enumerate(zip(lsf, speech, strict=True))]
+    utterance each codeword comes from), in ``workers`` processes."""
+    def one(k: int) -> float:
+        return voice_distance(lsf[k], speech[k], cb_lsf, exclude=codeword_utterance == k)
+
+    d = [x for _, x in fan_out(one, range(len(lsf)), workers)]
     d = [x for x in d if np.isfinite(x)]
     return float(np.median(d)) if d else float("nan")
 

@@ -14,7 +14,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from ..config import SynthConfig
-from ..evaluation.baselines import Baselines, FrameData, evaluate_baselines, fit_baselines, frame_data
+from ..evaluation.baselines import BaselineGather, Baselines, FrameData, frame_data, score_baselines
 from ..evaluation.paper import FIGURE4_TEXT, paper_table1
 from ..evaluation.scores import (
     EvalResult,
@@ -27,13 +27,14 @@ from ..evaluation.scores import (
     table2,
     trajectory_correlations,
 )
-from ..fanout import Skips
+from ..fanout import Skips, fan_out
 from ..io.corpus import Corpus, load_corpus
 from ..method.model import Model
 from ..method.pipeline import resmooth, synthesize
 from ..method.similarity import top_similar
 from ..method.training import train
 from ..progress import Progress
+from ..threads import one_blas_thread
 from .data import Figure4Data, ReportData
 from .rows import ComparisonRow, CorpusSummary, ModelSummary, summarise, sweep_table
 
@@ -99,15 +100,32 @@ def _timed(timings: dict[str, float], stage: str) -> Iterator[None]:
     timings[stage] = time.perf_counter() - t
 
 
-def _baselines(model: Model, corpus: Corpus, progress: Progress) -> tuple[Baselines, list[UtteranceScore]]:
-    """Fit the two baselines on the training split and score them on both splits."""
-    frames: dict[str, list[FrameData]] = {"train": [], "test": []}
+def _baselines(model: Model, corpus: Corpus, progress: Progress, workers: int = 1
+               ) -> tuple[Baselines, list[UtteranceScore]]:
+    """Fit the two baselines on the training split and score them on both splits: the corpus
+    streamed twice (fitted from the training utterances' frames an utterance at a time, then
+    each utterance scored), in ``workers`` processes, BLAS on one thread as in the
+    evaluation."""
+    train_ids = list(corpus.info.train)
     ids = [(sp, u) for sp in ("train", "test") for u in getattr(corpus.info, sp)]
-    for k, (sp, utt_id) in enumerate(ids):
-        progress(0.8 + 0.15 * k / max(len(ids), 1), f"baselines: {utt_id}")
-        frames[sp].append(frame_data(model, corpus.utterance(utt_id)))
-    base = fit_baselines(model, frames["train"])
-    return base, evaluate_baselines(model, base, frames)
+
+    def fitting(utt_id: str) -> FrameData:
+        return frame_data(model, corpus.utterance(utt_id), keep_original=False)
+
+    def scoring(pair: tuple[str, str]) -> list[UtteranceScore]:
+        return score_baselines(model, base, frame_data(model, corpus.utterance(pair[1])), pair[0])
+
+    gather = BaselineGather(model, len(train_ids))
+    scores: list[UtteranceScore] = []
+    with one_blas_thread():
+        for _, fd in fan_out(fitting, train_ids, workers, progress=_stage(progress, 0.8, 0.85),
+                             describe=lambda u: f"baselines: {u}"):
+            gather.add(fd)
+        base = gather.baselines()
+        for _, utt_scores in fan_out(scoring, ids, workers, progress=_stage(progress, 0.85, 0.95),
+                                     describe=lambda pair: f"baselines: {pair[1]}"):
+            scores.extend(utt_scores)
+    return base, scores
 
 
 def comparison_rows(paper_modes: EvalResult, indexed: EvalResult, indexed_config: SynthConfig,
@@ -209,7 +227,7 @@ def compute_report(corpus_dir: str | os.PathLike[str], model: Model | None = Non
         res5 = sweep_n(model, corpus, ns, progress=_stage(progress, 0.47, 0.8),
                        workers=workers)
     with _timed(timings, "baselines"):
-        base, base_scores = _baselines(model, corpus, progress)
+        base, base_scores = _baselines(model, corpus, progress, workers)
     with _timed(timings, "figure4"):
         progress(0.96, "Figure 4")
         fig4 = figure4_data(model, corpus)

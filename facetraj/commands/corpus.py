@@ -28,7 +28,7 @@ def cmd_corpus_build(args: argparse.Namespace) -> int:
         kw["n_sentences"] = args.sentences
     if args.seed is not None:
         kw["seed"] = args.seed
-    build_corpus(args.output, **kw)
+    build_corpus(args.output, workers=args.jobs, **kw)
     print(args.output)
     return 0
 
@@ -100,6 +100,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     b.add_argument("output", type=Path)
     b.add_argument("--sentences", type=integer(1, 100000), help="number of sentences")
     b.add_argument("--seed", type=int, help="random seed")
+    b.add_argument("--jobs", "-j", type=integer(1, 256), metavar="N",
+                   help="sentences synthesized in N processes (default: every core); the corpus "
+                        "is the same bits whatever N")
     b.set_defaults(func=cmd_corpus_build)
     i = csub.add_parser("init", help="describe a folder of your own recordings as a corpus")
     i.add_argument("data_dir", type=Path,

@@ -22,7 +22,7 @@ def cmd_train(args: argparse.Namespace) -> int:
     corpus = load_corpus(args.corpus)
     skipped = skips(args)
     model = train(corpus, config=train_config(args), progress=TerminalProgress("train"),
-                  workers=jobs(args, 1), skip=skipped)
+                  workers=jobs(args), skip=skipped)
     folds = tune_folds(args, model.trained_labels, len(model.train_utterances))
     if folds:
         from facetraj_engine.evaluation.tuning import cross_validate
@@ -78,6 +78,6 @@ def register(sub: argparse._SubParsersAction) -> None:
                            "training labels are not hand-checked")
     tune.add_argument("--no-tune", dest="tune", action="store_const", const=0,
                       help="do not cross-validate, even for automatic labels")
-    add_corpus_work_options(p, jobs_default="1")
+    add_corpus_work_options(p)
     add_train_options(p)
     p.set_defaults(func=cmd_train)
