@@ -259,3 +259,25 @@ def assert_legible(fig, renderer, what: str) -> None:
             xy = xy[np.isfinite(xy).all(axis=1)]
             inside = ((xy[:, 0] > lb.x0) & (xy[:, 0] < lb.x1) & (xy[:, 1] > lb.y0) & (xy[:, 1] < lb.y1))
             assert not inside.any(), (what, "legend over a line", line.get_label())
+
+
+def opened_window(qtbot, utterance: str | None = None, wait_ms: int = 240_000):
+    """The main window as ``facetraj`` opens it on the default corpus (``place_on_screen``: 1600 x
+    1000 where the screen has room; no sound device), shown and ready; closed after the test
+    (a generator for a fixture to yield from)."""
+    from facetraj.paths import default_corpus
+    from facetraj_app.main import WINDOW_SIZE, build_window
+
+    w = build_window(default_corpus(), utterance=utterance, use_audio=False)
+    w.set_correlation_sweep(False)
+    qtbot.addWidget(w)
+    w.place_on_screen(WINDOW_SIZE)
+    with qtbot.waitSignal(w.synthesisChanged, timeout=wait_ms):
+        w.show()
+    qtbot.waitExposed(w)
+    w.place_on_screen(WINDOW_SIZE)                # again once shown, as facetraj does
+    qtbot.waitUntil(lambda: w.view is not None and not w.busy and not w.timeline.building,
+                    timeout=wait_ms)
+    yield w
+    w.extension("analysis").close()
+    w.close()

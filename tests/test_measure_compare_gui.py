@@ -20,10 +20,8 @@ pytest.importorskip("pyvistaqt")
 if not os.environ.get("DISPLAY"):
     pytest.skip("the app tests need an X display (run under xvfb-run)", allow_module_level=True)
 
-from screens import colour_of, near, project
+from screens import colour_of, near, opened_window, project
 
-from facetraj.paths import default_corpus
-from facetraj_app.main import WINDOW_SIZE, build_window
 from facetraj_engine.analysis.apertures import aperture, phone_apertures, readout_at
 from facetraj_engine.io.markerfiles import read_marker_table
 
@@ -42,18 +40,7 @@ def win(screen, qtbot, trained_cache):
     if not screen.local:
         yield None
         return
-    w = build_window(default_corpus(), utterance="s002", use_audio=False)
-    w.set_correlation_sweep(False)
-    qtbot.addWidget(w)
-    w.place_on_screen(WINDOW_SIZE)
-    with qtbot.waitSignal(w.synthesisChanged, timeout=WAIT_MS):
-        w.show()
-    qtbot.waitExposed(w)
-    w.place_on_screen(WINDOW_SIZE)                # again once shown, as facetraj does
-    qtbot.waitUntil(lambda: ready(w), timeout=WAIT_MS)
-    yield w
-    w.extension("analysis").close()
-    w.close()
+    yield from opened_window(qtbot, "s002", WAIT_MS)
 
 
 def middle(phones, label: str) -> float:

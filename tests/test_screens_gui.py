@@ -29,15 +29,16 @@ from screens import (
     assert_legible,
     image_array,
     near,
+    opened_window,
     overlap,
     pixels_inside,
     project,
     view_settled,
 )
 
-from facetraj.paths import default_corpus, shared_path
+from facetraj.paths import shared_path
 from facetraj_app import style
-from facetraj_app.main import WINDOW_SIZE, build_window
+from facetraj_app.main import WINDOW_SIZE
 
 pytestmark = pytest.mark.gui
 
@@ -57,18 +58,7 @@ def win(screen, qtbot, trained_cache):
     if not screen.local:
         yield None
         return
-    w = build_window(default_corpus(), use_audio=False)
-    w.set_correlation_sweep(False)
-    qtbot.addWidget(w)
-    w.place_on_screen(WINDOW_SIZE)
-    with qtbot.waitSignal(w.synthesisChanged, timeout=WAIT_MS):
-        w.show()
-    qtbot.waitExposed(w)
-    w.place_on_screen(WINDOW_SIZE)                # again once shown, as facetraj does
-    qtbot.waitUntil(lambda: ready(w), timeout=WAIT_MS)
-    yield w
-    w.extension("analysis").close()
-    w.close()
+    yield from opened_window(qtbot, wait_ms=WAIT_MS)
 
 
 def show(w, qtbot, utt_id: str) -> None:

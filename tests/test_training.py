@@ -16,7 +16,7 @@ from facetraj_engine.io.corpus import Corpus
 from facetraj_engine.method.closure import ClosureGather, closure_part, regression_direction
 from facetraj_engine.method.moments import Moments
 from facetraj_engine.method.pca import fit_pca, pca_of
-from facetraj_engine.method.training import train
+from facetraj_engine.method.training import DETECTOR_UTTERANCES, train
 
 
 def _every_frame(model, corpus) -> np.ndarray:
@@ -124,12 +124,14 @@ class _Watched(Corpus):
 
 def test_training_holds_one_utterance_at_a_time(toy_corpus, toy_model):
     """Each utterance is let go before the next is read; after the first pass only its markers
-    are read again; and the model is the one of the corpus read whole."""
+    are read again (and the detector's few whole); and the model is the one of the corpus read
+    whole."""
     watched = _Watched(toy_corpus.root, toy_corpus.info)
     model = train(watched)
     n = len(toy_corpus.info.train)
     assert watched.most == 1
-    assert watched.loads == n + min(n, 40)             # pass 1, and the voice reference's
+    # pass 1, the voice reference's and the closure detector's (pass 4)
+    assert watched.loads == n + min(n, 40) + min(n, DETECTOR_UTTERANCES)
     assert watched.marker_reads == 2 * n - min(n, 40)  # passes 2 and 3
     np.testing.assert_array_equal(model.codebook.lsf, toy_model.codebook.lsf)
     np.testing.assert_array_equal(model.pca.components, toy_model.pca.components)

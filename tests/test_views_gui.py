@@ -18,7 +18,7 @@ if not os.environ.get("DISPLAY"):
 
 from PyQt6.QtGui import QImage
 from PyQt6.QtWidgets import QAbstractButton, QSlider
-from screens import Heartbeat, image_array, on_screen, place_in
+from screens import Heartbeat, figure_texts, image_array, on_screen, place_in
 
 from facetraj.paths import default_corpus
 from facetraj_app.analysis import PANELS, VIEWS
@@ -203,28 +203,13 @@ def test_the_face_shows_the_mouth_closed_at_a_b_and_the_lip_panels_where_closed_
         assert any(np.allclose(y, closed.markers[marker, 1]) for y in ys), panel
 
 
-def _texts(fig) -> list:
-    """Every visible text of a figure: titles, axis labels, tick labels, legends' texts."""
-    out = list(fig.texts)
-    for ax in fig.axes:
-        out += [ax.title, ax.xaxis.label, ax.yaxis.label]
-        for axis in (ax.xaxis, ax.yaxis):       # the tick labels drawn: those in the view
-            lo, hi = sorted(axis.get_view_interval())
-            out += [label for tick, label in zip(axis.get_ticklocs(), axis.get_ticklabels(),
-                                                 strict=True) if lo <= tick <= hi]
-        legend = ax.get_legend()
-        if legend is not None:
-            out += [*legend.get_texts(), legend.get_title()]
-    return [t for t in out if t.get_visible() and t.get_text().strip()]
-
-
 def assert_plots_legible(canvas, what: str) -> None:
     """Every text of ``canvas``'s figure inside it and none over another (titles, labels, tick
     labels, legends); no legend over a bar."""
     canvas.finish()
     fig, renderer = canvas.figure, canvas.get_renderer()
     box = fig.bbox
-    texts = [(t.get_text(), t.get_window_extent(renderer)) for t in _texts(fig)]
+    texts = [(t.get_text(), t.get_window_extent(renderer)) for t in figure_texts(fig)]
     for text, e in texts:
         assert e.x0 >= box.x0 - 1 and e.y0 >= box.y0 - 1 and e.x1 <= box.x1 + 1 \
             and e.y1 <= box.y1 + 1, (what, text, e)

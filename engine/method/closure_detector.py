@@ -47,6 +47,7 @@ import numpy as np
 
 from ..config import TrainConfig
 from ..data import PhoneSegment
+from ..level import unit_exponent
 from .lsf import analysis_frames, lsf_at, resample_audio
 
 #: The phones whose lips close (the detector's positive frames).
@@ -289,8 +290,11 @@ def input_energy_db(config: TrainConfig, audio: np.ndarray, sample_rate: int,
                     times: np.ndarray) -> np.ndarray:
     """The energy (dB) of the analysis frames of the input LSFs at ``times`` (resampled to
     ``config.audio_rate``, pre-emphasized, windowed as :func:`~facetraj_engine.method.lsf.lsf_at`
-    frames them; only differences of energy are used)."""
+    frames them; only differences of energy are used, so the signal is first brought to a peak
+    in [0.5, 1) by a power of two, :func:`facetraj_engine.level.unit_exponent`: exact, and no
+    sample squared overflows at any gain)."""
     x = resample_audio(np.asarray(audio, dtype=np.float64), sample_rate, config.audio_rate)
+    x = np.ldexp(x, unit_exponent(x))
     return frame_energy_db(analysis_frames(x, config.audio_rate, np.asarray(times, dtype=np.float64),
                                            config.window_s, config.preemphasis))
 
