@@ -91,14 +91,36 @@ def write_trajectories(path: str | os.PathLike[str], markers: np.ndarray, rate: 
 SPEECH_DESCRIPTION = "speech, scaled to a peak of 1"
 
 
+def band_limited(x: np.ndarray, ratio: float) -> np.ndarray:
+    """``x`` resampled by ``ratio`` (``round(len(x) ratio)`` samples) in the frequency domain:
+    its spectrum cut or padded with zeros, so nothing above the lower Nyquist frequency is
+    aliased (numpy's FFT: a C3D's speech channel does not wait for ``scipy.signal``'s import).
+
+    >>> t = np.arange(1600)
+    >>> y = band_limited(np.sin(2 * np.pi * 50 * t / 1600), 1.5)     # 50 cycles either way
+    >>> len(y), round(float(np.abs(np.fft.rfft(y)).argmax()))
+    (2400, 50)
+    """
+    x = np.asarray(x, dtype=np.float64)
+    n, m = len(x), int(round(len(x) * ratio))
+    if m == n or n == 0:
+        return x
+    spectrum = np.fft.rfft(x)
+    keep = min(len(spectrum), m // 2 + 1)
+    out = np.zeros(m // 2 + 1, dtype=complex)
+    out[:keep] = spectrum[:keep]
+    return np.fft.irfft(out, m) * (m / n)
+
+
 def speech_channel(audio: tuple[np.ndarray, int] | None, marker_rate: float, n_frames: int
                    ) -> C3dExtras:
     """A C3D output's extras: its axes, and the speech (``audio``: samples and rate; ``None``: no
-    analog data) as one analog channel, resampled to the whole number of samples per marker frame
-    nearest its rate (C3D's analog rate is a multiple of the point rate: 16 kHz speech at 60 Hz is
-    267 samples a frame, 16,020 Hz), one frame's worth per marker frame (cut at the last, or
-    silence after the speech), scaled to a peak of 1 (the level of a recording is its maker's
-    choice, not a measurement; scaled, the channel is the same whatever the recording's gain).
+    analog data) as one analog channel, resampled (:func:`band_limited`) to the whole number of
+    samples per marker frame nearest its rate (C3D's analog rate is a multiple of the point
+    rate: 16 kHz speech at 60 Hz is 267 samples a frame, 16,020 Hz), one frame's worth per
+    marker frame (cut at the last, or silence after the speech), scaled to a peak of 1 (the
+    level of a recording is its maker's choice, not a measurement; scaled, the channel is the
+    same whatever the recording's gain).
 
     >>> e = speech_channel((np.sin(np.arange(16000) / 9.0), 16000), 60.0, 61)
     >>> e.analog.shape, e.analog_rate, round(float(np.abs(e.analog).max()), 6)
@@ -106,17 +128,11 @@ def speech_channel(audio: tuple[np.ndarray, int] | None, marker_rate: float, n_f
     """
     if audio is None:
         return C3dExtras()
-    from fractions import Fraction
-
-    from scipy.signal import resample_poly  # here: scipy.signal takes 1-2 s to import
-
     from ..level import to_full_scale
 
     samples, rate = np.asarray(audio[0], dtype=np.float64), int(audio[1])
     per_frame = max(1, int(round(rate / marker_rate)))
-    ratio = Fraction(per_frame * marker_rate / rate).limit_denominator(4000)
-    x = samples if ratio == 1 else resample_poly(samples, ratio.numerator, ratio.denominator)
-    x = to_full_scale(x)
+    x = to_full_scale(band_limited(samples, per_frame * marker_rate / rate))
     n = n_frames * per_frame
     x = np.concatenate([x[:n], np.zeros(max(0, n - len(x)))])
     return C3dExtras(analog=x.reshape(n_frames, per_frame), analog_rate=per_frame * marker_rate,
