@@ -15,7 +15,6 @@ PocketSphinx version. Corpora and folders are labelled in :mod:`facetraj_engine.
 from __future__ import annotations
 
 import functools
-import hashlib
 import json
 import logging
 import os
@@ -45,6 +44,8 @@ def label_cache_key(audio: np.ndarray, rate: int, method: str, text: str = "",
                     extra_dict: Mapping[str, Sequence[str]] | None = None) -> str:
     """A hash of the audio samples (as 16-bit PCM at the labeller's level), the rate, the method,
     the text, extra pronunciations, the PocketSphinx version and :data:`LABELLER_VERSION`."""
+    import hashlib  # here: a label file read needs no hashing
+
     from ..labels.alignment import pcm16, pocketsphinx_version
 
     h = hashlib.sha256()
