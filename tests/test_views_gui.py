@@ -18,11 +18,10 @@ if not os.environ.get("DISPLAY"):
 
 from PyQt6.QtGui import QImage
 from PyQt6.QtWidgets import QAbstractButton, QSlider
-from screens import Heartbeat, figure_texts, image_array, on_screen, place_in
+from screens import Heartbeat, figure_texts, image_array, on_screen, place_in, view_settled
 
 from facetraj.paths import default_corpus
 from facetraj_app.analysis import PANELS, VIEWS
-from facetraj_app.figure_canvas import BackgroundCanvas
 from facetraj_app.main import build_window
 
 pytestmark = pytest.mark.gui
@@ -46,19 +45,6 @@ def window(qtbot, trained_cache):
     win.close()
 
 
-def settled(win, key: str) -> bool:
-    """View ``key`` is open, has done its work and drawn it, and so has the window."""
-    views = win.extension("analysis")
-    w = views.widgets.get(key)
-    if w is None or win.busy or win.timeline.building:
-        return False
-    if key == "similarity" and w.clustering is None:
-        return False
-    if key == "pc_modes" and not w.is_ready:
-        return False
-    return not any(c.busy for c in w.findChildren(BackgroundCanvas))
-
-
 def open_all(win, qtbot) -> dict[str, tuple[int, int]]:
     """Open every analysis view from the menu, one after the other, each until it has settled;
     the longest event-loop stall of each: (wall ms, the GUI thread's CPU ms in that stall)."""
@@ -67,7 +53,7 @@ def open_all(win, qtbot) -> dict[str, tuple[int, int]]:
     for key in VIEWS:
         beat.start()
         views.view_actions[key].trigger()
-        qtbot.waitUntil(lambda k=key: settled(win, k), timeout=WAIT_MS)
+        qtbot.waitUntil(lambda k=key: view_settled(win, k), timeout=WAIT_MS)
         longest[key] = (beat.stop(), beat.longest_cpu)
     return longest
 
@@ -106,7 +92,7 @@ def test_docks_keep_the_window_on_the_screen(window, qtbot):
     widths = []
     for key in VIEWS:
         views.view_actions[key].trigger()
-        qtbot.waitUntil(lambda k=key: settled(win, k), timeout=WAIT_MS)
+        qtbot.waitUntil(lambda k=key: view_settled(win, k), timeout=WAIT_MS)
         widths.append(win.frameGeometry().width())
         assert screen.contains(win.frameGeometry()), (key, win.frameGeometry())
         for control in views.widgets[key].findChildren((QAbstractButton, QSlider)):
@@ -148,7 +134,7 @@ def test_saved_screenshot_shows_each_3d_view_as_the_screen_does(window, qtbot, t
     win = window
     views = win.extension("analysis")
     views.view_actions["pc_modes"].trigger()
-    qtbot.waitUntil(lambda: settled(win, "pc_modes"), timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: view_settled(win, "pc_modes"), timeout=WAIT_MS)
     win.activateWindow()
     win.raise_()
     qtbot.wait(300)                                    # the 3-D views painted on the screen
@@ -236,7 +222,7 @@ def test_the_views_plots_are_legible_in_their_docks(window, qtbot):
     views = win.extension("analysis")
     for key in ("metrics", "errors", "pc_modes"):
         views.view_actions[key].trigger()
-        qtbot.waitUntil(lambda k=key: settled(win, k), timeout=WAIT_MS)
+        qtbot.waitUntil(lambda k=key: view_settled(win, k), timeout=WAIT_MS)
     metrics = views.widgets["metrics"]
     views.docks["metrics"].raise_()
     metrics.per_split.setValue(1)

@@ -33,17 +33,13 @@ _BLOCK_SAMPLES = 1 << 20
 
 def _held_audio(path: Path) -> tuple[np.ndarray, int] | None:
     """The speech a marker file holds (an MVIEW ``.mat``), ``None`` for a file of no such format."""
-    from .markerformats import format_for, read_recording
+    from .markerformats import held_recording
 
-    try:
-        fmt = format_for(path)
-    except InputError:
+    rec = held_recording(path, "carries_audio")
+    if rec is None:
         return None
-    if not fmt.carries_audio:
-        return None
-    rec = read_recording(path)
     if rec.audio is None:
-        raise InputError(path, f"the {fmt.name} file holds no audio channel")
+        raise InputError(path, f"the {rec.format} file holds no audio channel")
     return rec.audio, rec.audio_rate
 
 

@@ -21,7 +21,7 @@ from ..errors import InputError, warn_file
 from .audio import read_audio
 from .files import atomic_write, check_output_path
 from .hash_memo import folder_key, memoized_hash
-from .labelfiles import held_labels, label_file_provenance, read_labels, read_textgrid
+from .labelfiles import LABEL_SUFFIXES, held_labels, label_file_provenance, read_labels, read_textgrid
 from .markerfiles import read_markers
 from .markerformats import NAMES_FILE, check_names, format_for, marker_suffixes, read_names_file
 
@@ -615,7 +615,7 @@ def label_kinds(corpus: Corpus) -> dict[str, int]:
     counts: dict[str, int] = {}
     for utt_id in corpus.info.ids:
         source = label_source(corpus.data_root, utt_id)
-        if source.suffix.lower() in (".textgrid", ".lab", ".phn"):
+        if source.suffix.lower() in LABEL_SUFFIXES:
             kind = label_file_provenance(source, corpus.info.label_provenance or None).kind
         else:
             kind = "aligned"

@@ -240,17 +240,12 @@ def _resolve(audio_path: Path, audio: np.ndarray, rate: int, request: LabelReque
 def _held_by(audio_path: Path):
     """The recording of a marker file that holds the speech and its phones (MVIEW), else ``None``."""
     from .audio import AUDIO_SUFFIXES
-    from .markerformats import format_for, read_recording
+    from .markerformats import held_recording
 
     if audio_path.suffix.lower() in AUDIO_SUFFIXES or not audio_path.is_file():
         return None
-    try:
-        if not format_for(audio_path).carries_labels:
-            return None
-    except InputError:
-        return None
-    rec = read_recording(audio_path)
-    return rec if rec.phones else None
+    rec = held_recording(audio_path, "carries_labels")
+    return rec if rec is not None and rec.phones else None
 
 
 def made_from(labels: Labels, origin: str) -> Labels:

@@ -341,7 +341,7 @@ def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = 
         phone_set = sorted({SILENCE} | {apply_label_map(str(lab), label_map)
                                         for r in reads for lab in set(r.phones.labels)})
         pid = {ph: i for i, ph in enumerate(phone_set)}
-        voice = _voice_picks(len(reads))
+        voice = _evenly(len(reads), VOICE_UTTERANCES)
         closure = ClosureGather(pca.n_components)
         cb, frames = _codebook(p, kept, reads, reference, pca, pid, closure, voice)
 
@@ -376,11 +376,6 @@ def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = 
 def _evenly(n: int, most: int) -> list[int]:
     """Up to ``most`` of ``range(n)``, evenly spaced (all of them when ``n <= most``)."""
     return [int(j) for j in np.unique(np.linspace(0, n - 1, min(n, most)).astype(int))]
-
-
-def _voice_picks(n: int) -> list[int]:
-    """The (up to :data:`VOICE_UTTERANCES`, evenly spaced) utterances ``D0`` is measured on."""
-    return _evenly(n, VOICE_UTTERANCES)
 
 
 # --------------------------------------------------------------------------- pass 4: the detector

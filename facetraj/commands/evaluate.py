@@ -37,11 +37,12 @@ def mode_rule(args: argparse.Namespace, model, corpus, splits) -> EvalConfig:
         choice = choose_mode(synth_config(args), utt.phones, utt.provenance, explicit=explicit,
                              tuned=model.tuned, keep=keep)
         from facetraj_engine.io.corpus import label_source
+        from facetraj_engine.io.labelfiles import LABEL_SUFFIXES
 
-        where = label_source(corpus.data_root, first).name
+        where = label_source(corpus.data_root, first)
         log.info("%s: labels %s [%s]; %s%s", first, utt.provenance.describe(),
-                 f"{where} beside the audio" if where.endswith((".TextGrid", ".lab", ".phn"))
-                 else f"{where}'s PHONES", choice.describe(),
+                 f"{where.name} beside the audio" if where.suffix.lower() in LABEL_SUFFIXES
+                 else f"{where.name}'s PHONES", choice.describe(),
                  "" if explicit else " (each utterance's mode follows its labels)")
     return EvalConfig(by_labels=not explicit, keep=keep)
 

@@ -8,8 +8,16 @@ the registry, the error messages, corpus reading, ``corpus init`` and the app's 
 
 from .channels import NAMES_FILE, apply_names, check_names, read_names_file
 from .recording import MarkerRecording
-from .registry import MarkerFormat, accepted, format_for, formats, marker_suffixes, read_recording
+from .registry import (
+    MarkerFormat,
+    accepted,
+    format_for,
+    formats,
+    held_recording,
+    marker_suffixes,
+    read_recording,
+)
 
 __all__ = ["NAMES_FILE", "MarkerFormat", "MarkerRecording", "accepted", "apply_names",
-           "check_names", "format_for", "formats", "marker_suffixes", "read_names_file",
+           "check_names", "format_for", "formats", "held_recording", "marker_suffixes", "read_names_file",
            "read_recording"]

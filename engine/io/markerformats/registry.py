@@ -133,3 +133,14 @@ def read_recording(path: str | Path, rate: float | None = None) -> MarkerRecordi
                                f"{' ...' if len(empty) > 5 else ''} ({rec.missing} samples marked "
                                f"missing); leave such channels out with --channel-names NAME=-")
     return rec
+
+
+def held_recording(path: str | Path, carries: str) -> MarkerRecording | None:
+    """The recording of ``path`` when it is a marker file whose format can hold the speech itself
+    (``carries="carries_audio"``) or its labels (``"carries_labels"``): an MVIEW file; ``None``
+    for any other file, of no format or of one that holds neither."""
+    try:
+        fmt = format_for(path)
+    except InputError:
+        return None
+    return read_recording(path) if getattr(fmt, carries) else None
