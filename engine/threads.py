@@ -5,7 +5,8 @@ OpenBLAS keeps a thread per core and lets idle ones spin while they wait for wor
 products are small (frames x codewords), so a second BLAS thread buys little, and when the cores
 are busy (the evaluation's worker processes, the app's synthesis beside its rendering, other
 programs) the spinning threads take the cores from the work (docs/benchmarks.md measures it).
-Work that runs beside other work therefore uses one BLAS thread.
+Work that runs beside other work therefore uses one BLAS thread, and so does synthesis itself
+(:func:`above_blas`): its own frame threads are the other work.
 
 Synthesis parallelises above BLAS instead: its per-frame stages (the LSF analysis, the LSF index
 search, eqs 5-8) are independent from frame to frame, and numpy releases the interpreter lock
@@ -18,17 +19,19 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import functools
 import os
 from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import AbstractContextManager
 from contextvars import ContextVar
 from itertools import pairwise
-from typing import TypeVar
+from typing import ParamSpec, TypeVar
 
 from threadpoolctl import threadpool_limits
 
 T = TypeVar("T")
+P = ParamSpec("P")
 
 #: environment variable that sets the frame threads (a positive integer) in place of the cores
 THREADS_ENV = "FACETRAJ_THREADS"
@@ -66,6 +69,18 @@ def one_blas_thread() -> AbstractContextManager:
     3.0
     """
     return threadpool_limits(limits=1, user_api="blas")
+
+
+def above_blas(fn: Callable[P, T]) -> Callable[P, T]:
+    """``fn`` splits its work between frame threads (:func:`map_spans`): while it runs, BLAS
+    runs on one thread, else its idle threads spin beside the frame threads and take the cores
+    from them (docs/benchmarks.md, "BLAS beside the frame threads")."""
+    @functools.wraps(fn)
+    def run(*args: P.args, **kwargs: P.kwargs) -> T:
+        with one_blas_thread():
+            return fn(*args, **kwargs)
+
+    return run
 
 
 def usable_cores() -> int:

@@ -3,6 +3,8 @@ recordings with one corrupt file, through ``facetraj.cli.main``."""
 
 import json
 import shutil
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -64,6 +66,19 @@ def test_a_folder_with_a_corrupt_file_finishes_the_others_and_names_it(model_pat
     for name in ("s001", "s002", "s003"):
         table = read_marker_table(out / f"{name}.tsv")
         assert table.markers.shape[1:] == (54, 3) and np.isfinite(table.markers).all()
+
+
+def test_one_files_npz_is_the_batchs_to_the_bit(model_path, folder, tmp_path):
+    """``synth`` on one file in a new process (BLAS on its default threads until synthesis
+    runs it on one) writes the bytes a batch's worker (one BLAS thread) writes for that file:
+    full float64, not a rounded table."""
+    single = tmp_path / "single.npz"
+    subprocess.run([sys.executable, "-m", "facetraj", "-q", "synth", str(model_path),
+                    str(folder / "s001.flac"), "-o", str(single)], check=True, cwd=tmp_path)
+    out = tmp_path / "out"
+    assert main(["-q", "synth", str(model_path), str(folder / "s00[12].flac"), "-o", str(out),
+                 "--format", "npz", "-j", "2"]) == 0
+    assert (out / "s001.npz").read_bytes() == single.read_bytes()
 
 
 def test_each_output_is_the_one_file_commands_and_a_run_resumes(model_path, folder, tmp_path,

@@ -113,3 +113,34 @@ def test_evaluation_synthesizes_on_one_frame_thread(default_model, default_corpu
     corpus = type(default_corpus)(default_corpus.root, sub)
     evaluate(default_model, corpus, ("train", "test"), [SynthConfig()], ("triangular",))
     assert seen and set(seen) == {1}
+
+
+def _blas_threads() -> int:
+    from threadpoolctl import threadpool_info
+
+    return max(i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas")
+
+
+def test_synthesis_runs_blas_on_one_thread_and_gives_it_back(default_model, default_corpus,
+                                                             monkeypatch):
+    """While synthesize() runs, BLAS runs on one thread (its idle threads would spin beside the
+    frame threads, facetraj_engine.threads.above_blas); after it, on as many as before."""
+    from threadpoolctl import threadpool_limits
+
+    from facetraj_engine.method import pipeline
+
+    seen = []
+    real = pipeline.smooth
+
+    def spy(*args, **kwargs):
+        seen.append(_blas_threads())
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(pipeline, "smooth", spy)
+    utt = default_corpus.utterance(default_corpus.info.test[0])
+    with threadpool_limits(limits=2, user_api="blas"):
+        before = _blas_threads()
+        if before < 2:
+            pytest.skip("BLAS runs on one thread on this machine")
+        synthesize(default_model, utt.audio, utt.sample_rate, config=SynthConfig(mode="acoustic"))
+        assert (before, seen, _blas_threads()) == (2, [1], 2)

@@ -458,7 +458,9 @@ def analysis_frames(audio: np.ndarray, rate: int, times: np.ndarray, window_s: f
     """Hamming-windowed frames of ``window_s`` centred on ``times`` (zero outside the signal;
     ``exponent`` as :func:`padded_signal`'s)."""
     pad, starts, n = padded_signal(audio, rate, times, window_s, preemphasis, exponent)
-    return np.lib.stride_tricks.sliding_window_view(pad, n)[starts] * np.hamming(n)
+    frames = np.lib.stride_tricks.sliding_window_view(pad, n)[starts]     # a copy: windowed in place
+    frames *= np.hamming(n)
+    return frames
 
 
 def frame_lsf(frames: np.ndarray, order: int) -> np.ndarray:

@@ -226,11 +226,12 @@ def _smallest(d: np.ndarray, count: int) -> np.ndarray:
     if count == 1:                    # the nearest alone (the voice match): the first smallest
         return d.argmin(axis=1)[:, None]
     kth = np.partition(d, count - 1, axis=1)[:, count - 1]
-    r, cols = np.nonzero(d <= kth[:, None])
-    if len(r) > rows * count:                                  # ties at the edge: the first ones
+    at = np.flatnonzero(d <= kth[:, None])                     # flat: faster than row and column
+    if len(at) > rows * count:                                 # ties at the edge: the first ones
+        r = at // width
         first = np.searchsorted(r, np.arange(rows))
-        cols = cols[np.arange(len(r)) - first[r] < count]
-    return cols.reshape(rows, count)
+        at = at[np.arange(len(at)) - first[r] < count]
+    return at.reshape(rows, count) - np.arange(0, rows * width, width)[:, None]
 
 
 def default_cells(n_codewords: int) -> int:

@@ -22,7 +22,7 @@ from ..data import PhoneSegment, Provenance
 from ..errors import InputError, warn_file
 from ..io.labelfiles import validate_phones
 from ..labels.phoneset import SILENCE, map_labels, normalise_label
-from ..threads import frame_threads
+from ..threads import above_blas, frame_threads
 from .closure import ClosurePlan, aperture_functional, apply_closure, closure_intervals, closure_strengths
 from .closure_detector import beside, closure_runs, input_probability
 from .closure_search import search_rows
@@ -102,6 +102,7 @@ def check_length(model: Model, n_samples: int, sample_rate: int, source: str | N
         raise InputError(source, f"the audio is too short ({duration * 1000:.1f} ms) to synthesize")
 
 
+@above_blas
 def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                phones: Sequence[PhoneSegment] | None = None, config: SynthConfig | None = None,
                n_frames: int | None = None, label_map: Mapping[str, str] | None = None,
