@@ -28,7 +28,7 @@ from contextvars import ContextVar
 from itertools import pairwise
 from typing import ParamSpec, TypeVar
 
-from threadpoolctl import threadpool_limits
+from threadpoolctl import ThreadpoolController, threadpool_limits
 
 T = TypeVar("T")
 P = ParamSpec("P")
@@ -77,10 +77,17 @@ def above_blas(fn: Callable[P, T]) -> Callable[P, T]:
     from them (docs/benchmarks.md, "BLAS beside the frame threads")."""
     @functools.wraps(fn)
     def run(*args: P.args, **kwargs: P.kwargs) -> T:
-        with one_blas_thread():
+        with _loaded_blas().limit(limits=1, user_api="blas"):
             return fn(*args, **kwargs)
 
     return run
+
+
+@functools.cache
+def _loaded_blas() -> ThreadpoolController:
+    """The BLAS libraries loaded when first asked (numpy's among them), found once: finding
+    them walks the process's libraries, which takes longer than synthesizing a short input."""
+    return ThreadpoolController()
 
 
 def usable_cores() -> int:
