@@ -172,12 +172,11 @@ _WORKER: dict[str, Any] = {}
 
 
 def _worker_init(model_path: Path, job: SynthJob, one_thread: bool) -> None:
-    """A worker process: the model loaded once (unless inherited from the parent), one BLAS
-    thread (the products are small: more threads spin, ``facetraj_engine.threads``),
-    and one frame thread when the workers share the cores (``one_thread``)."""
-    from facetraj_engine.threads import THREADS_ENV, one_blas_thread
+    """A worker process: the model loaded once (unless inherited from the parent) and one frame
+    thread when the workers share the cores (``one_thread``); synthesis runs BLAS on one thread
+    itself (``facetraj_engine.threads.above_blas``)."""
+    from facetraj_engine.threads import THREADS_ENV
 
-    one_blas_thread()
     if one_thread:
         os.environ[THREADS_ENV] = "1"                   # this process's frames on one thread
     if _WORKER.get("path") != model_path:

@@ -21,9 +21,9 @@ pytest.importorskip("pyvistaqt")
 if not os.environ.get("DISPLAY"):
     pytest.skip("the app tests need an X display (run under xvfb-run)", allow_module_level=True)
 
+from screens import opened_window
+
 from facetraj.cli import main
-from facetraj.paths import default_corpus
-from facetraj_app.main import build_window
 
 pytestmark = pytest.mark.gui
 
@@ -34,15 +34,7 @@ WAIT_MS = 240_000   # a hang guard (a loaded machine is slow), not a speed limit
 
 @pytest.fixture
 def window(qtbot, trained_cache):
-    win = build_window(default_corpus(), use_audio=False)
-    qtbot.addWidget(win)
-    win.resize(1600, 1000)
-    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
-        win.show()
-    qtbot.waitExposed(win)
-    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
-    yield win
-    win.close()
+    yield from opened_window(qtbot, wait_ms=WAIT_MS)
 
 
 def _folder(tmp_path: Path) -> Path:
