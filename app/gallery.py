@@ -336,10 +336,6 @@ def video_figures(out: Path) -> list[Path]:
     return written
 
 
-def _ready(win) -> bool:
-    return win.view is not None and not win.busy and not win.timeline.building
-
-
 def laptop_figures(out: Path) -> list[Path]:
     """The window on a 1366 x 768 laptop screen (the size ``place_on_screen`` gives it there)
     with Kinematics and Errors docked: the lip panels keep their height, the legend is in its
@@ -350,11 +346,11 @@ def laptop_figures(out: Path) -> list[Path]:
     views = win.extension("analysis")
     for key in ("kinematics", "errors"):
         views.view_actions[key].trigger()
-        wait_until(lambda k=key: k in views.widgets and _ready(win))
+        wait_until(lambda k=key: k in views.widgets and win.settled)
     errors = views.widgets["errors"]
     errors.per_split.setValue(4)
     errors.start()
-    wait_until(lambda: errors.report is not None and _ready(win), 600)
+    wait_until(lambda: errors.report is not None and win.settled, 600)
     path = _shoot(win, out / "app_1366x768_docks.png", 2.38)
     views.close()
     win.close()
@@ -382,7 +378,7 @@ def measure_figures(out: Path) -> list[Path]:
         done = []
         win.synthesisChanged.connect(lambda: done.append(1))
         change()
-        wait_until(lambda: bool(done) and _ready(win), 600)
+        wait_until(lambda: bool(done) and win.settled, 600)
 
     labels(lambda: win.open_audio(DEFAULT_CORPUS / "s002.flac"))
     labels(lambda: win.audio_opener.switch("aligned"))

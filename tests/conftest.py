@@ -150,7 +150,7 @@ def shown_corpus_window(qtbot, path: Path, monkeypatch, timeout_ms: int = 240_00
     qtbot.addWidget(win)
     win.resize(1400, 900)
     win.show()
-    qtbot.waitUntil(lambda: errors or (win.view is not None and not win.busy), timeout=timeout_ms)
+    qtbot.waitUntil(lambda: errors or win.settled, timeout=timeout_ms)
     assert not errors, errors
     monkeypatch.undo()
     return win

@@ -210,7 +210,7 @@ def view_settled(win, key: str) -> bool:
     from facetraj_app.figure_canvas import BackgroundCanvas
 
     w = win.extension("analysis").widgets.get(key)
-    if w is None or win.busy or win.timeline.building:
+    if w is None or not win.settled:
         return False
     if key == "similarity" and w.clustering is None:
         return False
@@ -276,8 +276,7 @@ def opened_window(qtbot, utterance: str | None = None, wait_ms: int = 240_000):
         w.show()
     qtbot.waitExposed(w)
     w.place_on_screen(WINDOW_SIZE)                # again once shown, as facetraj does
-    qtbot.waitUntil(lambda: w.view is not None and not w.busy and not w.timeline.building,
-                    timeout=wait_ms)
+    qtbot.waitUntil(lambda: w.settled, timeout=wait_ms)
     yield w
     w.extension("analysis").close()
     w.close()

@@ -459,7 +459,7 @@ def test_installed_in_main_window(qtbot, corpus, model):
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
         win.show()
     qtbot.waitExposed(win)
-    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
     texts = [a.text() for a in win.analysis_menu.actions()]
     for t in VIEWS.values():
         assert t in texts

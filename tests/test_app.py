@@ -45,7 +45,7 @@ def window(qtbot, trained_cache):
         win.show()
     qtbot.waitExposed(win)
     win.activateWindow()
-    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
     yield win
     win.close()
 
@@ -183,7 +183,7 @@ def test_changing_n_resynthesizes(window, qtbot):
     win.set_synth_config(win.synth_config.with_(n_context_phones=2))
     qtbot.waitUntil(lambda: win.view.utterance.name == other
                     and win.view.synthesis.config.n_context_phones == 2, timeout=WAIT_MS)
-    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
     assert win.view.utterance.name == other and win.settings.n.value() == 2
 
 
@@ -205,14 +205,14 @@ def test_acoustic_search_choice(window, qtbot):
                               ("acoustic-full", n_codewords, "acoustic only, whole codebook")):
         with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
             choose(mode, key)
-        qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+        qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
         synthesis = win.view.synthesis
         assert synthesis.config.mode == "acoustic"
         assert synthesis.frames.candidates.shape == (win.view.n_frames, width)
         assert title in win.title.text() and win.settings.shown_search() == key
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
         choose(mode, "phonetic")
-    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
     assert win.synth_config == SynthConfig(n_context_phones=win.synth_config.n_context_phones)
 
 

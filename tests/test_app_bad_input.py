@@ -32,7 +32,7 @@ def probe(qtbot, workspace):
     win.resize(1280, 800)
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
         win.show()
-    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
     yield AppProbe(win)
     win.close()
 
@@ -61,7 +61,7 @@ def test_each_kind_of_bad_file_gives_a_dialog_and_the_window_runs_on(probe, work
     # and the window still plays
     win = probe.win
     win.open_corpus(workspace.corpus, workspace.model)
-    qtbot.waitUntil(lambda: not win.busy and win.view is not None, timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
     win.seek(0.0)
     start = win.displayed_frame
     win.play()

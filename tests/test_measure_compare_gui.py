@@ -31,10 +31,6 @@ WAIT_MS = 240_000
 CORPUS = Path(__file__).resolve().parent.parent / "data_samples"
 
 
-def ready(w) -> bool:
-    return w.view is not None and not w.busy and not w.timeline.building
-
-
 @pytest.fixture
 def win(screen, qtbot, trained_cache):
     if not screen.local:
@@ -51,7 +47,7 @@ def middle(phones, label: str) -> float:
 def resynthesize(w, qtbot, change) -> None:
     with qtbot.waitSignal(w.synthesisChanged, timeout=WAIT_MS):
         change()
-    qtbot.waitUntil(lambda: ready(w), timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: w.settled, timeout=WAIT_MS)
 
 
 def test_the_readout_and_the_table_give_the_lips_in_mm(screen, win, qtbot, tmp_path):
@@ -141,7 +137,7 @@ def test_a_pinned_result_is_drawn_beside_the_next(screen, win, qtbot):
     w.seek(middle(view.utterance.phones, "b"))
     assert "pin 1" in w.extension("measure").readout.text()
     compare.clear()
-    qtbot.waitUntil(lambda: ready(w), timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: w.settled, timeout=WAIT_MS)
     assert diff_panel not in tl.panels and w.face.pins == []
     assert not [line for line in tl.axes_of(next(p for p in tl.panels if p.title == "upper lip y")).lines
                 if line.get_color() == pin.color]
@@ -156,7 +152,7 @@ def test_the_b_of_boy_aligned_against_recognized_from_the_window(screen, win, qt
         pytest.skip("the walk-through is checked on the smaller screen")
     w = win
     resynthesize(w, qtbot, lambda: w.open_audio(CORPUS / "s002.flac"))
-    qtbot.waitUntil(lambda: w.view.split == "external" and ready(w), timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: w.view.split == "external" and w.settled, timeout=WAIT_MS)
     assert w.view.original is not None
     resynthesize(w, qtbot, lambda: w.audio_opener.switch("aligned"))
     assert w.view.utterance.label_source == "aligned"

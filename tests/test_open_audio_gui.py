@@ -134,7 +134,7 @@ def test_empty_sentence_recognizes_and_wrong_sentence_is_refused(window, qtbot, 
     win.open_audio(clip, text="Tornadoes often destroy acres of farm land")
     qtbot.waitUntil(lambda: bool(shown), timeout=WAIT_MS)
     assert "recording.flac" in shown[0] and "does not match the audio" in shown[0]
-    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
     assert win.view.utterance.name == name and win.view.utterance.label_source == "recognized"
     # a transcript beside the audio is used without asking
     clip.with_suffix(".txt").write_text(SENTENCE)
@@ -203,7 +203,7 @@ def test_the_search_shown_is_the_search_used_for_each_label_choice(window, qtbot
             with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
                 box.combo.setCurrentIndex(box.combo.findData(source))
                 box.combo.activated.emit(box.combo.currentIndex())
-        qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+        qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
         config = win.view.synthesis.config
         used[source] = search_key(config)
         assert win.settings.shown_search() == used[source], source
@@ -217,7 +217,7 @@ def test_the_search_shown_is_the_search_used_for_each_label_choice(window, qtbot
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
         box.combo.setCurrentIndex(box.combo.findData("aligned"))
         box.combo.activated.emit(box.combo.currentIndex())
-    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
     assert win.settings.shown_search() == "robust"
     generation = win.state.generation
     mode.activated.emit(mode.findData("robust"))
@@ -225,7 +225,7 @@ def test_the_search_shown_is_the_search_used_for_each_label_choice(window, qtbot
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
         mode.setCurrentIndex(mode.findData("phonetic"))
         mode.activated.emit(mode.currentIndex())
-    qtbot.waitUntil(lambda: not win.busy, timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
     assert win.view.synthesis.config.mode == "phonetic" and win.settings.shown_search() == "phonetic"
     assert "phonetic (the paper), N=3" in win.title.text()
     assert not win.settings.mode_reason.isVisible()

@@ -167,7 +167,7 @@ def window(qtbot, trained_cache):
     with qtbot.waitSignal(win.synthesisChanged, timeout=240_000):
         win.show()
     qtbot.waitExposed(win)
-    qtbot.waitUntil(lambda: not win.busy, timeout=240_000)
+    qtbot.waitUntil(lambda: win.settled, timeout=240_000)
     win.timeline.canvas.draw()           # any pending full draw (layout, resize) done now
     qtbot.waitUntil(lambda: win.timeline.cursor_ready, timeout=10_000)
     yield win

@@ -47,10 +47,6 @@ CORPUS = Path(__file__).resolve().parent.parent / "data_samples"
 WHITE = "#ffffff"
 
 
-def ready(w) -> bool:
-    return w.view is not None and not w.busy and not w.timeline.building
-
-
 @pytest.fixture
 def win(screen, qtbot, trained_cache):
     """The main window as ``facetraj`` opens it (``place_on_screen``: 1600 x 1000 where the
@@ -64,14 +60,14 @@ def win(screen, qtbot, trained_cache):
 def show(w, qtbot, utt_id: str) -> None:
     with qtbot.waitSignal(w.synthesisChanged, timeout=WAIT_MS):
         w.set_utterance(utt_id)
-    qtbot.waitUntil(lambda: ready(w), timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: w.settled, timeout=WAIT_MS)
 
 
 def open_view(w, qtbot, key: str):
     views = w.extension("analysis")
     views.view_actions[key].trigger()
     qtbot.waitUntil(lambda: view_settled(w, key), timeout=WAIT_MS)
-    qtbot.waitUntil(lambda: ready(w), timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: w.settled, timeout=WAIT_MS)
     return views.widgets[key]
 
 
@@ -328,7 +324,7 @@ def test_a_recording_opened_with_markers_beside_shows_them(screen, win, qtbot):
     w = win
     with qtbot.waitSignal(w.synthesisChanged, timeout=WAIT_MS):
         assert w.open_audio(CORPUS / "s002.flac")
-    qtbot.waitUntil(lambda: ready(w) and w.view.split == "external", timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: w.settled and w.view.split == "external", timeout=WAIT_MS)
     corpus_utt = w.corpus.utterance("s002")
     assert w.view.original is not None
     np.testing.assert_allclose(w.view.original, w.model.normalise_markers(corpus_utt.markers)[
@@ -339,7 +335,7 @@ def test_a_recording_opened_with_markers_beside_shows_them(screen, win, qtbot):
         return
     with qtbot.waitSignal(w.synthesisChanged, timeout=WAIT_MS):
         assert w.open_audio(mocha)
-    qtbot.waitUntil(lambda: ready(w) and w.notice.isVisible(), timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: w.settled and w.notice.isVisible(), timeout=WAIT_MS)
     text = w.notice.text.text()
     assert "fsew0_001.ema" in text and "Import" in text and w.view.original is None
     assert w.notice.button.isVisible() and "Import" in w.notice.button.text()

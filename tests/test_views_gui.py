@@ -39,7 +39,7 @@ def window(qtbot, trained_cache):
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
         win.show()
     qtbot.waitExposed(win)
-    qtbot.waitUntil(lambda: not win.busy and not win.timeline.building, timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
     yield win
     win.extension("analysis").close()
     win.close()
@@ -73,7 +73,7 @@ def test_no_view_freezes_the_window_while_it_opens(window, qtbot):
     for key in PANELS:                                  # the panels not opened by a view
         beat.start()
         views.panel_actions[key].setChecked(True)
-        qtbot.waitUntil(lambda: not window.timeline.building and not window.busy, timeout=WAIT_MS)
+        qtbot.waitUntil(lambda: window.settled, timeout=WAIT_MS)
         longest[f"panel {key}"] = (beat.stop(), beat.longest_cpu)
     print("longest event-loop stall per view (wall ms, GUI-thread CPU ms):", longest)
     assert max(cpu for _wall, cpu in longest.values()) <= MAX_STALL_MS, longest
@@ -158,7 +158,7 @@ def test_the_face_shows_the_mouth_closed_at_a_b_and_the_lip_panels_where_closed_
     win = window
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
         win.set_utterance("s002")
-    qtbot.waitUntil(lambda: not win.busy and not win.timeline.building, timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
     win.view_bar.show_synth.setChecked(False)             # the surface follows the original set
     win.view_bar.set_camera("front")
     model, face = win.model, win.face
