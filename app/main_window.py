@@ -174,13 +174,8 @@ class MainWindow(QMainWindow):
     pins = property(lambda self: self.state.pins, doc="Results kept to compare (``app/pins.py``).")
     displayed_frame = property(lambda self: self.playback.displayed_frame, doc="The frame on screen.")
     busy = property(lambda self: self.tasks.busy, doc="Whether foreground work (model, synthesis) runs.")
-
-    @property
-    def settled(self) -> bool:
-        """Whether an utterance is shown, no foreground work runs and the panels are laid out
-        and drawn (what a screenshot, a figure or a test waits for)."""
-        return self.view is not None and not self.busy and not self.timeline.building
-
+    settled = property(lambda self: self.view is not None and not self.busy and not self.timeline.building,
+                       doc="An utterance shown, no foreground work, the panels laid out and drawn.")
     correlations_running = property(lambda self: self.scores.running,
                                     doc="Whether the background lip-correlation sweep runs.")
     stats = property(lambda self: self.playback.stats, lambda self, v: setattr(self.playback, "stats", v),
