@@ -236,9 +236,10 @@ def figure_texts(fig) -> list:
     return [t for t in out if t.get_visible() and t.get_text().strip()]
 
 
-def assert_legible(fig, renderer, what: str) -> None:
+def assert_legible(fig, renderer, what: str, overlaps=overlap) -> None:
     """Every text of ``fig`` inside it and none over another; no legend over an axes' data (a
-    legend inside an axes must keep clear of its lines, bars and points)."""
+    legend inside an axes must keep clear of its lines, bars and points). ``overlaps(a, b)``
+    judges two boxes (default: by more than a pixel)."""
     box = fig.bbox
     texts = [(t.get_text(), t.get_window_extent(renderer)) for t in figure_texts(fig)]
     for text, e in texts:
@@ -246,14 +247,14 @@ def assert_legible(fig, renderer, what: str) -> None:
             and e.y1 <= box.y1 + 1, (what, text, e)
     for i, (a, ea) in enumerate(texts):
         for b, eb in texts[i + 1:]:
-            assert not overlap(ea, eb), (what, a, b)
+            assert not overlaps(ea, eb), (what, a, b)
     for ax in fig.axes:
         legend = ax.get_legend()
         if legend is None:
             continue
         lb = legend.get_window_extent(renderer)
         for bar in ax.patches:
-            assert not overlap(lb, bar.get_window_extent(renderer)), (what, "legend over a bar")
+            assert not overlaps(lb, bar.get_window_extent(renderer)), (what, "legend over a bar")
         for line in ax.lines:
             xy = line.get_transform().transform(line.get_xydata())
             xy = xy[np.isfinite(xy).all(axis=1)]

@@ -16,9 +16,10 @@ pytest.importorskip("pyvistaqt")
 if not os.environ.get("DISPLAY"):
     pytest.skip("the app tests need an X display (run under xvfb-run)", allow_module_level=True)
 
+from matplotlib.transforms import Bbox
 from PyQt6.QtGui import QImage
 from PyQt6.QtWidgets import QAbstractButton, QSlider
-from screens import Heartbeat, figure_texts, image_array, on_screen, place_in, view_settled
+from screens import Heartbeat, assert_legible, image_array, on_screen, place_in, view_settled
 
 from facetraj.paths import default_corpus
 from facetraj_app.analysis import PANELS, VIEWS
@@ -190,25 +191,9 @@ def test_the_face_shows_the_mouth_closed_at_a_b_and_the_lip_panels_where_closed_
 
 
 def assert_plots_legible(canvas, what: str) -> None:
-    """Every text of ``canvas``'s figure inside it and none over another (titles, labels, tick
-    labels, legends); no legend over a bar."""
+    """``canvas``'s figure legible (``screens.assert_legible``), no two boxes even touching."""
     canvas.finish()
-    fig, renderer = canvas.figure, canvas.get_renderer()
-    box = fig.bbox
-    texts = [(t.get_text(), t.get_window_extent(renderer)) for t in figure_texts(fig)]
-    for text, e in texts:
-        assert e.x0 >= box.x0 - 1 and e.y0 >= box.y0 - 1 and e.x1 <= box.x1 + 1 \
-            and e.y1 <= box.y1 + 1, (what, text, e)
-    for i, (a, ea) in enumerate(texts):
-        for b, eb in texts[i + 1:]:
-            assert not ea.overlaps(eb), (what, a, b)
-    for ax in fig.axes:
-        legend = ax.get_legend()
-        if legend is None:
-            continue
-        lb = legend.get_window_extent(renderer)
-        for bar in ax.patches:
-            assert not lb.overlaps(bar.get_window_extent(renderer)), (what, "legend over a bar")
+    assert_legible(canvas.figure, canvas.get_renderer(), what, overlaps=Bbox.overlaps)
 
 
 def test_the_views_plots_are_legible_in_their_docks(window, qtbot):
