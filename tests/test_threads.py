@@ -144,3 +144,23 @@ def test_synthesis_runs_blas_on_one_thread_and_gives_it_back(default_model, defa
             pytest.skip("BLAS runs on one thread on this machine")
         synthesize(default_model, utt.audio, utt.sample_rate, config=SynthConfig(mode="acoustic"))
         assert (before, seen, _blas_threads()) == (2, [1], 2)
+
+
+def test_input_lsf_is_synthesis_own_whatever_the_callers_blas(default_model, default_corpus):
+    """LSFs a caller analyses (``Model.input_lsf``, to pass as ``lsf=``) are the ones synthesis
+    analyses, to the bit, with BLAS on two threads around the call: the LSF analysis runs BLAS
+    on one thread itself (its matrix products add terms in another order on two)."""
+    from threadpoolctl import threadpool_limits
+
+    utt = default_corpus.utterance(default_corpus.info.test[0])
+    res = synthesize(default_model, utt.audio, utt.sample_rate, utt.phones, SynthConfig(),
+                     n_frames=utt.n_frames)
+    with threadpool_limits(limits=2, user_api="blas"):
+        if _blas_threads() < 2:
+            pytest.skip("BLAS runs on one thread on this machine")
+        w = default_model.input_lsf(utt.audio, utt.sample_rate, res.times)
+        assert _blas_threads() == 2
+    np.testing.assert_array_equal(w, res.lsf)
+    again = synthesize(default_model, utt.audio, utt.sample_rate, utt.phones, SynthConfig(),
+                       n_frames=utt.n_frames, lsf=w)
+    np.testing.assert_array_equal(again.markers, res.markers)

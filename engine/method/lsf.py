@@ -10,7 +10,7 @@ from itertools import pairwise
 import numpy as np
 
 from ..level import unit_exponent
-from ..threads import map_spans
+from ..threads import above_blas, map_spans
 
 #: white-noise correction added to r[0] (a -40 dB noise floor) so that LPC of near-silent or
 #: perfectly periodic frames stays well conditioned.
@@ -468,6 +468,7 @@ def frame_lsf(frames: np.ndarray, order: int) -> np.ndarray:
     return poly2lsf(lpc(frames, order))
 
 
+@above_blas
 def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
            window_s: float = 0.025, audio_rate: int = 16000,
            preemphasis: float = 0.97, threads: int | None = 1) -> np.ndarray:
@@ -477,6 +478,8 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     are analysed in ``threads`` spans at once (``None``: :func:`facetraj_engine.threads.frame_threads`).
     The LSFs equal one thread's to rounding: BLAS's matrix products (autocorrelation lags, the
     root bracketing grid) may add a row's terms in another order for another number of rows.
+    BLAS runs on one thread here (:func:`facetraj_engine.threads.above_blas`), so the LSFs do not
+    depend on the caller's BLAS threads: a caller's ``Model.input_lsf`` is synthesis's own.
 
     Examples
     --------
