@@ -117,14 +117,19 @@ def _cpu_model() -> str:
     return platform.processor() or platform.machine()
 
 
-def _ram_gib() -> float:
+def ram_gib() -> float:
+    """This machine's memory (GiB): ``MemTotal`` of /proc/meminfo, else the OS's page count (NaN
+    when neither says)."""
     try:
         for line in Path("/proc/meminfo").read_text().splitlines():
             if line.startswith("MemTotal:"):
                 return int(line.split()[1]) / 1024**2
     except OSError:
         pass
-    return float("nan")
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**30
+    except (ValueError, OSError, AttributeError):
+        return float("nan")
 
 
 def machine_info() -> dict[str, str]:
@@ -136,7 +141,7 @@ def machine_info() -> dict[str, str]:
     return {
         "CPU": _cpu_model(),
         "cores": f"{os.cpu_count()} logical ({usable} usable by this process)",
-        "RAM": f"{_ram_gib():.1f} GiB",
+        "RAM": f"{ram_gib():.1f} GiB",
         "OS": f"{platform.system()} {platform.release()}",
         "Python": platform.python_version(),
         "numpy": np.__version__,

@@ -35,7 +35,7 @@ import numpy as np
 
 from facetraj_engine.io.corpus import Corpus
 
-from .common import BenchContext, BenchRow
+from .common import BenchContext, BenchRow, ram_gib
 
 log = logging.getLogger(__name__)
 
@@ -284,13 +284,6 @@ class _Figures:
         return "" if row is None else row.note
 
 
-def _ram_mib() -> float:
-    try:
-        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**20
-    except (ValueError, OSError, AttributeError):
-        return float("nan")
-
-
 def section(rows: Sequence[BenchRow]) -> list[str]:
     """The Markdown section of the corpus scaling rows (none when they did not run): the table by
     size, the growth, and from these figures where one machine stops being enough."""
@@ -343,7 +336,7 @@ def _limits(fig: _Figures, command: str) -> tuple[float, float]:
     memory, and at which it would run longer than :data:`NIGHT_H`."""
     per_hour = fig(f"{command}: peak memory per hour of training speech")
     at = fig(f"{command}: at {HOURS:g} h of training speech (extrapolated): peak memory")
-    by_memory = (_ram_mib() - (at - HOURS * per_hour)) / per_hour if per_hour > 0 else math.inf
+    by_memory = (ram_gib() * 1024 - (at - HOURS * per_hour)) / per_hour if per_hour > 0 else math.inf
     lo = fig.factors[0]
     exponent_ = max(fig(f"{command}: time growth exponent"), 1.0)
     base_h = fig(f"x{lo}: training speech") / 60
@@ -358,7 +351,7 @@ def _one_machine(fig: _Figures) -> list[str]:
     what = "memory" if limits[command][0] <= limits[command][1] else "time"
     return [
         "### Past one machine", "",
-        f"On this machine ({_ram_mib() / 1024:.0f} GiB, {os.cpu_count()} cores), from these "
+        f"On this machine ({ram_gib():.0f} GiB, {os.cpu_count()} cores), from these "
         f"figures: training would need all the memory at about {limits['train'][0]:,.0f} h of "
         f"training speech and run longer than {NIGHT_H:g} h at about {limits['train'][1]:,.0f} h; "
         f"the evaluation at about {limits['eval'][0]:,.0f} h and {limits['eval'][1]:,.0f} h. One "

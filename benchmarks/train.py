@@ -4,11 +4,11 @@ rest of
 the codebook.
 
 The split is measured inside one ``train()`` call by wrapping the engine's own functions as
-``facetraj_engine.method.training`` calls them (``lsf_at``; ``fill_gaps``, ``reference_pose``,
-``remove_head_motion``; ``pca_of``, the PCA of the merged moments); the codebook time is the
-remainder (context-phones, codeword times, PC interpolation, eqs 1-2). Peak memory is measured
-in a second call under ``tracemalloc`` (numpy reports its buffers to it), so that tracing does
-not slow the timed run.
+``facetraj_engine.method.training`` calls them (``analysed_lsf``: ``lsf_at`` with the model's
+settings; ``fill_gaps``, ``reference_pose``, ``remove_head_motion``; ``pca_of``, the PCA of the
+merged moments); the codebook time is the remainder (context-phones, codeword times, PC
+interpolation, eqs 1-2). Peak memory is measured in a second call under ``tracemalloc`` (numpy
+reports its buffers to it), so that tracing does not slow the timed run.
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ log = logging.getLogger(__name__)
 
 #: the engine functions timed, grouped by stage
 STAGES: dict[str, tuple[str, ...]] = {
-    "lsf": ("lsf_at",),
+    "lsf": ("analysed_lsf",),
     "normalisation": ("fill_gaps", "reference_pose", "remove_head_motion"),
     "pca": ("pca_of",),
 }

@@ -13,11 +13,9 @@ JSON beside the outputs (:data:`SUMMARY_NAME`).
 
 from __future__ import annotations
 
-import functools
 import glob
 import logging
 import math
-import os
 import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass, field
@@ -167,23 +165,8 @@ def c3d_contents(audio: bool) -> str:
             "software keeps a recording's sound in sync with its points; --no-audio leaves it out)")
 
 
-#: a worker's model and job (set before the pool forks, else by :func:`_worker_init`)
+#: a worker's model and job (set before the workers fork: they inherit them)
 _WORKER: dict[str, Any] = {}
-
-
-def _worker_init(model_path: Path, job: SynthJob, one_thread: bool) -> None:
-    """A worker process: the model loaded once (unless inherited from the parent) and one frame
-    thread when the workers share the cores (``one_thread``); synthesis runs BLAS on one thread
-    itself (``facetraj_engine.threads.above_blas``)."""
-    from facetraj_engine.threads import THREADS_ENV
-
-    if one_thread:
-        os.environ[THREADS_ENV] = "1"                   # this process's frames on one thread
-    if _WORKER.get("path") != model_path:
-        from facetraj_engine.method.model import Model
-
-        _WORKER.update(path=model_path, model=Model.load(model_path))
-    _WORKER["job"] = job
 
 
 def _worker_run(pair: tuple[Path, Path]) -> Outcome:
@@ -257,12 +240,11 @@ def run_batch(model_path: Path, specs: Sequence[str], outdir: Path, fmt: str, jo
              len(inputs), len(todo), workers, "es" * (workers > 1), len(outcomes))
     if workers > 1:
         import_synthesis()
-    _WORKER.update(path=model_path, model=model)          # shared by forked workers
+    _WORKER.update(model=model, job=job)          # read by _worker_run, here or in a forked worker
     t0 = time.perf_counter()
     died = Skips("inputs", verb="failed")         # a worker that died: its input failed
     for _, outcome in fan_out(_worker_run, todo, workers, skip=died, progress=progress,
-                              describe=lambda pair: str(pair[0]), ordered=False,
-                              setup=functools.partial(_worker_init, model_path, job, workers > 1)):
+                              describe=lambda pair: str(pair[0]), ordered=False):
         outcomes[Path(outcome.input)] = outcome
         if outcome.status == "failed":
             log.info("%s", outcome.reason)          # and in the summary at the end

@@ -13,7 +13,7 @@ import pytest
 
 from facetraj_engine.data import PhoneSegment
 from facetraj_engine.io.corpus import Corpus
-from facetraj_engine.method.closure import ClosureGather, closure_part, regression_direction
+from facetraj_engine.method.closure import ClosureGather, closure_part
 from facetraj_engine.method.moments import Moments
 from facetraj_engine.method.pca import fit_pca, pca_of
 from facetraj_engine.method.training import DETECTOR_UTTERANCES, train
@@ -65,6 +65,15 @@ def test_moments_merged_in_blocks_equal_the_moments_of_all_rows():
 
 def _segs(*spans: tuple[float, float, str]) -> list[PhoneSegment]:
     return [PhoneSegment(a, b, lab) for a, b, lab in spans]
+
+
+def regression_direction(pcs: np.ndarray, aperture: np.ndarray) -> np.ndarray:
+    """The oracle of the closing direction, from every frame at once: ``d = cov(p, a) / var(a)``
+    over the finite rows (the gather's comes from moments merged an utterance at a time)."""
+    ok = np.isfinite(pcs).all(axis=1) & np.isfinite(aperture)
+    p = pcs[ok] - pcs[ok].mean(axis=0)
+    a = aperture[ok] - aperture[ok].mean()
+    return p.T @ a / (a @ a)
 
 
 def test_closure_statistics_gathered_an_utterance_at_a_time():
@@ -155,6 +164,7 @@ def test_the_neutral_pose_in_blocks_is_the_pose_of_all_frames_at_once():
     """``reference_pose`` fits a block of frames at a time (what it holds stays the same whatever
     the corpus's length) and sums the aligned frames one after the other: the same bits as the
     mean of every frame aligned at once."""
+    from facetraj_engine.corpusgen.face import _rotation
     from facetraj_engine.method.markers import kabsch, reference_pose
 
     rng = np.random.default_rng(11)
@@ -168,14 +178,6 @@ def test_the_neutral_pose_in_blocks_is_the_pose_of_all_frames_at_once():
         ref = (np.einsum("tij,tmj->tmi", rot, frames) + trans[:, None, :]).mean(axis=0)
     for block in (1, 7, 500, 8192):
         np.testing.assert_array_equal(reference_pose(frames, np.arange(4), block=block), ref)
-
-
-def _rotation(a: float, b: float, c: float) -> np.ndarray:
-    ca, sa, cb, sb, cc, sc = np.cos(a), np.sin(a), np.cos(b), np.sin(b), np.cos(c), np.sin(c)
-    rx = np.array([[1, 0, 0], [0, ca, -sa], [0, sa, ca]])
-    ry = np.array([[cb, 0, sb], [0, 1, 0], [-sb, 0, cb]])
-    rz = np.array([[cc, -sc, 0], [sc, cc, 0], [0, 0, 1]])
-    return rz @ ry @ rx
 
 
 def test_training_reports_its_progress_through_the_passes(toy_corpus):

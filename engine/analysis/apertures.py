@@ -114,11 +114,11 @@ def readout_at(t: float, times: np.ndarray, synthesized: np.ndarray, upper: int,
     k = int(np.clip(np.argmin(np.abs(times - t)), 0, len(times) - 1)) if len(times) else 0
     syn = np.asarray(synthesized, dtype=np.float64)[k]
     values = dict(upper_y=float(syn[upper, 1]), lower_y=float(syn[lower, 1]),
-                  aperture=float(np.linalg.norm(syn[upper] - syn[lower])))
+                  aperture=float(aperture(syn[None], upper, lower)[0]))
     if original is not None and k < len(original):
         org = np.asarray(original, dtype=np.float64)[k]
         values.update(original_upper_y=float(org[upper, 1]), original_lower_y=float(org[lower, 1]),
-                      original_aperture=float(np.linalg.norm(org[upper] - org[lower])))
+                      original_aperture=float(aperture(org[None], upper, lower)[0]))
     return LipReadout(float(t), k, label_at(phones, t), label_at(words, t), **values)
 
 

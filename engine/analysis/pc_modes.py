@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..method.model import Model
+from .apertures import aperture
 
 
 def mode_sd(model: Model) -> np.ndarray:
@@ -41,7 +42,7 @@ def mode_aperture(model: Model, component: int, sds: np.ndarray) -> np.ndarray:
     passes the talker's closed aperture (``facetraj_engine.analysis.lips.closed_lips``)."""
     sd = float(mode_sd(model)[component])
     faces = np.stack([model.mode_shape(component, float(s) * sd) for s in np.atleast_1d(sds)])
-    return np.linalg.norm(faces[:, model.upper_lip] - faces[:, model.lower_lip], axis=-1)
+    return aperture(faces, model.upper_lip, model.lower_lip)
 
 
 def opening_direction(apertures_at_minus_plus: tuple[float, float], least_mm: float = 1.0) -> int:

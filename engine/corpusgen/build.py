@@ -27,6 +27,7 @@ from ..io.corpus import CorpusInfo, save_corpus_info
 from ..io.labelfiles import write_textgrid
 from ..io.markerfiles import write_c3d
 from ..progress import Progress
+from ..threads import usable_cores
 from .durations import PAUSE, DurationModel, Segment, load_cmudict, pronounce, time_phones
 from .face import (
     FIXED_MARKERS,
@@ -213,7 +214,7 @@ def build_corpus(out_dir: str | os.PathLike[str], n_sentences: int = DEFAULT_SEN
     """Build the corpus into ``out_dir`` (``corpus.json`` + four files per sentence).
 
     ``progress(fraction, message)`` is called before synthesis and after each utterance (the
-    engine's progress convention). ``workers`` processes (default: the number of CPUs; forked by
+    engine's progress convention). ``workers`` processes (default: the usable cores; forked by
     :func:`facetraj_engine.fanout.fan_out`) synthesize in parallel; every utterance comes out the same
     bits however many. Returns the corpus description.
     """
@@ -237,7 +238,7 @@ def build_corpus(out_dir: str | os.PathLike[str], n_sentences: int = DEFAULT_SEN
         m = re.fullmatch(r"(s\d{3,})\.(flac|wav|TextGrid|c3d|txt)", p.name)
         if m and m.group(1) not in keep:
             p.unlink()
-    results = _build_all(ids, root, seed, config, workers or os.cpu_count() or 1, progress)
+    results = _build_all(ids, root, seed, config, workers or usable_cores(), progress)
     train_counts: Counter = Counter()
     for u in train:
         train_counts.update(results[u].phone_counts)

@@ -25,6 +25,7 @@ import numpy as np
 from ..config import EvalConfig
 from ..data import Utterance
 from ..labels.phoneset import normalise_label
+from ..method.closure_detector import stacked
 from ..method.context import segment_index
 from ..method.model import Model
 from ..method.moments import Moments
@@ -158,7 +159,9 @@ def fit_viseme(pcs: np.ndarray, phone: np.ndarray, n_phones: int) -> VisemeLooku
 
 # ---------------------------------------------------------------------- ridge regression
 def stack_context(x: np.ndarray, k: int = RIDGE_CONTEXT) -> np.ndarray:
-    """Stack the rows ``t-k .. t+k`` of ``x`` (``(T, P)``) into ``(T, (2k+1) P)``, edges repeated.
+    """Stack the rows ``t-k .. t+k`` of ``x`` (``(T, P)``) into ``(T, (2k+1) P)``, edges repeated
+    (:func:`facetraj_engine.method.closure_detector.stacked` at offsets ``-k .. k``); no rows
+    are refused.
 
     Examples
     --------
@@ -166,9 +169,9 @@ def stack_context(x: np.ndarray, k: int = RIDGE_CONTEXT) -> np.ndarray:
     [[1.0, 1.0, 2.0], [1.0, 2.0, 3.0], [2.0, 3.0, 3.0]]
     """
     x = np.asarray(x, dtype=np.float64)
-    n = x.shape[0]
-    idx = np.clip(np.arange(n)[:, None] + np.arange(-k, k + 1)[None, :], 0, n - 1)
-    return x[idx].reshape(n, -1)
+    if not len(x):
+        raise ValueError("cannot stack the context of no rows")
+    return stacked(x, range(-k, k + 1))
 
 
 @dataclass

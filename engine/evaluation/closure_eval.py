@@ -34,7 +34,6 @@ from ..io.corpus import Corpus
 from ..io.files import read_json, write_json
 from ..io.label_rule import label_audio, read_transcript
 from ..io.labelling import relabelled
-from ..method.closure_detector import closure_runs
 from ..method.model import Model
 from ..method.modes import choose_mode
 from ..method.pipeline import Synthesis, synthesize
@@ -104,11 +103,6 @@ CORPUS_CONDITIONS = (
 )
 
 
-def _scored(model: Model, res: Synthesis, reference: Sequence[PhoneSegment], utt=None
-            ) -> tuple[ClosureScore, dict]:
-    return _aperture_scored(model, res.markers, res.times, reference, utt)
-
-
 def _aperture_scored(model: Model, markers: np.ndarray, times: np.ndarray,
                      reference: Sequence[PhoneSegment], utt=None) -> tuple[ClosureScore, dict]:
     """The closure of ``markers`` at the ``reference`` phones, and (``utt`` with markers: its
@@ -129,15 +123,15 @@ def _detected(res: Synthesis, reference: Sequence[PhoneSegment]) -> DetectorScor
     return detector_score(res.closure.intervals, res.times, reference)
 
 
-def _take_detected(model: Model, take: FileTake, config: SynthConfig,
+def _take_detected(model: Model, take: FileTake,
                    reference: Sequence[PhoneSegment]) -> DetectorScore | None:
-    """The detector's score on one streamed take (its probabilities, as the stream found them)."""
-    p = take.stream.closure_probability if take.stream is not None else None
+    """The detector's score on one streamed take (its closures, as the stream found them)."""
+    stream = take.stream
+    p = stream.closure_probability if stream is not None else None
     if p is None or not len(p):
         return None
-    times = np.arange(len(p)) / model.marker_rate
-    runs = closure_runs(p, times, config.closure_threshold, model.detector.spec.min_frames)
-    return detector_score(runs, times, reference)
+    return detector_score(stream.detected_closures, np.arange(len(p)) / model.marker_rate,
+                          reference)
 
 
 def _pooled_detector(parts: Sequence[DetectorScore | None]) -> dict | None:
@@ -162,7 +156,7 @@ def corpus_rows(model: Model, corpus: Corpus, progress: Callable[[float, str], N
             c = choose_mode(cfg, phones, utt.provenance, tuned=model.tuned).config if rule else cfg
             res = synthesize(model, utt.audio, utt.sample_rate, phones, c, n_frames=utt.n_frames,
                              source=utt.name, confidence=utt.confidence, provenance=utt.provenance)
-            s, r = _scored(model, res, ref.phones, utt)
+            s, r = _aperture_scored(model, res.markers, res.times, ref.phones, utt)
             scores.append(s)
             cors.append(r)
             found.append(_detected(res, ref.phones))
@@ -208,8 +202,7 @@ def acoustic_rows(model: Model, corpus: Corpus, progress: Callable[[float, str],
             if cfg is None:
                 take = stream_file(model, audio[voice], utt.sample_rate, LIVE_BLOCK_S,
                                    config=LiveConfig(phones=False))
-                markers, found = take.frames.markers, _take_detected(model, take, SynthConfig(),
-                                                                     utt.phones)
+                markers, found = take.frames.markers, _take_detected(model, take, utt.phones)
             else:
                 res = synthesize(model, audio[voice], utt.sample_rate, None, cfg,
                                  n_frames=utt.n_frames, source=utt.name)
@@ -288,7 +281,7 @@ def live_scores(model: Model, refs: dict[Path, tuple[np.ndarray, int, list[Phone
         take = stream_file(model, audio, rate, block_s, synth, config, cmn=cmn)
         aperture = lip_aperture(take.frames.markers, model.upper_lip, model.lower_lip)
         scores.append(closure_score(aperture, take.frames.times, ref, model.closure.closed))
-        found.append(_take_detected(model, take, synth or SynthConfig(), ref))
+        found.append(_take_detected(model, take, ref))
     det = [f for f in found if f is not None]
     return ClosureScore.pooled(scores), (DetectorScore.pooled(det) if det else None)
 
@@ -312,8 +305,9 @@ def arctic_rows(model: Model, folder: Path, progress: Callable[[float, str], Non
                     shutil.copyfile(w, path)
                 done = synthesize_recording(model, path, cfg, request, explicit=explicit,
                                             audio=(audio, rate))
-            scores.append(_scored(model, done.synthesis, ref)[0])
-            found.append(_detected(done.synthesis, ref))
+            res = done.synthesis
+            scores.append(_aperture_scored(model, res.markers, res.times, ref)[0])
+            found.append(_detected(res, ref))
         rows.append(ClosureRow(folder.name, kind, name, ClosureScore.pooled(scores).to_json(),
                                detector=_pooled_detector(found)))
     for k, (name, config, synth, session) in enumerate(LIVE_CONDITIONS):

@@ -12,34 +12,6 @@ from ..errors import InputError
 from .c3d_layout import C3dExtras
 from .files import atomic_write, write_npz
 from .markerfiles import write_c3d, write_marker_tsv
-from .numtext import fixed_point_lines
-
-
-def write_labelled_table(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
-                         names: Sequence[str], labels: Mapping[str, Sequence[str]],
-                         overwrite: bool = True) -> Path:
-    """The trajectory table of :func:`~facetraj_engine.io.markerfiles.write_marker_tsv` with a
-    text column per entry of ``labels`` after the coordinates (e.g. ``phone`` and ``word``: the
-    label at each frame, :func:`facetraj_engine.analysis.apertures.frame_labels`); tab separated,
-    or comma separated for ``.csv`` (a label holding the separator has it replaced by a space).
-    :func:`~facetraj_engine.io.markerformats.table.read_marker_table` reads it back, label columns left
-    out."""
-    path = Path(path)
-    n = markers.shape[0]
-    for key, column in labels.items():
-        if len(column) != n:
-            raise ValueError(f"{key}: {len(column)} labels for {n} frames")
-    sep = "," if path.suffix.lower() == ".csv" else "\t"
-    t = np.arange(n) / rate
-    header = ["time"] + [f"{m}_{a}" for m in names for a in "xyz"] + list(labels)
-    table = np.column_stack([t, markers.reshape(n, -1)])
-    rows = fixed_point_lines(table, [6] + [4] * (table.shape[1] - 1), sep).decode().splitlines()
-    columns = [[str(v).replace(sep, " ").replace("\n", " ") for v in col] for col in labels.values()]
-    text = "\n".join([sep.join(header)] + [sep.join([row, *(c[i] for c in columns)])
-                                           for i, row in enumerate(rows)]) + "\n"
-    with atomic_write(path, overwrite) as tmp:
-        tmp.write_text(text, encoding="utf-8")
-    return path
 
 #: The suffixes a trajectory file may have (:func:`write_trajectories`; ``.txt`` is a TSV).
 TRAJECTORY_SUFFIXES = (".c3d", ".tsv", ".csv", ".npz", ".txt")
@@ -56,7 +28,7 @@ def write_trajectories(path: str | os.PathLike[str], markers: np.ndarray, rate: 
     :meth:`~facetraj_engine.method.pipeline.Synthesis.arrays`: times, smoothed and raw PCs, gamma, input LSF
     and settings), and says ``which`` trajectories it holds (synthesized or original). A TSV/CSV
     carries ``labels`` (``{"phone": [...], "word": [...]}``, one per frame) as text columns after
-    the coordinates (:func:`write_labelled_table`).
+    the coordinates (:func:`~facetraj_engine.io.markerfiles.write_marker_tsv`).
 
     A C3D declares its axes (POINT:X_SCREEN ``+X``, POINT:Y_SCREEN ``+Y``: a viewer that honours
     them shows the face upright) and carries ``audio`` (samples, rate; the speech the face was
@@ -70,10 +42,8 @@ def write_trajectories(path: str | os.PathLike[str], markers: np.ndarray, rate: 
     if suffix == ".c3d":
         write_c3d(path, markers, rate, list(names), overwrite,
                   extras=speech_channel(audio, rate, len(markers)))
-    elif suffix in (".tsv", ".txt", ".csv") and labels:
-        write_labelled_table(path, markers, rate, list(names), labels, overwrite)
     elif suffix in (".tsv", ".txt", ".csv"):
-        write_marker_tsv(path, markers, rate, list(names), overwrite)
+        write_marker_tsv(path, markers, rate, list(names), overwrite, labels)
     elif suffix == ".npz":
         out = {"markers": markers, "marker_names": np.array(list(names)), "which": np.array(which)}
         out.update(arrays or {})

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import logging
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -70,17 +70,31 @@ def write_c3d(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
 
 
 def write_marker_tsv(path: str | os.PathLike[str], markers: np.ndarray, rate: float,
-                     names: Sequence[str], overwrite: bool = True) -> None:
-    """Write trajectories as a table: a ``time`` column then ``<name>_x <name>_y <name>_z``;
-    tab separated, or comma separated for a ``.csv`` path."""
-    t = np.arange(markers.shape[0]) / rate
-    header = ["time"] + [f"{n}_{a}" for n in names for a in "xyz"]
-    table = np.column_stack([t, markers.reshape(markers.shape[0], -1)])
+                     names: Sequence[str], overwrite: bool = True,
+                     labels: Mapping[str, Sequence[str]] | None = None) -> None:
+    """Write trajectories as a table: a ``time`` column then ``<name>_x <name>_y <name>_z``, then
+    a text column per entry of ``labels`` (e.g. ``phone`` and ``word``: the label at each frame,
+    :func:`facetraj_engine.analysis.apertures.frame_labels`; a label holding the separator has it
+    replaced by a space); tab separated, or comma separated for a ``.csv`` path.
+    :func:`~facetraj_engine.io.markerformats.table.read_marker_table` reads it back, label columns
+    left out."""
+    n = markers.shape[0]
+    labels = labels or {}
+    for key, column in labels.items():
+        if len(column) != n:
+            raise ValueError(f"{key}: {len(column)} labels for {n} frames")
+    t = np.arange(n) / rate
+    header = ["time"] + [f"{m}_{a}" for m in names for a in "xyz"] + list(labels)
+    table = np.column_stack([t, markers.reshape(n, -1)])
     sep = "," if Path(path).suffix.lower() == ".csv" else "\t"
     text = fixed_point_lines(table, [6] + [4] * (table.shape[1] - 1), sep)   # what savetxt wrote
+    if labels:
+        columns = [[str(v).replace(sep, " ").replace("\n", " ") for v in col]
+                   for col in labels.values()]
+        text = "".join(sep.join([row, *(c[i] for c in columns)]) + "\n"
+                       for i, row in enumerate(text.decode().splitlines())).encode()
     with atomic_write(path, overwrite) as tmp:
         write_bytes(tmp, (sep.join(header) + "\n").encode() + text)
-
 
 
 def __getattr__(name: str):

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FacetrajError
-from .corpus import marker_path, marker_set_difference
+from .corpus import fitted_frames, marker_path, marker_set_difference
 from .markerfiles import read_markers
 
 
@@ -29,18 +29,6 @@ def marker_file_beside(audio_path: str | os.PathLike[str]) -> Path | None:
         return marker_path(audio_path.parent, audio_path.stem)
     except FacetrajError:
         return None
-
-
-def fit_to_frames(markers: np.ndarray, n_frames: int) -> np.ndarray:
-    """``markers`` cut to ``n_frames`` frames, or padded with NaN (frames not seen) up to them.
-
-    >>> fit_to_frames(np.zeros((3, 1, 3)), 5)[:, 0, 0].tolist()
-    [0.0, 0.0, 0.0, nan, nan]
-    """
-    if len(markers) >= n_frames:
-        return markers[:n_frames]
-    pad = np.full((n_frames - len(markers), *markers.shape[1:]), np.nan)
-    return np.concatenate([markers, pad])
 
 
 @dataclass(frozen=True)
@@ -79,7 +67,7 @@ def read_markers_beside(audio_path: str | os.PathLike[str], marker_names: Sequen
         return MarkersBeside(path, list(data.names), None,
                              marker_set_difference(list(data.names), list(marker_names)))
     n_frames = int(np.floor(duration_s * marker_rate + 1e-9)) + 1
-    return MarkersBeside(path, list(data.names), fit_to_frames(data.markers, n_frames))
+    return MarkersBeside(path, list(data.names), fitted_frames(data.markers, n_frames))
 
 
-__all__ = ["MarkersBeside", "fit_to_frames", "marker_file_beside", "read_markers_beside"]
+__all__ = ["MarkersBeside", "marker_file_beside", "read_markers_beside"]

@@ -79,19 +79,6 @@ def aperture_functional(pca: PCA, upper: int, lower: int) -> tuple[float, np.nda
                                                          dtype=np.float64)
 
 
-def regression_direction(pcs: np.ndarray, aperture: np.ndarray) -> np.ndarray:
-    """The closing direction: the regression of the PCs on the aperture over training frames,
-    ``d = cov(p, a) / var(a)``: how the whole face moves, on average, per mm of aperture. When
-    ``a = a0 + p . g`` exactly, ``g . d = 1``.
-
-    >>> p = np.array([[0.0, 0.0], [1.0, 2.0], [2.0, 4.0]])
-    >>> regression_direction(p, 3.0 + p @ np.array([1.0, 0.0])).tolist()
-    [1.0, 2.0]
-    """
-    return _direction(_joint_moments(np.asarray(pcs, dtype=np.float64),
-                                     np.asarray(aperture, dtype=np.float64)))
-
-
 def _joint_moments(p: np.ndarray, a: np.ndarray) -> Moments:
     """The moments of the rows ``[p, a]`` where both are finite."""
     ok = np.isfinite(p).all(axis=1) & np.isfinite(a)
@@ -99,7 +86,14 @@ def _joint_moments(p: np.ndarray, a: np.ndarray) -> Moments:
 
 
 def _direction(joint: Moments) -> np.ndarray:
-    """``cov(p, a) / var(a)`` from the moments of ``[p, a]``."""
+    """The closing direction ``d = cov(p, a) / var(a)`` from the moments of ``[p, a]``: the
+    regression of the PCs on the aperture over the training frames, how the whole face moves, on
+    average, per mm of aperture (when ``a = a0 + p . g`` exactly, ``g . d = 1``).
+
+    >>> p = np.array([[0.0, 0.0], [1.0, 2.0], [2.0, 4.0]])
+    >>> _direction(_joint_moments(p, 3.0 + p @ np.array([1.0, 0.0]))).tolist()
+    [1.0, 2.0]
+    """
     return joint.scatter[:-1, -1] / joint.scatter[-1, -1]
 
 
@@ -165,24 +159,14 @@ class ClosureGather:
         self.joint = self.joint.merged(part.joint)
 
     def stats(self) -> ClosureStats:
-        """The statistics of every utterance added."""
+        """The statistics of every utterance added: the median aperture minimum over /p b m/
+        (else the aperture's 10th percentile), the closing direction (:func:`_direction`), the
+        median face of long pauses (else of every frame)."""
         rows = np.concatenate(self.rest) if self.rest else np.concatenate(self.all_pcs)
         rows = rows[np.isfinite(rows).all(axis=1)]
         closed = (float(np.median(self.minima)) if self.minima else
                   float(np.nanpercentile(np.concatenate(self.all_apertures), 10)))
         return ClosureStats(closed, _direction(self.joint), np.median(rows, axis=0))
-
-
-def closure_stats(pcs: Sequence[np.ndarray], phones: Sequence[Sequence[PhoneSegment]],
-                  rate: float, a0: float, g: np.ndarray, pause_s: float = 0.15) -> ClosureStats:
-    """:class:`ClosureStats` from the training utterances' PCs (``(T, K)`` each, NaN where a
-    marker was unseen) and their phone labels: the median aperture minimum over /p b m/ (else
-    the aperture's 10th percentile), the regression direction, the median face of long pauses
-    (else of every frame)."""
-    gather = ClosureGather(len(g))
-    for p, segs in zip(pcs, phones, strict=True):
-        gather.add(closure_part(p, segs, rate, a0, g, pause_s))
-    return gather.stats()
 
 
 # --------------------------------------------------------------------------- where and how much

@@ -48,10 +48,9 @@ import numpy as np
 from ..config import TrainConfig
 from ..data import PhoneSegment
 from ..level import unit_exponent
+from .closure import BILABIALS
 from .lsf import analysis_frames, lsf_at, resample_audio
 
-#: The phones whose lips close (the detector's positive frames).
-BILABIALS = ("p", "b", "m")
 #: Added to a frame's mean square before its logarithm (digital silence is -300 dB: far below
 #: any energy dip's floor, so the energies of a signal and of the same signal scaled differ by
 #: one constant and their dips are equal).

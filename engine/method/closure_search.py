@@ -14,8 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..config import SynthConfig
-from .closure import aperture_functional
-from .closure_detector import BILABIALS
+from .closure import BILABIALS, aperture_functional
 from .model import Model
 from .search import acoustic_candidates, gammas
 from .synthesis import FrameWeights, perceptual_weights, weight_frames

@@ -93,22 +93,20 @@ class Codebook:
         return np.repeat(self.centre, self.n_per_phone)
 
 
-def concatenate(parts: list[Codebook], release: bool = False) -> Codebook:
-    """Join codebooks built per utterance. With ``release`` the parts' arrays are let go field by
+def concatenate(parts: list[Codebook]) -> Codebook:
+    """Join codebooks built per utterance, consuming them: the parts' arrays are let go field by
     field as they are joined (training's parts: the peak is the joined codebook and one field of
-    the parts, not the codebook twice)."""
+    the parts, not the codebook twice); the parts are left without their arrays."""
     if not parts:
         raise ValueError("no codebook entries: the training data has no usable phone tokens")
     joined: dict[str, np.ndarray | None] = {}
     for name in ("contexts", "lsf", "pcs", "token_utt", "token_start", "token_end",
                  "lsf_context"):
         arrays = [getattr(p, name) for p in parts]
-        if release:
-            for part in parts:
-                setattr(part, name, None)
+        for part in parts:
+            setattr(part, name, None)
         joined[name] = (np.concatenate(arrays) if all(a is not None for a in arrays)
                         else None)
         del arrays
-        if release:
-            give_back()                            # the parts' small arrays, freed
+        give_back()                                # the parts' small arrays, freed
     return Codebook(**joined, n_per_phone=parts[0].n_per_phone)

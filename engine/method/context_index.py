@@ -15,7 +15,6 @@ context of the centre phone grows with it, and with it the evaluation's time per
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -166,20 +165,3 @@ def _tau(sizes: np.ndarray, p: np.ndarray, tokens: np.ndarray, count: int) -> np
     tau = by_groups
     tau[some] = np.maximum(tau[some], np.maximum.reduceat(big, starts[some]))
     return tau
-
-
-_CACHE: dict[int, tuple[weakref.ref, ContextIndex]] = {}
-
-
-def context_index(codebook: np.ndarray, n_phones: int) -> ContextIndex:
-    """The :class:`ContextIndex` of ``codebook``, made on its first use and kept while the array
-    lives (a model's codebook: every synthesis with it reuses it)."""
-    key = id(codebook)
-    hit = _CACHE.get(key)
-    if hit is not None and hit[0]() is codebook and len(hit[1].centre_tokens) == n_phones:
-        return hit[1]
-    for k in [k for k, (ref, _) in _CACHE.items() if ref() is None]:
-        del _CACHE[k]
-    index = ContextIndex.of(codebook, n_phones)
-    _CACHE[key] = (weakref.ref(codebook), index)
-    return index

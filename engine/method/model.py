@@ -25,6 +25,7 @@ from .chain import join_scale
 from .closure import ClosureStats
 from .closure_detector import ClosureDetector
 from .codebook import Codebook
+from .context_index import ContextIndex
 from .lsf import lsf_at
 from .lsf_index import LsfIndex, build_index
 from .markers import fill_gaps, remove_head_motion
@@ -133,6 +134,13 @@ class Model:
         if nu is None or nu == self.config.nu:
             return self.trained_similarity
         return similarity_matrix(self.distances, nu, self.scale)
+
+    @cached_property
+    def context_index(self) -> ContextIndex:
+        """The codebook's contexts grouped for eq 4's search
+        (:class:`~facetraj_engine.method.context_index.ContextIndex`), made on first use: every
+        synthesis with the model reuses it."""
+        return ContextIndex.of(self.codebook.contexts, len(self.distances))
 
     @cached_property
     def trained_similarity(self) -> np.ndarray:

@@ -134,8 +134,8 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     """
     config = config or SynthConfig()
     mode = mode_of(config)
-    times, w, warp = _input(model, audio, sample_rate, n_frames, lsf, config,
-                            audio_source or source)
+    times, w, warp, analysed = _input(model, audio, sample_rate, n_frames, lsf, config,
+                                      audio_source or source)
     energy = SpeechEnergy(audio, sample_rate)
     ratio = _voice_ratio(model, energy, times, w, config, provenance, voice)
     job = SearchInput(model, w, times, config, voice_ratio=ratio)
@@ -147,10 +147,9 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         if mode.weighs_labels:
             job.confidence = frame_confidence(list(phones), confidence, times)
     found = mode.search(job)
-    unwarped = warp == 1.0 and not (mode.weighs_labels and config.mean_normalise)
     plan = plan_closure(model, audio, sample_rate, times, job.segs, provenance,
                         voice_match(ratio, 1.0), config, energy.filtered if config.closure else None,
-                        w if unwarped else None, found.frames)
+                        analysed, found.frames)
     res = _finish(model, times, w, found.frames, config, found.segments, found.frame_segment,
                   warp, plan)
     res.voice_match, res.voice_ratio = voice_match(ratio, 1.0), ratio
@@ -159,9 +158,12 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
 
 def _input(model: Model, audio: np.ndarray, sample_rate: int, n_frames: int | None,
            lsf: np.ndarray | None, config: SynthConfig, source: str | None
-           ) -> tuple[np.ndarray, np.ndarray, float]:
-    """The frame times, the input LSFs (computed here unless given; speaker-normalised) and the
-    speaker warp."""
+           ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray | None]:
+    """The frame times, the input LSFs w of eq 5 (computed here unless given; speaker-normalised),
+    the speaker warp, and the LSFs before the normalisation for the closure detector: those
+    computed here, or the given ones when no normalisation changed them (``None`` otherwise: the
+    detector analyses the audio itself, inside :func:`synthesize`'s BLAS limit, and a caller's
+    LSFs may differ from those to rounding)."""
     rate = model.marker_rate
     if n_frames is None:
         n_frames = frame_count(len(audio), sample_rate, rate)
@@ -169,15 +171,15 @@ def _input(model: Model, audio: np.ndarray, sample_rate: int, n_frames: int | No
     times = np.arange(n_frames) / rate
     order = model.config.lpc_order
     if lsf is None:
-        w = model.input_lsf(audio, sample_rate, times, frame_threads())
+        raw = model.input_lsf(audio, sample_rate, times, frame_threads())
     elif lsf.shape != (n_frames, order):
         raise ValueError(f"lsf must be ({n_frames}, {order}) for these frames, got {lsf.shape}")
     else:
-        w = lsf
-    w, warp = normalise_speaker(model, w, config)
+        raw = lsf
+    w, warp = normalise_speaker(model, raw, config)
     if mode_of(config).weighs_labels and config.mean_normalise:
         w = mean_normalise(w, model.lsf_mean)
-    return times, w, warp
+    return times, w, warp, raw if lsf is None or w is lsf else None
 
 
 def _model_phones(model: Model, phones: Sequence[PhoneSegment], duration: float,
@@ -232,9 +234,9 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
     recognized labels by the voice ``match``; NaN: unknown, untrusted), and beside recognized
     ones the detector's closures where none is recognized, trusted by the voice ``match``
     (``config.closure_second_opinion``); without labels, the closures the model's detector finds
-    (``config.closure_detector``, fully trusted; ``lsf``: the input's unwarped LSFs at ``times``,
-    when computed; ``frames``: the acoustic-only search's, whose opinion counts by the voice
-    ``match``); and the pauses by energy (``filtered``:
+    (``config.closure_detector``, fully trusted; ``lsf``: the input's LSFs at ``times`` before
+    any speaker warp or mean normalisation, when computed; ``frames``: the acoustic-only
+    search's, whose opinion counts by the voice ``match``); and the pauses by energy (``filtered``:
     :func:`~facetraj_engine.method.speech.filtered_energy_db` of the audio, when already
     computed)."""
     if not config.closure or model.closure is None:
@@ -268,10 +270,11 @@ def _detected(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarr
     det = model.detector
     if lsf is None:
         lsf = model.input_lsf(audio, sample_rate, times, frame_threads())
-    if frames is None and det.search is not None and np.isfinite(match) and match > 0:
+    counts = det.search is not None and np.isfinite(match) and match > 0
+    if frames is None and counts:
         acoustic = config.with_(mode="acoustic")
         frames = mode_of(acoustic).search(SearchInput(model, lsf, times, acoustic)).frames
-    search = search_rows(model, frames) if frames is not None and det.search is not None else None
+    search = search_rows(model, frames) if frames is not None and counts else None
     p = input_probability(det, model.config, audio, sample_rate, times, lsf, search, match)
     return p, closure_runs(p, times, config.closure_threshold, det.spec.min_frames)
 

@@ -66,7 +66,8 @@ def eq4(model: Model, segs: list[PhoneSegment], times: np.ndarray, config: Synth
     pid = {p: i for i, p in enumerate(model.phones)}
     ctx = context_ids([pid[s.label] for s in segs], mc.context, pid[SILENCE])
     top, scores = top_context_phones(ctx, cb.contexts, model.similarity(config.nu), config.xi,
-                                     min(config.context, mc.context), config.n_context_phones)
+                                     min(config.context, mc.context), config.n_context_phones,
+                                     model.context_index)
     segments = [SegmentChoice(seg, ctx[i], top[i], scores[i]) for i, seg in enumerate(segs)]
     frame_seg = segment_index(segs, times)
     return segments, frame_seg, cb.codewords_of(top)[frame_seg]

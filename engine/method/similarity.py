@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .context_index import context_index
+from .context_index import ContextIndex
 
 
 def phone_means(pcs: np.ndarray, phone_of: np.ndarray, n_phones: int) -> np.ndarray:
@@ -144,7 +144,8 @@ def top_contexts(n: np.ndarray, count: int) -> np.ndarray:
 
 
 def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, xi: float,
-                       context: int | None, count: int) -> tuple[np.ndarray, np.ndarray]:
+                       context: int | None, count: int, index: ContextIndex | None = None
+                       ) -> tuple[np.ndarray, np.ndarray]:
     """Eq 4 then :func:`top_contexts`, without scoring every codebook context for every query:
     the fast kernel of the pair (the reference).
 
@@ -160,6 +161,9 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     (tested). With a context (``context >= 1``) the contexts that can win are found by groups
     of the same centre and first neighbours (:mod:`facetraj_engine.method.context_index`): their
     number stops growing with the corpus, where the contexts of a centre phone grow with it.
+    ``index``: the :class:`~facetraj_engine.method.context_index.ContextIndex` of ``codebook``
+    over the phones of ``s`` when the caller keeps it (a model's, :attr:`Model.context_index`),
+    else made here.
 
     Returns ``(top, scores)``, both ``(Q, count)``.
 
@@ -179,7 +183,8 @@ def top_context_phones(query: np.ndarray, codebook: np.ndarray, s: np.ndarray, x
     tables = context_weights(c, xi)[:, None, None] * s                       # (2c+1) x n x n
     if n_q > 0 and c >= 1:                        # the contexts that can win, by groups
         rest = 2.0 * sum(xi ** (-i) for i in range(2, c + 1))
-        rows, cand = context_index(codebook, n_ph).candidates(q, s, xi ** -1.0, bound, rest, count)
+        index = ContextIndex.of(codebook, n_ph) if index is None else index
+        rows, cand = index.candidates(q, s, xi ** -1.0, bound, rest, count)
         return _best(q, codebook, rows, cand, tables, cols, count)
     # the contexts that can win, per distinct query centre u: cand_all[u_start[u]:][:u_size[u]]
     centres, inverse = np.unique(q[:, full], return_inverse=True)

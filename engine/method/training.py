@@ -48,7 +48,6 @@ from .closure_detector import ClosureDetector, bilabial_frames, train_detector, 
 from .closure_search import left_out_rows
 from .codebook import Codebook, codeword_times, concatenate, interpolate_frames
 from .context import context_ids
-from .lsf import lsf_at
 from .lsf_index import build_index
 from .markers import fill_gaps, reference_pose, remove_head_motion
 from .model import Model, analysed_lsf
@@ -187,14 +186,12 @@ def _read(p: _Passes, k: int) -> _Read:
     read = _Read(utt.name, utt.n_frames, _Segments.of(utt.phones), _Segments.of(segments),
                  utt.provenance.kind, filled[::POSE_STEP][:, p.roles.fixed])
     times = read.times(config).ravel()
-    read.lsf = lsf_at(utt.audio, utt.sample_rate, times, config.lpc_order, config.window_s,
-                      config.audio_rate, config.preemphasis)
+    read.lsf = analysed_lsf(config, utt.audio, utt.sample_rate, times)
     if config.lsf_context_frames > 0:
         off = config.lsf_context_frames / p.source.marker_rate
-        read.lsf_context = np.stack([lsf_at(utt.audio, utt.sample_rate,
-                                             np.clip(times + o, 0, None), config.lpc_order,
-                                             config.window_s, config.audio_rate,
-                                             config.preemphasis) for o in (-off, off)], axis=1)
+        read.lsf_context = np.stack([analysed_lsf(config, utt.audio, utt.sample_rate,
+                                                  np.clip(times + o, 0, None)) for o in (-off, off)],
+                                    axis=1)
     return read
 
 
@@ -302,7 +299,7 @@ def _codebook(p: _Passes, kept: Sequence[int], reads: Sequence[_Read], reference
         closure.add(done.closure)
         if done.voice is not None:
             frames[j] = done.voice
-    return concatenate(parts, release=True), frames
+    return concatenate(parts), frames
 
 
 # --------------------------------------------------------------------------- the whole

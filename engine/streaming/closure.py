@@ -15,12 +15,14 @@ emitted has no end yet (its end is infinity).
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+
 import numpy as np
 
 from ..method.closure import ClosurePlan, ClosureStats, aperture_functional, bump
 from ..method.model import Model
 from ..method.speech import speech_runs
-from .speech import SILENT
+from .speech import SILENT, UNRANGED
 
 
 def closure_moves(aperture: np.ndarray, times: np.ndarray, intervals: np.ndarray,
@@ -89,6 +91,26 @@ def pause_runs(decisions: np.ndarray, times: np.ndarray, min_s: float) -> np.nda
     length = np.where(np.isfinite(runs[:, 1]), runs[:, 1] - runs[:, 0],
                       times[-1] - runs[:, 0] if len(times) else 0.0)
     return runs[length > min_s]
+
+
+def decided_pauses(decisions: Sequence[int], first: int, rate: float, min_s: float,
+                   unranged_silent: Callable[[np.ndarray], np.ndarray] | None = None
+                   ) -> np.ndarray:
+    """:func:`pause_runs` among the decisions from frame ``first`` on (``rate`` frames a second);
+    a frame whose energy is not ranged yet counts as silent where ``unranged_silent(times)`` says
+    so (the recognizer's silence), else as speech (nothing rests).
+
+    >>> decided_pauses([SILENT] * 3 + [UNRANGED] * 3, 1, 10.0, 0.1).tolist()
+    [[0.1, 0.30000000000000004]]
+    >>> decided_pauses([UNRANGED] * 4, 0, 10.0, 0.1, lambda t: t < 1).tolist()
+    [[0.0, inf]]
+    """
+    dec = np.asarray(decisions[first:])
+    if not len(dec):
+        return np.zeros((0, 2))
+    times = np.arange(first, first + len(dec)) / rate
+    silent = unranged_silent(times) if unranged_silent is not None else False
+    return pause_runs(np.where((dec == UNRANGED) & silent, SILENT, dec), times, min_s)
 
 
 class ClosureStream:

@@ -68,6 +68,12 @@ class DetectorStream:
         return closure_runs(p, np.arange(since, since + len(p)) / self.rate, threshold,
                             self.spec.min_frames, open_end=not final)
 
+    def record_runs(self, threshold: float) -> np.ndarray:
+        """``(J, 2)`` closures (seconds, step 6) among every probability given out (the take's
+        record, :meth:`probabilities`), ended."""
+        p = self.probabilities()
+        return closure_runs(p, np.arange(len(p)) / self.rate, threshold, self.spec.min_frames)
+
     def _out(self, stop: int, match: float) -> np.ndarray:
         """Probabilities of frames ``known .. stop - 1`` (their rows are in)."""
         if stop <= self.known:

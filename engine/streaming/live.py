@@ -40,7 +40,7 @@ from ..method.modes import ModeChoice, choose_mode
 from .phones import KnownPhones, PhoneSnapshot
 from .phonetic import PhoneticSynthesizer, PhoneticTiming
 from .recognizer import RecognizerConfig, RunningCmn, StreamingRecognizer
-from .synthesizer import LIVE_BATCH_FRAMES, StreamConfig, StreamFrames, StreamingSynthesizer
+from .synthesizer import LIVE_BATCH_FRAMES, StreamClosure, StreamConfig, StreamFrames, StreamingSynthesizer
 
 log = logging.getLogger(__name__)
 
@@ -238,13 +238,25 @@ class LiveStream:
         return self.phonetic.phones.snapshot(since_s)
 
     @property
-    def closure_probability(self) -> np.ndarray | None:
-        """Per frame so far, the bilabial-closure detector's probability (acoustic-only with the
+    def _detecting(self) -> StreamClosure | None:
+        """The closure step when it has the bilabial-closure detector (acoustic-only with the
         closure step and a model with a detector; else ``None``)."""
         closure = self.acoustic.closure if self.acoustic is not None else None
-        if closure is None or closure.detector is None:
-            return None
-        return closure.detector.probabilities()
+        return closure if closure is not None and closure.detector is not None else None
+
+    @property
+    def closure_probability(self) -> np.ndarray | None:
+        """Per frame so far, the bilabial-closure detector's probability (``None`` without it)."""
+        closure = self._detecting
+        return closure.detector.probabilities() if closure is not None else None
+
+    @property
+    def detected_closures(self) -> np.ndarray | None:
+        """``(J, 2)`` the detector's closures (seconds) over the frames so far, at the stream's
+        own threshold (``None`` without the detector)."""
+        closure = self._detecting
+        return closure.detector.record_runs(closure.synth.closure_threshold) \
+            if closure is not None else None
 
     @property
     def voice_ratio(self) -> float:

@@ -40,10 +40,10 @@ from ..method.similarity import top_context_phones
 from ..method.smoothing import TriangularStream
 from ..method.synthesis import gamma_grid, weight_frames
 from ..method.voice_match import trust_by_voice
-from .closure import ClosureStream, pause_runs
+from .closure import ClosureStream, decided_pauses
 from .front import LsfFront
 from .phones import PhoneSnapshot
-from .speech import SILENT, UNRANGED, SpeechStream
+from .speech import SpeechStream
 from .synthesizer import StreamFrames
 from .voice import RunningVoice, VoiceTracker
 
@@ -95,7 +95,8 @@ class ContextCodewords:
         if new:
             mc, cb, cfg = self.model.config, self.model.codebook, self.config
             top, _ = top_context_phones(np.array(new), cb.contexts, self.model.similarity(cfg.nu),
-                                        cfg.xi, min(cfg.context, mc.context), cfg.n_context_phones)
+                                        cfg.xi, min(cfg.context, mc.context), cfg.n_context_phones,
+                                        self.model.context_index)
             self._known.update(zip(new, cb.codewords_of(top), strict=True))
         return np.array([self._known[k] for k in keys])
 
@@ -264,10 +265,8 @@ class PhoneticSynthesizer:
         intervals = np.array([(s.start, min(s.end, snap.settled_s)) for s in bil]).reshape(-1, 2)
         strengths = closure_strengths(len(bil), self.kind, self.voice.match)
         first = max(0, self._emitted - int(PAUSE_LOOKBACK_S * self.rate))
-        dec = np.asarray(self.speech.decisions[first:])
-        times = np.arange(first, first + len(dec)) / self.rate
-        dec = np.where((dec == UNRANGED) & recognized_silence(snap, times), SILENT, dec)
-        pauses = pause_runs(dec, times, self.synth.rest_pause_s) if len(dec) else np.zeros((0, 2))
+        pauses = decided_pauses(self.speech.decisions, first, self.rate, self.synth.rest_pause_s,
+                                lambda times: recognized_silence(snap, times))
         return ClosurePlan(intervals, strengths, pauses)
 
 

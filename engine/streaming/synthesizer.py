@@ -38,10 +38,10 @@ from ..method.search import acoustic_candidates
 from ..method.smoothing import TriangularStream
 from ..method.speaker import warp_lsf
 from ..method.synthesis import FrameWeights, gamma_grid, weight_frames
-from .closure import ClosureStream, pause_runs
+from .closure import ClosureStream, decided_pauses
 from .detector import DetectorStream
 from .front import LsfFront
-from .speech import SPEECH, UNRANGED, SpeechStream
+from .speech import SpeechStream
 from .voice import VoiceTracker
 
 log = logging.getLogger(__name__)
@@ -258,10 +258,7 @@ class StreamClosure:
         since = max(0, emitted)
         intervals = self.detector.runs(since, self.synth.closure_threshold, self._final) \
             if self.detector is not None else np.zeros((0, 2))
-        dec = np.asarray(self.speech.decisions[since:])
-        dec = np.where(dec == UNRANGED, SPEECH, dec)     # not ranged: nothing rests
-        times = np.arange(since, since + len(dec)) / self.rate
-        pauses = pause_runs(dec, times, self.synth.rest_pause_s) if len(dec) else np.zeros((0, 2))
+        pauses = decided_pauses(self.speech.decisions, since, self.rate, self.synth.rest_pause_s)
         return ClosurePlan(intervals, np.ones(len(intervals)), pauses)
 
 

@@ -28,7 +28,7 @@ def cmd_corpus_build(args: argparse.Namespace) -> int:
         kw["n_sentences"] = args.sentences
     if args.seed is not None:
         kw["seed"] = args.seed
-    build_corpus(args.output, workers=args.jobs, **kw)
+    build_corpus(args.output, workers=jobs(args), **kw)
     print(args.output)
     return 0
 

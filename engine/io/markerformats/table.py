@@ -18,7 +18,7 @@ from .recording import MarkerRecording
 from .registry import MarkerFormat
 
 #: text columns of a trajectory table that hold labels, not coordinates (left out when read:
-#: facetraj's labelled tables, :func:`facetraj_engine.io.export.write_labelled_table`)
+#: facetraj's labelled tables, :func:`facetraj_engine.io.markerfiles.write_marker_tsv`)
 LABEL_COLUMNS = frozenset({"phone", "word"})
 
 
