@@ -70,7 +70,8 @@ class Compare(QObject):
         menu.addSeparator()
         menu.addAction(self.pin_action)
         menu.addAction(self.clear_action)
-        window.synthesisChanged.connect(self.refresh)
+        self._shown: list = []          # the pins shown at the last refresh (app/pins.py: Pin)
+        window.synthesisChanged.connect(lambda: self.refresh(new_result=True))
         self.refresh()
 
     def pin(self) -> None:
@@ -84,16 +85,16 @@ class Compare(QObject):
         self.refresh()
 
     def clear(self) -> None:
-        had = bool(self.window.pins.shown(self.window.view))
         self.window.pins.clear()
-        self.refresh(redraw=had)
+        self.refresh()
 
-    def refresh(self, redraw: bool = False) -> None:
+    def refresh(self, new_result: bool = False) -> None:
         """Show the pins of the utterance on screen: the difference panel there while one is
-        shown, the pinned faces in 3-D, and (``redraw``: the pins shown changed without a new
-        result, which redraws the panels anyway) the panels redrawn with their curves."""
+        shown, the pinned faces in 3-D, and the panels redrawn with their curves when the pins
+        shown changed without a new result (``new_result``: a new result redraws them anyway)."""
         w = self.window
         shown = w.pins.shown(w.view)
+        changed, self._shown = shown != self._shown, shown
         self.clear_action.setEnabled(len(w.pins) > 0)
         self.label.setText("  ".join(f"{p.name}: {p.settings}" for p in shown) if shown else
                            (f"{len(w.pins)} pinned (another utterance)" if len(w.pins) else ""))
@@ -103,7 +104,7 @@ class Compare(QObject):
             tl.add_panel(self.panel, soon=True)
         elif not shown and self.panel in tl.panels:
             tl.remove_panel(self.panel, soon=True)
-        elif redraw and tl.view is not None:
+        elif changed and not new_result and tl.view is not None:
             tl.relayout(tl.xlim() if tl.axes else None, soon=True)
         self.changed.emit()
 

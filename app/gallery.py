@@ -53,15 +53,10 @@ def _window(corpus: Path, size: tuple[int, int], utterance: str | None = None):
 
 
 def _shoot(win, path: Path, t: float) -> Path:
-    from .analysis.figures import settle
-    from .figure_canvas import BackgroundCanvas
+    from .analysis.figures import draw_plots
 
     win.seek(t)
-    settle()
-    for canvas in win.findChildren(BackgroundCanvas):     # the docked views' plots drawn
-        if canvas.isVisible():
-            canvas.finish()
-    settle(200)
+    draw_plots(win, 200)                # the docked views' plots drawn
     win.save_screenshot(path)
     log.info("wrote %s", path)
     return path
@@ -290,8 +285,7 @@ def live_figure(out: Path) -> list[Path]:
     window.open_recording(audio_path(corpus.root, "s002"))     # Open recording…
     wait_until(lambda: bool(done), 120)
     path = _grab(window, out / "live_window.png")
-    window.face.close_view()
-    window.close()
+    window.close()                      # its 3-D view let go (LiveWindow.closeEvent)
     return [path]
 
 

@@ -47,7 +47,7 @@ from facetraj_engine.method.model import Model
 from .live_input import MIC_RATE, FileFeeder, InputHealth, InputLost, MicFeeder, input_devices
 from .live_phones import PhonePanel
 from .plotter_widget import grab_with_3d
-from .style import CLOSED_COLOR, SPEECH_DOT_COLOR, SYNTH_COLOR, TRIANGULAR_COLOR
+from .style import SPEECH_DOT_COLOR, SYNTH_COLOR, TRIANGULAR_COLOR, closed_line
 from .view3d import FaceView
 from .window_frame import fit_to_screen
 
@@ -169,8 +169,7 @@ class LiveWindow(QMainWindow):
             (line,) = ax.plot([], [], color=line_color, lw=1.6, animated=True, label=line_label)
             (dots,) = ax.plot([], [], ls="none", marker=".", ms=3, color=SPEECH_DOT_COLOR,
                               animated=True, label="speech frames (live energy)")
-            ax.axhline(closed_y, color=CLOSED_COLOR, lw=0.9, ls=(0, (6, 3)), zorder=0.5,
-                       label="closed (the talker's /p b m/)")
+            closed_handle = closed_line(ax, closed_y)
             self.lines.append(line)
             self.dots.append(dots)
         # the legend: part of the background (drawn with the axes, not per frame), above them
@@ -178,8 +177,7 @@ class LiveWindow(QMainWindow):
             handles=[Line2D([], [], color=line_color, lw=1.6, label=line_label),
                      Line2D([], [], ls="none", marker=".", ms=5, color=SPEECH_DOT_COLOR,
                             label="speech frames (live energy)"),
-                     Line2D([], [], color=CLOSED_COLOR, lw=0.9, ls=(0, (6, 3)),
-                            label="closed (the talker's /p b m/)")],
+                     closed_handle],
             loc="outside upper center", fontsize=7, ncol=2, frameon=False)
         self.axes[1].set_xlabel("time (s, 0 = now)", fontsize=8)
         self._background = None
@@ -259,9 +257,9 @@ class LiveWindow(QMainWindow):
     def stop(self, reason: str = "") -> None:
         """End the take: the last frames come out (the smoothing's lookahead) and it is kept
         (``reason``: why it ended, when not by the user)."""
+        self._timer.stop()
         if self.stream is None:
             return
-        self._timer.stop()
         self.feeder.stop()
         stream, self.stream = self.stream, None
         self._consume(stream.flush())
@@ -279,7 +277,6 @@ class LiveWindow(QMainWindow):
         """The take ends (the recognizer's thread with it), the 3-D view is let go, and
         ``closed`` says so (the main window's Live toggle follows it)."""
         self.stop()
-        self._timer.stop()
         self.face.close_view()
         super().closeEvent(event)
         self.closed.emit()

@@ -27,7 +27,7 @@ from PyQt6.QtWidgets import (
 )
 
 from .analysis.common import NumberItem, export_with_dialog, fill_table, text_item
-from .measure_model import TABLE_COLUMNS, Measure, cell
+from .measure_model import TABLE_COLUMNS, Measure
 
 
 class ApertureTable(QWidget):
@@ -60,19 +60,15 @@ class ApertureTable(QWidget):
         lay.addWidget(self.table, 1)
 
     def refresh(self) -> None:
-        rows = self.measure.rows(self.filter.text())
-        self._times = {id(r): r.min_time for r in rows}
         items = []
-        for r in rows:
+        for r in self.measure.rows(self.filter.text()):
             row = []
             for _head, attribute, fmt in TABLE_COLUMNS:
-                text, value = cell(r, attribute, fmt)
-                row.append(text_item(text) if isinstance(value, str) else _number(value, text))
+                v = getattr(r, attribute)
+                row.append(text_item(v) if isinstance(v, str) else NumberItem(v, fmt))
             row[0].setData(Qt.ItemDataRole.UserRole + 1, r.min_time)
             items.append(row)
-        self.table.setSortingEnabled(False)
         fill_table(self.table, [c[0] for c in TABLE_COLUMNS], items)
-        self.table.setSortingEnabled(True)
         view = self.measure.view
         has_original = view is not None and view.original is not None
         self.note.setText("Lip aperture (mm, upper to lower lip centre marker) of each phone at its "
@@ -105,12 +101,6 @@ class _Readout(QLabel):
         return QSize(120, super().minimumSizeHint().height())
 
 
-def _number(value: float, text: str) -> NumberItem:
-    item = NumberItem(value, "{}")
-    item.setText(text)
-    return item
-
-
 class MeasureTools:
     """The readout (a bottom toolbar) and the per-phone table's dock, following the window."""
 
@@ -136,12 +126,11 @@ class MeasureTools:
         self.dock = None
         self.action = window.menu("Analysis").addAction("Measure: lip aperture per phone…",
                                                           self.open_table)
-        window.synthesisChanged.connect(self._new_result)
         window.cursorMoved.connect(self._cursor)
-        try:                                    # the pins shown change: their apertures too
+        try:            # after each new result and each change of the pins shown (their apertures)
             window.extension("compare").changed.connect(self._new_result)
-        except KeyError:
-            pass
+        except KeyError:                        # no pins: after each new result
+            window.synthesisChanged.connect(self._new_result)
 
     def _new_result(self) -> None:
         w = self.window

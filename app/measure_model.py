@@ -16,6 +16,8 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from facetraj_engine.analysis.apertures import (
     LipReadout,
     PhoneAperture,
@@ -110,19 +112,15 @@ class Measure:
 
     def frame_labels(self) -> dict[str, list[str]]:
         """The phone and word of each frame (the trajectory table's label columns)."""
-        v = self.view
-        if v is None:
-            return {}
-        return {"phone": frame_labels(v.utterance.phones, v.times),
-                "word": frame_labels(v.utterance.words, v.times)}
+        return {} if self.view is None else view_frame_labels(self.view)
 
 
-def cell(row: PhoneAperture, attribute: str, fmt: str) -> tuple[str, float | str]:
-    """A table cell: its text and the value it sorts by."""
-    value = getattr(row, attribute)
-    if isinstance(value, str):
-        return value, value
-    return ("" if not math.isfinite(value) else fmt.format(value)), float(value)
+def view_frame_labels(view: UtteranceView, times: np.ndarray | None = None) -> dict[str, list[str]]:
+    """The phone and word of each frame of ``view`` (at ``times``, else at its frames): the
+    trajectory table's label columns."""
+    t = view.times if times is None else times
+    return {"phone": frame_labels(view.utterance.phones, t),
+            "word": frame_labels(view.utterance.words, t)}
 
 
-__all__ = ["TABLE_COLUMNS", "Measure", "cell", "mm"]
+__all__ = ["TABLE_COLUMNS", "Measure", "mm", "view_frame_labels"]

@@ -44,7 +44,7 @@ from PyQt6.QtWidgets import (
 )
 
 from facetraj_app.analysis.common import ask_save_path
-from facetraj_engine.analysis.apertures import frame_labels
+from facetraj_app.measure_model import view_frame_labels
 from facetraj_engine.errors import FacetrajError
 from facetraj_engine.io.corpus import FolderScan, init_corpus, scan_folder
 from facetraj_engine.io.export import write_trajectories
@@ -334,11 +334,9 @@ def export_trajectories(window, path: Path, which: str = "synthesized") -> Path:
     if markers is None:
         raise FacetrajError(f"{view.utterance.name} has no original markers")
     times = view.times[:len(markers)]
-    labels = {"phone": frame_labels(view.utterance.phones, times),
-              "word": frame_labels(view.utterance.words, times)}
     return write_trajectories(path, markers, model.marker_rate, model.marker_names,
                               view.synthesis.arrays() if view.synthesis is not None else None,
-                              which=which, labels=labels)
+                              which=which, labels=view_frame_labels(view, times))
 
 
 def export_figure(window, path: Path) -> Path:

@@ -84,10 +84,6 @@ class PinBoard:
     def clear(self) -> None:
         self.pins.clear()
 
-    def remove(self, pin: Pin) -> None:
-        if pin in self.pins:
-            self.pins.remove(pin)
-
     def set_model(self, model_name: str, marker_names: Sequence[str]) -> None:
         self.model_name, self.marker_names = model_name, tuple(marker_names)
 

@@ -32,6 +32,7 @@ from .provenance import settings_text
 from .state import UtteranceView
 from .style import CURSOR_COLOR, LABEL_MARGIN_PX
 from .timeline import BOTTOM_MARGIN_PX, TOP_MARGIN_PX, LipPanel, PhoneTierPanel, draw_panel
+from .viewer_model import view_heading
 
 CAPTION_PT = 9.0
 CAPTION_SEPARATOR = "  ·  "
@@ -48,12 +49,12 @@ class PanelContext:
     pins: PinBoard = field(default_factory=PinBoard)
 
 
-def caption_text(view: UtteranceView, pins: Sequence = ()) -> str:
+def caption_text(view: UtteranceView, pins: Sequence = (), heading: str | None = None) -> str:
     """The utterance, its sentence (not for recognized labels), how it was synthesized and where
-    the labels came from, and each pinned result shown with it."""
-    utt = view.utterance
-    text = f" “{utt.text}”" if utt.text and view.label_origin.source != "recognized" else ""
-    parts = [f"{utt.name} ({view.split}){text}", f"synthesized: {settings_text(view)}"]
+    the labels came from, and each pinned result shown with it; ``heading``: written in place of
+    the utterance and its sentence ("": nothing)."""
+    head = view_heading(view, " ") if heading is None else heading
+    parts = ([head] if head else []) + [f"synthesized: {settings_text(view)}"]
     return CAPTION_SEPARATOR.join(parts + [f"{pin.name}: {pin.settings}" for pin in pins])
 
 
@@ -137,6 +138,8 @@ def _draw(fig: Figure, layout: FigureLayout, view: UtteranceView, heights: list[
           scale: float) -> tuple[Figure, FigureLayout]:
     width, height = fig.get_figwidth() * fig.dpi, fig.get_figheight() * fig.dpi
     entries: list[LegendEntry] = []
+    counted: list[LegendEntry] = []         # the entries ``ncol`` was measured for
+    ncol = 1
     legend_px = 0.0
     for _ in range(2):                      # the legend's height known once its entries are
         grid = fig.add_gridspec(len(heights), 1, height_ratios=heights,
@@ -155,7 +158,8 @@ def _draw(fig: Figure, layout: FigureLayout, view: UtteranceView, heights: list[
         entries = (legend_entries(layout.axes) + list(extra)) if legend else []
         if not entries:
             break
-        ncol = fitting_columns(fig, entries, width - 12 * scale)
+        if entries != counted:
+            counted, ncol = entries, fitting_columns(fig, entries, width - 12 * scale)
         rows = -(-len(entries) // ncol)
         needed = rows * 1.45 * LEGEND_PT * fig.dpi / 72.0 + 6 * scale
         if abs(needed - legend_px) < 1:
@@ -169,18 +173,17 @@ def _draw(fig: Figure, layout: FigureLayout, view: UtteranceView, heights: list[
     if entries:
         layout.legend = fig.legend(handles=legend_handles(entries), loc="upper left",
                                    bbox_to_anchor=(6 * scale / width, 1 - top / height),
-                                   ncol=fitting_columns(fig, entries, width - 12 * scale),
-                                   **LEGEND_STYLE)
+                                   ncol=ncol, **LEGEND_STYLE)
     return fig, layout
 
 
-def point_entries(original: bool, pins: Sequence = ()) -> list[LegendEntry]:
+def point_entries(original: bool) -> list[LegendEntry]:
     """The 3-D view's point colours as legend entries (a video's face beside the panels)."""
     from .style import ORIGINAL_COLOR, SYNTH_COLOR
 
     out = [LegendEntry("original points", ORIGINAL_COLOR, "dots")] if original else []
     out.append(LegendEntry("synthesized points", SYNTH_COLOR, "dots"))
-    return out + [LegendEntry(f"{p.name} points", p.color, "dots") for p in pins]
+    return out
 
 
 __all__ = ["FigureLayout", "PanelContext", "caption_text", "fitting_columns", "main_panels",

@@ -101,12 +101,22 @@ def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig,
                      config, n_frames=n_frames, source=utt.name, confidence=utt.confidence,
                      provenance=utt.provenance, voice=True)
     original = model.normalise_markers(utt.markers) if utt.markers is not None else None
-    triangular = res.markers if config.smoothing == "triangular" else resmooth(model, res, "triangular")
-    spline = res.markers if config.smoothing == "spline" else resmooth(model, res, "spline")
-    speech = speech_mask(utt.audio, utt.sample_rate, res.times)
+    triangular, spline, speech = _tracks(model, res, utt.audio, utt.sample_rate)
     return UtteranceView(utterance=utt, split=split, synthesis=res, original=original,
                          triangular=triangular, spline=spline, speech=speech, times=res.times,
                          mode_reason=mode_reason, voice_match=res.voice_match, origin=origin)
+
+
+def _tracks(model: Model, synthesis: Synthesis, audio: np.ndarray | None,
+            sample_rate: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The triangular and the spline smoothing of ``synthesis`` (its markers for the smoothing it
+    was made with) and the speech frames of ``audio`` (none without it)."""
+    made = synthesis.config.smoothing
+    triangular, spline = (synthesis.markers if made == kind else resmooth(model, synthesis, kind)
+                          for kind in ("triangular", "spline"))
+    if audio is None:
+        return triangular, spline, np.zeros(len(synthesis.times), dtype=bool)
+    return triangular, spline, speech_mask(audio, sample_rate, synthesis.times)
 
 
 def view_of_synthesis(model: Model, synthesis: Synthesis, audio: np.ndarray | None = None,
@@ -115,14 +125,9 @@ def view_of_synthesis(model: Model, synthesis: Synthesis, audio: np.ndarray | No
                       split: str = "external") -> UtteranceView:
     """The view of a synthesis made elsewhere (``facetraj video``): both smoothings and the
     speech frames of ``audio`` (none without it) derived as :func:`build_view` derives them."""
-    cfg = synthesis.config
-    triangular, spline = (synthesis.markers if cfg.smoothing == kind else resmooth(model, synthesis, kind)
-                          for kind in ("triangular", "spline"))
+    triangular, spline, speech = _tracks(model, synthesis, audio, sample_rate)
     if audio is None:
         audio = np.zeros(int(round(synthesis.times[-1] * sample_rate)) + 1)
-        speech = np.zeros(len(synthesis.times), dtype=bool)
-    else:
-        speech = speech_mask(audio, sample_rate, synthesis.times)
     utt = Utterance(name=name, audio=audio, sample_rate=sample_rate, phones=list(phones or []),
                     markers=None, marker_rate=model.marker_rate,
                     marker_names=list(model.marker_names), words=list(words or []), text=text,

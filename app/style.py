@@ -1,7 +1,13 @@
 """Colours shared by the 3-D view and the panels, so a colour means the same thing everywhere, and
 the placing of the panels' y labels."""
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
 from weakref import WeakKeyDictionary
+
+if TYPE_CHECKING:
+    from matplotlib.lines import Line2D
 
 ORIGINAL_COLOR = "#1f5fbf"      # original markers: blue
 SYNTH_COLOR = "#e8590c"         # synthesized markers (the chosen smoothing): orange
@@ -14,6 +20,8 @@ SURFACE_COLOR = "#ecc9ae"       # the face surface
 CAVITY_COLOR = "#3b1f1a"        # the mouth opening (dark: the oral cavity behind the lips)
 CLOSED_COLOR = "#5f6b3a"        # the lips at closure (the lip panels' reference line)
 BACKGROUND = "#ffffff"
+#: the legend's name of the line of the lips at closure
+CLOSED_LABEL = "closed (the talker's /p b m/)"
 
 
 #: the width of the timeline's left margin (figure edge to axes): tick labels and the y labels
@@ -53,6 +61,12 @@ def fit_ylabel(ax, label: str, max_size: float = 8.0, min_size: float = 6.0) -> 
         x_px = 4.0
         ax.set_ylabel("\n".join(lines), fontsize=size, rotation=0, ha="left", va="center")
     ax.yaxis.set_label_coords(-(LABEL_MARGIN_PX - x_px) / width_px, 0.5)
+
+
+def closed_line(ax, y: float) -> Line2D:
+    """The line of the talker's lips at closure (the middles of /p b m/) across ``ax`` at ``y``:
+    dashed, under the curves, named in the legend."""
+    return ax.axhline(y, color=CLOSED_COLOR, lw=0.9, ls=(0, (6, 3)), zorder=0.5, label=CLOSED_LABEL)
 
 
 def refit_ylabels(axes) -> None:

@@ -27,11 +27,12 @@ from PyQt6 import sip
 from PyQt6.QtCore import Qt, QTimer, pyqtSignal
 from PyQt6.QtWidgets import QLabel, QSizePolicy, QVBoxLayout, QWidget
 
+from facetraj_engine.analysis.apertures import SILENT_LABELS
+
 from .figure_canvas import BackgroundCanvas
 from .panel_layout import GAP_PX, fit_heights, legend_entries, legend_html, panel_min_px, panel_priority
 from .state import UtteranceView
 from .style import (
-    CLOSED_COLOR,
     CURSOR_COLOR,
     LABEL_MARGIN_PX,
     LOOP_COLOR,
@@ -39,6 +40,7 @@ from .style import (
     SPEECH_DOT_COLOR,
     SPLINE_COLOR,
     TRIANGULAR_COLOR,
+    closed_line,
     fit_ylabel,
     refit_ylabels,
     text_width_px,
@@ -52,8 +54,6 @@ log = logging.getLogger(__name__)
 BOTTOM_MARGIN_PX = 40.0
 #: the timeline's top margin (px)
 TOP_MARGIN_PX = 4.0
-#: labels of silence in a phone tier (drawn grey on a grey band)
-SILENT = ("sil", "", "sp", "pau", "h#")
 #: the widest row name of the phone tier (its glyphs' outline, px at 100 dpi) written at full
 #: size (7 pt) in the left margin (100 px, less the tick pad and what the outline leaves out);
 #: a wider one ("phones (recognized)": 98 px) smaller
@@ -182,13 +182,12 @@ class PhoneTierPanel:
     min_px = 30.0
     priority = 90
 
-    def __init__(self, context=None):
+    def __init__(self, context):
         self.context = context
         self.labels: list[FittedLabels] = []     # the rows' label artists of the last draw
 
     def draw(self, ax, view: UtteranceView) -> None:
-        pins = [p for p in getattr(getattr(self.context, "pins", None), "shown", lambda v: [])(view)]
-        rows = tier_rows(view, pins)
+        rows = tier_rows(view, self.context.pins.shown(view))
         ax.set_ylim(0, len(rows))
         # each row named beside it, the phones with where they came from (a y label "words
         # phones (aligned)" shrank to a few pixels); the title and status line say it in full
@@ -208,7 +207,7 @@ class PhoneTierPanel:
             lo, hi = k / len(rows), (k + 1) / len(rows)
             if kind == "phones":
                 for seg in segments:
-                    if seg.label in SILENT:
+                    if seg.label in SILENT_LABELS:
                         ax.axvspan(seg.start, seg.end, lo, hi, color="#eeeeee", lw=0)
             if segments:
                 ax.vlines(sorted({t for s in segments for t in (s.start, s.end)}), lo, hi,
@@ -216,7 +215,7 @@ class PhoneTierPanel:
             if k:
                 ax.axhline(k, color="#bbbbbb", lw=0.5)
             spans = [Span(s.start, s.end, s.label, k + 0.5,
-                          "#999999" if s.label in SILENT else color,
+                          "#999999" if s.label in SILENT_LABELS else color,
                           "italic" if kind == "words" else "normal") for s in segments]
             fitted = FittedLabels(ax, spans, fontsize=8, shorten=kind == "words")
             ax.add_artist(fitted)
@@ -255,13 +254,13 @@ class LipPanel:
             orig = view.original[:, k, 1]
             ax.plot(t, orig, color=ORIGINAL_COLOR, lw=1.5, ls=(0, (2, 1.5)), label="original")
             ys.append(orig)
-        pins = getattr(self.context, "pins", None)
-        for pin in (pins.shown(view) if pins is not None else []):
+        pins = self.context.pins
+        for pin in pins.shown(view):
             y = pin.view.shown[:, k, 1]
             ax.plot(pin.view.times[:len(y)], y, color=pin.color, lw=1.4, ls=(0, (6, 2)),
                     label=pin.legend(pins.model_name))
             ys.append(y)
-        closed = getattr(self.context, "closed_lips", None)
+        closed = self.context.closed_lips
         closed_y = float(closed.markers[k, 1]) if closed is not None else None
         extra = [np.array([closed_y])] if closed_y is not None else []
         allv = np.concatenate([y[np.isfinite(y)] for y in ys] + extra)
@@ -273,8 +272,7 @@ class LipPanel:
         ax.plot(t[sp], np.full(int(sp.sum()), mid), ls="none", marker=".", ms=2.2,
                 color=SPEECH_DOT_COLOR, label="speech frames")
         if closed_y is not None:     # the talker's lip at closure (the middles of /p b m/)
-            ax.axhline(closed_y, color=CLOSED_COLOR, lw=0.9, ls=(0, (6, 3)), zorder=0.5,
-                       label="closed (the talker's /p b m/)")
+            closed_line(ax, closed_y)
         fit_ylabel(ax, f"{self.which} lip\ny (mm)")
 
 
@@ -470,14 +468,10 @@ class Timeline(QWidget):
                           bottom=min(0.3, BOTTOM_MARGIN_PX / height), hspace=GAP_PX / mean)
 
     def _show_legend(self) -> None:
-        """The legend row: every named curve of the panels (their in-axes legends taken out),
-        and the panels left out for lack of room (nothing once the window is gone: a relayout's
-        last step may come after it)."""
+        """The legend row: every named curve of the panels, and the panels left out for lack of
+        room (nothing once the window is gone: a relayout's last step may come after it)."""
         if sip.isdeleted(self) or sip.isdeleted(self.legend_bar):
             return
-        for ax in self.axes:
-            if ax.get_legend() is not None:
-                ax.get_legend().remove()
         self.legend = legend_entries(self.axes)
         note = f"no room for: {', '.join(p.title for p in self.hidden)}" if self.hidden else ""
         self.legend_bar.setText(legend_html(self.legend, note))

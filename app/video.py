@@ -180,8 +180,7 @@ class VideoFrames:
                  title: str = "", *, audio: np.ndarray | None = None, sample_rate: int = 16000,
                  view=None, pins=None, caption: str = ""):
         from .pins import PinBoard
-        from .provenance import settings_text
-        from .screen_export import CAPTION_SEPARATOR, PanelContext, point_entries
+        from .screen_export import PanelContext, caption_text, point_entries
         from .state import view_of_synthesis
 
         settings = settings or VideoSettings()
@@ -192,9 +191,7 @@ class VideoFrames:
         width = settings.width - settings.width % 16
         height = settings.height - settings.height % 16
         context = PanelContext(model, closed_lips(model), pins if pins is not None else PinBoard())
-        shown_pins = context.pins.shown(view)
-        caption = caption or CAPTION_SEPARATOR.join(([title] if title else [])
-                                                    + [f"synthesized: {settings_text(view)}"])
+        caption = caption or caption_text(view, heading=title or "")
         if width < 640:
             raise ValueError(f"video size {settings.width}x{settings.height} is too small "
                              "(at least 640x304)")
@@ -217,7 +214,6 @@ class VideoFrames:
         lips, tier, labels = self.panels.boxes(half, header.shape[0])
         self.layout = VideoLayout(width, height, (0, header.shape[0], half, height), legend_box,
                                   title_box, lips, tier, labels)
-        self.pins = shown_pins
 
     def _scene(self, model: Model, half: int, original: bool) -> None:
         """The off-screen 3-D scene: the synthesized face with its surface, mouth and lip

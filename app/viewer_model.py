@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from facetraj_engine.analysis.apertures import label_at
 from facetraj_engine.config import SynthConfig
 from facetraj_engine.data import Utterance
 from facetraj_engine.errors import FacetrajError
@@ -224,12 +225,7 @@ class ViewerModel:
     # ------------------------------------------------------------------ time and frames
     def phone_at(self, t: float) -> str:
         """The phone label at ``t`` seconds ("" outside the labels or without a view)."""
-        if self.view is None:
-            return ""
-        for seg in self.view.utterance.phones:
-            if seg.start <= t < seg.end:
-                return seg.label
-        return ""
+        return "" if self.view is None else label_at(self.view.utterance.phones, t)
 
     def step_frames_target(self, t: float, n: int) -> float:
         """The time of the frame ``n`` frames after the one at ``t`` (clipped to the view)."""
@@ -256,11 +252,11 @@ class ViewerModel:
         return [(s, u) for s in ("test", "train") for u in getattr(info, s)]
 
 
-def view_heading(view: UtteranceView) -> str:
-    """What is shown: the utterance, its split and its sentence (not for recognized labels: the
-    sentence is not what they say)."""
+def view_heading(view: UtteranceView, separator: str = " — ") -> str:
+    """What is shown: the utterance, its split and, after ``separator``, its sentence (not for
+    recognized labels: the sentence is not what they say)."""
     utt = view.utterance
-    text = f" — “{utt.text}”" if utt.text and view.label_origin.source != "recognized" else ""
+    text = f"{separator}“{utt.text}”" if utt.text and view.label_origin.source != "recognized" else ""
     return f"{utt.name} ({view.split}){text}"
 
 

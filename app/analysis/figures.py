@@ -55,14 +55,20 @@ def _finish(cond: Callable[[], bool], what: str, timeout_s: float = 1800.0) -> N
         raise RuntimeError(f"{what} did not finish within {timeout_s:.0f} s: no picture taken")
 
 
-def shoot(widget: QWidget, path: Path) -> Path:
-    """Save a picture of ``widget`` once its plots are drawn (they draw off the GUI thread) and
-    its 3-D views rendered (as on the screen)."""
+def draw_plots(widget: QWidget, after_ms: int = 100) -> None:
+    """Let ``widget`` settle, finish the draw of each of its visible plots (they draw off the GUI
+    thread), and let it settle again for ``after_ms``."""
     settle()
     for canvas in widget.findChildren(BackgroundCanvas):
         if canvas.isVisible():
             canvas.finish()
-    settle(100)
+    settle(after_ms)
+
+
+def shoot(widget: QWidget, path: Path) -> Path:
+    """Save a picture of ``widget`` once its plots are drawn (they draw off the GUI thread) and
+    its 3-D views rendered (as on the screen)."""
+    draw_plots(widget)
     grab_with_3d(widget).save(str(path))
     log.info("wrote %s", path)
     return path

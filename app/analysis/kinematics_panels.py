@@ -33,7 +33,7 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from facetraj_app.style import CLOSED_COLOR, ORIGINAL_COLOR, SYNTH_COLOR
+from facetraj_app.style import ORIGINAL_COLOR, SYNTH_COLOR, closed_line
 from facetraj_engine.analysis.lips import ClosedLips
 from facetraj_engine.evaluation.kinematics import (
     LABIAL_PHONES,
@@ -90,8 +90,7 @@ class LipMeasurePanel:
             ax.plot(view.times[: len(orig)], orig, color=ORIGINAL_COLOR, lw=1.3, ls=(0, (2, 1.5)),
                     label="original")
         if self.closed is not None:
-            ax.axhline(self.closed, color=CLOSED_COLOR, lw=0.9, ls=(0, (6, 3)), zorder=0.5,
-                       label="closed (the talker's /p b m/)")
+            closed_line(ax, self.closed)
         ax.set_ylabel(MEASURES[self.measure][1], fontsize=8)
 
 
