@@ -18,24 +18,38 @@ def has_display() -> bool:
         os.environ.get("QT_QPA_PLATFORM", "").split(":")[0] in ("offscreen", "minimal", "vnc")
 
 
+def start_xvfb(size: str, terminate: bool) -> tuple[subprocess.Popen, str]:
+    """An Xvfb of one screen ``size`` ("WxH", 24-bit) on a free display, in a session of its own;
+    (the process, ":N"). ``terminate``: the server exits by itself when its last client
+    disconnects. A :class:`RuntimeError` when it reports no display."""
+    read, write = os.pipe()
+    proc = subprocess.Popen(["Xvfb", "-displayfd", str(write), "-screen", "0", f"{size}x24", "-nolisten",
+                             "tcp", *(["-terminate"] if terminate else [])], pass_fds=(write,),
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    os.close(write)
+    with os.fdopen(read) as fh:
+        number = fh.readline().strip()
+    if not number:
+        proc.kill()
+        raise RuntimeError(f"Xvfb did not start a {size} screen")
+    return proc, f":{number}"
+
+
 def ensure_display() -> subprocess.Popen | None:
     """For a screenshot on a machine without a display: start a private Xvfb (None if not needed)."""
     if has_display():
         return None
-    xvfb = shutil.which("Xvfb")
-    if xvfb is None:
+    if shutil.which("Xvfb") is None:
         log.warning("no display and no Xvfb: the 3-D view needs an X display")
         return None
-    read, write = os.pipe()
     # -terminate: the server exits by itself when its last client (this process) disconnects
-    proc = subprocess.Popen([xvfb, "-displayfd", str(write), "-screen", "0", "1600x1200x24", "-nolisten",
-                             "tcp", "-terminate"], pass_fds=(write,), stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL, start_new_session=True)
-    os.close(write)
-    with os.fdopen(read) as fh:
-        number = fh.readline().strip()
-    os.environ["DISPLAY"] = f":{number}"
-    log.info("started Xvfb on display :%s for the screenshot", number)
+    try:
+        proc, display = start_xvfb("1600x1200", terminate=True)
+    except RuntimeError as exc:
+        log.warning("%s: the 3-D view needs an X display", exc)
+        return None
+    os.environ["DISPLAY"] = display
+    log.info("started Xvfb on display %s for the screenshot", display)
     return proc
 
 

@@ -13,6 +13,10 @@ sys.path.insert(0, str(Path(__file__).parent))
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_CORPUS = ROOT / "data_samples"
 MOCHA = ROOT.parent / "shared" / "data" / "mocha_fsew0_001"
+#: the screens every window is tested on (issue 39): a large desktop and a small laptop
+SCREENS = ("1920x1200", "1366x768")
+#: set in a test run that has a screen of that size ("WxH"); tests for other sizes skip there
+SCREEN_ENV = "FACETRAJ_TEST_SCREEN"
 
 
 def edited_model_file(src: Path, dst: Path, **arrays) -> Path:
@@ -35,8 +39,6 @@ def edited_model_file(src: Path, dst: Path, **arrays) -> Path:
 def _isolated_cache(tmp_path_factory):
     """One private model cache for the whole session, never the user's (a run on a screen of its
     own, started by the ``screen`` fixture, shares its parent's: the model is trained once)."""
-    from screens import SCREEN_ENV
-
     if os.environ.get(SCREEN_ENV) and os.environ.get("FACETRAJ_CACHE_DIR"):
         return
     os.environ["FACETRAJ_CACHE_DIR"] = str(tmp_path_factory.mktemp("cache"))
@@ -49,13 +51,14 @@ def _screen_runs():
     return ScreenRuns()
 
 
-@pytest.fixture(params=["1920x1200", "1366x768"])
+@pytest.fixture(params=SCREENS)
 def screen(request, _screen_runs):
-    """The screen size a test is for (``screens.SCREENS``). On a display of that size (a child run)
-    the test runs here; otherwise the module's tests for that size run once in a child pytest on
-    a private Xvfb of the size (the trained model cache shared), and this test reports its
-    outcome there without running its body here (``pytest_pyfunc_call``)."""
-    from screens import SCREEN_ENV, SCREENS, Screen
+    """The screen size a test is for (each of ``SCREENS``; a test for fewer sizes parametrizes
+    ``screen`` indirectly). On a display of that size (a child run) the test runs here; otherwise
+    the module's tests for that size run once in a child pytest on a private Xvfb of the size
+    (the trained model cache shared), and this test reports its outcome there without running
+    its body here (``pytest_pyfunc_call``)."""
+    from screens import Screen
 
     size = request.param
     assert size in SCREENS

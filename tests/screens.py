@@ -1,7 +1,7 @@
 """Pictures for the GUI tests: Qt images as arrays, a widget's place on the screen as the X
 server shows it (3-D views included), a heartbeat that measures how long the event loop
-stalls, and screens of a given size (:data:`SCREENS`: a test asks for the ``screen`` fixture of
-tests/conftest.py and runs on a private Xvfb of each size)."""
+stalls, and screens of a given size (``SCREENS`` of tests/conftest.py: a test asks for its
+``screen`` fixture and runs on a private Xvfb of each size)."""
 
 from __future__ import annotations
 
@@ -14,9 +14,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from conftest import SCREEN_ENV
 from PyQt6.QtCore import QElapsedTimer, QObject, QPoint, QTimer
 from PyQt6.QtGui import QGuiApplication, QImage
 from PyQt6.QtWidgets import QWidget
+
+from facetraj_app.display import start_xvfb
 
 
 def image_array(image: QImage) -> np.ndarray:
@@ -77,10 +80,10 @@ class Heartbeat(QObject):
 
 
 # ---------------------------------------------------------------------- screens of a given size
-#: the screens every window is tested on (issue 39): a large desktop and a small laptop
-SCREENS = ("1920x1200", "1366x768")
-#: set in a test run that has a screen of that size ("WxH"); tests for other sizes skip there
-SCREEN_ENV = "FACETRAJ_TEST_SCREEN"
+#: a child run of one screen size is stopped after this long: under pyproject's pytest-timeout
+#: (900 s) of the test whose ``screen`` fixture waits for it, which would otherwise end the whole
+#: run first (its thread method), the child's output unseen
+SCREEN_RUN_TIMEOUT_S = 840
 
 
 @dataclass(frozen=True)
@@ -90,29 +93,6 @@ class Screen:
 
     size: str
     local: bool
-
-    @property
-    def width(self) -> int:
-        return int(self.size.split("x")[0])
-
-    @property
-    def height(self) -> int:
-        return int(self.size.split("x")[1])
-
-
-def private_xvfb(size: str) -> tuple[subprocess.Popen, str]:
-    """An Xvfb of one screen ``size`` ("WxH") on a free display; (the process, ":N")."""
-    read, write = os.pipe()
-    proc = subprocess.Popen(["Xvfb", "-displayfd", str(write), "-screen", "0", f"{size}x24",
-                             "-nolisten", "tcp"], pass_fds=(write,), stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL, start_new_session=True)
-    os.close(write)
-    with os.fdopen(read) as fh:
-        number = fh.readline().strip()
-    if not number:
-        proc.kill()
-        raise RuntimeError(f"Xvfb did not start a {size} screen")
-    return proc, f":{number}"
 
 
 class ScreenRuns:
@@ -124,27 +104,38 @@ class ScreenRuns:
 
     def outcome(self, path: str, size: str, name: str) -> tuple[str, str]:
         """("passed" | "failed" | "skipped" | "missing", the message) of test ``name`` (its
-        function name with the parameters) of the module at ``path`` on a ``size`` screen."""
+        function name with the parameters) of the module at ``path`` on a ``size`` screen; a
+        child run that ended without its report (a crash, the time limit) fails every test with
+        its output."""
         key = (path, size)
         if key not in self._results:
             self._results[key] = self._run(path, size)
-        return self._results[key].get(name, ("missing", f"{name} did not run on the {size} screen"))
+        results = self._results[key]
+        if "" in results:
+            return results[""]
+        return results.get(name, ("missing", f"{name} did not run on the {size} screen"))
 
     @staticmethod
     def _run(path: str, size: str) -> dict[str, tuple[str, str]]:
+        """Each test's outcome by its name, or under "" the failure of a run without a report."""
         import xml.etree.ElementTree as ET
 
-        proc, display = private_xvfb(size)
+        proc, display = start_xvfb(size, terminate=False)
         try:
             with tempfile.TemporaryDirectory(prefix="facetraj-screen-") as tmp:
                 report = Path(tmp) / "report.xml"
                 env = {**os.environ, "DISPLAY": display, SCREEN_ENV: size}
                 env.pop("WAYLAND_DISPLAY", None)
-                run = subprocess.run([sys.executable, "-m", "pytest", path, "-k", size, "-q",
-                                      "-p", "no:cacheprovider", f"--junitxml={report}"],
-                                     env=env, capture_output=True, text=True, timeout=1800)
+                try:
+                    run = subprocess.run([sys.executable, "-m", "pytest", path, "-k", size, "-q",
+                                          "-p", "no:cacheprovider", f"--junitxml={report}"], env=env,
+                                         capture_output=True, text=True, timeout=SCREEN_RUN_TIMEOUT_S)
+                except subprocess.TimeoutExpired as timeout:
+                    return {"": ("failed", f"the {size} screen's run took over {SCREEN_RUN_TIMEOUT_S} s:\n"
+                                 + _text(timeout.stdout)[-4000:] + _text(timeout.stderr)[-4000:])}
                 if not report.exists():
-                    return {"": ("failed", run.stdout[-4000:] + run.stderr[-4000:])}
+                    return {"": ("failed", f"the {size} screen's run wrote no report (exit "
+                                 f"{run.returncode}):\n" + run.stdout[-4000:] + run.stderr[-4000:])}
                 out = {}
                 for case in ET.parse(report).getroot().iter("testcase"):
                     bad = [c for c in case if c.tag in ("failure", "error")]
@@ -160,6 +151,13 @@ class ScreenRuns:
         finally:
             proc.terminate()
             proc.wait(10)
+
+
+def _text(output: bytes | str | None) -> str:
+    """A timed-out child's captured output (bytes whatever ``text`` asked for) as text."""
+    if isinstance(output, bytes):
+        return output.decode(errors="replace")
+    return output or ""
 
 
 def project(plotter, points: np.ndarray) -> np.ndarray:
@@ -281,3 +279,31 @@ def opened_window(qtbot, utterance: str | None = None, wait_ms: int = 240_000):
     yield w
     w.extension("analysis").close()
     w.close()
+
+
+def screen_window(screen: Screen, qtbot, utterance: str | None = None, wait_ms: int = 240_000):
+    """:func:`opened_window` for a test on ``screen``; None when the test runs on a screen of
+    its own (in a child run: its body is not run here). A generator for a fixture to yield from."""
+    if not screen.local:
+        yield None
+        return
+    yield from opened_window(qtbot, utterance, wait_ms)
+
+
+def resynthesize(w, qtbot, change, wait_ms: int = 240_000) -> None:
+    """Call ``change()`` (a new utterance, setting or recording) and wait for the window's new
+    synthesis, drawn."""
+    with qtbot.waitSignal(w.synthesisChanged, timeout=wait_ms):
+        change()
+    qtbot.waitUntil(lambda: w.settled, timeout=wait_ms)
+
+
+def middle(w, label: str) -> float:
+    """The middle of the first phone ``label`` of the window's utterance, in seconds."""
+    seg = next(p for p in w.view.utterance.phones if p.label == label)
+    return 0.5 * (seg.start + seg.end)
+
+
+def face_image(plotter) -> np.ndarray:
+    """The 3-D view as rendered now, ``(h, w, 3)``."""
+    return np.asarray(plotter.screenshot(return_img=True))[..., :3]

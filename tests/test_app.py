@@ -21,6 +21,7 @@ if not os.environ.get("DISPLAY"):
 from PyQt6.QtCore import QPoint, Qt
 from PyQt6.QtGui import QImage
 from PyQt6.QtWidgets import QFileDialog, QMessageBox
+from screens import near
 
 from facetraj.paths import default_corpus
 from facetraj_app import style
@@ -216,11 +217,6 @@ def test_acoustic_search_choice(window, qtbot):
     assert win.synth_config == SynthConfig(n_context_phones=win.synth_config.n_context_phones)
 
 
-def _colour_count(img: np.ndarray, hex_colour: str, tol: float = 60.0) -> int:
-    rgb = np.array([int(hex_colour[i:i + 2], 16) for i in (1, 3, 5)], float)
-    return int((np.linalg.norm(img[..., :3].astype(float) - rgb, axis=-1) < tol).sum())
-
-
 def _read_png(path: Path) -> np.ndarray:
     img = QImage(str(path)).convertToFormat(QImage.Format.Format_RGB888)
     assert not img.isNull(), path
@@ -239,8 +235,8 @@ def test_screenshot_shows_both_point_sets_and_lip_panels(window, tmp_path):
     # the 3-D area: both marker colours are there
     p = win.face.mapTo(win, QPoint(0, 0))
     area = img[p.y():p.y() + win.face.height(), p.x():p.x() + win.face.width()]
-    assert _colour_count(area, style.ORIGINAL_COLOR) > 150
-    assert _colour_count(area, style.SYNTH_COLOR) > 150
+    assert near(area, style.ORIGINAL_COLOR, 60.0) > 150
+    assert near(area, style.SYNTH_COLOR, 60.0) > 150
     # the lip panels: curves drawn (non-white pixels, the spline and original colours)
     canvas = win.timeline.canvas
     c = canvas.mapTo(win, QPoint(0, 0))
@@ -254,8 +250,8 @@ def test_screenshot_shows_both_point_sets_and_lip_panels(window, tmp_path):
         lip = img[y0:y1, x0:x1]
         non_white = (lip.astype(int).sum(axis=2) < 720).mean()
         assert non_white > 0.01, title
-        assert _colour_count(lip, style.SPLINE_COLOR, 50) > 100, title
-        assert _colour_count(lip, style.ORIGINAL_COLOR, 50) > 100, title
+        assert near(lip, style.SPLINE_COLOR, 50.0) > 100, title
+        assert near(lip, style.ORIGINAL_COLOR, 50.0) > 100, title
 
 
 def test_screenshot_command_line(trained_cache, tmp_path):
@@ -266,8 +262,8 @@ def test_screenshot_command_line(trained_cache, tmp_path):
     assert proc.returncode == 0, proc.stderr[-2000:]
     img = _read_png(out)
     assert img.shape[0] >= 800 and img.shape[1] >= 1200
-    assert _colour_count(img, style.ORIGINAL_COLOR) > 300
-    assert _colour_count(img, style.SYNTH_COLOR) > 150
+    assert near(img, style.ORIGINAL_COLOR, 60.0) > 300
+    assert near(img, style.SYNTH_COLOR, 60.0) > 150
 
 
 def test_screenshot_error_is_printed_once(trained_cache, tmp_path):

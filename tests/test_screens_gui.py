@@ -12,7 +12,6 @@ import os
 import subprocess
 import sys
 from itertools import pairwise
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -23,16 +22,20 @@ pytest.importorskip("pyvistaqt")
 if not os.environ.get("DISPLAY"):
     pytest.skip("the app tests need an X display (run under xvfb-run)", allow_module_level=True)
 
+from conftest import DEFAULT_CORPUS
 from PyQt6.QtGui import QImage
 from PyQt6.QtWidgets import QAbstractButton, QSlider
 from screens import (
     assert_legible,
+    face_image,
     image_array,
+    middle,
     near,
-    opened_window,
     overlap,
     pixels_inside,
     project,
+    resynthesize,
+    screen_window,
     view_settled,
 )
 
@@ -43,42 +46,20 @@ from facetraj_app.main import WINDOW_SIZE
 pytestmark = pytest.mark.gui
 
 WAIT_MS = 240_000          # a hang guard (a loaded machine is slow), not a speed limit
-CORPUS = Path(__file__).resolve().parent.parent / "data_samples"
-WHITE = "#ffffff"
 
 
 @pytest.fixture
 def win(screen, qtbot, trained_cache):
     """The main window as ``facetraj`` opens it (``place_on_screen``: 1600 x 1000 where the
     screen has room), on the Figure 4 sentence; None when the test runs on its own screen."""
-    if not screen.local:
-        yield None
-        return
-    yield from opened_window(qtbot, wait_ms=WAIT_MS)
-
-
-def show(w, qtbot, utt_id: str) -> None:
-    with qtbot.waitSignal(w.synthesisChanged, timeout=WAIT_MS):
-        w.set_utterance(utt_id)
-    qtbot.waitUntil(lambda: w.settled, timeout=WAIT_MS)
+    yield from screen_window(screen, qtbot, wait_ms=WAIT_MS)
 
 
 def open_view(w, qtbot, key: str):
     views = w.extension("analysis")
     views.view_actions[key].trigger()
-    qtbot.waitUntil(lambda: view_settled(w, key), timeout=WAIT_MS)
-    qtbot.waitUntil(lambda: w.settled, timeout=WAIT_MS)
+    qtbot.waitUntil(lambda: view_settled(w, key), timeout=WAIT_MS)     # the window settled too
     return views.widgets[key]
-
-
-def middle(w, label: str, nth: int = 0) -> float:
-    seg = [p for p in w.view.utterance.phones if p.label == label][nth]
-    return 0.5 * (seg.start + seg.end)
-
-
-def face_image(plotter) -> np.ndarray:
-    """The 3-D view as rendered now, ``(h, w, 3)``."""
-    return np.asarray(plotter.screenshot(return_img=True))[..., :3]
 
 
 def between_lips(plotter, markers: np.ndarray, upper: int, lower: int, half_width: int = 5,
@@ -153,7 +134,7 @@ def test_the_pc_explorer_shows_a_closed_mouth_and_says_which_way_opens(screen, w
         pc.set_sd_units(sds)
         box = between_lips(pc.plotter, pc.displaced_points(), model.upper_lip, model.lower_lip)
         assert box.size
-        counts[sds] = (near(box, WHITE, 30), near(box, style.CAVITY_COLOR, 12))   # not the arrows
+        counts[sds] = (near(box, style.BACKGROUND, 30), near(box, style.CAVITY_COLOR, 12))   # not the arrows
         assert "mm" in pc.value_label.text() and "SD" in pc.value_label.text()
     assert counts[closing] == (0, 0), counts
     assert counts[-closing][0] == 0 and counts[-closing][1] > 10, counts
@@ -167,7 +148,7 @@ def test_side_by_side_both_faces_have_their_surface_and_close(screen, win, qtbot
     had points only) and its mouth is shut, like the synthesized face beside it; no face shows
     the background through its mouth."""
     w = win
-    show(w, qtbot, "s002")
+    resynthesize(w, qtbot, lambda: w.set_utterance("s002"), WAIT_MS)
     w.view_bar.side_by_side.setChecked(True)
     w.view_bar.set_camera("front")
     w.seek(middle(w, "b"))
@@ -176,7 +157,7 @@ def test_side_by_side_both_faces_have_their_surface_and_close(screen, win, qtbot
     for mset in (face.original, face.synth):
         assert mset.surface_actor.GetVisibility() and mset.line_actor.GetVisibility(), mset.name
         box = between_lips(w.plotter, mset.current, model.upper_lip, model.lower_lip)
-        assert near(box, WHITE, 30) == 0, mset.name
+        assert near(box, style.BACKGROUND, 30) == 0, mset.name
     closed = between_lips(w.plotter, face.original.current, model.upper_lip, model.lower_lip)
     assert near(closed, style.CAVITY_COLOR) == 0                   # the original lips meet at /b/
     image = face_image(w.plotter)
@@ -190,7 +171,7 @@ def test_the_open_mouth_has_no_see_through_corner_in_the_three_quarter_view(scre
     """s002's /oy/, the synthesized face alone in the 3/4 view: inside the mouth opening's outline
     every pixel is the dark mouth or skin, none the background (a sliver at the far corner was)."""
     w = win
-    show(w, qtbot, "s002")
+    resynthesize(w, qtbot, lambda: w.set_utterance("s002"), WAIT_MS)
     w.view_bar.show_original.setChecked(False)
     w.view_bar.set_camera("three-quarter")
     w.seek(middle(w, "oy"))
@@ -200,7 +181,7 @@ def test_the_open_mouth_has_no_see_through_corner_in_the_three_quarter_view(scre
     edge = np.vstack([mset.current, mouth.points(mset.current)])[mouth.opening_loop(len(mset.current))]
     inside = pixels_inside(face_image(w.plotter), project(w.plotter, edge))
     assert len(inside) > 30
-    assert near(inside, WHITE, 30) == 0
+    assert near(inside, style.BACKGROUND, 30) == 0
     assert near(inside, style.CAVITY_COLOR) > 10
 
 
@@ -246,9 +227,7 @@ def test_quitting_with_the_live_window_in_every_order_exits_cleanly(screen, trai
     """The app quits with status 0 and no error whichever way the Live window was closed (it hung
     and then aborted with "wrapped C/C++ object of type QAction has been deleted", exit 134), and
     the Live toggle follows the window (it stayed checked after the window's close button)."""
-    if not screen.local:
-        return
-    run = subprocess.run([sys.executable, "-c", LIVE_SCRIPT, str(CORPUS), order],
+    run = subprocess.run([sys.executable, "-c", LIVE_SCRIPT, str(DEFAULT_CORPUS), order],
                          capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr[-3000:]
     assert "exited" in run.stdout
@@ -323,7 +302,7 @@ def test_a_recording_opened_with_markers_beside_shows_them(screen, win, qtbot):
     the import (it was ignored)."""
     w = win
     with qtbot.waitSignal(w.synthesisChanged, timeout=WAIT_MS):
-        assert w.open_audio(CORPUS / "s002.flac")
+        assert w.open_audio(DEFAULT_CORPUS / "s002.flac")
     qtbot.waitUntil(lambda: w.settled and w.view.split == "external", timeout=WAIT_MS)
     corpus_utt = w.corpus.utterance("s002")
     assert w.view.original is not None
@@ -389,8 +368,6 @@ def test_the_live_window_follows_the_rules(screen, qtbot, default_model, default
     """The Live window on the screen: inside it, its legend above the lip panels (it covered the
     curve), the talker's closed lips as a dashed line in both panels, and a file's whole name in
     its input box ("file: cmu" was all it showed)."""
-    if not screen.local:
-        return
     from facetraj_app.live import LIVE_SIZE, LiveWindow
     from facetraj_app.window_frame import fit_to_screen
     from facetraj_engine.analysis.lips import closed_lips
@@ -426,8 +403,6 @@ def test_the_live_window_follows_the_rules(screen, qtbot, default_model, default
 def test_live_without_a_microphone_says_one_line(screen, trained_cache):
     """``facetraj live -q`` without an input device: its one-line error and nothing else (a dozen
     qt.multimedia lines came first)."""
-    if not screen.local:
-        return
     from facetraj_app.live_input import input_devices
 
     if input_devices():

@@ -19,7 +19,7 @@ if not os.environ.get("DISPLAY"):
 from matplotlib.transforms import Bbox
 from PyQt6.QtGui import QImage
 from PyQt6.QtWidgets import QAbstractButton, QSlider
-from screens import Heartbeat, assert_legible, image_array, on_screen, place_in, view_settled
+from screens import Heartbeat, assert_legible, colour_of, image_array, on_screen, place_in, view_settled
 
 from facetraj.paths import default_corpus
 from facetraj_app.analysis import PANELS, VIEWS
@@ -164,7 +164,7 @@ def test_the_face_shows_the_mouth_closed_at_a_b_and_the_lip_panels_where_closed_
     win.view_bar.set_camera("front")
     model, face = win.model, win.face
     phones = {p.label: p for p in win.view.utterance.phones}
-    cavity = np.array([int(style.CAVITY_COLOR[i:i + 2], 16) for i in (1, 3, 5)], float)
+    cavity = colour_of(style.CAVITY_COLOR)
     counts = {}
     for label in ("b", "oy"):
         seg = phones[label]
