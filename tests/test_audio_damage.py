@@ -116,3 +116,27 @@ def test_a_batch_counts_damaged_audio_as_failed(wav, model_file, tmp_path, capsy
         f"{wav}: the audio file is cut short")
     assert f"facetraj: failed: {wav}: the audio file is cut short" in err
     assert not (out / "s001.tsv").exists() and (out / "good.tsv").is_file()
+
+
+@pytest.mark.parametrize("kind", ["wav", "flac"])
+def test_a_header_with_the_wrong_rate_is_named_beside_the_labels(wav, model_file, tmp_path, kind,
+                                                                 capsys):
+    """A header that is consistent in itself but gives half the rate (the audio lasts twice as
+    long as its labels, issue 46): the message names the label file and the audio, the rate and
+    samples its header gives, and the rate at which they would fit."""
+    if kind == "wav":
+        data = bytearray(wav.read_bytes())
+        data[24:32] = struct.pack("<II", 8000, 16000)      # rate and byte rate, consistently
+        wav.write_bytes(bytes(data))
+        audio = wav
+    else:
+        audio = wav.with_suffix(".flac")
+        sf.write(audio, sf.read(S001)[0], 8000)
+        wav.unlink()
+    code = main(["synth", str(model_file), str(audio), "-o", str(tmp_path / "o.tsv")])
+    err = capsys.readouterr().err
+    assert code == 2 and not (tmp_path / "o.tsv").exists()
+    assert err.splitlines() == [
+        f"facetraj: error: {tmp_path / 's001.TextGrid'}: labels end at 3.400 s but the audio "
+        f"{audio.name} lasts 6.800 s by its header (54397 samples at 8000 Hz; at 16000 Hz it "
+        f"would last 3.400 s, as the labels do: is the rate in its header wrong?)"]

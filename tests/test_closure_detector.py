@@ -249,6 +249,22 @@ def test_a_corpus_without_bilabials_trains_no_detector(toy_corpus):
     assert model.detector is None and "n" in model.phones and "m" not in model.phones
 
 
+def test_an_lpc_order_under_eight_trains_a_detector_on_its_lsfs(toy_corpus, tmp_path):
+    """``facetraj train --lpc-order 3`` (a fuzz run's traceback, issue 46): the detector places
+    the formants with the 3 LSFs there are, survives its model file and finds closures."""
+    from facetraj_engine.config import TrainConfig
+    from facetraj_engine.method.training import train
+
+    model = Model.load(train(toy_corpus, config=TrainConfig(lpc_order=3)).save(tmp_path / "m3.npz"))
+    det = model.detector
+    assert det.spec.n_lsf == 3 and det.lsf_mean.shape == (3,)
+    assert det.acoustic.weights.shape == (len(det.spec.offsets) * 4,)
+    utt = toy_corpus.utterance(toy_corpus.info.test[0])
+    res = synthesize(model, utt.audio, utt.sample_rate, None, ACOUSTIC, n_frames=utt.n_frames)
+    assert res.closure.probability.shape == (utt.n_frames,)
+    assert np.all((res.closure.probability >= 0) & (res.closure.probability <= 1))
+
+
 def test_the_toy_corpus_detector_finds_its_nasal(toy_model, toy_corpus):
     """The toy corpus's /m/ (a murmur at a quarter of the vowels' level between them): the
     detector of its training sentences finds them in its test sentences."""

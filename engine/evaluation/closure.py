@@ -8,7 +8,9 @@ reference labels, the smallest aperture inside it; a closure counts when that mi
 cannot pass: the median over vowels of each vowel's largest aperture, and the median over pauses
 (silences over 150 ms) of each pause's median aperture; and where lips shut with no /p b m/ there
 (issue 40): the share of vowels whose largest aperture is within ``tol`` of closed (shut
-throughout), and of the other consonants whose smallest is.
+throughout), and of the non-labial consonants (not /p b m f v w/) whose smallest aperture over
+the middle half of the segment is (issue 46: the lips have no business closing there, and the
+middle half leaves out the tapers a true closure next door may reach into).
 
 The bilabial-closure detector's own score (:func:`detector_score`): the /p b m/ its closures
 reach, and its closures that reach none (false closures), by what they fall on.
@@ -30,6 +32,9 @@ VOWELS = ("aa", "ae", "ah", "ao", "aw", "ay", "eh", "er", "ey", "ih", "iy", "ow"
 PAUSE_S = 0.15
 #: Silence labels (neither vowels nor consonants).
 SILENCES = ("sil", "sp")
+#: The consonants whose lips may close or nearly close (bilabials, labiodentals, /w/): left out of
+#: "other consonants shut".
+LABIALS = (*BILABIALS, "f", "v", "w")
 
 
 def lip_aperture(markers: np.ndarray, upper: int, lower: int) -> np.ndarray:
@@ -41,6 +46,17 @@ def lip_aperture(markers: np.ndarray, upper: int, lower: int) -> np.ndarray:
     """
     m = np.asarray(markers, dtype=np.float64)
     return m[:, upper, 1] - m[:, lower, 1]
+
+
+def middle_half(segment: PhoneSegment) -> PhoneSegment:
+    """The middle half of ``segment`` (a quarter of its length off each end).
+
+    >>> middle_half(PhoneSegment(1.0, 1.4, "n"))
+    PhoneSegment(start=1.1, end=1.3, label='n')
+    """
+    quarter = 0.25 * (segment.end - segment.start)
+    return PhoneSegment(round(segment.start + quarter, 12), round(segment.end - quarter, 12),
+                        segment.label)
 
 
 def segment_frames(start: float, end: float, times: np.ndarray) -> np.ndarray:
@@ -77,8 +93,8 @@ def segment_values(aperture: np.ndarray, times: np.ndarray, segments: Sequence[P
 @dataclass(frozen=True)
 class ClosureScore:
     """The closure of one or more utterances against the ``closed`` aperture: per /p b m/ its
-    minimum (``minima``), per vowel its maximum, per pause its median, per other consonant its
-    minimum."""
+    minimum (``minima``), per vowel its maximum, per pause its median, per non-labial consonant
+    its minimum over the segment's middle half."""
 
     closed: float
     minima: np.ndarray
@@ -116,7 +132,8 @@ class ClosureScore:
 
     @property
     def consonants_shut(self) -> float:
-        """The share of the other consonants whose smallest aperture is within ``tol`` of closed."""
+        """The share of the non-labial consonants whose smallest aperture over the middle half of
+        the segment is within ``tol`` of closed."""
         return _share(self.consonant_minima <= self.closed + self.tol, self.consonant_minima)
 
     def to_json(self) -> dict:
@@ -160,7 +177,7 @@ def closure_score(aperture: np.ndarray, times: np.ndarray, phones: Sequence[Phon
     (2, 0.5, 11.75, 20.0, 11.0, 0.0)
     """
     pauses = [s for s in phones if s.label == "sil" and s.end - s.start > PAUSE_S]
-    others = [s for s in phones if s.label not in BILABIALS + VOWELS + SILENCES]
+    others = [middle_half(s) for s in phones if s.label not in LABIALS + VOWELS + SILENCES]
     return ClosureScore(float(closed),
                         segment_values(aperture, times, [s for s in phones if s.label in BILABIALS], "min"),
                         segment_values(aperture, times, [s for s in phones if s.label in VOWELS], "max"),

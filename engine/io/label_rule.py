@@ -29,7 +29,7 @@ from ..labels.provenance import Labels
 from ..progress import Progress
 from .cachedir import cache_dir
 from .files import atomic_write
-from .labelfiles import LABEL_SUFFIXES, held_labels, read_label_file
+from .labelfiles import LABEL_SUFFIXES, AudioExtent, held_labels, read_label_file
 
 log = logging.getLogger(__name__)
 
@@ -198,8 +198,10 @@ def _resolve(audio_path: Path, audio: np.ndarray, rate: int, request: LabelReque
     progress settings)."""
     duration = len(audio) / float(rate)
     detect = not request.label_map
+    extent = AudioExtent(audio_path.name, len(audio), int(rate))
     if request.labels is not None:
-        return FoundLabels(read_label_file(request.labels, rate, duration, request.declared, detect),
+        return FoundLabels(read_label_file(request.labels, rate, duration, request.declared, detect,
+                                           extent),
                            f"{Path(request.labels).name}, given", Path(request.labels))
     text, transcript = request.text, request.transcript
     if text is None and transcript is not None:
@@ -215,7 +217,8 @@ def _resolve(audio_path: Path, audio: np.ndarray, rate: int, request: LabelReque
         return FoundLabels(made_from(labels, audio_path.name), "recognition, as asked")
     label_file, txt = beside(audio_path)
     if label_file is not None:
-        return FoundLabels(read_label_file(label_file, rate, duration, request.declared, detect),
+        return FoundLabels(read_label_file(label_file, rate, duration, request.declared, detect,
+                                           extent),
                            f"{label_file.name} beside the audio", label_file)
     held = _held_by(audio_path)
     if held is not None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +17,42 @@ from .files import atomic_write, read_text
 from .textgrid import TextGridSyntaxError, Tier, parse_textgrid
 
 LABEL_SUFFIXES = (".textgrid", ".lab", ".phn")
+#: Sample rates a recording is commonly made at (a header's rate that makes the labels fit is
+#: suggested only when it is one of these).
+COMMON_RATES = (8000, 11025, 16000, 22050, 24000, 32000, 44100, 48000, 88200, 96000)
+
+
+@dataclass(frozen=True)
+class AudioExtent:
+    """The recording labels are checked against, as its file's header gives it: its ``name``,
+    ``samples`` and ``rate`` (issue 46: labels that do not fit a header with the wrong rate name
+    the audio too)."""
+
+    name: str
+    samples: int
+    rate: int
+
+    @property
+    def duration(self) -> float:
+        return self.samples / float(self.rate)
+
+    def lasts(self, labels_end: float) -> str:
+        """What the audio lasts by its header, and the common rate at which it would last as
+        long as the labels, if there is one.
+
+        >>> AudioExtent("r0.wav", 54400, 8000).lasts(3.4)
+        'the audio r0.wav lasts 6.800 s by its header (54400 samples at 8000 Hz; at 16000 Hz it would last 3.400 s, as the labels do: is the rate in its header wrong?)'
+        >>> AudioExtent("r0.wav", 54400, 16000).lasts(1.0)
+        'the audio r0.wav lasts 3.400 s by its header (54400 samples at 16000 Hz)'
+        """
+        note = f"{self.samples} samples at {self.rate} Hz"
+        if labels_end > 0:
+            fits = [r for r in COMMON_RATES if r != self.rate and
+                    abs(self.samples / r - labels_end) <= max(0.05, 0.02 * labels_end)]
+            if fits:
+                note += (f"; at {fits[0]} Hz it would last {self.samples / fits[0]:.3f} s, as the "
+                         f"labels do: is the rate in its header wrong?")
+        return f"the audio {self.name} lasts {self.duration:.3f} s by its header ({note})"
 
 
 def read_textgrid_tiers(path: str | os.PathLike[str]) -> dict[str, list[PhoneSegment]]:
@@ -135,12 +172,13 @@ def read_labels(path: str | os.PathLike[str], sample_rate: int = 16000,
 
 def validate_phones(phones: Sequence[PhoneSegment], duration: float,
                     path: str | os.PathLike[str] | None = None,
-                    tolerance: float = 0.05) -> list[PhoneSegment]:
+                    tolerance: float = 0.05, audio: AudioExtent | None = None) -> list[PhoneSegment]:
     """Check labels are sorted, do not overlap and cover ``[0, duration]``; return them tidied.
 
     Gaps between segments are filled with ``sil``; slivers shorter than 1 ms (rounding left-overs)
     are absorbed by the segment before; the first segment is extended to 0 and the last to
-    ``duration`` when they fall short by at most ``tolerance`` seconds.
+    ``duration`` when they fall short by at most ``tolerance`` seconds. Labels that end elsewhere
+    are refused naming ``path`` and, when given, the ``audio`` file with its header's rate.
     """
     if not phones:
         raise InputError(path, "the label file holds no segments")
@@ -161,8 +199,9 @@ def validate_phones(phones: Sequence[PhoneSegment], duration: float,
     if out[0].start > tolerance:
         raise InputError(path, f"labels start at {out[0].start:.3f} s, not at 0")
     if abs(out[-1].end - duration) > max(tolerance, 0.02 * duration):
-        raise InputError(path, f"labels end at {out[-1].end:.3f} s but the audio lasts "
-                               f"{duration:.3f} s")
+        lasts = audio.lasts(out[-1].end) if audio is not None else \
+            f"the audio lasts {duration:.3f} s"
+        raise InputError(path, f"labels end at {out[-1].end:.3f} s but {lasts}")
     out[0] = PhoneSegment(0.0, out[0].end, out[0].label)
     out[-1] = PhoneSegment(out[-1].start, max(duration, out[-1].start + 1e-3), out[-1].label)
     return out
@@ -175,18 +214,20 @@ def write_label_map(path: str | os.PathLike[str], table: dict[str, str]) -> None
 
 
 def read_label_file(path: str | os.PathLike[str], rate: int, duration: float,
-                    declared: str | None = None, detect_alphabet: bool = True) -> Labels:
+                    declared: str | None = None, detect_alphabet: bool = True,
+                    audio: AudioExtent | None = None) -> Labels:
     """The labels of a label file, checked against the audio's ``duration``: its phones, a
     TextGrid's ``words`` tier, and where they came from (the record a TextGrid written by
     facetraj holds, :func:`facetraj_engine.labels.provenance.labels_from_tiers`; else ``declared``;
     else aligned when the labels follow an aligner's conventions, saying why; else hand-checked).
     The phones are mapped onto ARPAbet from the alphabet they are in
     (:func:`facetraj_engine.labels.alphabets.to_arpabet`) unless ``detect_alphabet`` is off (a label
-    map given by the user maps them later)."""
+    map given by the user maps them later). Labels that do not fit the duration name the
+    ``audio`` too, when given."""
     path = Path(path)
     if path.suffix.lower() != ".textgrid":
         read = read_labels(path, rate)
-        phones = validate_phones(read, duration, path)
+        phones = validate_phones(read, duration, path, audio=audio)
         if detect_alphabet:
             phones = to_arpabet(phones, str(path))
         return labels_from_tiers(phones, [], {}, declared, [s.label for s in read])
@@ -196,7 +237,7 @@ def read_label_file(path: str | os.PathLike[str], rate: int, duration: float,
     raw = [PhoneSegment(s.start, s.end, s.label or "sil") for s in tiers["phones"]]
     if not raw:
         raise InputError(path, "the label file holds no segments")
-    phones = validate_phones(raw, duration, path)
+    phones = validate_phones(raw, duration, path, audio=audio)
     if detect_alphabet:
         phones = to_arpabet(phones, str(path))
     words = [w for w in tiers.get("words", []) if w.label]

@@ -41,7 +41,7 @@ waited for already: the detector adds no lookahead to a stream
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
 
@@ -360,8 +360,13 @@ def train_detector(lsf: Sequence[np.ndarray], energy_db: Sequence[np.ndarray],
                    ) -> ClosureDetector | None:
     """The detector of utterances' frames: their LSFs ``(T, P)``, energies ``(T,)`` (dB),
     targets ``(T,)`` (inside a /p b m/) and (``search``) the search's rows ``(T, 2)`` of each,
-    searched without its own codewords; ``None`` when no frame is one (or every one is)."""
+    searched without its own codewords; ``None`` when no frame is one (or every one is). A model
+    of fewer than ``spec.n_lsf`` LSFs (an LPC order under 8) places the formants with the LSFs it
+    has."""
     spec = spec or DetectorSpec()
+    width = min((np.shape(w)[1] for w in lsf), default=spec.n_lsf)
+    if width < spec.n_lsf:
+        spec = replace(spec, n_lsf=int(width))
     y = np.concatenate([np.asarray(t, dtype=bool) for t in targets])
     if not y.any() or y.all():
         return None
