@@ -110,17 +110,25 @@ class SynthConfig:
     chain_beta : robust mode: beta, the join cost's weight of the chain over frames that makes
         the codeword weights consistent over time (``facetraj_engine.method.chain``; 0: eq 8 frame by frame).
     closure : after the smoothing, close the lips at the labelled /p b m/ and rest the face in
-        pauses (``facetraj_engine.method.closure``, beyond the paper; the paper's tables run without it).
+        pauses (``facetraj_engine.method.closure``, beyond the paper; the paper's tables run without
+        it); off, every part below is off.
+    closure_labels : close the lips at the labelled /p b m/ (trusted by where the labels came
+        from).
+    rest : rest the face in pauses.
     closure_taper_s : the closure's raised-cosine tapers outside each /p b m/.
     closure_detector : without phone labels (the acoustic-only mode, ``facetraj live
         --acoustic-only``), close the lips where the model's bilabial-closure detector finds a
         closure (``facetraj_engine.method.closure_detector``; models without one close none).
+        Off by default: on the lips measured here its closures lowered the lip correlation
+        (issue 46, docs/algorithm.md).
     closure_threshold : the detector's probability from which a frame is closed (runs of 2
         frames or more).
     closure_second_opinion : beside recognized labels, close the lips also where the detector
         finds a closure and no /p b m/ is recognized, trusted as far as the voice matches the
-        training voice (whose recognized labels the step trusts least).
-    rest_pause_s, rest_taper_s : pauses longer than this rest the face; the tapers inside them.
+        training voice (whose recognized labels the step trusts least). Off by default: on real
+        talkers its closures fell where their lips were open (issue 46, docs/labels.md).
+    rest_pause_s, rest_taper_s : the face begins to rest once a pause has lasted this long, and
+        reaches the rest face over the taper.
     """
 
     n_context_phones: int = 3
@@ -144,10 +152,12 @@ class SynthConfig:
     mean_normalise: bool = False
     chain_beta: float = 0.1
     closure: bool = True
+    closure_labels: bool = True
+    rest: bool = True
     closure_taper_s: float = 0.05
-    closure_detector: bool = True
+    closure_detector: bool = False
     closure_threshold: float = 0.12
-    closure_second_opinion: bool = True
+    closure_second_opinion: bool = False
     rest_pause_s: float = 0.15
     rest_taper_s: float = 0.05
 

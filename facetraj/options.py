@@ -153,6 +153,7 @@ def add_synth_options(p: argparse.ArgumentParser, nu: bool = True) -> None:
     g.add_argument("--no-closure", dest="closure", action="store_false", default=None,
                    help="no closure step: the lips are not closed at /p b m/ nor the face rested "
                         "in pauses (the paper's synthesis as it is)")
+    add_closure_part_options(g)
     g.add_argument("--smoothing", choices=["triangular", "spline", "none"])
     g.add_argument("--acoustic-prefilter", type=count_or_all, metavar="K|all",
                    help="acoustic mode: weight the K codewords nearest to each frame (default "
@@ -160,6 +161,30 @@ def add_synth_options(p: argparse.ArgumentParser, nu: bool = True) -> None:
     g.add_argument("--acoustic-probe", type=count_or_all, metavar="P|all",
                    help="acoustic mode: find the K nearest in P cells of the model's LSF index "
                         "(default 8); 'all' compares every codeword (exact, slower)")
+
+
+#: The closure step's parts (``SynthConfig`` fields), each with its option and what it does; the
+#: defaults are those of SynthConfig (docs/algorithm.md says why each is on or off).
+CLOSURE_PARTS = (
+    ("closure_labels", "--no-closure-labels", False,
+     "do not close the lips at the labelled /p b m/"),
+    ("rest", "--no-rest", False, "do not rest the face in pauses"),
+    ("closure_detector", "--closure-detector", True,
+     "without phone labels, close the lips where the model's bilabial-closure detector hears a "
+     "closure (off by default: on the lips measured its closures lowered the correlation)"),
+    ("closure_second_opinion", "--closure-second-opinion", True,
+     "beside recognized phones, close the lips also where the detector hears a closure, trusted "
+     "by the voice match (off by default: on real talkers' lips it lowered the correlation)"),
+)
+
+
+def add_closure_part_options(g, second_opinion: bool = True) -> None:
+    """The options that turn each part of the closure step on or off (``CLOSURE_PARTS``; live
+    mode has no second opinion: ``second_opinion=False``)."""
+    for field, flag, value, text in CLOSURE_PARTS:
+        if field != "closure_second_opinion" or second_opinion:
+            g.add_argument(flag, dest=field, action="store_true" if value else "store_false",
+                           default=None, help=text)
 
 
 def train_config(args: argparse.Namespace) -> TrainConfig:
@@ -178,7 +203,8 @@ def train_config(args: argparse.Namespace) -> TrainConfig:
 def synth_config(args: argparse.Namespace) -> SynthConfig:
     """The synthesis configuration the options ask for (defaults elsewhere)."""
     kw = {}
-    for name in ("n_context_phones", "xi", "nu", "mode", "smoothing", "closure"):
+    for name in ("n_context_phones", "xi", "nu", "mode", "smoothing", "closure",
+                 *(part[0] for part in CLOSURE_PARTS)):
         val = getattr(args, name, None)
         if val is not None:
             kw[name] = val

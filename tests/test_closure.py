@@ -1,12 +1,20 @@
-"""The closure step's per-interval work (``facetraj_engine.method.closure``): each interval and pause
-touches only its own frames, with results equal to the bit to the formula over every frame."""
+"""The closure step's per-interval work (``facetraj_engine.method.closure``): each interval touches
+only its own frames, with results equal to the bit to the formula over every frame; the rest in
+pauses (issue 46) read from the frames before each, equal to the rule written frame by frame."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from facetraj_engine.method.closure import ClosurePlan, ClosureStats, bump, close_lips, rest_in_pauses
+from facetraj_engine.method.closure import (
+    ClosurePlan,
+    ClosureStats,
+    bump,
+    close_lips,
+    rest_in_pauses,
+    rest_weights,
+)
 
 
 def _close_lips_every_frame(pcs, times, plan, stats, a0, g, taper_s):
@@ -23,10 +31,23 @@ def _close_lips_every_frame(pcs, times, plan, stats, a0, g, taper_s):
     return pcs + c[:, None] * stats.direction[None, :]
 
 
-def _rest_every_frame(pcs, times, plan, stats, taper_s):
+def _rest_every_frame(pcs, plan, stats, rate, min_s, taper_s):
+    """The rest rule frame by frame: the silence through t, counted back to the last speech frame,
+    or to the input's start (long already); none on a speech frame."""
     b = np.zeros(len(pcs))
-    for t0, t1 in plan.pauses:
-        b = np.maximum(b, bump(times, t0, t1, taper_s, inside=True))
+    for t in range(len(pcs)):
+        k, length = t, 0
+        while k >= 0 and plan.silent[k]:
+            length, k = length + 1, k - 1
+        if not length:
+            continue
+        if k < 0:
+            b[t] = 1.0
+        elif taper_s > 0:
+            x = min(max((length / rate - min_s) / taper_s, 0.0), 1.0)
+            b[t] = 0.5 * (1 - np.cos(np.pi * x))
+        else:
+            b[t] = float(length / rate > min_s)
     return pcs + b[:, None] * (stats.rest[None, :] - pcs)
 
 
@@ -36,8 +57,8 @@ def _plan(rng, duration: float, n: int) -> ClosurePlan:
     starts = rng.uniform(-0.05, duration, n)
     lengths = np.where(rng.random(n) < 0.3, rng.uniform(0, 0.01, n), rng.uniform(0.02, 0.3, n))
     intervals = np.column_stack([starts, starts + lengths])
-    p0 = np.sort(rng.uniform(0, duration, 2 * (n // 3))).reshape(-1, 2)
-    return ClosurePlan(intervals, rng.uniform(0, 1, n), p0)
+    silent = np.repeat(rng.random(int(duration * 6) + 1) < 0.4, 10)[:int(duration * 60) + 1]
+    return ClosurePlan(intervals, rng.uniform(0, 1, n), silent)
 
 
 @pytest.mark.parametrize("taper_s", [0.0, 0.016, 0.05, 0.3])
@@ -53,6 +74,23 @@ def test_closure_step_equals_the_formula_over_every_frame(seed: int, taper_s: fl
     got = close_lips(pcs, times, plan, stats, 0.5, g, taper_s)
     assert np.array_equal(got, _close_lips_every_frame(pcs, times, plan, stats, 0.5, g, taper_s))
     assert not np.array_equal(got, pcs)                       # the intervals moved the lips
-    rested = rest_in_pauses(pcs, times, plan, stats, taper_s)
-    assert np.array_equal(rested, _rest_every_frame(pcs, times, plan, stats, taper_s))
+    rested = rest_in_pauses(pcs, plan, stats, 60.0, 0.15, taper_s)
+    np.testing.assert_allclose(rested, _rest_every_frame(pcs, plan, stats, 60.0, 0.15, taper_s),
+                               rtol=0, atol=1e-12)
     assert not np.array_equal(rested, pcs)
+
+
+def test_rest_reads_only_the_frames_before_each():
+    """A frame's rest weight does not change with what comes after it (a stream shows it before
+    it knows more), a silence the input starts with rests from its first frame, and no speech
+    frame rests."""
+    rng = np.random.default_rng(3)
+    silent = np.repeat(rng.random(40) < 0.5, 7)
+    whole = rest_weights(silent, 60.0, 0.15, 0.05)
+    for t in range(1, len(silent), 13):
+        part = rest_weights(silent[:t], 60.0, 0.15, 0.05)
+        assert np.array_equal(part, whole[:t])
+    starts_silent = np.array([True] * 5 + [False] * 5)
+    assert rest_weights(starts_silent, 60.0, 0.15, 0.05).tolist() == [1.0] * 5 + [0.0] * 5
+    assert rest_weights(starts_silent, 60.0, 0.15, 0.05, leading=False).max() == 0.0
+    assert whole[~silent].max() == 0.0

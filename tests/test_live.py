@@ -39,23 +39,29 @@ def test_live_from_file_writes_the_offline_synthesis(model_file, default_model, 
 
 def test_live_acoustic_only_closes_the_lips_where_the_detector_finds_closures(
         model_file, default_model, default_corpus, tmp_path):
-    """Without --no-closure the acoustic-only take has the closure step: the lips shut at the
-    closures the model's detector finds (the offline ones: ``facetraj synth --mode acoustic``)."""
+    """With --closure-detector the acoustic-only take closes the lips at the closures the model's
+    detector finds, as ``facetraj synth --mode acoustic --closure-detector`` does: the take is
+    the offline face (issue 46: both close and rest as a stream can); without it, the lips close
+    nowhere and the face only rests in pauses, as offline."""
     from facetraj_engine.evaluation.closure import lip_aperture
 
     wav = default_corpus.root / f"{default_corpus.info.test[0]}.flac"
-    out = tmp_path / "take.tsv"
-    assert main(["-q", "live", "--model", str(model_file), "--from-file", str(wav),
-                 "--as-fast-as-possible", "--acoustic-only", "-o", str(out)]) == 0
-    take = read_marker_table(out)
     audio, rate = read_audio(wav)
-    offline = synthesize(default_model, audio, rate, None, SynthConfig(mode="acoustic"))
-    a = lip_aperture(take.markers, default_model.upper_lip, default_model.lower_lip)
-    times = np.arange(len(a)) / default_model.marker_rate
-    assert len(offline.closure.intervals) >= 1
-    for t0, t1 in offline.closure.intervals:
-        inside = (times >= t0 - 0.02) & (times < t1)
-        assert a[inside].min() <= default_model.closure.closed + 0.5
+    for extra, cfg in ((["--closure-detector"], SynthConfig(mode="acoustic", closure_detector=True)),
+                       ([], SynthConfig(mode="acoustic"))):
+        out = tmp_path / f"take{len(extra)}.tsv"
+        assert main(["-q", "live", "--model", str(model_file), "--from-file", str(wav),
+                     "--as-fast-as-possible", "--acoustic-only", *extra, "-o", str(out)]) == 0
+        take = read_marker_table(out)
+        offline = synthesize(default_model, audio, rate, None, cfg)
+        assert (len(offline.closure.intervals) >= 1) == bool(extra)
+        a = lip_aperture(take.markers, default_model.upper_lip, default_model.lower_lip)
+        b = lip_aperture(offline.markers, default_model.upper_lip, default_model.lower_lip)
+        assert np.corrcoef(a, b)[0, 1] >= 0.99
+        times = np.arange(len(a)) / default_model.marker_rate
+        for t0, t1 in offline.closure.intervals:
+            inside = (times >= t0) & (times < t1)
+            assert a[inside].min() <= default_model.closure.closed + 0.5
 
 
 def test_live_from_file_with_phones_writes_them_beside_the_take(model_file, default_model,

@@ -14,10 +14,17 @@ from facetraj_engine.config import SynthConfig
 from facetraj_engine.data import PhoneSegment
 from facetraj_engine.labels.provenance import Labels
 from facetraj_engine.level import to_full_scale
-from facetraj_engine.method.closure import ClosurePlan, aperture_functional, close_lips, rest_in_pauses
+from facetraj_engine.method.closure import (
+    ClosurePlan,
+    aperture_functional,
+    close_lips,
+    closure_moves,
+    rest_in_pauses,
+    rest_weights,
+)
 from facetraj_engine.method.pipeline import synthesize
-from facetraj_engine.method.speech import filtered_energy_db, pauses, speech_mask
-from facetraj_engine.streaming.closure import ClosureStream, closure_moves, pause_runs, rest_weights
+from facetraj_engine.method.speech import filtered_energy_db, silent_frames, speech_mask
+from facetraj_engine.streaming.closure import ClosureStream, decided_silence
 from facetraj_engine.streaming.live import LiveConfig, LiveStream, live_mode, stream_file
 from facetraj_engine.streaming.phones import FrozenPhone, PhoneSnapshot, PhoneTrack
 from facetraj_engine.streaming.phonetic import PhoneticSynthesizer, PhoneticTiming
@@ -214,23 +221,52 @@ def test_streamed_closure_with_every_frame_known_is_the_offline_step(default_mod
     k = default_model.codebook.pcs.shape[1]
     pcs = np.cumsum(rng.standard_normal((120, k)) * 0.3, axis=0)
     times = np.arange(120) / 60
-    plan = ClosurePlan(np.array([[0.30, 0.42], [1.1, 1.2]]), np.array([1.0, 0.6]),
-                       np.array([[0.6, 0.95]]))
+    silent = np.zeros(120, dtype=bool)
+    silent[36:57] = True
+    plan = ClosurePlan(np.array([[0.30, 0.42], [1.1, 1.2]]), np.array([1.0, 0.6]), silent)
     stats = default_model.closure
     a0, g = aperture_functional(default_model.pca, default_model.upper_lip, default_model.lower_lip)
-    offline = rest_in_pauses(close_lips(pcs, times, plan, stats, a0, g, 0.05), times, plan, stats, 0.05)
+    offline = rest_in_pauses(close_lips(pcs, times, plan, stats, a0, g, 0.05), plan, stats, 60.0,
+                             0.15, 0.05)
     c = closure_moves(a0 + pcs @ g, times, plan.intervals, plan.strengths, stats.closed, 0.05,
                       np.full(120, 119))
-    b = rest_weights(times, plan.pauses, 0.05)
+    b = rest_weights(silent, 60.0, 0.15, 0.05)
     moved = pcs + c[:, None] * stats.direction[None, :]
     np.testing.assert_allclose(moved + b[:, None] * (stats.rest - moved), offline, atol=1e-9)
-    # held long enough to see each /p b m/ whole, the stream makes the same moves
+    assert b[36:45].max() == 0.0 and b[50:57].min() == 1.0 and b[58] == 0.0
+    # held long enough to see each /p b m/ whole, the stream makes the same moves and rests
     stream = ClosureStream(default_model, hold=30)
     out = np.concatenate([stream.feed(pcs[a:a + 7], plan) for a in range(0, 120, 7)] +
                          [stream.feed(np.zeros((0, k)), plan, final=True)])
     a_out, a_off = a0 + out @ g, a0 + offline @ g
     inside = ((times >= 0.30) & (times < 0.42)) | ((times >= 1.1) & (times < 1.2))
     assert a_out[inside].min() == pytest.approx(a_off[inside].min(), abs=1e-9)
+    np.testing.assert_allclose(out[40:60], offline[40:60], atol=1e-9)     # the pause alike
+
+
+def test_causal_intervals_are_the_streams_closures(default_model):
+    """The detector's closures (causal intervals): the offline step and a stream that knows each
+    frame's own fate only when it shows it make the same face, frame for frame."""
+    rng = np.random.default_rng(9)
+    k = default_model.codebook.pcs.shape[1]
+    pcs = np.cumsum(rng.standard_normal((150, k)) * 0.4, axis=0)
+    times = np.arange(150) / 60
+    iv = np.array([[0.25, 0.40], [1.0, 1.1], [2.0, 2.3]])
+    plan = ClosurePlan(iv, np.ones(3), np.zeros(150, dtype=bool), causal=np.ones(3, dtype=bool))
+    stats = default_model.closure
+    a0, g = aperture_functional(default_model.pca, default_model.upper_lip, default_model.lower_lip)
+    offline = close_lips(pcs, times, plan, stats, a0, g, 0.05)
+    stream = ClosureStream(default_model, hold=0)
+    out = []
+    for a in range(0, 150, 4):      # a closure and its end are known once their frames are shown
+        shown = (a + 3) / 60 + 1e-9
+        known = iv[iv[:, 0] <= shown].copy()
+        known[:, 1] = np.where(known[:, 1] <= shown, known[:, 1], np.inf)
+        out.append(stream.feed(pcs[a:a + 4], ClosurePlan(known, np.ones(len(known)),
+                                                         causal=np.ones(len(known), dtype=bool))))
+    np.testing.assert_allclose(np.concatenate(out), offline, atol=1e-9)
+    before = (times >= 0.25 - 0.05) & (times < 0.25)
+    np.testing.assert_array_equal(offline[before], pcs[before])        # no taper before it
 
 
 def test_causal_closure_closes_each_bilabial_and_never_past_closed():
@@ -244,11 +280,15 @@ def test_causal_closure_closes_each_bilabial_and_never_past_closed():
     assert (closed >= np.minimum(a, 11.0) - 1e-12).all()       # nothing pressed past closed
 
 
-def test_pauses_of_a_stream():
-    times = np.arange(20) / 10
-    d = np.array([SPEECH] * 5 + [SILENT] * 4 + [SPEECH] * 5 + [SILENT] * 6)
-    np.testing.assert_allclose(pause_runs(d, times, 0.15), [[0.5, 0.9], [1.4, np.inf]])
-    assert len(pause_runs(np.full(20, UNRANGED), times, 0.15)) == 0
+def test_silence_of_a_stream():
+    d = [UNRANGED] * 3 + [SPEECH] * 5 + [SILENT] * 4 + [SPEECH] * 2
+    silent, leading = decided_silence(d, 0)
+    assert silent.tolist() == [True] * 3 + [False] * 5 + [True] * 4 + [False] * 2 and leading
+    silent, leading = decided_silence(d, 8)
+    assert silent.tolist() == [True] * 4 + [False] * 2 and not leading
+    # before the energy is ranged, the recognizer's silence says (live mode with phones)
+    silent, _ = decided_silence(d, 0, lambda t: t < 0.02, 60.0)
+    assert silent[:3].tolist() == [True, True, False]
 
 
 # --------------------------------------------------------------------------- speech, voice
@@ -268,7 +308,9 @@ def test_speech_stream_filters_the_energy_as_offline(utterance):
     mask = speech_mask(audio, rate, times)
     ranged = d != UNRANGED
     assert ranged.mean() > 0.8 and ((d == SPEECH) == mask)[ranged].mean() > 0.95
-    assert len(pause_runs(d, times, 0.15)) == len(pauses(audio, rate, times))
+    silent, _ = decided_silence(d, 0)
+    offline = silent_frames(audio, rate, times)
+    assert (silent == offline)[ranged].mean() > 0.95
 
 
 def test_running_voice_ratio_approaches_the_offline_one(default_model, arctic_wav):

@@ -19,6 +19,15 @@ from ..method.modes import choose_mode
 from ..method.pipeline import Synthesis, resmooth, synthesize
 from ..method.speech import speech_mask
 from ..threads import limit_frame_threads, one_blas_thread, usable_cores
+from .closed_lips import (
+    CLOSED_TOL_MM,
+    ClosureAgreement,
+    TalkerClosed,
+    TalkerLips,
+    agreements,
+    talker_closed,
+    talker_lips,
+)
 
 log = logging.getLogger(__name__)
 
@@ -86,10 +95,25 @@ class ConditionScores:
 
 @dataclass(kw_only=True)
 class UtteranceScore(ConditionScores):
-    """Correlations of one utterance under one condition, on its ``speech_frames`` frames."""
+    """Correlations of one utterance under one condition, on its ``speech_frames`` frames; and on
+    the same frames the synthesized closures against the talker's own lips
+    (:mod:`facetraj_engine.evaluation.closed_lips`: frames closed in the original, in the synthesis,
+    in both; counted once the talker's closed value is known, :func:`evaluate`)."""
 
     utterance: str
     speech_frames: int
+    closed_frames: int = 0
+    synthesized_closed_frames: int = 0
+    both_closed_frames: int = 0
+
+    @property
+    def closures(self) -> ClosureAgreement:
+        return ClosureAgreement(self.closed_frames, self.synthesized_closed_frames,
+                                self.both_closed_frames)
+
+    def set_closures(self, agreement: ClosureAgreement) -> None:
+        self.closed_frames, self.synthesized_closed_frames, self.both_closed_frames = \
+            agreement.talker, agreement.synthesized, agreement.both
 
 
 def _nanmean(values: Sequence[float]) -> float:
@@ -102,16 +126,21 @@ def _nanmean(values: Sequence[float]) -> float:
 
 @dataclass
 class EvalResult:
-    """Per-utterance scores and their averages per condition."""
+    """Per-utterance scores and their averages per condition, and the talker's closed lip
+    aperture the closures were judged by (``None``: not measured)."""
 
     scores: list[UtteranceScore] = field(default_factory=list)
+    talker: TalkerClosed | None = None
 
     def mean(self, split: str, smoothing: str, mode: str = "phonetic",
              n: int | None = None) -> dict[str, float]:
-        """Mean correlation over utterances of one condition (the paper averages utterances)."""
+        """Mean correlation over utterances of one condition (the paper averages utterances), and
+        the closures' precision and recall against the talker's lips, pooled over its frames."""
         rows = [r for r in self.scores if r.split == split and r.smoothing == smoothing
                 and r.mode == mode and (n is None or r.n_context_phones == n)]
-        return {m: _nanmean([getattr(r, m) for r in rows]) for m in METRICS}
+        pooled = ClosureAgreement.pooled([r.closures for r in rows])
+        return {**{m: _nanmean([getattr(r, m) for r in rows]) for m in METRICS},
+                "closure_precision": pooled.precision, "closure_recall": pooled.recall}
 
     def conditions(self) -> list[tuple[str, str, str, int]]:
         seen: dict[tuple[str, str, str, int], None] = {}
@@ -127,7 +156,10 @@ class EvalResult:
     def to_json(self) -> dict:
         # the utterance first, as it reads
         return {"table": self.table(),
-                "utterances": [{"utterance": r.utterance, **asdict(r)} for r in self.scores]}
+                **({"talker_closed": self.talker.to_json()} if self.talker is not None else {}),
+                "utterances": [{"utterance": r.utterance, **asdict(r),
+                                "closure_precision": r.closures.precision,
+                                "closure_recall": r.closures.recall} for r in self.scores]}
 
 
 def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
@@ -136,7 +168,8 @@ def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
                        eval_config: EvalConfig | None = None,
                        synthesis: Synthesis | None = None, original: np.ndarray | None = None,
                        speech: np.ndarray | None = None,
-                       lsf: np.ndarray | None = None) -> list[UtteranceScore]:
+                       lsf: np.ndarray | None = None,
+                       lips: TalkerLips | None = None) -> list[UtteranceScore]:
     """Synthesize one utterance and score each smoothing against its original markers.
 
     With ``eval_config.by_labels`` the mode follows the utterance's labels as in every command;
@@ -145,7 +178,8 @@ def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
 
     ``original`` (head-normalised markers), ``speech`` (the speech-frame mask) and ``lsf`` (the
     input LSFs, :meth:`Model.input_lsf`) may be passed when already computed, e.g. when one
-    utterance is scored under several configs.
+    utterance is scored under several configs. ``lips``: the utterance's
+    :class:`~facetraj_engine.evaluation.closed_lips.TalkerLips`, given each smoothing's face.
     """
     config = config or SynthConfig()
     if eval_config is not None and eval_config.by_labels:
@@ -163,6 +197,8 @@ def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
     out = []
     for sm in smoothings:
         markers = resmooth(model, res, sm)
+        if lips is not None:
+            lips.add(markers)
         c = trajectory_correlations(original, markers, mask, model, eval_config)
         out.append(UtteranceScore(split=split, mode=config.mode, smoothing=sm,
                                   n_context_phones=config.n_context_phones, **c,
@@ -172,18 +208,32 @@ def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
 
 def _score_utterance(model: Model, corpus: Corpus, split: str, utt_id: str,
                      configs: Sequence[SynthConfig], smoothings: Sequence[str],
-                     eval_config: EvalConfig | None) -> list[UtteranceScore]:
-    """Every config's scores of one corpus utterance (its audio, markers and LSFs read once)."""
+                     eval_config: EvalConfig | None) -> tuple[list[UtteranceScore], TalkerLips]:
+    """Every config's scores of one corpus utterance (its audio, markers and LSFs read once),
+    and its lips (:class:`~facetraj_engine.evaluation.closed_lips.TalkerLips`, a face per score)."""
     utt = corpus.utterance(utt_id)
     original = model.normalise_markers(utt.markers)
-    speech = speech_mask(utt.audio, utt.sample_rate, utt.frame_times(), eval_config)
+    times = utt.frame_times()
+    speech = speech_mask(utt.audio, utt.sample_rate, times, eval_config)
     lsf = model.input_lsf(utt.audio, utt.sample_rate,                 # synthesize()'s frames
                           np.arange(utt.n_frames) / model.marker_rate)
+    lips = talker_lips(original, times, utt.phones, speech, model.upper_lip, model.lower_lip)
     out: list[UtteranceScore] = []
     for cfg in configs:
         out.extend(evaluate_utterance(model, utt, split, cfg, smoothings, eval_config,
-                                      original=original, speech=speech, lsf=lsf))
-    return out
+                                      original=original, speech=speech, lsf=lsf, lips=lips))
+    return out, lips
+
+
+def judged_by_the_talker(done: Sequence[tuple[list[UtteranceScore], TalkerLips]]) -> EvalResult:
+    """The utterances' scores with their closures counted against the talker's closed value,
+    found over all of them (:func:`~facetraj_engine.evaluation.closed_lips.talker_closed`)."""
+    parts = [lips for _, lips in done]
+    talker = talker_closed(parts)
+    for (scores, _), counts in zip(done, agreements(parts, talker), strict=True):
+        for score, agreement in zip(scores, counts, strict=True):
+            score.set_closures(agreement)
+    return EvalResult([s for scores, _ in done for s in scores], talker)
 
 
 def default_workers() -> int:
@@ -197,7 +247,9 @@ def evaluate(model: Model, corpus: Corpus, splits: Iterable[str] = ("train", "te
              eval_config: EvalConfig | None = None,
              progress: Callable[[float, str], None] | None = None,
              workers: int = 1, skip: Skips | None = None) -> EvalResult:
-    """Score every utterance of ``splits`` under each synthesis config (Table 2 and more).
+    """Score every utterance of ``splits`` under each synthesis config (Table 2 and more), and
+    judge its synthesized closures by the talker's own lips
+    (:mod:`facetraj_engine.evaluation.closed_lips`, the closed value found over these utterances).
 
     With ``workers > 1`` the utterances are scored in that many processes
     (:func:`facetraj_engine.fanout.fan_out`: forked, so the model is shared, not copied through pickle);
@@ -214,7 +266,7 @@ def evaluate(model: Model, corpus: Corpus, splits: Iterable[str] = ("train", "te
     configs = list(configs or [SynthConfig()])
     split_of = {u: sp for sp in splits for u in getattr(corpus.info, sp)}
 
-    def score(utt_id: str) -> list[UtteranceScore]:
+    def score(utt_id: str) -> tuple[list[UtteranceScore], TalkerLips]:
         with limit_frame_threads(1):        # also in a worker, which may run in a new context
             return _score_utterance(model, corpus, split_of[utt_id], utt_id, configs,
                                     list(smoothings), eval_config)
@@ -222,7 +274,7 @@ def evaluate(model: Model, corpus: Corpus, splits: Iterable[str] = ("train", "te
     with one_blas_thread(), limit_frame_threads(1):
         done = fan_out(score, list(split_of), workers, skip=skip, progress=progress,
                        describe=lambda u: f"{split_of[u]}: {u}")
-        return EvalResult([s for _, scores in done for s in scores])
+        return judged_by_the_talker([result for _, result in done])
 
 
 def table2(model: Model, corpus: Corpus, acoustic: bool = True,
@@ -251,10 +303,21 @@ def sweep_n(model: Model, corpus: Corpus, ns: Sequence[int] = tuple(range(1, 11)
 
 
 def format_table2(result: EvalResult) -> str:
-    """Table 2 as text: one line per condition with whole face, lower lip, upper lip."""
-    lines = [f"{'Test condition':<34} {'Whole Face':>10} {'Lower Lip':>10} {'Upper Lip':>10}"]
+    """Table 2 as text: one line per condition with whole face, lower lip, upper lip, and the
+    closures' precision and recall against the talker's lips (the closed value said below)."""
+    lines = [f"{'Test condition':<34} {'Whole Face':>10} {'Lower Lip':>10} {'Upper Lip':>10} "
+             f"{'Closed P':>9} {'Closed R':>9}"]
     for row in result.table():
         name = f"{row['split'].title()} ({row['smoothing']}, {row['mode']}, N={row['n_context_phones']})"
         lines.append(f"{name:<34} {row['whole_face']:>10.4f} {row['lower_lip']:>10.4f} "
-                     f"{row['upper_lip']:>10.4f}")
+                     f"{row['upper_lip']:>10.4f} {_share(row['closure_precision']):>9} "
+                     f"{_share(row['closure_recall']):>9}")
+    if result.talker is not None:
+        lines.append(f"Closed P, R: frames closed within {CLOSED_TOL_MM:g} mm in the synthesis "
+                     f"that are closed in the original, and the reverse; "
+                     f"{result.talker.describe()}")
     return "\n".join(lines)
+
+
+def _share(x: float) -> str:
+    return "-" if not np.isfinite(x) else f"{100 * x:.1f} %"

@@ -40,8 +40,10 @@ class AudioExtent:
         """What the audio lasts by its header, and the common rate at which it would last as
         long as the labels, if there is one.
 
-        >>> AudioExtent("r0.wav", 54400, 8000).lasts(3.4)
-        'the audio r0.wav lasts 6.800 s by its header (54400 samples at 8000 Hz; at 16000 Hz it would last 3.400 s, as the labels do: is the rate in its header wrong?)'
+        >>> AudioExtent("r0.wav", 54400, 8000).lasts(3.4)[:72]
+        'the audio r0.wav lasts 6.800 s by its header (54400 samples at 8000 Hz; '
+        >>> AudioExtent("r0.wav", 54400, 8000).lasts(3.4)[72:]
+        'at 16000 Hz it would last 3.400 s, as the labels do: is the rate in its header wrong?)'
         >>> AudioExtent("r0.wav", 54400, 16000).lasts(1.0)
         'the audio r0.wav lasts 3.400 s by its header (54400 samples at 16000 Hz)'
         """

@@ -1,4 +1,4 @@
-"""Lips that close, and a face that rests in pauses (beyond the paper, issue 25).
+"""Lips that close, and a face that rests in pauses (beyond the paper, issues 25, 40 and 46).
 
 The paper's eqs 5-8 average codewords, and its 100 ms triangular window averages frames: both
 shave the extremes off, and the most visible extreme of speech is a bilabial closure (the paper's
@@ -10,9 +10,16 @@ them). This step, after eq 8 and the smoothing, leaves the paper's equations alo
    lips move together as the talker's do) until the aperture's minimum inside the segment reaches
    the talker's closed aperture; the move is flat over the segment with raised-cosine tapers of
    ``closure_taper_s`` outside it, scaled by how much the label is trusted
-   (:func:`closure_strengths`);
-2. **rests the face** in pauses longer than ``rest_pause_s`` (by energy, as the evaluation finds
-   speech frames): the PCs blend towards the training talker's median face in long pauses.
+   (:func:`closure_strengths`). The closures the bilabial-closure detector finds without phones
+   are closed as a stream can close them (*causal* intervals, :func:`closure_moves`): from their
+   first frame, each frame by the smallest aperture of the closure so far, tapered after their end
+   only -- so that ``facetraj live --acoustic-only`` and ``synth --mode acoustic`` make the same
+   face (issue 46);
+2. **rests the face** in pauses (by energy, as the evaluation finds speech frames) once they have
+   lasted ``rest_pause_s``: the PCs blend towards the training talker's median face, reading only
+   each frame and those before it (:func:`rest_weights`: what a stream knows when it shows a
+   frame, so offline and live rest alike); the silence a recording starts with is rested from its
+   first frame, and no speech frame is rested.
 
 The lip aperture (upper-lip centre y minus lower-lip centre y) is linear in the PCs,
 ``a(p) = a0 + p . g`` (:func:`aperture_functional`), so every move is exact.
@@ -21,7 +28,7 @@ The lip aperture (upper-lip centre y minus lower-lip centre y) is linear in the 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -53,14 +60,26 @@ class ClosureStats:
 @dataclass(frozen=True)
 class ClosurePlan:
     """Where the step acts on one input: ``intervals`` ``(J, 2)`` seconds of /p b m/ and their
-    ``strengths`` ``(J,)`` in [0, 1]; ``pauses`` ``(P, 2)`` seconds; ``probability``: per frame,
-    the bilabial-closure detector's (:mod:`facetraj_engine.method.closure_detector`) when it
-    ran."""
+    ``strengths`` ``(J,)`` in [0, 1]; ``silent`` ``(F,)`` whether each frame from frame
+    ``silent_from`` on is decided silent (frames after the last decided one count as speech), and
+    ``leading``: no frame before ``silent_from`` is speech (the input began in silence);
+    ``causal`` ``(J,)`` which intervals are closed as a stream closes them (the detector's,
+    :func:`closure_moves`; ``None``: none); ``probability``: per frame, the bilabial-closure
+    detector's (:mod:`facetraj_engine.method.closure_detector`) when it ran."""
 
     intervals: np.ndarray
     strengths: np.ndarray
-    pauses: np.ndarray
+    silent: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
     probability: np.ndarray | None = None
+    causal: np.ndarray | None = None
+    silent_from: int = 0
+    leading: bool = True
+
+    @property
+    def is_causal(self) -> np.ndarray:
+        """``(J,)`` which intervals are causal."""
+        return np.zeros(len(self.intervals), dtype=bool) if self.causal is None else \
+            np.asarray(self.causal, dtype=bool)
 
 
 # --------------------------------------------------------------------------- the aperture
@@ -198,15 +217,18 @@ def closure_strengths(n_phones: int, kind: str, voice_match: float) -> np.ndarra
     return np.full(n_phones, 1.0 if kind != "recognized" else 1.0 - float(voice_match))
 
 
-def bump(times: np.ndarray, start: float, end: float, taper_s: float, inside: bool = False
-         ) -> np.ndarray:
+def bump(times: np.ndarray, start: float, end: float, taper_s: float, inside: bool = False,
+         lead: bool = True) -> np.ndarray:
     """A flat-topped weight: 1 on ``[start, end]``, raised-cosine tapers of ``taper_s`` outside
-    the interval (``inside``: the tapers inside it, 0 outside).
+    the interval (``inside``: the tapers inside it, 0 outside; ``lead=False``: no taper before
+    it, 0 there).
 
     >>> bump(np.arange(7) / 10, 0.3, 0.4, 0.2).round(3).tolist()
     [0.0, 0.0, 0.5, 1.0, 1.0, 0.5, 0.0]
     >>> bump(np.arange(7) / 10, 0.1, 0.5, 0.2, inside=True).round(3).tolist()
     [0.0, 0.0, 0.5, 1.0, 0.5, 0.0, 0.0]
+    >>> bump(np.arange(7) / 10, 0.3, 0.4, 0.2, lead=False).round(3).tolist()
+    [0.0, 0.0, 0.0, 1.0, 1.0, 0.5, 0.0]
     """
     t = np.asarray(times, dtype=np.float64)
     if inside:
@@ -215,7 +237,17 @@ def bump(times: np.ndarray, start: float, end: float, taper_s: float, inside: bo
     if taper_s <= 0:
         return ((t >= start) & (t <= end)).astype(np.float64)
     dist = np.maximum(np.maximum(start - t, t - end), 0.0)
-    return np.where(dist >= taper_s, 0.0, 0.5 * (1 + np.cos(np.pi * np.minimum(dist / taper_s, 1.0))))
+    w = np.where(dist >= taper_s, 0.0, 0.5 * (1 + np.cos(np.pi * np.minimum(dist / taper_s, 1.0))))
+    return w if lead else np.where(t < start, 0.0, w)
+
+
+def ramp(x: np.ndarray) -> np.ndarray:
+    """A raised-cosine rise from 0 at ``x <= 0`` to 1 at ``x >= 1``.
+
+    >>> ramp(np.array([-1.0, 0.0, 0.5, 1.0, 2.0])).round(3).tolist()
+    [0.0, 0.0, 0.5, 1.0, 1.0]
+    """
+    return 0.5 * (1 - np.cos(np.pi * np.clip(np.asarray(x, dtype=np.float64), 0.0, 1.0)))
 
 
 # --------------------------------------------------------------------------- the step
@@ -224,11 +256,12 @@ def close_lips(pcs: np.ndarray, times: np.ndarray, plan: ClosurePlan, stats: Clo
     """Step 1: for each interval j, the aperture's minimum over its frames ``m_j`` and the move
     ``c_j = s_j min(0, closed - m_j)`` (mm, at most 0); the PCs move by ``c(t) d``, ``c(t)`` the
     most negative ``c_j bump_j(t)``. With strength 1 the minimum inside each interval reaches the
-    closed aperture exactly; frames away from every interval are unchanged. ``times``: the
+    closed aperture exactly; frames away from every interval are unchanged. Causal intervals
+    (the detector's) move as :func:`closure_moves` moves a stream's frames. ``times``: the
     frames' times, ascending.
 
     >>> st = ClosureStats(1.0, np.array([1.0]), np.array([0.0]))
-    >>> plan = ClosurePlan(np.array([[0.2, 0.3]]), np.array([1.0]), np.zeros((0, 2)))
+    >>> plan = ClosurePlan(np.array([[0.2, 0.3]]), np.array([1.0]))
     >>> t = np.arange(6) / 10
     >>> close_lips(np.full((6, 1), 3.0), t, plan, st, 0.0, np.array([1.0]), 0.1)[:, 0].tolist()
     [3.0, 3.0, 1.0, 1.0, 3.0, 3.0]
@@ -237,7 +270,8 @@ def close_lips(pcs: np.ndarray, times: np.ndarray, plan: ClosurePlan, stats: Clo
     times = np.asarray(times, dtype=np.float64)
     a = a0 + pcs @ g
     c = np.zeros(len(pcs))
-    for (t0, t1), s in zip(plan.intervals, plan.strengths, strict=True):
+    causal = plan.is_causal
+    for (t0, t1), s in zip(plan.intervals[~causal], plan.strengths[~causal], strict=True):
         lo, hi = np.searchsorted(times, (t0, t1))        # the frames in [t0, t1)
         if lo == hi:                                     # shorter than a frame: its nearest one
             lo = int(np.argmin(np.abs(times - 0.5 * (t0 + t1))))
@@ -246,7 +280,50 @@ def close_lips(pcs: np.ndarray, times: np.ndarray, plan: ClosurePlan, stats: Clo
         if move < 0:
             near = _support(times, t0, t1, taper_s)
             c[near] = np.minimum(c[near], move * bump(times[near], t0, t1, taper_s))
+    if causal.any():
+        c = np.minimum(c, closure_moves(a, times, plan.intervals[causal], plan.strengths[causal],
+                                        stats.closed, taper_s, np.arange(len(a)), clamp=True,
+                                        lead=False))
     return pcs + c[:, None] * stats.direction[None, :]
+
+
+def closure_moves(aperture: np.ndarray, times: np.ndarray, intervals: np.ndarray,
+                  strengths: np.ndarray, closed: float, taper_s: float, seen: np.ndarray,
+                  at: np.ndarray | None = None, clamp: bool = False, lead: bool = True
+                  ) -> np.ndarray:
+    """Per frame t, the aperture move ``c(t)`` (mm, at most 0) of :func:`close_lips`, each
+    interval's minimum taken over its frames up to ``seen[t]`` (frame t's own aperture when none
+    of them is): the move a stream makes when it emits frame t (``seen = t``: causal). ``at``:
+    the frames to compute (default all); the result is one move per frame of ``at``. With
+    ``clamp``, no frame is moved past the closed aperture (offline a frame can be, where a taper
+    after a segment meets a frame already closer than the segment's minimum); ``lead=False``: no
+    taper before an interval (a stream does not know a closure before it begins).
+
+    >>> a = np.array([15.0, 14.0, 13.0, 16.0, 15.0]); t = np.arange(5) / 10
+    >>> iv, s = np.array([[0.1, 0.3]]), np.array([1.0])
+    >>> closure_moves(a, t, iv, s, 11.0, 0.15, np.arange(5)).round(9).tolist()    # causal
+    [-1.0, -3.0, -2.0, -2.0, -0.5]
+    >>> closure_moves(a, t, iv, s, 11.0, 0.15, np.full(5, 4)).round(9).tolist()   # offline
+    [-0.5, -2.0, -2.0, -2.0, -0.5]
+    >>> closure_moves(a, t, iv, s, 11.0, 0.15, np.arange(5), lead=False).round(9).tolist()
+    [0.0, -3.0, -2.0, -2.0, -0.5]
+    """
+    a = np.asarray(aperture, dtype=np.float64)
+    times = np.asarray(times, dtype=np.float64)
+    seen = np.asarray(seen)
+    at = np.arange(len(a)) if at is None else np.asarray(at)
+    c = np.zeros(len(at))
+    for (t0, t1), s in zip(intervals, strengths, strict=True):
+        idx = np.flatnonzero((times >= t0) & (times < t1))
+        if idx.size == 0:                                # shorter than a frame: its nearest one
+            idx = np.array([int(np.argmin(np.abs(times - 0.5 * (t0 + min(t1, times[-1])))))])
+        w = bump(times[at], t0, t1, taper_s, lead=lead)
+        for k in np.flatnonzero(w > 0):
+            t = at[k]
+            known = idx[idx <= seen[t]]
+            m = float(a[known].min()) if known.size else float(a[t])
+            c[k] = min(c[k], s * min(0.0, closed - m) * w[k])
+    return c if not clamp else np.maximum(c, np.minimum(0.0, closed - a[at]))
 
 
 def _support(times: np.ndarray, start: float, end: float, taper_s: float) -> slice:
@@ -261,29 +338,67 @@ def _support(times: np.ndarray, start: float, end: float, taper_s: float) -> sli
     return slice(int(lo), int(np.searchsorted(times, end + taper, side="right")))
 
 
-def rest_in_pauses(pcs: np.ndarray, times: np.ndarray, plan: ClosurePlan, stats: ClosureStats,
-                   taper_s: float) -> np.ndarray:
-    """Step 2: in each pause the PCs blend towards the rest face with weight ``b(t)`` (1 inside
-    the pause, raised-cosine tapers of ``taper_s`` inside it, 0 outside; ``times`` ascending).
+def rest_weights(silent: np.ndarray, rate: float, min_s: float, taper_s: float,
+                 leading: bool = True) -> np.ndarray:
+    """Per frame t of ``silent`` (whether each frame is silent), how far the face rests, read from
+    frame t and the frames before it alone (what a stream has decided when it shows frame t): 0
+    on a speech frame and until a silence has lasted ``min_s``, then a raised-cosine rise over
+    ``taper_s`` to 1. A silence from the input's start (``leading``: no speech before
+    ``silent``'s first frame) counts as long already: the talker rests before speaking.
+
+    >>> s = np.array([1, 1, 0, 0, 1, 1, 1, 1, 1, 1, 0], dtype=bool)
+    >>> rest_weights(s, 10.0, 0.15, 0.1).round(3).tolist()
+    [1.0, 1.0, 0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0, 1.0, 0.0]
+    >>> rest_weights(s, 10.0, 0.15, 0.1, leading=False)[:3].round(3).tolist()
+    [0.0, 0.5, 0.0]
+    """
+    s = np.asarray(silent, dtype=bool)
+    if not len(s):
+        return np.zeros(0)
+    idx = np.arange(len(s))
+    last_speech = np.maximum.accumulate(np.where(s, -1, idx))
+    run = (idx - last_speech).astype(np.float64)            # silent frames ending at each frame
+    if leading:
+        run[last_speech < 0] = np.inf
+    lasted = run / float(rate)
+    x = (lasted - min_s) / taper_s if taper_s > 0 else np.where(lasted > min_s, 1.0, 0.0)
+    return np.where(run > 0, ramp(np.where(np.isfinite(x), x, 1.0)), 0.0)
+
+
+def rest_in_pauses(pcs: np.ndarray, plan: ClosurePlan, stats: ClosureStats, rate: float,
+                   min_s: float, taper_s: float) -> np.ndarray:
+    """Step 2: the PCs ``(T, K)`` of frames 0 .. T-1 blend towards the rest face with the weights
+    of :func:`rest_weights` (the plan's silent frames, from its first on).
 
     >>> st = ClosureStats(1.0, np.array([1.0]), np.array([0.0]))
-    >>> plan = ClosurePlan(np.zeros((0, 2)), np.zeros(0), np.array([[0.1, 0.5]]))
-    >>> rest_in_pauses(np.full((7, 1), 2.0), np.arange(7) / 10, plan, st, 0.2)[:, 0].round(9).tolist()
-    [2.0, 2.0, 1.0, 0.0, 1.0, 2.0, 2.0]
+    >>> plan = ClosurePlan(np.zeros((0, 2)), np.zeros(0), np.array([0, 1, 1, 1, 1, 0], dtype=bool))
+    >>> rest_in_pauses(np.full((6, 1), 2.0), plan, st, 10.0, 0.15, 0.1)[:, 0].round(9).tolist()
+    [2.0, 2.0, 1.0, 0.0, 0.0, 2.0]
     """
     pcs = np.asarray(pcs, dtype=np.float64)
-    times = np.asarray(times, dtype=np.float64)
-    b = np.zeros(len(pcs))
-    for t0, t1 in plan.pauses:
-        near = _support(times, t0, t1, taper_s)
-        b[near] = np.maximum(b[near], bump(times[near], t0, t1, taper_s, inside=True))
+    b = frame_rest(plan, len(pcs), rate, min_s, taper_s)
     return pcs + b[:, None] * (stats.rest[None, :] - pcs)
 
 
+def frame_rest(plan: ClosurePlan, count: int, rate: float, min_s: float, taper_s: float,
+               first: int = 0) -> np.ndarray:
+    """The rest weights (:func:`rest_weights`) of frames ``first .. first + count - 1`` from the
+    plan's silent frames (undecided ones speech)."""
+    stop = first + count
+    silent = np.zeros(max(stop - plan.silent_from, 0), dtype=bool)
+    known = plan.silent[:len(silent)]
+    silent[:len(known)] = known
+    w = rest_weights(silent, rate, min_s, taper_s, plan.leading)
+    out = np.zeros(count)
+    lo = max(first, plan.silent_from)
+    out[lo - first:] = w[lo - plan.silent_from:]
+    return out
+
+
 def apply_closure(pcs: np.ndarray, times: np.ndarray, plan: ClosurePlan, stats: ClosureStats,
-                  a0: float, g: np.ndarray, closure_taper_s: float = 0.05,
-                  rest_taper_s: float = 0.05) -> np.ndarray:
-    """The whole step on smoothed PCs ``(T, K)``: the lips close (:func:`close_lips`), then the
-    face rests in pauses (:func:`rest_in_pauses`)."""
-    return rest_in_pauses(close_lips(pcs, times, plan, stats, a0, g, closure_taper_s), times, plan,
-                          stats, rest_taper_s)
+                  a0: float, g: np.ndarray, rate: float, closure_taper_s: float = 0.05,
+                  rest_pause_s: float = 0.15, rest_taper_s: float = 0.05) -> np.ndarray:
+    """The whole step on smoothed PCs ``(T, K)`` of frames 0 .. T-1 at ``rate``: the lips close
+    (:func:`close_lips`), then the face rests in pauses (:func:`rest_in_pauses`)."""
+    return rest_in_pauses(close_lips(pcs, times, plan, stats, a0, g, closure_taper_s), plan, stats,
+                          rate, rest_pause_s, rest_taper_s)

@@ -146,18 +146,19 @@ class ClosureDetector:
     search: Logistic | None = None
 
     def probability(self, x: np.ndarray, x_search: np.ndarray | None = None,
-                    match: float = 0.0) -> np.ndarray:
+                    match: float | np.ndarray = 0.0) -> np.ndarray:
         """``p(t)`` (steps 5-6) of feature rows ``x`` ``(T, F)``, the search's stacked rows
-        ``x_search`` ``(T, 2 len(offsets))`` (``None``: not known) and the voice ``match``
-        (NaN: unknown, 0)."""
+        ``x_search`` ``(T, 2 len(offsets))`` (``None``: not known) and the voice ``match``, one
+        for every row or one per row (NaN: unknown, 0)."""
         p = self.acoustic.probability(x)
-        m = float(match) if np.isfinite(match) else 0.0
-        if self.search is None or x_search is None or m <= 0.0:
+        m = np.broadcast_to(np.nan_to_num(np.asarray(match, dtype=np.float64), nan=0.0), p.shape)
+        if self.search is None or x_search is None or not (m > 0.0).any():
             return p
         return (1.0 - m) * p + m * self.search.probability(np.concatenate([x, x_search], axis=1))
 
     def frame_probability(self, lsf: np.ndarray, energy_db: np.ndarray,
-                          search: np.ndarray | None = None, match: float = 0.0) -> np.ndarray:
+                          search: np.ndarray | None = None,
+                          match: float | np.ndarray = 0.0) -> np.ndarray:
         """``p(t)`` of every frame of an input from its LSFs ``(T, P)``, frame energies ``(T,)``
         (dB), and the search's rows ``(T, 2)`` (:mod:`facetraj_engine.method.closure_search`)."""
         x = detector_features(lsf, energy_db, self.spec, self.lsf_mean)
@@ -391,9 +392,11 @@ def utterance_inputs(config: TrainConfig, audio: np.ndarray, sample_rate: int,
 
 def input_probability(detector: ClosureDetector, config: TrainConfig, audio: np.ndarray,
                       sample_rate: int, times: np.ndarray, lsf: np.ndarray | None = None,
-                      search: np.ndarray | None = None, match: float = 0.0) -> np.ndarray:
+                      search: np.ndarray | None = None,
+                      match: float | np.ndarray = 0.0) -> np.ndarray:
     """``p(t)`` of an input's frames at ``times`` (``lsf``: its input LSFs there, unwarped, when
-    already computed; ``search``, ``match``: the search's rows and the voice match, step 6)."""
+    already computed; ``search``, ``match``: the search's rows and the voice match, one or one
+    per frame, step 6)."""
     w = lsf if lsf is not None else lsf_at(audio, sample_rate, times, config.lpc_order,
                                            config.window_s, config.audio_rate, config.preemphasis)
     return detector.frame_probability(w, input_energy_db(config, audio, sample_rate, times),
@@ -422,6 +425,22 @@ def closure_runs(p: np.ndarray, times: np.ndarray, threshold: float, min_frames:
     if open_end and stops[keep][-1] == len(t):
         out[-1, 1] = np.inf
     return np.round(out, 12)
+
+
+def causal_closures(runs: np.ndarray, rate: float, min_frames: int = 2) -> np.ndarray:
+    """The closures the lips make of ``runs`` ``(J, 2)`` of at least ``min_frames`` frames
+    (:func:`closure_runs`): from each run's ``min_frames``-th frame, the first at which a stream
+    knows the run is one (it shows a frame once the frame's own probability is known, not the
+    next one's), to its last frame; the bounds half a frame from the frames' times, so that which
+    frames are inside does not hang on rounding (an unended run stays unended).
+
+    >>> causal_closures(np.array([[0.2, 0.4], [0.5, np.inf]]), 10.0).tolist()
+    [[0.25, 0.35], [0.55, inf]]
+    """
+    runs = np.asarray(runs, dtype=np.float64).reshape(-1, 2)
+    half = 0.5 / rate
+    return np.round(np.column_stack([runs[:, 0] + (min_frames - 1) / rate - half,
+                                     runs[:, 1] - half]), 12)
 
 
 def beside(runs: np.ndarray, intervals: np.ndarray) -> np.ndarray:

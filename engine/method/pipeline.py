@@ -24,7 +24,7 @@ from ..io.labelfiles import validate_phones
 from ..labels.phoneset import SILENCE, map_labels, normalise_label
 from ..threads import above_blas, frame_threads
 from .closure import ClosurePlan, aperture_functional, apply_closure, closure_intervals, closure_strengths
-from .closure_detector import beside, closure_runs, input_probability
+from .closure_detector import beside, causal_closures, closure_runs, input_probability
 from .closure_search import search_rows
 from .context import segment_index
 from .model import Model
@@ -33,9 +33,9 @@ from .search import SearchInput, SegmentChoice
 from .selection import mean_normalise
 from .smoothing import smooth
 from .speaker import choose_warp, warp_lsf
-from .speech import filtered_energy_db, pauses, speech_mask
+from .speech import filtered_energy_db, ranged_speech, speech_mask
 from .synthesis import FrameWeights
-from .voice_match import voice_distance, voice_match
+from .voice_match import frame_matches, match_from, voice_distance, voice_match
 
 log = logging.getLogger(__name__)
 
@@ -220,8 +220,8 @@ def _smoothed(model: Model, raw: np.ndarray, times: np.ndarray, config: SynthCon
     if plan is None:
         return pcs
     a0, g = aperture_functional(model.pca, model.upper_lip, model.lower_lip)
-    return apply_closure(pcs, times, plan, model.closure, a0, g, config.closure_taper_s,
-                         config.rest_taper_s)
+    return apply_closure(pcs, times, plan, model.closure, a0, g, model.marker_rate,
+                         config.closure_taper_s, config.rest_pause_s, config.rest_taper_s)
 
 
 def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
@@ -230,53 +230,65 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
                  lsf: np.ndarray | None = None, frames: FrameWeights | None = None
                  ) -> ClosurePlan | None:
     """Where the closure step acts (``None``: off, or a model file without its statistics): the
-    labelled /p b m/, trusted as :func:`~facetraj_engine.method.closure.closure_strengths` says (for
-    recognized labels by the voice ``match``; NaN: unknown, untrusted), and beside recognized
-    ones the detector's closures where none is recognized, trusted by the voice ``match``
-    (``config.closure_second_opinion``); without labels, the closures the model's detector finds
-    (``config.closure_detector``, fully trusted; ``lsf``: the input's LSFs at ``times`` before
-    any speaker warp or mean normalisation, when computed; ``frames``: the acoustic-only
-    search's, whose opinion counts by the voice ``match``); and the pauses by energy (``filtered``:
-    :func:`~facetraj_engine.method.speech.filtered_energy_db` of the audio, when already
-    computed)."""
+    labelled /p b m/ (``config.closure_labels``), trusted as
+    :func:`~facetraj_engine.method.closure.closure_strengths` says (for recognized labels by the
+    voice ``match``; NaN: unknown, untrusted), and beside recognized ones the detector's closures
+    where none is recognized, trusted by the voice ``match`` (``config.closure_second_opinion``,
+    off by default); without labels, the closures the model's detector finds
+    (``config.closure_detector``, fully trusted, closed as a stream closes them; ``lsf``: the
+    input's LSFs at ``times`` before any speaker warp or mean normalisation, when computed;
+    ``frames``: the acoustic-only search's, whose opinion counts by the voice ``match`` from the
+    frame a stream would have measured it); and the silent frames by energy, where the face rests
+    (``config.rest``; ``filtered``: :func:`~facetraj_engine.method.speech.filtered_energy_db` of
+    the audio, when already computed)."""
     if not config.closure or model.closure is None:
         return None
     intervals, strengths, p = np.zeros((0, 2)), np.zeros(0), None
+    causal = np.zeros(0, dtype=bool)
+    speech, ranged = ranged_speech(audio, sample_rate, times, filtered=filtered)
     detecting = config.closure_detector and model.detector is not None
+    heard = match_from(speech & ranged)
     if segs:
         kind = (provenance or Provenance()).kind
-        trust = closure_strengths(len(segs), kind, match if np.isfinite(match) else 1.0)
-        intervals, strengths = closure_intervals(segs, trust)
-        if detecting and kind == "recognized" and config.closure_second_opinion and \
-                np.isfinite(match) and match > 0:
-            p, runs = _detected(model, audio, sample_rate, times, lsf, None, match, config)
+        if config.closure_labels:
+            trust = closure_strengths(len(segs), kind, match if np.isfinite(match) else 1.0)
+            intervals, strengths = closure_intervals(segs, trust)
+            causal = np.zeros(len(intervals), dtype=bool)
+        if model.detector is not None and kind == "recognized" and \
+                config.closure_second_opinion and np.isfinite(match) and match > 0:
+            p, runs = _detected(model, audio, sample_rate, times, lsf, None, match, heard, config)
             added = beside(runs, intervals)
             intervals = np.concatenate([intervals, added])
             strengths = np.concatenate([strengths, np.full(len(added), match)])
+            causal = np.concatenate([causal, np.ones(len(added), dtype=bool)])
     elif detecting:
-        p, intervals = _detected(model, audio, sample_rate, times, lsf, frames, match, config)
-        strengths = np.ones(len(intervals))
-        log.info("closure step: the lips close at %d closures the detector found", len(intervals))
-    return ClosurePlan(intervals, strengths, pauses(audio, sample_rate, times, config.rest_pause_s,
-                                                    filtered=filtered), p)
+        p, intervals = _detected(model, audio, sample_rate, times, lsf, frames, match, heard, config)
+        strengths, causal = np.ones(len(intervals)), np.ones(len(intervals), dtype=bool)
+        log.debug("closure step: the lips close at %d closures the detector found", len(intervals))
+    silent = ~speech & ranged if config.rest else np.zeros(len(times), dtype=bool)
+    return ClosurePlan(intervals, strengths, silent, p, causal, leading=config.rest)
 
 
 def _detected(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
-              lsf: np.ndarray | None, frames: FrameWeights | None, match: float,
+              lsf: np.ndarray | None, frames: FrameWeights | None, match: float, heard: int,
               config: SynthConfig) -> tuple[np.ndarray, np.ndarray]:
-    """The detector's probabilities and closures of an input (:func:`plan_closure`); the
-    acoustic-only search is made here when its opinion counts (``match`` above 0) and ``frames``
-    is not that search's."""
+    """The detector's probabilities and closures of an input (:func:`plan_closure`; the closures
+    from each run's confirming frame, :func:`~facetraj_engine.method.closure_detector.causal_closures`);
+    the voice ``match`` counts from frame ``heard`` on (before it a stream has not measured the
+    voice: :func:`~facetraj_engine.method.voice_match.match_from`); the acoustic-only search is
+    made here when its opinion counts and ``frames`` is not that search's."""
     det = model.detector
     if lsf is None:
         lsf = model.input_lsf(audio, sample_rate, times, frame_threads())
-    counts = det.search is not None and np.isfinite(match) and match > 0
+    m = frame_matches(match, len(times), heard)
+    counts = det.search is not None and bool((m > 0).any())
     if frames is None and counts:
         acoustic = config.with_(mode="acoustic")
         frames = mode_of(acoustic).search(SearchInput(model, lsf, times, acoustic)).frames
     search = search_rows(model, frames) if frames is not None and counts else None
-    p = input_probability(det, model.config, audio, sample_rate, times, lsf, search, match)
-    return p, closure_runs(p, times, config.closure_threshold, det.spec.min_frames)
+    p = input_probability(det, model.config, audio, sample_rate, times, lsf, search, m)
+    runs = closure_runs(p, times, config.closure_threshold, det.spec.min_frames)
+    return p, causal_closures(runs, model.marker_rate, det.spec.min_frames)
 
 
 class SpeechEnergy:

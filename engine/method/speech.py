@@ -161,13 +161,39 @@ def speech_runs(mask: np.ndarray, times: np.ndarray, min_s: float = 0.0) -> np.n
     return np.array([r for r in runs if r[1] - r[0] > min_s], dtype=np.float64).reshape(-1, 2)
 
 
+def ranged_speech(audio: np.ndarray, rate: int, times: np.ndarray, min_range_db: float = 20.0,
+                  config: EvalConfig | None = None, filtered: np.ndarray | None = None
+                  ) -> tuple[np.ndarray, bool]:
+    """The speech frames at ``times`` (:func:`speech_mask`) and whether the recording's energy
+    spans ``min_range_db`` (99th minus 5th percentile, median-filtered): where it does not, as
+    in a recording without a pause, whose quiet speech would pass for one, neither its speech
+    nor its silence is told (``filtered``: :func:`filtered_energy_db` when already computed)."""
+    if filtered is None:
+        filtered = filtered_energy_db(audio, rate, config)
+    floor, peak = np.percentile(filtered, [5, 99])
+    return _above(filtered, times, config or EvalConfig(), floor, peak), bool(peak - floor >= min_range_db)
+
+
+def silent_frames(audio: np.ndarray, rate: int, times: np.ndarray, min_range_db: float = 20.0,
+                  config: EvalConfig | None = None, filtered: np.ndarray | None = None) -> np.ndarray:
+    """Whether each frame at ``times`` is silent: not a speech frame, where the energy's range
+    tells (:func:`ranged_speech`; else none is).
+
+    >>> rate = 16000
+    >>> x = np.zeros(rate); x[4000:12000] = np.sin(np.arange(8000) * 0.3)   # 0.25-0.75 s tone
+    >>> t = np.arange(60) / 60
+    >>> s = silent_frames(x, rate, t)
+    >>> int(s[:15].sum()), int(s[15:46].sum()), int(s[46:].sum())
+    (15, 0, 14)
+    """
+    speech, ranged = ranged_speech(audio, rate, times, min_range_db, config, filtered)
+    return ~speech & ranged
+
+
 def pauses(audio: np.ndarray, rate: int, times: np.ndarray, min_s: float = 0.15,
            min_range_db: float = 20.0, config: EvalConfig | None = None,
            filtered: np.ndarray | None = None) -> np.ndarray:
-    """``(J, 2)`` pauses: runs of non-speech frames (:func:`speech_mask`) longer than ``min_s``;
-    none when the recording's energy range (99th minus 5th percentile, median-filtered) is under
-    ``min_range_db``, as in a recording without a pause, whose quiet speech would pass for one
-    (``filtered``: :func:`filtered_energy_db` when already computed).
+    """``(J, 2)`` pauses: runs of silent frames (:func:`silent_frames`) longer than ``min_s``.
 
     >>> rate = 16000
     >>> x = np.zeros(rate); x[4000:12000] = np.sin(np.arange(8000) * 0.3)   # 0.25-0.75 s tone
@@ -175,10 +201,4 @@ def pauses(audio: np.ndarray, rate: int, times: np.ndarray, min_s: float = 0.15,
     >>> pauses(x, rate, t).round(2).tolist()
     [[0.0, 0.25], [0.77, 1.0]]
     """
-    if filtered is None:
-        filtered = filtered_energy_db(audio, rate, config)
-    floor, peak = np.percentile(filtered, [5, 99])
-    if peak - floor < min_range_db:
-        return np.zeros((0, 2))
-    mask = _above(filtered, times, config or EvalConfig(), floor, peak)     # the percentiles once
-    return speech_runs(~mask, times, min_s)
+    return speech_runs(silent_frames(audio, rate, times, min_range_db, config, filtered), times, min_s)

@@ -28,6 +28,37 @@ from .synthesis import lsf_distances, perceptual_weights
 MATCH_FULL, MATCH_NONE = 1.5, 3.0
 #: Speech frames a recording's figure is computed on, at most (evenly spaced).
 MAX_FRAMES = 400
+#: Speech frames heard before a voice is measured (0.5 s of speech at 60 Hz): a stream's running
+#: match counts from then (:mod:`facetraj_engine.streaming.voice`), and so does the detector's
+#: use of the match offline (:func:`match_from`), so that both treat the first half second alike.
+MIN_FRAMES = 30
+#: The voice match assumed until the voice has been measured (a person at a microphone is not the
+#: training voice, which is synthetic).
+PRIOR_MATCH = 0.0
+
+
+def match_from(speech: np.ndarray, min_frames: int = MIN_FRAMES) -> int:
+    """The first frame that may use the voice match, as a stream measures it: the frame after the
+    ``min_frames``-th speech frame (``speech``: per frame; ``len(speech)``: none does).
+
+    >>> match_from(np.array([0, 1, 1, 0, 1, 0, 0], bool), 3)
+    5
+    >>> match_from(np.array([0, 1, 0], bool), 3)
+    3
+    """
+    heard = np.flatnonzero(np.asarray(speech, dtype=bool))
+    return int(heard[min_frames - 1]) + 1 if heard.size >= min_frames else len(speech)
+
+
+def frame_matches(match: float, count: int, first: int) -> np.ndarray:
+    """Per frame, the voice match a frame may use: ``match`` from frame ``first`` on, before it
+    :data:`PRIOR_MATCH` (NaN: unknown, the prior throughout).
+
+    >>> frame_matches(1.0, 5, 3).tolist(), frame_matches(float("nan"), 2, 0).tolist()
+    ([0.0, 0.0, 0.0, 1.0, 1.0], [0.0, 0.0])
+    """
+    m = float(match) if np.isfinite(match) else PRIOR_MATCH
+    return np.where(np.arange(count) >= first, m, PRIOR_MATCH)
 
 
 def nearest_distances(w: np.ndarray, cb_lsf: np.ndarray, exclude: np.ndarray | None = None,

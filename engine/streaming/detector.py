@@ -6,7 +6,8 @@ Frame t's probability needs the frames up to t + 3 (its features' last offset); 
 and the running mean of the LSFs look only back, so they carry from block to block (the last
 ``back`` energies, the running sums). At the end the last frames are repeated, as offline. The
 acoustic search's opinion (step 6) counts by the voice match known when the probability is
-computed (offline: the whole recording's).
+computed (offline: the whole recording's), in both from the frame after the voice has been heard
+(:func:`facetraj_engine.method.voice_match.match_from`).
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..method.closure_detector import ClosureDetector, closure_runs, frame_rows, stacked
+from ..method.voice_match import frame_matches
 
 
 class DetectorStream:
@@ -43,10 +45,12 @@ class DetectorStream:
         return np.concatenate(self._given) if self._given else np.zeros(0)
 
     def feed(self, lsf: np.ndarray, energy_db: np.ndarray, search: np.ndarray | None = None,
-             match: float = 0.0) -> np.ndarray:
+             match: float = 0.0, trusted_from: int = 0) -> np.ndarray:
         """The next frames' LSFs ``(n, P)``, energies ``(n,)`` and the search's rows ``(n, 2)``
         (:mod:`facetraj_engine.method.closure_search`; ``None``: not known); the probabilities
-        now known, the search's opinion counting by the voice ``match``."""
+        now known, the search's opinion counting by the voice ``match`` in frames from
+        ``trusted_from`` on (before it the prior, as offline:
+        :func:`facetraj_engine.method.voice_match.frame_matches`)."""
         if len(energy_db):
             rows, self._sums = frame_rows(lsf, energy_db, self.spec, self.detector.lsf_mean,
                                           self._energy, self._sums)
@@ -54,11 +58,11 @@ class DetectorStream:
             self._rows = np.concatenate([self._rows, rows])
             self._search = np.concatenate([self._search, np.zeros((len(rows), 2)) if search is None
                                            else search])
-        return self._out(self._first + len(self._rows) - self.spec.ahead, match)
+        return self._out(self._first + len(self._rows) - self.spec.ahead, match, trusted_from)
 
-    def flush(self, match: float = 0.0) -> np.ndarray:
+    def flush(self, match: float = 0.0, trusted_from: int = 0) -> np.ndarray:
         """The probabilities of the remaining frames (the input ended: its last frame repeated)."""
-        return self._out(self._first + len(self._rows), match)
+        return self._out(self._first + len(self._rows), match, trusted_from)
 
     def runs(self, since: int, threshold: float, final: bool = False) -> np.ndarray:
         """``(J, 2)`` closures (seconds, step 6) among the frames known from frame ``since`` on;
@@ -74,7 +78,7 @@ class DetectorStream:
         p = self.probabilities()
         return closure_runs(p, np.arange(len(p)) / self.rate, threshold, self.spec.min_frames)
 
-    def _out(self, stop: int, match: float) -> np.ndarray:
+    def _out(self, stop: int, match: float, trusted_from: int) -> np.ndarray:
         """Probabilities of frames ``known .. stop - 1`` (their rows are in)."""
         if stop <= self.known:
             return np.zeros(0)
@@ -83,7 +87,8 @@ class DetectorStream:
         # row is repeated, as offline): clipping to them is offline's clipping to the input
         x = stacked(self._rows, self.spec.offsets, lo, stop - self.known)
         xs = stacked(self._search, self.spec.offsets, lo, stop - self.known)
-        p = self.detector.probability(x, xs, match)
+        first = min(max(trusted_from - self.known, 0), stop - self.known)
+        p = self.detector.probability(x, xs, frame_matches(match, stop - self.known, first))
         self._given.append(p)
         self._p = np.concatenate([self._p, p])
         cut = len(self._p) - int(self.KEEP_S * self.rate)

@@ -40,15 +40,13 @@ from ..method.similarity import top_context_phones
 from ..method.smoothing import TriangularStream
 from ..method.synthesis import gamma_grid, weight_frames
 from ..method.voice_match import trust_by_voice
-from .closure import ClosureStream, decided_pauses
+from .closure import ClosureStream, decided_silence
 from .front import LsfFront
 from .phones import PhoneSnapshot
 from .speech import SpeechStream
 from .synthesizer import StreamFrames
 from .voice import RunningVoice, VoiceTracker
 
-#: Seconds of decided speech/silence the pauses are looked for in, before the frames emitted.
-PAUSE_LOOKBACK_S = 2.0
 #: Frames whose LSFs are computed together once their windows are in (before they are analysed:
 #: a frame waits for its phone far longer than for its window; fewer, larger numpy calls).
 LSF_BATCH = 6
@@ -124,7 +122,8 @@ class PhoneticSynthesizer:
         self._smoother = TriangularStream(self.rate, synth.triangle_s if synth.smoothing ==
                                           "triangular" else 0.0)
         self._closure = ClosureStream(model, self.timing.hold, synth.closure_taper_s,
-                                      synth.rest_taper_s) if synth.closure and model.closure else None
+                                      synth.rest_taper_s, synth.rest_pause_s) \
+            if synth.closure and model.closure else None
         self._gammas = gamma_grid(synth.gamma_min, synth.gamma_max, synth.gamma_steps)
         self._grouped = model.lsf_index().grouped(cb.lsf)
         self._eq4 = ContextCodewords(model, synth)
@@ -251,8 +250,10 @@ class PhoneticSynthesizer:
     def _emit(self, smoothed: np.ndarray | None, final: bool) -> StreamFrames:
         self._voice.update(final)
         pcs = np.zeros((0, self._k)) if smoothed is None else smoothed
-        if self._closure is not None and (len(pcs) or final):
-            pcs = self._closure.feed(pcs, self._plan(), final)
+        closure = self._closure
+        if closure is not None and (len(pcs) or final or closure.received > closure.emitted):
+            pcs = closure.feed(pcs, self._plan(), final,
+                               self.speech.known if self.synth.rest else None)
         index = np.arange(self._emitted, self._emitted + len(pcs))
         self._emitted += len(pcs)
         return StreamFrames(index, index / self.rate, pcs, self.model.to_markers(pcs))
@@ -264,10 +265,13 @@ class PhoneticSynthesizer:
         bil = [s for s in snap.segments if s.label in BILABIALS]
         intervals = np.array([(s.start, min(s.end, snap.settled_s)) for s in bil]).reshape(-1, 2)
         strengths = closure_strengths(len(bil), self.kind, self.voice.match)
-        first = max(0, self._emitted - int(PAUSE_LOOKBACK_S * self.rate))
-        pauses = decided_pauses(self.speech.decisions, first, self.rate, self.synth.rest_pause_s,
-                                lambda times: recognized_silence(snap, times))
-        return ClosurePlan(intervals, strengths, pauses)
+        first = max(0, self._emitted - self._closure.lookback)
+        silent, leading = decided_silence(self.speech.decisions, first,
+                                          lambda times: recognized_silence(snap, times), self.rate) \
+            if self.synth.rest else (np.zeros(0, dtype=bool), False)
+        if not self.synth.closure_labels:
+            intervals, strengths = np.zeros((0, 2)), np.zeros(0)
+        return ClosurePlan(intervals, strengths, silent, silent_from=first, leading=leading)
 
 
 

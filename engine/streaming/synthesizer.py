@@ -32,13 +32,14 @@ import numpy as np
 
 from ..config import SynthConfig
 from ..method.closure import ClosurePlan
+from ..method.closure_detector import causal_closures
 from ..method.closure_search import bilabial_codewords, search_rows
 from ..method.model import Model
 from ..method.search import acoustic_candidates
 from ..method.smoothing import TriangularStream
 from ..method.speaker import warp_lsf
 from ..method.synthesis import FrameWeights, gamma_grid, weight_frames
-from .closure import ClosureStream, decided_pauses
+from .closure import ClosureStream, decided_silence
 from .detector import DetectorStream
 from .front import LsfFront
 from .speech import SpeechStream
@@ -204,9 +205,10 @@ class StreamingSynthesizer:
 
 
 class StreamClosure:
-    """The closure step of an acoustic-only stream: the pauses by energy, the detector's
-    closures (the search's opinion counting by the running voice match), and the step on the
-    smoothed frames (none held)."""
+    """The closure step of an acoustic-only stream: the silent frames by energy, the detector's
+    closures (the search's opinion counting by the running voice match from the frame after the
+    voice has been heard, :func:`facetraj_engine.method.voice_match.match_from`, as offline), and
+    the step on the smoothed frames (none held)."""
 
     def __init__(self, model: Model, sample_rate: int, synth: SynthConfig):
         self.model, self.synth, self.rate = model, synth, model.marker_rate
@@ -216,13 +218,21 @@ class StreamClosure:
         searching = self.detector is not None and model.detector.search is not None
         self.voice = VoiceTracker(model, self.speech) if searching else None
         self._bilabial = bilabial_codewords(model) if searching else None
-        self.step = ClosureStream(model, 0, synth.closure_taper_s, synth.rest_taper_s)
+        self.step = ClosureStream(model, 0, synth.closure_taper_s, synth.rest_taper_s,
+                                  synth.rest_pause_s)
         self._final = False
 
     @property
     def match(self) -> float:
         """The running voice match (the prior until it is measured)."""
         return self.voice.voice.match if self.voice is not None else 0.0
+
+    @property
+    def trusted_from(self) -> int:
+        """The first frame whose detector probability uses the voice match (none yet: a frame
+        beyond every one)."""
+        heard = self.voice.heard_from if self.voice is not None else None
+        return heard if heard is not None else np.iinfo(np.int64).max
 
     def analysed(self, lsf: np.ndarray, energy_db: np.ndarray, w: np.ndarray,
                  frames: FrameWeights) -> None:
@@ -235,7 +245,7 @@ class StreamClosure:
             self.voice.add(w)
             self.voice.update()
             search = search_rows(self.model, frames, self._bilabial)
-        self.detector.feed(lsf, energy_db, search, self.match)
+        self.detector.feed(lsf, energy_db, search, self.match, self.trusted_from)
 
     def finish(self, total: int) -> None:
         """The audio ended (``total`` frames in all)."""
@@ -243,23 +253,28 @@ class StreamClosure:
         if self.detector is not None:
             if self.voice is not None:
                 self.voice.update(final=True)
-            self.detector.flush(self.match)
+            self.detector.flush(self.match, self.trusted_from)
         self._final = True
 
     def feed(self, pcs: np.ndarray, final: bool = False) -> np.ndarray:
         """The smoothed frames after the step, as far as the plan is known now."""
-        if not len(pcs) and not final:
+        if not len(pcs) and not final and self.step.received <= self.step.emitted:
             return pcs
-        return self.step.feed(pcs, self.plan(), final)
+        return self.step.feed(pcs, self.plan(), final,
+                              self.speech.known if self.synth.rest else None)
 
     def plan(self) -> ClosurePlan:
-        """The detector's closures and the pauses around the frames about to be emitted."""
-        emitted = self.step.received - int(ClosureStream.KEEP_S * self.rate)
-        since = max(0, emitted)
-        intervals = self.detector.runs(since, self.synth.closure_threshold, self._final) \
-            if self.detector is not None else np.zeros((0, 2))
-        pauses = decided_pauses(self.speech.decisions, since, self.rate, self.synth.rest_pause_s)
-        return ClosurePlan(intervals, np.ones(len(intervals)), pauses)
+        """The detector's closures and the silent frames around the frames about to be emitted."""
+        intervals = np.zeros((0, 2))
+        if self.detector is not None and self.synth.closure_detector:
+            since = max(0, self.step.received - int(ClosureStream.KEEP_S * self.rate))
+            runs = self.detector.runs(since, self.synth.closure_threshold, self._final)
+            intervals = causal_closures(runs, self.rate, self.detector.spec.min_frames)
+        first = max(0, self.step.emitted - self.step.lookback)
+        silent, leading = decided_silence(self.speech.decisions, first) if self.synth.rest else \
+            (np.zeros(0, dtype=bool), False)
+        return ClosurePlan(intervals, np.ones(len(intervals)), silent, None,
+                           np.ones(len(intervals), dtype=bool), first, leading)
 
 
 def stream_synthesize(model: Model, audio: np.ndarray, sample_rate: int, block: int,

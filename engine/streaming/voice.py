@@ -20,13 +20,16 @@ from collections import deque
 
 import numpy as np
 
-from ..method.voice_match import MAX_FRAMES, indexed_distances, label_weight_scale, voice_match
+from ..method.voice_match import (
+    MAX_FRAMES,
+    MIN_FRAMES,
+    PRIOR_MATCH,
+    indexed_distances,
+    label_weight_scale,
+    voice_match,
+)
 from .speech import SPEECH, SpeechStream
 
-#: Speech frames heard before the running ratio counts (0.5 s of speech at 60 Hz).
-MIN_FRAMES = 30
-#: The voice match assumed until then.
-PRIOR_MATCH = 0.0
 #: Speech frames whose voice distances are computed together (the running ratio moves slowly).
 VOICE_BATCH = 30
 
@@ -85,6 +88,20 @@ class VoiceTracker:
         self.voice = RunningVoice(model.voice_distance)
         self._pending: list[np.ndarray] = []             # LSFs of analysed frames _voiced ...
         self._voiced = 0
+        self._counted, self._heard = 0, 0                 # decisions counted, speech among them
+        self.heard_from: int | None = None
+
+    def _count_heard(self) -> None:
+        """:attr:`heard_from`: the frame after the ``MIN_FRAMES``-th speech frame decided
+        (:func:`facetraj_engine.method.voice_match.match_from`, as offline), once it is."""
+        if self.heard_from is not None:
+            return
+        new = np.asarray(self.speech.decisions[self._counted:]) == SPEECH
+        at = np.flatnonzero(new)
+        if self._heard + at.size >= MIN_FRAMES:
+            self.heard_from = self._counted + int(at[MIN_FRAMES - self._heard - 1]) + 1
+        self._heard += at.size
+        self._counted += new.size
 
     def add(self, lsf: np.ndarray) -> None:
         """The next analysed frames' LSFs."""
@@ -93,6 +110,7 @@ class VoiceTracker:
     def update(self, final: bool = False) -> None:
         """The voice distances of the analysed frames now known to be speech, once there are
         ``VOICE_BATCH`` of them (``final``: all)."""
+        self._count_heard()
         pending = np.concatenate(self._pending) if self._pending else np.zeros((0, 1))
         known = min(self.speech.known, self._voiced + len(pending))
         speech = np.asarray(self.speech.decisions[self._voiced:known]) == SPEECH

@@ -22,7 +22,7 @@ import numpy as np
 from facetraj_engine.errors import FacetrajError
 
 from ..app_modules import app_module
-from ..options import count_or_all, real, synth_config
+from ..options import add_closure_part_options, count_or_all, real, synth_config
 from ..paths import default_corpus
 from .align import add_label_options, label_request
 
@@ -138,8 +138,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="audio block size in ms (default 10)")
     p.add_argument("--acoustic-only", action="store_true",
                    help="the paper's acoustic search without recognizing the phones (lower "
-                        "latency); the lips close where the model's bilabial-closure detector "
-                        "finds a closure")
+                        "latency); the face rests in pauses, and with --closure-detector the "
+                        "lips close where the model's bilabial-closure detector hears a closure")
     p.add_argument("--warp", type=real(0.5, 2.0), default=1.0, metavar="ALPHA",
                    help="with --acoustic-only: speaker warp of the input LSFs "
                         "(facetraj_engine.method.speaker; "
@@ -152,6 +152,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="no closure step: the lips are not closed (at the recognized /p b m/, or "
                         "acoustic-only where the model's detector finds a closure) nor the face "
                         "rested in pauses")
+    add_closure_part_options(g, second_opinion=False)
     g.add_argument("--smoothing", choices=["triangular", "none"])
     g.add_argument("--acoustic-prefilter", type=count_or_all, metavar="K|all",
                    help="weight the K codewords nearest to each frame (default 128)")
