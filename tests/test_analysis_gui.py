@@ -294,6 +294,14 @@ def test_error_view_matches_engine_and_jumps(qtbot, model, corpus, view):
     assert cell_values(w.phone_table, 2) == pytest.approx([p.frames for p in rep.phones])
     assert cell_values(w.phone_table, 4) == pytest.approx([p.correlation for p in rep.phones], nan_ok=True)
     assert cell_values(w.utt_table, 5) == pytest.approx([u.rms for u in rep.utterances])
+    # the closures against the talker's own lips (issue 46): per utterance and pooled
+    assert cell_values(w.utt_table, 9) == pytest.approx([u.closure_precision for u in rep.utterances],
+                                                        nan_ok=True)
+    assert cell_values(w.utt_table, 10) == pytest.approx([u.closure_recall for u in rep.utterances],
+                                                         nan_ok=True)
+    assert rep.closures.talker > 0 and np.isfinite(rep.talker.closed)
+    assert f"recall {100 * rep.closures.recall:.0f} %" in w.status.text()
+    assert "1st percentile" in w.status.toolTip()
     # under the table: the per-phone RMS errors as bars, the worst at the top, with frame counts
     w.phone_chart.finish()                              # built and drawn off the GUI thread
     ax = w.phone_chart.figure.axes[0]

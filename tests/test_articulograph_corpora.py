@@ -94,7 +94,8 @@ def test_two_d_data_runs_the_whole_method(toy_corpus_dir, tmp_path, capsys):
     code, out, err = run(["eval", tmp_path / "m.npz", folder], capsys)
     assert code == 0, err
     rows = [ln.split() for ln in out.splitlines() if ln.startswith(("Train (", "Test ("))]
-    assert len(rows) == 4 and all(-1 <= float(r[-1]) <= 1 for r in rows)
+    assert len(rows) == 4 and all(-1 <= float(r[-3]) <= 1 for r in rows)      # upper lip r
+    assert all(np.isnan(float(r[-1])) or 0 <= float(r[-1]) <= 1 for r in rows)   # closed recall
     code, _, err = run(["synth", tmp_path / "m.npz", folder / "toy004.wav", "-o", tmp_path / "o.tsv"],
                        capsys)
     assert code == 0, err

@@ -93,6 +93,29 @@ def draw_phone_chart(fig: Figure, phones: list) -> None:
     ax.grid(axis="x", alpha=0.3)
 
 
+def closures_line(report: ErrorReport) -> str:
+    """The closures against the talker's own lips, in a sentence (issue 46; the definitions in
+    :data:`CLOSURES_TIP`)."""
+    c, talker = report.closures, report.talker
+    if c is None or talker is None or not np.isfinite(talker.closed):
+        return ""
+    return (f"Closed lips against the talker's (within 1 mm of {talker.closed:.1f} mm): "
+            f"precision {_percent(c.precision)}, recall {_percent(c.recall)} "
+            f"({c.talker} closed frames).")
+
+
+#: What the closed-lips figures mean (the status line's and the table columns' tooltip).
+CLOSURES_TIP = ("A frame's lips are closed when their aperture is within 1 mm of the talker's "
+                "closed aperture: the median of its lips' minima at its labelled /p b m/, else the "
+                "1st percentile of its speech frames. Precision: of the synthesized closed frames, "
+                "the share closed in the original; recall: of the original's closed frames, the "
+                "share closed in the synthesis (speech frames, as the correlations).")
+
+
+def _percent(x: float) -> str:
+    return "–" if not np.isfinite(x) else f"{100 * x:.0f} %"
+
+
 class ErrorView(QWidget):
     """Per-phone, per-utterance and worst-segment errors over a corpus."""
 
@@ -203,10 +226,13 @@ class ErrorView(QWidget):
                  *(heat_item(getattr(u, m), 0.0, 1.0, "{:.3f}", "RdYlGn")
                    for m in ("whole_face", "lower_lip", "upper_lip")),
                  heat_item(u.rms, rms_ulo, rms_u, "{:.2f}"), text_item(u.worst_label),
-                 NumberItem(u.worst_time, "{:.2f}"), NumberItem(u.worst_error, "{:.2f}")]
+                 NumberItem(u.worst_time, "{:.2f}"), NumberItem(u.worst_error, "{:.2f}"),
+                 *(heat_item(v, 0.0, 1.0, "{:.2f}", "RdYlGn")
+                   for v in (u.closure_precision, u.closure_recall))]
                 for u in report.utterances]
         fill_table(self.utt_table, ["utterance", "split", "whole face r", "lower lip r", "upper lip r",
-                                    "RMS (mm)", "worst phone", "at (s)", "its error (mm)"], rows)
+                                    "RMS (mm)", "worst phone", "at (s)", "its error (mm)",
+                                    "closed precision", "closed recall"], rows)
         rows = [[text_item(s.utterance), text_item(s.label), NumberItem(s.start, "{:.3f}"),
                  NumberItem(s.end, "{:.3f}"),
                  heat_item(s.error, report.worst[-1].error, report.worst[0].error, "{:.2f}")]
@@ -214,7 +240,10 @@ class ErrorView(QWidget):
         fill_table(self.worst_table, ["utterance", "phone", "start (s)", "end (s)", "mean lip error (mm)"],
                    rows)
         self.status.setText(f"{len(report.utterances)} utterances, {len(report.phones)} phones. "
-                            "Click an utterance or a segment to go there.")
+                            f"{closures_line(report)} Click an utterance or a segment to go there.")
+        self.status.setToolTip(CLOSURES_TIP)
+        for col in (9, 10):
+            self.utt_table.horizontalHeaderItem(col).setToolTip(CLOSURES_TIP)
 
     def _draw_phone_chart(self, report: ErrorReport) -> None:
         """Per-phone RMS error as horizontal bars (built and drawn off the GUI thread)."""

@@ -1,5 +1,7 @@
 """The errors view's numbers: per-frame lip error, per-phone correlation and RMS error,
-per-utterance errors and the worst segments of a synthesis against the original markers."""
+per-utterance errors and the worst segments of a synthesis against the original markers; and the
+synthesized closures judged by the talker's own lips (issue 46,
+:mod:`facetraj_engine.evaluation.closed_lips`)."""
 
 from __future__ import annotations
 
@@ -12,6 +14,14 @@ import numpy as np
 
 from ..config import EvalConfig, SynthConfig
 from ..data import PhoneSegment, Utterance
+from ..evaluation.closed_lips import (
+    ClosureAgreement,
+    TalkerClosed,
+    TalkerLips,
+    agreements,
+    talker_closed,
+    talker_lips,
+)
 from ..evaluation.scores import pearson, speech_mask, trajectory_correlations
 from ..io.corpus import Corpus
 from ..labels.phoneset import SILENCE
@@ -107,7 +117,9 @@ class PhoneError:
 @dataclass
 class UtteranceError:
     """Errors of one utterance: the Table 2 correlations on speech frames, the RMS lip error on
-    speech frames (mm), and its worst segment (time = segment centre)."""
+    speech frames (mm), its worst segment (time = segment centre), and on the same frames the
+    synthesized closures' precision and recall against the talker's closed lips (NaN until the
+    talker's closed value is known over the utterances analysed, :func:`error_report`)."""
 
     utterance: str
     split: str
@@ -118,6 +130,8 @@ class UtteranceError:
     worst_label: str
     worst_time: float
     worst_error: float
+    closure_precision: float = float("nan")
+    closure_recall: float = float("nan")
 
 
 @dataclass
@@ -130,6 +144,7 @@ class UtteranceAnalysis:
     segments: list[SegmentError]
     frame_phone: list[str]          # label of each frame
     lips_y: np.ndarray              # (T, 2, 2): [frame, (original, synthesized), (upper, lower)]
+    lips: TalkerLips | None = None  # the original and synthesized apertures on speech frames
 
 
 def analyse_utterance(model: Model, utt: Utterance, split: str = "test",
@@ -160,16 +175,32 @@ def analyse_utterance(model: Model, utt: Utterance, split: str = "test",
                        syn[:, [model.upper_lip, model.lower_lip], y]], axis=1)
     summary = UtteranceError(utt.name, split, corr["whole_face"], corr["lower_lip"],
                              corr["upper_lip"], rms, w.label, 0.5 * (w.start + w.end), w.error)
-    return UtteranceAnalysis(summary, times, err, segs, labels, lips_y)
+    lips = talker_lips(orig, times, utt.phones, mask, model.upper_lip, model.lower_lip)
+    lips.add(syn)
+    return UtteranceAnalysis(summary, times, err, segs, labels, lips_y, lips)
 
 
 @dataclass
 class ErrorReport:
-    """Per-phone and per-utterance errors over a set of utterances, and the worst segments."""
+    """Per-phone and per-utterance errors over a set of utterances, the worst segments, and the
+    closures against the talker's lips (``talker``: its closed value; ``closures``: pooled)."""
 
     phones: list[PhoneError] = field(default_factory=list)
     utterances: list[UtteranceError] = field(default_factory=list)
     worst: list[SegmentError] = field(default_factory=list)
+    talker: TalkerClosed | None = None
+    closures: ClosureAgreement | None = None
+
+
+def judge_closures(analyses: Sequence[UtteranceAnalysis]) -> tuple[TalkerClosed, ClosureAgreement]:
+    """The talker's closed value over ``analyses`` (each with its lips), each utterance's
+    closure precision and recall set on its summary, and the pooled agreement."""
+    parts = [a.lips for a in analyses if a.lips is not None]
+    talker = talker_closed(parts)
+    counts = [c[0] for c in agreements(parts, talker)]
+    for a, c in zip([a for a in analyses if a.lips is not None], counts, strict=True):
+        a.summary.closure_precision, a.summary.closure_recall = c.precision, c.recall
+    return talker, ClosureAgreement.pooled(counts)
 
 
 def phone_errors(analyses: Sequence[UtteranceAnalysis],
@@ -217,19 +248,22 @@ def error_report(model: Model, corpus: Corpus, splits: Sequence[str] = ("test",)
     if progress:
         progress(1.0, "done")
     segs = [s for a in analyses for s in a.segments]
+    talker, closures = judge_closures(analyses)
     return ErrorReport(phone_errors(analyses), [a.summary for a in analyses],
-                       worst_segments(segs, worst_count))
+                       worst_segments(segs, worst_count), talker, closures)
 
 
 def write_error_csv(path: str | os.PathLike[str], report: ErrorReport, overwrite: bool = True) -> Path:
     """Write the per-utterance errors as CSV."""
     return write_csv(path, ["utterance", "split", "whole_face", "lower_lip", "upper_lip", "rms_mm",
-                            "worst_phone", "worst_time", "worst_error_mm"],
+                            "worst_phone", "worst_time", "worst_error_mm", "closure_precision",
+                            "closure_recall"],
                      ([u.utterance, u.split, u.whole_face, u.lower_lip, u.upper_lip, u.rms,
-                       u.worst_label, u.worst_time, u.worst_error] for u in report.utterances),
+                       u.worst_label, u.worst_time, u.worst_error, u.closure_precision,
+                       u.closure_recall] for u in report.utterances),
                      overwrite)
 
 
 __all__ = ["MIN_CORRELATION_FRAMES", "ErrorReport", "PhoneError", "SegmentError", "UtteranceAnalysis",
-           "UtteranceError", "analyse_utterance", "error_report", "lip_error", "phone_errors",
-           "segment_errors", "worst_segments", "write_error_csv"]
+           "UtteranceError", "analyse_utterance", "error_report", "judge_closures", "lip_error",
+           "phone_errors", "segment_errors", "worst_segments", "write_error_csv"]

@@ -34,11 +34,14 @@ def condition_name(split: str, smoothing: str, mode: str = "phonetic", n: int | 
 @dataclass(kw_only=True)
 class Table2Row(ConditionScores):
     """One row of Table 2: the condition, its three mean correlations (the fields of
-    :class:`~facetraj_engine.evaluation.scores.ConditionScores`), a row ``name`` and the number of
-    utterances."""
+    :class:`~facetraj_engine.evaluation.scores.ConditionScores`), a row ``name``, the number of
+    utterances, and the synthesized closures' precision and recall against the talker's own lips
+    (:mod:`facetraj_engine.evaluation.closed_lips`)."""
 
     name: str
     utterances: int
+    closure_precision: float = float("nan")
+    closure_recall: float = float("nan")
 
 
 def table2_rows(result: EvalResult) -> list[Table2Row]:
@@ -61,9 +64,11 @@ def write_table2_csv(path: str | os.PathLike[str], result: EvalResult, overwrite
     """Write Table 2 (plus acoustic-only rows) as CSV."""
     rows = table2_rows(result)
     return write_csv(path, ["condition", "split", "mode", "smoothing", "N", "whole_face",
-                            "lower_lip", "upper_lip", "utterances"],
+                            "lower_lip", "upper_lip", "utterances", "closure_precision",
+                            "closure_recall"],
                      ([r.name, r.split, r.mode, r.smoothing, r.n_context_phones, r.whole_face,
-                       r.lower_lip, r.upper_lip, r.utterances] for r in rows), overwrite)
+                       r.lower_lip, r.upper_lip, r.utterances, r.closure_precision,
+                       r.closure_recall] for r in rows), overwrite)
 
 
 @dataclass

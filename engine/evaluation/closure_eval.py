@@ -40,7 +40,11 @@ from ..method.pipeline import Synthesis, synthesize
 from ..streaming.live import FileTake, LiveConfig, stream_file
 from ..streaming.recognizer import RecognizerConfig, RunningCmn
 from ..workflow.recording import LabelRequest, synthesize_recording
+from .closed_lips import ClosureAgreement, TalkerClosed, TalkerLips, agreements, talker_closed, talker_lips
 from .closure import ClosureScore, DetectorScore, closure_score, detector_score, lip_aperture
+from .closure_parts import PartRow, real_talker_rows
+from .closure_parts import corpus_rows as part_rows
+from .closure_parts import format_markdown as parts_markdown
 from .scores import speech_mask, trajectory_correlations
 from .second_voice import second_voice
 
@@ -52,8 +56,11 @@ ARCTIC_DIR = "data/arctic_samples"
 AIMS = {"corpus exact": 0.9, "arctic aligned": 0.8, "arctic recognized": 0.7,
         "arctic acoustic": 0.5, "vowel max mm": 17.0, "vowels shut": 0.05}
 #: How the report names the acoustic-only synthesis with the closure step, and live mode's.
-ACOUSTIC_STEP = "acoustic-only + closure step: the detector's closures, rest in pauses (--mode acoustic)"
-LIVE_ACOUSTIC = "live mode, acoustic-only (--acoustic-only): the detector's closures"
+ACOUSTIC_STEP = ("acoustic-only + closure step with the detector: its closures, rest in pauses "
+                 "(--mode acoustic --closure-detector)")
+LIVE_ACOUSTIC = "live mode, acoustic-only with the detector (--acoustic-only --closure-detector)"
+#: The acoustic-only synthesis with the detector asked for.
+DETECTING = SynthConfig(mode="acoustic", closure_detector=True)
 #: Live mode's audio blocks (a typical audio callback).
 LIVE_BLOCK_S = 0.01
 
@@ -61,7 +68,9 @@ LIVE_BLOCK_S = 0.01
 @dataclass
 class ClosureRow:
     """One condition: its data set, labels, how it was synthesized, the closure score and (on
-    the corpus) the Table 2 correlations."""
+    the corpus) the Table 2 correlations and the closures against the talker's own lips
+    (``lips``: their :class:`~facetraj_engine.evaluation.closed_lips.TalkerLips`, judged once the
+    talker's closed value is known, :func:`judge_rows`)."""
 
     data: str
     labels: str
@@ -69,22 +78,43 @@ class ClosureRow:
     score: dict
     correlations: dict = field(default_factory=dict)
     detector: dict | None = None
+    lips: list[TalkerLips] = field(default_factory=list)
+    closed: dict = field(default_factory=dict)
 
     def to_json(self) -> dict:
         return {"data": self.data, "labels": self.labels, "synthesis": self.synthesis,
                 **self.score, **{f"r_{k}": v for k, v in self.correlations.items()},
+                **self.closed,
                 **({"detector": self.detector} if self.detector is not None else {})}
+
+
+def judge_rows(rows: Sequence[ClosureRow]) -> TalkerClosed | None:
+    """The talker's closed value over the first row's utterances with lips (every row of a data
+    set holds the same originals), and each row's closures judged by it: precision and recall
+    (``closed_precision``, ``closed_recall``)."""
+    first = next((r for r in rows if r.lips), None)
+    if first is None:
+        return None
+    talker = talker_closed(first.lips)
+    for r in rows:
+        if r.lips:
+            pooled = ClosureAgreement.pooled([c[0] for c in agreements(r.lips, talker)])
+            r.closed = {"closed_precision": pooled.precision, "closed_recall": pooled.recall}
+    return talker
 
 
 @dataclass
 class ClosureEval:
-    """Every row, and the closed aperture they are measured against."""
+    """Every row, the closed aperture they are measured against, and each part of the closure
+    step with and without it (:mod:`facetraj_engine.evaluation.closure_parts`)."""
 
     closed: float
     rows: list[ClosureRow] = field(default_factory=list)
+    parts: list[PartRow] = field(default_factory=list)
 
     def to_json(self) -> dict:
-        return {"closed": self.closed, "rows": [r.to_json() for r in self.rows]}
+        return {"closed": self.closed, "rows": [r.to_json() for r in self.rows],
+                "parts": [r.to_json() for r in self.parts]}
 
 
 # --------------------------------------------------------------------------- the corpus
@@ -99,21 +129,25 @@ CORPUS_CONDITIONS = (
     ("recognized", "default (robust + closure step)", SynthConfig(), True),
     ("recognized", "the paper's phonetic mode", SynthConfig(closure=False), False),
     ("none", "acoustic-only (paper)", SynthConfig(mode="acoustic", closure=False), False),
-    ("none", ACOUSTIC_STEP, SynthConfig(mode="acoustic"), False),
+    ("none", ACOUSTIC_STEP, DETECTING, False),
 )
 
 
 def _aperture_scored(model: Model, markers: np.ndarray, times: np.ndarray,
-                     reference: Sequence[PhoneSegment], utt=None) -> tuple[ClosureScore, dict]:
+                     reference: Sequence[PhoneSegment], utt=None
+                     ) -> tuple[ClosureScore, dict, TalkerLips | None]:
     """The closure of ``markers`` at the ``reference`` phones, and (``utt`` with markers: its
-    original face, speech and audio) their correlations with the original face."""
+    original face, speech and audio) their correlations with the original face and the lips of
+    both (:func:`~facetraj_engine.evaluation.closed_lips.talker_lips`)."""
     aperture = lip_aperture(markers, model.upper_lip, model.lower_lip)
     score = closure_score(aperture, times, reference, model.closure.closed)
     if utt is None or utt.markers is None:
-        return score, {}
+        return score, {}, None
     mask = speech_mask(utt.audio, utt.sample_rate, times)
-    return score, trajectory_correlations(model.normalise_markers(utt.markers), markers, mask,
-                                          model)
+    original = model.normalise_markers(utt.markers)
+    lips = talker_lips(original, times, reference, mask, model.upper_lip, model.lower_lip)
+    lips.add(markers)
+    return score, trajectory_correlations(original, markers, mask, model), lips
 
 
 def _detected(res: Synthesis, reference: Sequence[PhoneSegment]) -> DetectorScore | None:
@@ -149,20 +183,22 @@ def corpus_rows(model: Model, corpus: Corpus, progress: Callable[[float, str], N
         if kind not in by_kind:
             by_kind[kind] = relabelled(corpus, kind, split="test")
         lab = by_kind[kind]
-        scores, cors, found = [], [], []
+        scores, cors, found, lips = [], [], [], []
         for utt_id in lab.info.test:
             ref, utt = corpus.utterance(utt_id), lab.utterance(utt_id)
             phones = None if kind == "none" else utt.phones
             c = choose_mode(cfg, phones, utt.provenance, tuned=model.tuned).config if rule else cfg
             res = synthesize(model, utt.audio, utt.sample_rate, phones, c, n_frames=utt.n_frames,
                              source=utt.name, confidence=utt.confidence, provenance=utt.provenance)
-            s, r = _aperture_scored(model, res.markers, res.times, ref.phones, utt)
+            s, r, lip = _aperture_scored(model, res.markers, res.times, ref.phones, ref)
             scores.append(s)
             cors.append(r)
+            lips.append(lip)
             found.append(_detected(res, ref.phones))
         rows.append(ClosureRow(f"{corpus.root.name} test", kind, name,
                                ClosureScore.pooled(scores).to_json(), _mean_correlations(cors),
-                               _pooled_detector(found)))
+                               _pooled_detector(found), lips))
+    judge_rows(rows)
     return rows
 
 
@@ -178,7 +214,7 @@ def _mean_correlations(cors: Sequence[dict]) -> dict:
 #: second voice: (synthesis shown, config offline or ``None`` for live mode's stream).
 ACOUSTIC_CONDITIONS = (
     ("acoustic-only (paper)", SynthConfig(mode="acoustic", closure=False)),
-    (ACOUSTIC_STEP, SynthConfig(mode="acoustic")),
+    (ACOUSTIC_STEP, DETECTING),
     (LIVE_ACOUSTIC, None),
 )
 
@@ -190,7 +226,8 @@ def acoustic_rows(model: Model, corpus: Corpus, progress: Callable[[float, str],
     :data:`ACOUSTIC_CONDITIONS`: the detector on a voice it was not trained on."""
     conditions = [(v, name, cfg) for v in voices for name, cfg in ACOUSTIC_CONDITIONS
                   if v == "second" or cfg is None]
-    parts: dict[tuple[str, str], tuple[list, list, list]] = {c[:2]: ([], [], []) for c in conditions}
+    parts: dict[tuple[str, str], tuple[list, list, list, list]] = {c[:2]: ([], [], [], [])
+                                                                    for c in conditions}
     test = list(corpus.info.test)
     for j, utt_id in enumerate(test):
         progress(j / len(test), f"closure: acoustic-only, {utt_id}")
@@ -200,20 +237,23 @@ def acoustic_rows(model: Model, corpus: Corpus, progress: Callable[[float, str],
             audio["second"] = second_voice(utt.audio, utt.sample_rate)
         for voice, name, cfg in conditions:
             if cfg is None:
-                take = stream_file(model, audio[voice], utt.sample_rate, LIVE_BLOCK_S,
-                                   config=LiveConfig(phones=False))
+                take = stream_file(model, audio[voice], utt.sample_rate, LIVE_BLOCK_S, DETECTING,
+                                   LiveConfig(phones=False))
                 markers, found = take.frames.markers, _take_detected(model, take, utt.phones)
             else:
                 res = synthesize(model, audio[voice], utt.sample_rate, None, cfg,
                                  n_frames=utt.n_frames, source=utt.name)
                 markers, found = res.markers, _detected(res, utt.phones)
-            s, r = _aperture_scored(model, markers, utt.frame_times(len(markers)), utt.phones, utt)
-            for part, x in zip(parts[(voice, name)], (s, r, found), strict=True):
+            s, r, lips = _aperture_scored(model, markers, utt.frame_times(len(markers)), utt.phones,
+                                          utt)
+            for part, x in zip(parts[(voice, name)], (s, r, found, lips), strict=True):
                 part.append(x)
     data = {"training": f"{corpus.root.name} test", "second": f"{corpus.root.name} test, second voice"}
-    return [ClosureRow(data[voice], "none", name, ClosureScore.pooled(scores).to_json(),
-                       _mean_correlations(cors), _pooled_detector(found))
-            for (voice, name), (scores, cors, found) in parts.items()]
+    rows = [ClosureRow(data[voice], "none", name, ClosureScore.pooled(scores).to_json(),
+                       _mean_correlations(cors), _pooled_detector(found), lips)
+            for (voice, name), (scores, cors, found, lips) in parts.items()]
+    judge_rows(rows)
+    return rows
 
 
 # --------------------------------------------------------------------------- real voices
@@ -225,7 +265,9 @@ ARCTIC_CONDITIONS = (
     ("recognized", "the paper's phonetic mode", "recognize", SynthConfig(closure=False), True),
     ("none", "default: synth with the recording alone (recognizes its phones)", "alone",
      SynthConfig(), False),
-    ("none", ACOUSTIC_STEP, "none", SynthConfig(mode="acoustic"), True),
+    ("none", "acoustic-only + closure step as by default: rest in pauses (--mode acoustic)", "none",
+     SynthConfig(mode="acoustic"), True),
+    ("none", ACOUSTIC_STEP, "none", DETECTING, True),
     ("none", "acoustic-only (paper)", "none", SynthConfig(mode="acoustic", closure=False), True),
 )
 
@@ -244,7 +286,7 @@ LIVE_CONDITIONS = (
         recognizer=RecognizerConfig(cmn_every=None)), SynthConfig(), False),
     ("live mode, the six as takes of one Live window (cepstral mean kept)", LiveConfig(),
      SynthConfig(), True),
-    (LIVE_ACOUSTIC, LiveConfig(phones=False), SynthConfig(), False),
+    (LIVE_ACOUSTIC, LiveConfig(phones=False), DETECTING, False),
 )
 
 
@@ -320,16 +362,22 @@ def arctic_rows(model: Model, folder: Path, progress: Callable[[float, str], Non
 
 
 def evaluate_closure(model: Model, corpus: Corpus, arctic: str | os.PathLike[str] | None = None,
-                     progress: Callable[[float, str], None] | None = None) -> ClosureEval:
+                     progress: Callable[[float, str], None] | None = None,
+                     mocha: str | os.PathLike[str] | None = None, workers: int = 1) -> ClosureEval:
     """Every condition on ``corpus``'s test split, and on the recordings of ``arctic`` when
-    given (a folder of ``.wav`` with their ``.txt``)."""
+    given (a folder of ``.wav`` with their ``.txt``); each part of the closure step with and
+    without it on the corpus and, when given, on the real talker of the MOCHA-TIMIT sample
+    folder ``mocha`` (:mod:`facetraj_engine.evaluation.closure_parts`)."""
     progress = progress or (lambda f, m: None)
     if model.closure is None:
         raise ValueError("the model has no closure statistics: train it again")
-    out = ClosureEval(model.closure.closed, corpus_rows(model, corpus, lambda f, m: progress(0.5 * f, m)))
-    out.rows += acoustic_rows(model, corpus, lambda f, m: progress(0.5 + 0.25 * f, m))
+    out = ClosureEval(model.closure.closed, corpus_rows(model, corpus, lambda f, m: progress(0.4 * f, m)))
+    out.rows += acoustic_rows(model, corpus, lambda f, m: progress(0.4 + 0.2 * f, m))
     if arctic is not None and Path(arctic).is_dir():
-        out.rows += arctic_rows(model, Path(arctic), lambda f, m: progress(0.75 + 0.25 * f, m))
+        out.rows += arctic_rows(model, Path(arctic), lambda f, m: progress(0.6 + 0.2 * f, m))
+    if mocha is not None and Path(mocha).is_dir():
+        out.parts += real_talker_rows(model, mocha)
+    out.parts += part_rows(model, corpus, workers, lambda f, m: progress(0.8 + 0.2 * f, m))
     progress(1.0, "closure: done")
     return out
 
@@ -354,29 +402,38 @@ def format_markdown(data: dict) -> list[str]:
              f"beside it the median minimum, the median over vowels of each vowel's largest "
              f"aperture (lips that stay shut cannot pass), the median aperture in pauses over "
              f"150 ms, and where the lips shut with no /p b m/ there: the share of vowels whose "
-             f"largest aperture is within 1 mm of closed (*vowels shut*), and of the other "
-             f"consonants whose smallest is (*consonants shut*; the tapers of a closure reach its "
-             f"neighbours: compare the rows with labels). The *closure step* "
-             f"(`engine/method/closure.py`) runs after eq 8 and the smoothing: the lips close at "
-             f"the labelled /p b m/ (recognized ones trusted as far as the voice is not the "
-             f"training voice, and beside them the detector's closures as far as it is), without "
-             f"labels where the bilabial-closure detector finds a closure "
-             f"(`engine/method/closure_detector.py`), and the face rests in pauses. The "
+             f"largest aperture is within 1 mm of closed (*vowels shut*), and of the non-labial "
+             f"consonants (not /p b m f v w/) whose smallest aperture over the middle half of "
+             f"the segment is (*consonants shut*). The *closure step* "
+             f"(`engine/method/closure.py`) runs after eq 8 and the smoothing: by default the "
+             f"lips close at the labelled /p b m/ (recognized ones trusted as far as the voice "
+             f"is not the training voice) and the face rests in pauses; asked for "
+             f"(`--closure-detector`), without labels the lips close where the bilabial-closure "
+             f"detector finds a closure (`engine/method/closure_detector.py`), and "
+             f"(`--closure-second-opinion`) beside recognized labels too, trusted by the voice "
+             f"match. The "
              f"*second voice* is each held-out sentence made to sound as a shorter vocal tract "
              f"and a higher voice (`engine/evaluation/second_voice.py`), its face the original's. "
+             f"*Closed P, R*: the synthesized closures judged by the talker's own lips, where "
+             f"there are lips (`engine/evaluation/closed_lips.py`): a frame is closed within 1 mm "
+             f"of the talker's closed aperture (the median of its lips' minima at the labelled "
+             f"/p b m/), and of the synthesized closed frames the share closed in the original "
+             f"(precision), of the original's the share closed in the synthesis (recall), on "
+             f"speech frames. "
              f"Computed by `facetraj report --closure` (`engine/evaluation/closure_eval.py`).", "",
              "| Data | Labels | Synthesis | /p b m/ | Within 1 mm | Median min (mm) | "
              "Vowel max (mm) | Pause (mm) | Vowels shut | Consonants shut | Whole face | "
-             "Lower lip | Upper lip |",
-             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+             "Lower lip | Upper lip | Closed P | Closed R |",
+             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in data["rows"]:
         cor = [f"{r[k]:.3f}" if f"{k}" in r else "–" for k in ("r_whole_face", "r_lower_lip",
                                                                   "r_upper_lip")]
         lines.append(f"| {r['data']} | {r['labels']} | {r['synthesis']} | {r['n']} | "
                      f"{100 * r['within']:.0f} % | {r['median_min']:.1f} | {r['vowel_max']:.1f} | "
                      f"{r['pause']:.1f} | {_percent(r, 'vowels_shut')} | "
-                     f"{_percent(r, 'consonants_shut')} | " + " | ".join(cor) + " |")
-    return [*lines, "", *detector_markdown(data)]
+                     f"{_percent(r, 'consonants_shut')} | " + " | ".join(cor) + " | "
+                     f"{_percent(r, 'closed_precision')} | {_percent(r, 'closed_recall')} |")
+    return [*lines, "", *parts_markdown(data.get("parts", [])), *detector_markdown(data)]
 
 
 def _percent(row: dict, key: str) -> str:

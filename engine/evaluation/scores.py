@@ -310,14 +310,11 @@ def format_table2(result: EvalResult) -> str:
     for row in result.table():
         name = f"{row['split'].title()} ({row['smoothing']}, {row['mode']}, N={row['n_context_phones']})"
         lines.append(f"{name:<34} {row['whole_face']:>10.4f} {row['lower_lip']:>10.4f} "
-                     f"{row['upper_lip']:>10.4f} {_share(row['closure_precision']):>9} "
-                     f"{_share(row['closure_recall']):>9}")
+                     f"{row['upper_lip']:>10.4f} {row['closure_precision']:>9.3f} "
+                     f"{row['closure_recall']:>9.3f}")
     if result.talker is not None:
-        lines.append(f"Closed P, R: frames closed within {CLOSED_TOL_MM:g} mm in the synthesis "
-                     f"that are closed in the original, and the reverse; "
+        lines.append(f"Closed P, R: the share of the synthesized frames closed within "
+                     f"{CLOSED_TOL_MM:g} mm that are closed in the original, and the reverse; "
                      f"{result.talker.describe()}")
     return "\n".join(lines)
 
-
-def _share(x: float) -> str:
-    return "-" if not np.isfinite(x) else f"{100 * x:.1f} %"

@@ -108,13 +108,15 @@ def cmd_report(args: argparse.Namespace) -> int:
             evaluate_closure,
             write_closure_eval,
         )
+        from facetraj_engine.evaluation.closure_parts import MOCHA_DIR
         from facetraj_engine.io.corpus import load_corpus
         from facetraj_engine.method.training import train
 
         corpus = load_corpus(args.corpus or default_corpus())
         args.output.mkdir(parents=True, exist_ok=True)
         result = evaluate_closure(model or train(corpus), corpus, shared_path(ARCTIC_DIR),
-                                  progress=TerminalProgress("closure"))
+                                  progress=TerminalProgress("closure"),
+                                  mocha=shared_path(MOCHA_DIR), workers=jobs(args))
         write_closure_eval(args.output / CLOSURE_EVAL_FILE, result)
     skipped = skips(args)
     out = write_report(args.corpus, args.output, model=model, progress=TerminalProgress("report"),
