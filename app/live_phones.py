@@ -150,8 +150,8 @@ class PhonePanel:
         self.switch.setCurrentIndex(0 if phones else 1)
         self.switch.setToolTip("phones + acoustics: phones recognized as they are spoken weigh "
                                "the search and close the lips (about 230 ms behind the voice); "
-                               "acoustic-only: the paper's search, the lips closed where the "
-                               "model's detector hears a closure (about 130 ms); for the next take")
+                               "acoustic-only: the paper's search, the face resting in pauses "
+                               "(about 130 ms); for the next take")
         toolbar.addWidget(QLabel(" mode: "))
         toolbar.addWidget(self.switch)
         self.open_action = toolbar.addAction("Open recording...", window.open_dialog)
