@@ -7,6 +7,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass, field, replace
+from typing import ClassVar
 
 import numpy as np
 
@@ -19,6 +20,7 @@ from ..method.modes import choose_mode
 from ..method.pipeline import Synthesis, resmooth, synthesize
 from ..method.speech import speech_mask
 from ..threads import limit_frame_threads, one_blas_thread, usable_cores
+from .sensors import SensorTable, pooled, sensor_scores
 
 log = logging.getLogger(__name__)
 
@@ -86,10 +88,14 @@ class ConditionScores:
 
 @dataclass(kw_only=True)
 class UtteranceScore(ConditionScores):
-    """Correlations of one utterance under one condition, on its ``speech_frames`` frames."""
+    """Correlations of one utterance under one condition, on its ``speech_frames`` frames;
+    ``sensors``: every sensor coordinate's r and RMSE
+    (:func:`~facetraj_engine.evaluation.sensors.sensor_scores`, set by the evaluation; not a
+    field, so not in a score's JSON: :meth:`EvalResult.sensor_table` pools them)."""
 
     utterance: str
     speech_frames: int
+    sensors: ClassVar[tuple] = ()
 
 
 def _nanmean(values: Sequence[float]) -> float:
@@ -113,6 +119,13 @@ class EvalResult:
                 and r.mode == mode and (n is None or r.n_context_phones == n)]
         return {m: _nanmean([getattr(r, m) for r in rows]) for m in METRICS}
 
+    def sensor_table(self, split: str, smoothing: str, mode: str = "phonetic",
+                     n: int | None = None) -> SensorTable:
+        """Per-sensor r and RMSE (mm) of one condition over its utterances
+        (:func:`~facetraj_engine.evaluation.sensors.pooled`)."""
+        return pooled(r.sensors for r in self.scores if r.split == split and r.smoothing == smoothing
+                      and r.mode == mode and (n is None or r.n_context_phones == n))
+
     def conditions(self) -> list[tuple[str, str, str, int]]:
         seen: dict[tuple[str, str, str, int], None] = {}
         for r in self.scores:
@@ -127,7 +140,10 @@ class EvalResult:
     def to_json(self) -> dict:
         # the utterance first, as it reads
         return {"table": self.table(),
-                "utterances": [{"utterance": r.utterance, **asdict(r)} for r in self.scores]}
+                "utterances": [{"utterance": r.utterance, **asdict(r)} for r in self.scores],
+                "sensors": [{"split": sp, "mode": mo, "smoothing": sm, "n_context_phones": n,
+                             **self.sensor_table(sp, sm, mo, n).to_json()}
+                            for sp, mo, sm, n in self.conditions()]}
 
 
 def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
@@ -167,6 +183,7 @@ def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
         out.append(UtteranceScore(split=split, mode=config.mode, smoothing=sm,
                                   n_context_phones=config.n_context_phones, **c,
                                   utterance=utt.name, speech_frames=int(mask.sum())))
+        out[-1].sensors = tuple(sensor_scores(original, markers, mask, model))
     return out
 
 
