@@ -59,6 +59,16 @@ def _lines(segments: list[list[int]]) -> np.ndarray:
     return np.concatenate([[len(s), *s] for s in segments]) if segments else np.zeros(0, int)
 
 
+def link_segments(roles: SensorRoles) -> list[list[int]]:
+    """The thin lines between sensors: the aperture (upper to lower lip), each lip corner to both
+    lips, the jaw sensors joined."""
+    segs = [[roles.upper_lip, roles.lower_lip]]
+    segs += [[roles.upper_lip, c, roles.lower_lip] for c in roles.lip_corners]
+    if len(roles.jaw) > 1:
+        segs.append(list(roles.jaw))
+    return segs
+
+
 def _verts(indices) -> np.ndarray:
     return np.column_stack([np.ones(len(indices), int), np.asarray(indices, int)]).ravel()
 
@@ -88,7 +98,7 @@ class ArticulatorSet:
                                                 name=f"{name}-reference", **common)
         self.links = pv.PolyData()
         self.links.SetPoints(self.points.GetPoints())
-        self.links.lines = _lines(self._link_segments())
+        self.links.lines = _lines(link_segments(roles))
         self.link_actor = plotter.add_mesh(self.links, color=color, line_width=2.0,
                                            name=f"{name}-links", **common)
         self.tongue = pv.PolyData(tongue_curve(self.current[list(roles.tongue)]))
@@ -103,16 +113,6 @@ class ArticulatorSet:
         self.palate_actor.SetVisibility(False)
         self.has_palate = False
         self._actors = [self.actor, self.reference_actor, self.link_actor, self.tongue_actor]
-
-    def _link_segments(self) -> list[list[int]]:
-        """The thin lines: the aperture (upper to lower lip), each lip corner to both lips, the
-        jaw sensors joined."""
-        r = self.roles
-        segs = [[r.upper_lip, r.lower_lip]]
-        segs += [[r.upper_lip, c, r.lower_lip] for c in r.lip_corners]
-        if len(r.jaw) > 1:
-            segs.append(list(r.jaw))
-        return segs
 
     def tongue_points(self) -> np.ndarray:
         """The tongue curve as drawn, ``(n, 3)``."""
@@ -200,11 +200,8 @@ class ProfileDrawing:
         curve = tongue_curve(points[list(r.tongue)]) if r.tongue else np.zeros((0, 3))
         self.tongue.set_data(curve[:, h], curve[:, v])
         self.points.set_data(points[self.moving, h], points[self.moving, v])
-        segs = [[r.upper_lip, r.lower_lip], *([r.upper_lip, c, r.lower_lip] for c in r.lip_corners)]
-        if len(r.jaw) > 1:
-            segs.append(list(r.jaw))
         xs, ys = [], []
-        for seg in segs:                          # one line, broken by NaN between the segments
+        for seg in link_segments(r):                          # one line, broken by NaN between the segments
             xs += [*points[seg, h], np.nan]
             ys += [*points[seg, v], np.nan]
         self.links.set_data(xs, ys)

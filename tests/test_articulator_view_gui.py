@@ -121,8 +121,8 @@ def test_articulators_not_a_face(which, corpora, qtbot, monkeypatch, tmp_path, c
         xy = project(win.plotter, mset.current[tip][None])[0]
         assert drawn_in(area, xy, (colour,)) and not drawn_in(area, xy, (other,), 40), mset.name
     if which == "mocha":                      # the reference sensors: small and grey
-        bn = project(win.plotter, face.original.current[[roles.names.index("BN")]])[0]
-        pix = colours_near(area, bn, 3)
+        ui = project(win.plotter, face.original.current[[roles.names.index("UI")]])[0]
+        pix = colours_near(area, ui, 3)
         assert near(pix, REFERENCE_COLOR, 30) > 0 and not any(near(pix, c, 60) for c in SET_COLOURS)
     win.close()
 
@@ -182,6 +182,35 @@ def test_pc_modes_of_an_ema_model_in_profile(corpora, qtbot, monkeypatch):
     np.testing.assert_allclose(pcs.face_set.tongue_points(), expected)
     views.open_view("kinematics")                       # kinematics work on an EMA model
     qtbot.waitUntil(lambda: "kinematics" in views.widgets and win.settled, timeout=WAIT_MS)
+    win.close()
+
+
+def test_metrics_view_per_sensor_tab(corpora, qtbot, monkeypatch, tmp_path):
+    """The metrics view's per-sensor tab: r and RMSE of every coordinate, the method and the
+    baselines side by side, as the engine pools them; its CSV."""
+    import csv
+
+    win = window_on(qtbot, monkeypatch, corpora["mocha"])
+    views = win.extension("analysis")
+    views.open_view("metrics")
+    qtbot.waitUntil(lambda: "metrics" in views.widgets, timeout=WAIT_MS)
+    m = views.widgets["metrics"]
+    with qtbot.waitSignal(m.table2Done, timeout=WAIT_MS):
+        m.start_table2()
+    table = m.sensor_table
+    head = [table.horizontalHeaderItem(c).text() for c in range(table.columnCount())]
+    assert head[2:] == ["phonetic N=3\nr", "phonetic N=3\nRMSE mm", "acoustic N=3\nr",
+                        "acoustic N=3\nRMSE mm", "viseme\nr", "viseme\nRMSE mm", "ridge\nr",
+                        "ridge\nRMSE mm"]
+    names = [table.item(r, 0).text() for r in range(table.rowCount())]
+    assert names[:3] == ["whole face", "lower lip y", "upper lip y"] and names[-1] == "articulators (mean)"
+    tt = m.table2_result.sensor_table("train", "triangular", "phonetic", 3).row("TT y")
+    row = names.index("TT y")
+    assert table.item(row, 1).text() == "tongue"
+    assert table.item(row, 2).text() == f"{tt.r:.3f}" and table.item(row, 3).text() == f"{tt.rmse_mm:.2f}"
+    with open(m.export_sensor_csv(tmp_path / "s.csv"), newline="") as fh:
+        rows = {r["row"]: r for r in csv.DictReader(fh)}
+    assert float(rows["TT y"]["phonetic N=3 rmse_mm"]) == pytest.approx(tt.rmse_mm, rel=1e-5)
     win.close()
 
 

@@ -169,6 +169,7 @@ class MetricsView(QWidget):
         self.sensor_table = QTableWidget()          # r and RMSE per sensor coordinate
         self.sensor_table.setSortingEnabled(False)
         self.sensor_table.verticalHeader().setVisible(False)
+        self.sensor_table.verticalHeader().setDefaultSectionSize(self.table.fontMetrics().height() + 6)
         self.tables = QTabWidget()
         self.tables.addTab(self.table, "Table 2")
         self.tables.addTab(self.sensor_table, "Per sensor")
@@ -301,9 +302,13 @@ class MetricsView(QWidget):
         per condition; the paper's three correlations first."""
         names, rows = sensor_rows(self._results(), self.sensor_split())
         head = ["row", "role", *(f"{n}\n{w}" for n in names for w in ("r", "RMSE mm"))]
+        def r_item(value: float, role: str):        # a reference sensor's r is noise: no heat
+            return (NumberItem(value, "{:.3f}") if role == "reference"
+                    else heat_item(value, 0.4, 1.0, "{:.3f}", "RdYlGn"))
+
         items = [[text_item(r.name), text_item(r.role),
                   *(item for rv, ev in zip(r.r, r.rmse_mm, strict=True)
-                    for item in (heat_item(rv, 0.4, 1.0, "{:.3f}", "RdYlGn"), NumberItem(ev, "{:.2f}")))]
+                    for item in (r_item(rv, r.role), NumberItem(ev, "{:.2f}")))]
                  for r in rows]
         fill_table(self.sensor_table, head, items)
         self.sensor_table.resizeColumnsToContents()

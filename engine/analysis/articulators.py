@@ -88,11 +88,6 @@ class Articulators:
     aperture: float
     jaw_opening: float
 
-    def minus(self, other: Articulators) -> Articulators:
-        """The difference, this minus ``other``."""
-        return Articulators(self.tongue_tip - other.tongue_tip, self.aperture - other.aperture,
-                            self.jaw_opening - other.jaw_opening)
-
 
 def measure(markers: np.ndarray, roles: SensorRoles, top: float) -> Articulators:
     """The :class:`Articulators` of one frame's markers ``(M, 3)`` (``top``: :func:`jaw_top`).

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..evaluation.scores import ConditionScores, EvalResult
-from ..evaluation.sensors import condition_columns
+from ..evaluation.sensors import TableRow, condition_columns, table_rows
 from .common import write_csv
 
 SMOOTHING_NAMES = {"triangular": "Triang.", "spline": "Spline", "none": "None"}
@@ -101,37 +101,12 @@ def write_sweep_csv(path: str | os.PathLike[str], result: EvalResult, overwrite:
     return write_csv(path, ["split", "N", "whole_face", "lower_lip", "upper_lip"], rows, overwrite)
 
 
-@dataclass
-class SensorRow:
-    """One row of the per-sensor table: a coordinate (``TT y``) or one of the paper's three
-    correlations (``whole face``), its role, and per condition its r and RMSE (mm; NaN for the
-    paper's rows, which have no RMSE)."""
-
-    name: str
-    role: str
-    r: list[float]
-    rmse_mm: list[float]
-
-
 def sensor_rows(results: list[EvalResult], split: str, smoothing: str = "triangular"
-                ) -> tuple[list[str], list[SensorRow]]:
+                ) -> tuple[list[str], list[TableRow]]:
     """The per-sensor table of ``results`` (the method's and the baselines') on ``split``: the
-    conditions' names, then the paper's three correlations, every coordinate and the
-    articulators' mean as rows."""
+    conditions' names, and the rows (:func:`facetraj_engine.evaluation.sensors.table_rows`)."""
     cols = condition_columns(results, split, smoothing)
-    nan = [float("nan")] * len(cols)
-    rows = [SensorRow(label, "the paper's", [c[2][m] for c in cols], list(nan))
-            for label, m in (("whole face", "whole_face"), ("lower lip y", "lower_lip"),
-                             ("upper lip y", "upper_lip"))]
-    keys = list(dict.fromkeys(r.key for c in cols for r in c[1].rows))
-    for key in keys:
-        cells = [c[1].row(key) for c in cols]
-        rows.append(SensorRow(key, next(x.role for x in cells if x is not None),
-                              [x.r if x else float("nan") for x in cells],
-                              [x.rmse_mm if x else float("nan") for x in cells]))
-    rows.append(SensorRow("articulators (mean)", "", [c[1].mean_r for c in cols],
-                          [c[1].mean_rmse_mm for c in cols]))
-    return [c[0] for c in cols], rows
+    return [c[0] for c in cols], table_rows(cols)
 
 
 def write_sensor_csv(path: str | os.PathLike[str], results: list[EvalResult], split: str,
@@ -143,5 +118,5 @@ def write_sensor_csv(path: str | os.PathLike[str], results: list[EvalResult], sp
                                                         for v in pair)] for r in rows), overwrite)
 
 
-__all__ = ["SMOOTHING_NAMES", "SensorRow", "SweepCurve", "Table2Row", "condition_name", "sensor_rows",
+__all__ = ["SMOOTHING_NAMES", "SweepCurve", "Table2Row", "condition_name", "sensor_rows",
            "sweep_curves", "table2_rows", "write_sensor_csv", "write_sweep_csv", "write_table2_csv"]

@@ -159,30 +159,20 @@ def pooled(per_utterance: Iterable[Sequence[CoordinateScore]]) -> SensorTable:
                        count)
 
 
-def format_sensor_tables(columns: Sequence[tuple[str, SensorTable]],
-                         paper: Sequence[tuple[str, Sequence[float]]] = ()) -> str:
-    """The per-sensor table as text: a row per coordinate (with its role), r and RMSE (mm) of
-    each of ``columns`` (name, table) side by side, the articulators' mean last; ``paper``: rows of
-    the paper's correlations (name, one r per column) above them."""
-    if not columns:
-        return ""
-    cw = max(14, *(len(name) for name, _ in columns))      # a column: r, a space, RMSE (7)
+#: the paper's three correlations, as the per-sensor table's first rows name them
+PAPER_ROWS = (("whole face", "whole_face"), ("lower lip y", "lower_lip"), ("upper lip y", "upper_lip"))
 
-    def cell(r: float, e: float) -> str:
-        return f"{_num(r, 3):>{cw - 8}} {_num(e, 2):>7}"
 
-    lines = [f"{'sensor':<12} {'role':<10} " + " ".join(f"{name:>{cw}}" for name, _ in columns),
-             f"{'':<23} " + " ".join(f"{'r':>{cw - 8}} {'RMSE mm':>7}" for _ in columns)]
-    lines += [f"{name:<23} " + " ".join(f"{_num(r, 3):>{cw - 8}} {'':>7}" for r in rs)
-              for name, rs in paper]
-    for key in dict.fromkeys(r.key for _, t in columns for r in t.rows):
-        rows = [t.row(key) for _, t in columns]
-        role = next(r.role for r in rows if r is not None)
-        lines.append(f"{key:<12} {role:<10} " + " ".join(
-            cell(r.r, r.rmse_mm) if r else cell(float("nan"), float("nan")) for r in rows))
-    lines.append(f"{'articulators (mean)':<23} " + " ".join(cell(t.mean_r, t.mean_rmse_mm)
-                                                          for _, t in columns))
-    return "\n".join(line.rstrip() for line in lines)
+@dataclass(frozen=True)
+class TableRow:
+    """One row of the per-sensor table: a coordinate (``TT y``), one of the paper's three
+    correlations (``whole face``, role ``the paper's``: no RMSE) or the articulators' mean; per
+    condition its r and RMSE (mm)."""
+
+    name: str
+    role: str
+    r: list[float]
+    rmse_mm: list[float]
 
 
 def condition_columns(results: Sequence[Results], split: str, smoothing: str = "triangular"
@@ -199,26 +189,50 @@ def condition_columns(results: Sequence[Results], split: str, smoothing: str = "
     return out
 
 
+def table_rows(columns: Sequence[tuple[str, SensorTable, dict[str, float]]]) -> list[TableRow]:
+    """The rows of the per-sensor table of ``columns`` (:func:`condition_columns`): the paper's
+    three correlations, every coordinate (in the order first seen, the reference sensors' last),
+    the articulators' mean."""
+    nan = [float("nan")] * len(columns)
+    rows = [TableRow(label, "the paper's", [c[2][m] for c in columns], list(nan))
+            for label, m in PAPER_ROWS]
+    coords = []
+    for key in dict.fromkeys(r.key for c in columns for r in c[1].rows):
+        cells = [c[1].row(key) for c in columns]
+        coords.append(TableRow(key, next(x.role for x in cells if x is not None),
+                               [x.r if x else float("nan") for x in cells],
+                               [x.rmse_mm if x else float("nan") for x in cells]))
+    rows += sorted(coords, key=lambda r: r.role == "reference")     # the references last
+    rows.append(TableRow("articulators (mean)", "", [c[1].mean_r for c in columns],
+                         [c[1].mean_rmse_mm for c in columns]))
+    return rows
+
+
 def format_sensor_report(results: Sequence[Results], splits: Sequence[str],
                          smoothing: str = "triangular") -> str:
-    """Per split, the per-sensor table of every condition side by side under the paper's three
-    correlations (whole face, lower lip y, upper lip y), as ``facetraj eval`` prints it."""
+    """Per split, the per-sensor table of every condition side by side (r and RMSE in mm), the
+    paper's three correlations in its first rows, as ``facetraj eval`` prints it."""
     blocks = []
     for split in splits:
         cols = condition_columns(results, split, smoothing)
         if not cols:
             continue
-        paper = [(f"{label} (r)", [c[2][m] for c in cols]) for label, m in
-                 (("whole face", "whole_face"), ("lower lip y", "lower_lip"),
-                  ("upper lip y", "upper_lip"))]
-        blocks.append(f"Per sensor, {split} split ({smoothing} smoothing; r and RMSE on speech "
-                      f"frames):\n" + format_sensor_tables([(c[0], c[1]) for c in cols], paper))
+        cw = max(14, *(len(c[0]) for c in cols))      # a column: r, a space, RMSE (7)
+        lines = [f"Per sensor, {split} split ({smoothing} smoothing; r and RMSE on speech frames):",
+                 f"{'sensor':<12} {'role':<10} " + " ".join(f"{c[0]:>{cw}}" for c in cols),
+                 f"{'':<23} " + " ".join(f"{'r':>{cw - 8}} {'RMSE mm':>7}" for _ in cols)]
+        for row in table_rows(cols):
+            head = f"{row.name} (r)" if row.role == "the paper's" else row.name
+            head = f"{head:<23}" if row.role in ("the paper's", "") else f"{head:<12} {row.role:<10}"
+            lines.append(head + " " + " ".join(f"{_num(r, 3):>{cw - 8}} {_num(e, 2, ''):>7}"
+                                               for r, e in zip(row.r, row.rmse_mm, strict=True)))
+        blocks.append("\n".join(line.rstrip() for line in lines))
     return "\n\n".join(blocks)
 
 
-def _num(v: float, digits: int) -> str:
-    return f"{v:.{digits}f}" if np.isfinite(v) else "—"
+def _num(v: float, digits: int, missing: str = "—") -> str:
+    return f"{v:.{digits}f}" if np.isfinite(v) else missing
 
 
-__all__ = ["CoordinateScore", "SensorTable", "condition_columns", "format_sensor_report",
-           "format_sensor_tables", "pooled", "scored_coordinates", "sensor_scores"]
+__all__ = ["PAPER_ROWS", "CoordinateScore", "SensorTable", "TableRow", "condition_columns",
+           "format_sensor_report", "pooled", "scored_coordinates", "sensor_scores", "table_rows"]
