@@ -186,7 +186,7 @@ def test_pc_modes_of_an_ema_model_in_profile(corpora, qtbot, monkeypatch):
 
 
 def test_metrics_view_per_sensor_tab(corpora, qtbot, monkeypatch, tmp_path):
-    """The metrics view's per-sensor tab: r and RMSE of every coordinate, the method and the
+    """The metrics view's per-sensor table: r and RMSE of every coordinate, the method and the
     baselines side by side, as the engine pools them; its CSV."""
     import csv
 

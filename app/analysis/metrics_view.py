@@ -18,6 +18,7 @@ from PyQt6.QtCore import pyqtSignal
 from PyQt6.QtGui import QColor
 from PyQt6.QtWidgets import (
     QCheckBox,
+    QComboBox,
     QGridLayout,
     QGroupBox,
     QHBoxLayout,
@@ -25,8 +26,8 @@ from PyQt6.QtWidgets import (
     QProgressBar,
     QPushButton,
     QSpinBox,
+    QStackedWidget,
     QTableWidget,
-    QTabWidget,
     QVBoxLayout,
     QWidget,
 )
@@ -170,9 +171,17 @@ class MetricsView(QWidget):
         self.sensor_table.setSortingEnabled(False)
         self.sensor_table.verticalHeader().setVisible(False)
         self.sensor_table.verticalHeader().setDefaultSectionSize(self.table.fontMetrics().height() + 6)
-        self.tables = QTabWidget()
-        self.tables.addTab(self.table, "Table 2")
-        self.tables.addTab(self.sensor_table, "Per sensor")
+        # Table 2 or the per-sensor table in the same place, chosen beside the status line (tabs
+        # took height the plots need on a laptop screen)
+        self.tables = QStackedWidget()
+        self.tables.addWidget(self.table)
+        self.tables.addWidget(self.sensor_table)
+        self.table_choice = QComboBox()
+        self.table_choice.addItems(["Table 2", "per sensor"])
+        self.table_choice.setToolTip("Table 2, or r and RMSE (mm) of every sensor coordinate "
+                                     "(triangular smoothing)")
+        self.table_choice.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToContents)
+        self.table_choice.currentIndexChanged.connect(self.tables.setCurrentIndex)
         self.canvas = Canvas(6, 5.2)
         self.canvas.setMinimumHeight(260)
         lay = QVBoxLayout(self)
@@ -192,7 +201,8 @@ class MetricsView(QWidget):
         g.addWidget(self.run_sweep, 1, 1, 1, 2)
         g.addWidget(self.max_n, 1, 3)
         g.addWidget(self.progress, 2, 0, 1, 4)
-        g.addWidget(self.status, 3, 0, 1, 4)
+        g.addWidget(self.status, 3, 0, 1, 3)
+        g.addWidget(self.table_choice, 3, 3)
         buttons = QHBoxLayout()
         buttons.addWidget(QLabel("export:"))
         for text, slot in exports:
@@ -312,7 +322,7 @@ class MetricsView(QWidget):
                  for r in rows]
         fill_table(self.sensor_table, head, items)
         self.sensor_table.resizeColumnsToContents()
-        self.tables.setTabText(1, f"Per sensor ({self.sensor_split()}, triangular)")
+        self.table_choice.setItemText(1, f"per sensor ({self.sensor_split()})")
 
     def set_sweep(self, result: EvalResult) -> None:
         self.sweep_result = result

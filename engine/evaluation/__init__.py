@@ -3,7 +3,7 @@
 - ``scores``: speech-only frames (energy, 112 ms median filter), the correlations of Table 2,
   the N sweep of Figure 5;
 - ``sensors``: per sensor coordinate, r and RMSE in mm, as articulatory-inversion papers
-  tabulate them;
+  tabulate them; ``correlation``: the Pearson correlation both use;
 - ``baselines``: a viseme lookup and a ridge regression, scored the same way;
 - ``tuning``: the robust mode's settings cross-validated on the training split;
 - ``label_accuracy``, ``label_eval``: automatic labels, their accuracy and every mode with them;

@@ -20,29 +20,12 @@ from ..method.modes import choose_mode
 from ..method.pipeline import Synthesis, resmooth, synthesize
 from ..method.speech import speech_mask
 from ..threads import limit_frame_threads, one_blas_thread, usable_cores
+from .correlation import pearson
 from .sensors import SensorTable, pooled, sensor_scores
 
 log = logging.getLogger(__name__)
 
 METRICS = ("whole_face", "lower_lip", "upper_lip")
-
-
-def pearson(a: np.ndarray, b: np.ndarray) -> float:
-    """Pearson correlation of two 1-D series; NaN when either is constant or shorter than 3.
-
-    Examples
-    --------
-    >>> round(pearson(np.array([1.0, 2, 3, 4]), np.array([2.0, 4, 6, 8.5])), 4)
-    0.9984
-    """
-    a = np.asarray(a, dtype=np.float64)
-    b = np.asarray(b, dtype=np.float64)
-    if len(a) < 3:
-        return float("nan")
-    a = a - a.mean()
-    b = b - b.mean()
-    den = np.sqrt((a * a).sum() * (b * b).sum())
-    return float((a * b).sum() / den) if den > 0 else float("nan")
 
 
 def moving_coordinates(model: Model, fraction: float = 0.1) -> np.ndarray:

@@ -23,6 +23,7 @@ from typing import Protocol
 import numpy as np
 
 from ..method.model import Model
+from .correlation import pearson
 
 
 class Results(Protocol):
@@ -68,12 +69,6 @@ def scored_coordinates(model: Model) -> list[tuple[int, int]]:
     return [(m, a) for m in range(model.n_markers) for a in range(3) if std[m, a] > STILL_MM]
 
 
-def _pearson(a: np.ndarray, b: np.ndarray) -> float:
-    a, b = a - a.mean(), b - b.mean()
-    den = np.sqrt((a * a).sum() * (b * b).sum())
-    return float((a * b).sum() / den) if len(a) >= 3 and den > 0 else float("nan")
-
-
 def sensor_scores(original: np.ndarray, synthesized: np.ndarray, mask: np.ndarray,
                   model: Model) -> list[CoordinateScore]:
     """Every moving coordinate's r and RMSE (mm) on the frames of ``mask`` where both
@@ -97,7 +92,7 @@ def sensor_scores(original: np.ndarray, synthesized: np.ndarray, mask: np.ndarra
         ok = mask & np.isfinite(x) & np.isfinite(y)
         x, y = x[ok], y[ok]
         rmse = float(np.sqrt(np.mean((y - x) ** 2))) if len(x) else float("nan")
-        out.append(CoordinateScore(roles.names[m], AXES[a], roles.role(m), _pearson(x, y), rmse,
+        out.append(CoordinateScore(roles.names[m], AXES[a], roles.role(m), pearson(x, y), rmse,
                                    int(ok.sum())))
     return out
 
