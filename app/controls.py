@@ -118,9 +118,11 @@ class ViewBar(QWidget):
         box.blockSignals(False)
 
     def set_planar(self, planar: bool) -> None:
-        """Midsagittal (2-D) markers: the profile camera, and no face surface to offer."""
+        """Midsagittal (2-D) markers or articulograph sensors: the profile camera, and no face
+        surface to offer."""
         self.surface.setEnabled(not planar)
-        self.surface.setToolTip("2-D (midsagittal) markers: no face surface to draw" if planar
+        self.surface.setToolTip("midsagittal (2-D) markers or articulograph sensors: no face "
+                                "surface to draw" if planar
                                 else "the synthesized face as a surface through its markers")
         if planar:
             self.set_camera("profile")

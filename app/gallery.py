@@ -4,8 +4,10 @@
 
 The main window as a phonetician meets it, at 1280x800 and 1920x1080 and on a 1366x768 laptop
 with Kinematics and Errors docked; the walk-through of docs/app.md (Measure, Compare, the
-exports); the default corpus, a 2-D MOCHA-TIMIT utterance (``../shared/data/mocha_fsew0_001``,
-or under ``$FACETRAJ_SHARED``, read in place), an utterance with no
+exports); the default corpus, the articulator view of a 2-D MOCHA-TIMIT utterance
+(``../shared/data/mocha_fsew0_001``, or under ``$FACETRAJ_SHARED``, read in place) and of an
+MVIEW file in HPRC's layout that the tests make from it (with the PC modes of the MOCHA model),
+an utterance with no
 original markers (File > Open audio of a WAV) and a long file (a few corpus utterances joined
 into one WAV); the dialogs of *Open audio* (the sentence, words missing from the dictionary, the
 error of a corrupt WAV) and the synthesis settings with each search mode's note, each shown
@@ -82,9 +84,9 @@ def long_file(corpus_dir: Path, out: Path, n: int = LONG_FILE_UTTERANCES) -> Pat
 
 
 def app_figures(out: Path, scratch: Path) -> list[Path]:
-    """The main window: default corpus at both sizes, MOCHA, open audio, a long file."""
+    """The main window: default corpus at both sizes, open audio, a long file."""
     from facetraj_engine.io.audio import write_audio
-    from facetraj_engine.io.corpus import init_corpus, load_corpus
+    from facetraj_engine.io.corpus import load_corpus
 
     from .main import WINDOW_SIZE
 
@@ -106,14 +108,57 @@ def app_figures(out: Path, scratch: Path) -> list[Path]:
             _open_audio(win, long_file(DEFAULT_CORPUS, scratch / "long_file.wav"))
             written.append(_shoot(win, out / "app_long_file.png", 5.0))
         win.close()
-    if (MOCHA / "fsew0_001.ema").exists():
-        mocha, _ = init_corpus(MOCHA, scratch / "mocha" / "mocha.json", ["UI", "BN"], "UL", "LL",
-                               label_map="mocha", test_fraction=0)
-        win = _window(mocha, SIZES["1280x800"])
-        written.append(_shoot(win, out / "app_mocha_2d.png", 1.0))
-        win.close()
-    else:
-        log.warning("%s is absent: no MOCHA screenshot", MOCHA)
+    return written
+
+
+def _mview_from_mocha(scratch: Path) -> Path:
+    """The folder of the MVIEW file (HPRC's layout) that the tests make from the MOCHA sample
+    (``tests/articulograph.py: mview_from_mocha``; the real HPRC files are not in the
+    repository), described as a corpus."""
+    import importlib.util
+
+    from facetraj_engine.io.corpus import init_corpus
+
+    spec = importlib.util.spec_from_file_location("articulograph", ROOT / "tests" / "articulograph.py")
+    maker = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(maker)
+    folder = maker.mview_from_mocha(MOCHA, scratch / "mview").parent
+    init_corpus(folder, upper_lip="UL", lower_lip="LL", test_fraction=0)
+    return folder
+
+
+def articulator_figures(out: Path, scratch: Path) -> list[Path]:
+    """The articulator view: the MOCHA sample (2-D) and the MVIEW file made from it (3-D, in
+    profile and in the 3/4 view), and the PC modes of the MOCHA model in profile."""
+    from facetraj_engine.io.corpus import init_corpus
+
+    from .analysis.figures import _finish, shoot
+
+    if not (MOCHA / "fsew0_001.ema").exists():
+        log.warning("%s is absent: no articulator screenshots", MOCHA)
+        return []
+    mocha, _ = init_corpus(MOCHA, scratch / "mocha" / "mocha.json", ["UI", "BN"], "UL", "LL",
+                           label_map="mocha", test_fraction=0)
+    win = _window(mocha, SIZES["1280x800"])
+    written = [_shoot(win, out / "app_mocha_2d.png", 1.0)]
+    views = win.extension("analysis")
+    views.open_view("pc_modes")
+    _finish(lambda: "pc_modes" in views.docks and views.widgets["pc_modes"].is_ready, "PC modes")
+    dock = views.docks["pc_modes"]
+    dock.setFloating(True)
+    dock.resize(600, 950)
+    views.widgets["pc_modes"].set_sd_units(3.0)
+    written.append(shoot(dock, out / "analysis_pc_modes_ema.png"))
+    win.close()
+    folder = _mview_from_mocha(scratch)
+    win = _window(folder, SIZES["1280x800"])
+    written.append(_shoot(win, out / "app_mview.png", 1.0))
+    win.close()
+    win = _window(folder, SIZES["1920x1080"])       # 3-D data: the 3/4 view
+    win.seek(1.0)
+    win.view_bar.set_camera("three-quarter")
+    written.append(_grab(win.face, out / "articulators_3d.png"))
+    win.close()
     return written
 
 
@@ -418,6 +463,7 @@ def make_gallery(out: Path, analysis: bool = True) -> list[Path]:
         written += mouth_figure(out)
         written += live_figure(out)
         written += app_figures(out, Path(tmp))
+        written += articulator_figures(out, Path(tmp))
         written += laptop_figures(out)
         written += measure_figures(out)
         written += dialog_figures(out, Path(tmp))
@@ -434,7 +480,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--no-analysis", action="store_true", help="leave out the analysis views")
     p.add_argument("--only-dialogs", action="store_true",
                    help="just the dialogs and the settings panel (a quick look)")
-    p.add_argument("--only", choices=["video", "mouth", "live", "app", "laptop", "measure"],
+    p.add_argument("--only", choices=["video", "mouth", "live", "app", "articulators", "laptop",
+                                      "measure"],
                    action="append", help="just these pictures (a quick look)")
     args = p.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
@@ -448,8 +495,10 @@ def main(argv: list[str] | None = None) -> int:
         makers = {"video": video_figures, "mouth": mouth_figure, "live": live_figure,
                   "laptop": laptop_figures, "measure": measure_figures}
         with tempfile.TemporaryDirectory(prefix="facetraj-gallery-") as tmp:
+            with_scratch = {"app": app_figures, "articulators": articulator_figures}
             paths = [p for name in args.only for p in
-                     (app_figures(args.out, Path(tmp)) if name == "app" else makers[name](args.out))]
+                     (with_scratch[name](args.out, Path(tmp)) if name in with_scratch
+                      else makers[name](args.out))]
     else:
         paths = make_gallery(args.out, analysis=not args.no_analysis)
     for path in paths:

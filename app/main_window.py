@@ -75,6 +75,7 @@ from facetraj_engine.io.corpus import Corpus, load_corpus
 from facetraj_engine.method.model import Model
 from facetraj_engine.workflow.model_cache import load_or_train
 
+from .articulators import dimensions_note
 from .browser import UtteranceBrowser
 from .controls import (
     SPEEDS,
@@ -364,8 +365,8 @@ class MainWindow(QMainWindow):
         self.browser.populate({"test": list(info.test), "train": list(info.train)}, texts)
         self.status_label.setText(f"{corpus.root}: {len(info.train)} training and {len(info.test)} test "
                                   f"utterances, {model.n_markers} markers, {model.pca.n_components} PCs")
-        self.dimensions_label.setVisible(model.is_planar)   # midsagittal (2-D) data shown as such:
-        self.view_bar.set_planar(model.is_planar)           # a status-bar note, the profile camera
+        self.status.set_note(dimensions_note(model))        # midsagittal data, articulators: a
+        self.view_bar.set_planar(model.is_planar or self.face.articulators)  # note, the profile
         self.marker_panels.set_model(model)
         self.modelReady.emit()
         if first:

@@ -1,7 +1,8 @@
 """Time-aligned panels of single marker coordinates (e.g. the jaw of midsagittal EMA data).
 
 :class:`MarkerPanels` keeps the panels the user added (View menu) and, for a planar model
-(:attr:`facetraj_engine.method.model.Model.is_planar`: midsagittal 2-D data), puts the jaw beside the lips.
+(:attr:`facetraj_engine.method.model.Model.is_planar`: midsagittal 2-D data) or articulograph sensors
+(:attr:`facetraj_engine.method.model.Model.roles`), puts the jaw beside the lips.
 """
 
 from __future__ import annotations
@@ -14,7 +15,8 @@ from facetraj_engine.method.model import Model
 from .style import ORIGINAL_COLOR, SPLINE_COLOR, TRIANGULAR_COLOR, fit_ylabel
 from .timeline import Timeline
 
-JAW_NAMES = ("LI", "MNI", "JAW", "JAW_C", "CN_C", "CHIN", "CN")
+#: a face's chin markers, the jaw's stand-in where no sensor is the jaw's
+CHIN_NAMES = ("JAW_C", "CN_C", "CHIN", "CN")
 
 
 class MarkerPanel:
@@ -43,24 +45,25 @@ class MarkerPanel:
                     label="original")
         fit_ylabel(ax, f"{self.marker}\n{self.axis} (mm)")
 
-def jaw_marker(names: list[str]) -> str | None:
-    """The jaw marker among ``names`` (MOCHA's lower incisor LI, or a chin/jaw marker), if any."""
-    upper = [n.upper() for n in names]
-    for cand in JAW_NAMES:
-        if cand in upper:
-            return names[upper.index(cand)]
-    return None
+def jaw_marker(model: Model) -> str | None:
+    """The jaw marker of ``model`` (its jaw sensor, e.g. MOCHA's lower incisor LI: ``roles.jaw``,
+    else a chin marker), if any."""
+    roles = model.roles
+    if roles.jaw:
+        return roles.names[roles.jaw[0]]
+    upper = [n.upper() for n in roles.names]
+    return next((roles.names[upper.index(c)] for c in CHIN_NAMES if c in upper), None)
 
 class MarkerPanelDialog(QDialog):
     """Choose a marker and an axis for a new time-aligned panel."""
 
-    def __init__(self, names: list[str], parent: QWidget | None = None):
+    def __init__(self, model: Model, parent: QWidget | None = None):
         super().__init__(parent)
         self.setWindowTitle("Add a marker trajectory panel")
         form = QFormLayout(self)
         self.marker = QComboBox()
-        self.marker.addItems(names)
-        jaw = jaw_marker(names)
+        self.marker.addItems(list(model.marker_names))
+        jaw = jaw_marker(model)
         if jaw:
             self.marker.setCurrentText(jaw)
         self.axis = QComboBox()
@@ -104,14 +107,18 @@ class MarkerPanels:
         """Let the user choose a marker and a coordinate; add that panel."""
         if model is None:
             raise FacetrajError("no model yet")
-        dlg = MarkerPanelDialog(list(model.marker_names), parent)
+        dlg = MarkerPanelDialog(model, parent)
         if dlg.exec() == QDialog.DialogCode.Accepted:
             self.add(dlg.panel())
 
     def set_model(self, model: Model) -> None:
-        """A new model: no panels, except the jaw's for midsagittal (planar) data."""
+        """A new model: no panels, except the jaw's for midsagittal (planar) data and
+        articulograph sensors (more, e.g. the tongue tip's height: View > Add a marker
+        trajectory panel; each panel takes height from the articulator view)."""
         self.clear()
-        if model.is_planar:
-            jaw = jaw_marker(list(model.marker_names))     # midsagittal EMA: the jaw beside the lips
+        roles = model.roles
+        if model.is_planar or roles.articulograph:
+            jaw = jaw_marker(model)             # midsagittal EMA: the jaw beside the lips
             if jaw:
                 self.add(MarkerPanel(jaw, "y"))
+

@@ -26,6 +26,8 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
+from facetraj_engine.analysis.articulators import jaw_top
+
 from .analysis.common import NumberItem, export_with_dialog, fill_table, text_item
 from .measure_model import TABLE_COLUMNS, Measure
 
@@ -107,6 +109,7 @@ class MeasureTools:
     def __init__(self, window):
         self.window = window
         self.measure = Measure()
+        self._jaw_top: tuple = (None, float("nan"))
         bar = QToolBar("Measure")
         bar.setObjectName("measure-toolbar")
         bar.setMovable(False)
@@ -118,7 +121,9 @@ class MeasureTools:
         self.readout.setFixedHeight(2 * self.readout.fontMetrics().lineSpacing() + 4)
         self.readout.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
         self.readout.setToolTip("at the cursor: the lips of the synthesis in 3-D, the original's and "
-                                "each pin's (mm); the aperture is upper to lower lip centre marker")
+                                "each pin's (mm); the aperture is upper to lower lip centre marker; "
+                                "for articulograph sensors also the tongue tip's height and the jaw "
+                                "opening (below the talker's highest jaw position)")
         bar.addWidget(QLabel(" Measure: "))
         bar.addWidget(self.readout)
         window.addToolBar(Qt.ToolBarArea.BottomToolBarArea, bar)
@@ -136,7 +141,10 @@ class MeasureTools:
         w = self.window
         if w.model is None:
             return
-        self.measure.set_view(w.view, w.model.upper_lip, w.model.lower_lip, w.pins.shown(w.view))
+        if self._jaw_top[0] is not w.model:          # the talker's highest jaw, once per model
+            self._jaw_top = (w.model, jaw_top(w.model) if w.model.roles.articulograph else float("nan"))
+        self.measure.set_view(w.view, w.model.upper_lip, w.model.lower_lip, w.pins.shown(w.view),
+                              w.model.roles, self._jaw_top[1])
         self._cursor(w.current_time())
         if self.table is not None:
             self.table.refresh()

@@ -4,7 +4,9 @@ words them.
 
 * :meth:`Measure.readout_text`: at the cursor, the phone and word there, the upper and lower lip
   y and the aperture of the synthesis shown in 3-D, the original's and the difference, and each
-  pinned result's phone there (its own labels'), aperture and difference (mm).
+  pinned result's phone there (its own labels'), aperture and difference (mm); for articulograph
+  sensors the tongue tip height, the lip aperture and the jaw opening instead
+  (:mod:`facetraj_engine.analysis.articulators`).
 * :meth:`Measure.rows`: the per-phone table (each phone's aperture at its minimum and at its
   midpoint, original, synthesized, error), filtered by phone; :meth:`Measure.write_csv`.
 """
@@ -18,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from facetraj_engine.analysis import articulators as art
 from facetraj_engine.analysis.apertures import (
     LipReadout,
     PhoneAperture,
@@ -26,6 +29,7 @@ from facetraj_engine.analysis.apertures import (
     readout_at,
     write_phone_apertures_csv,
 )
+from facetraj_engine.io.sensor_roles import SensorRoles
 
 from .pins import Pin
 from .state import UtteranceView
@@ -53,17 +57,61 @@ def mm(value: float, signed: bool = False) -> str:
 @dataclass
 class Measure:
     """The numbers of the utterance on screen: its ``view``, the model's lip markers
-    (``upper``, ``lower``) and the ``pins`` shown with it."""
+    (``upper``, ``lower``) and the ``pins`` shown with it; for articulograph sensors their
+    ``roles`` and the talker's highest jaw position ``jaw_top``
+    (:func:`facetraj_engine.analysis.articulators.jaw_top`)."""
 
     view: UtteranceView | None = None
     upper: int = 0
     lower: int = 0
     pins: list[Pin] = field(default_factory=list)
+    roles: SensorRoles | None = None
+    jaw_top: float = float("nan")
     _rows: list[PhoneAperture] | None = None
 
-    def set_view(self, view: UtteranceView | None, upper: int, lower: int, pins: list[Pin]) -> None:
+    def set_view(self, view: UtteranceView | None, upper: int, lower: int, pins: list[Pin],
+                 roles: SensorRoles | None = None, jaw_top: float = float("nan")) -> None:
         self.view, self.upper, self.lower, self.pins = view, upper, lower, list(pins)
+        self.roles = roles if roles is not None and roles.articulograph else None
+        self.jaw_top = jaw_top
         self._rows = None
+
+    def articulators_at(self, t: float) -> tuple[art.ArticulatorReadout, list] | None:
+        """At ``t``: the articulators of the synthesis (and the original), and each pin's
+        ``(pin, Articulators)``; None for a face."""
+        v = self.view
+        if v is None or self.roles is None:
+            return None
+        r = art.readout_at(t, v.times, v.shown, self.roles, self.jaw_top, v.original,
+                           v.utterance.phones, v.utterance.words)
+        pins = [(p, art.readout_at(t, p.view.times, p.view.shown, self.roles, self.jaw_top,
+                                   phones=p.view.utterance.phones)) for p in self.pins]
+        return r, pins
+
+    def articulator_text(self, t: float) -> str:
+        """The readout of articulograph sensors: where the cursor is, then the tongue tip
+        height, the lip aperture and the jaw opening of the synthesis, each with the original's
+        and the difference (synthesized − original), then each pin's."""
+        r, pins = self.articulators_at(t)
+        where = f"{t:.3f} s" + (f"  /{r.phone}/" + (f" in “{r.word}”" if r.word else "") if r.phone else "")
+        parts = [where]
+        names = ((f"tongue tip ({self.roles.names[self.roles.tongue[0]]}) height", "tongue_tip"),
+                 ("lip aperture", "aperture"), ("jaw opening", "jaw_opening"))
+        for label, key in names:
+            value = getattr(r.synthesized, key)
+            if not math.isfinite(value):
+                continue
+            text = f"{label} {mm(value)}"
+            if r.original is not None:
+                text += (f" (original {mm(getattr(r.original, key))}, "
+                         f"{mm(value - getattr(r.original, key), signed=True)})")
+            parts.append(text)
+        for pin, pr in pins:
+            parts.append(f"{pin.name}" + (f" /{pr.phone}/" if pr.phone else "") + ": " + ", ".join(
+                f"{short} {mm(getattr(pr.synthesized, key))}" for short, key in
+                (("tip", "tongue_tip"), ("aperture", "aperture"), ("jaw", "jaw_opening"))
+                if math.isfinite(getattr(pr.synthesized, key))))
+        return "  ·  ".join(parts)
 
     def readout(self, t: float) -> LipReadout | None:
         v = self.view
@@ -78,6 +126,8 @@ class Measure:
 
     def readout_text(self, t: float) -> str:
         """One line: where the cursor is and how far apart the lips are there."""
+        if self.roles is not None and self.view is not None:
+            return self.articulator_text(t)
         r = self.readout(t)
         if r is None:
             return ""

@@ -1,5 +1,6 @@
-"""The main window's status bar: a message, a note for midsagittal data, and the progress of the
-task runner's work (foreground work owns the bar; background work shows when nothing else runs)."""
+"""The main window's status bar: a message, a note for midsagittal data and articulograph sensors,
+and the progress of the task runner's work (foreground work owns the bar; background work shows
+when nothing else runs)."""
 
 from __future__ import annotations
 
@@ -28,6 +29,12 @@ class StatusArea:
         tasks.started.connect(self._on_started)
         tasks.progressed.connect(self._on_progress)
         tasks.busyChanged.connect(self.progress.setVisible)
+
+    def set_note(self, note: str) -> None:
+        """The note on how the markers are shown (midsagittal data, articulograph sensors:
+        ``app/articulators.py: dimensions_note``); hidden when empty."""
+        self.dimensions_label.setText(note)
+        self.dimensions_label.setVisible(bool(note))
 
     def show(self, text: str, timeout_ms: int = 0) -> None:
         """A message (a temporary one with ``timeout_ms``)."""

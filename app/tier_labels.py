@@ -99,4 +99,46 @@ class FittedLabels(Artist):
         self.stale = False
 
 
-__all__ = ["FittedLabels", "Span"]
+class StackedLabels(Artist):
+    """Labels of spans that must all be read (the lip-error panel's worst segments): each centred
+    over its span (kept inside the axes) at the top, and one that would touch a label already
+    drawn goes a row lower, as many rows as it takes: never one over another (they printed over
+    each other: "sp 9.4", "L", "AE", "9.9"). A label has a white backing, so that a lower row is
+    read over the curves. ``drawn`` as :class:`FittedLabels`' (text, extent, span in px)."""
+
+    def __init__(self, ax, spans: Sequence[Span], fontsize: float = 7.0):
+        super().__init__()
+        self.axes = ax
+        self.spans = sorted(spans, key=lambda s: s.start)
+        self.fontsize = fontsize
+        self.drawn: list[tuple[str, Bbox, tuple[float, float]]] = []
+        self.set_zorder(4)
+
+    def draw(self, renderer) -> None:
+        self.drawn = []
+        if not self.get_visible() or not self.spans:
+            return
+        box = self.axes.bbox
+        margin = MARGIN_PT * renderer.points_to_pixels(1.0)
+        placed: list[Bbox] = []
+        for span in self.spans:
+            (x0, _), (x1, _) = self.axes.transData.transform([(span.start, 0), (span.end, 0)])
+            prop = FontProperties(size=self.fontsize, style=span.style)
+            w, h, _d = renderer.get_text_width_height_descent(span.label, prop, ismath=False)
+            centre = min(max(0.5 * (x0 + x1), box.x0 + w / 2 + margin), box.x1 - w / 2 - margin)
+            top = box.y1 - margin
+            while top - h > box.y0 and any(
+                    b.x0 - margin < centre + w / 2 and centre - w / 2 < b.x1 + margin
+                    and b.y0 - margin < top and top - h < b.y1 + margin for b in placed):
+                top -= h + 2 * margin                     # a row lower
+            artist = Text(centre, top, span.label, ha="center", va="top", fontproperties=prop,
+                          color=span.color, transform=IdentityTransform(), figure=self.figure,
+                          bbox={"facecolor": "white", "alpha": 0.8, "edgecolor": "none", "pad": 0.5})
+            artist.draw(renderer)
+            extent = Bbox.from_extents(centre - w / 2, top - h, centre + w / 2, top)
+            placed.append(extent)
+            self.drawn.append((span.label, extent, (x0, x1)))
+        self.stale = False
+
+
+__all__ = ["FittedLabels", "Span", "StackedLabels"]

@@ -26,6 +26,7 @@ from facetraj_engine.io.files import atomic_write
 from facetraj_engine.method.model import Model
 from facetraj_engine.method.pipeline import Synthesis
 
+from .articulators import ArticulatorSet, is_articulograph
 from .style import BACKGROUND, CURSOR_COLOR, ORIGINAL_COLOR, SYNTH_COLOR
 from .surface import Mouth, face_triangles, lip_contours
 from .view3d import CAMERA_PRESETS, MarkerSet
@@ -221,14 +222,21 @@ class VideoFrames:
         import pyvista as pv
 
         neutral = model.neutral_face()
-        contours = lip_contours(neutral, model.upper_lip, model.lower_lip, list(model.lip_corners))
-        triangles = face_triangles(neutral, contours)
         self.plotter = pv.Plotter(off_screen=True, window_size=(half, 300))
         self.plotter.set_background(BACKGROUND)
         self.plotter.remove_all_lights()
         self.plotter.add_light(pv.Light(light_type="headlight", intensity=0.75))
         self.plotter.add_light(pv.Light(position=(0.4, 1.0, 0.6), light_type="camera light",
                                         intensity=0.35))
+        if is_articulograph(model):      # articulators in profile, as the window draws them
+            self.synth_set = ArticulatorSet(self.plotter, "synthesized", SYNTH_COLOR, neutral, model.roles)
+            self.orig_set = (ArticulatorSet(self.plotter, "original", ORIGINAL_COLOR, neutral, model.roles)
+                             if original else None)
+            self.plotter.enable_parallel_projection()
+            _fit_camera(self.plotter, neutral[list(model.roles.moving)], True)
+            return
+        contours = lip_contours(neutral, model.upper_lip, model.lower_lip, list(model.lip_corners))
+        triangles = face_triangles(neutral, contours)
         mouth = Mouth.between(neutral, contours, closed_lips(model).markers)   # it shuts at /p b m/
         self.synth_set = MarkerSet(self.plotter, "synthesized", SYNTH_COLOR, neutral, contours,
                                    triangles, mouth)

@@ -18,6 +18,7 @@ from PyQt6.QtWidgets import QToolTip, QVBoxLayout, QWidget
 from facetraj_engine.analysis.lips import ClosedLips, closed_lips
 from facetraj_engine.method.model import Model
 
+from .articulators import ArticulatorSet, fit_parallel, gap_axis, is_articulograph
 from .plotter_widget import is_native, make_plotter
 from .state import UtteranceView
 from .style import BACKGROUND, CAVITY_COLOR, ORIGINAL_COLOR, SURFACE_COLOR, SYNTH_COLOR
@@ -189,6 +190,7 @@ class FaceView(QWidget):
         self.original: MarkerSet | None = None
         self.synth: MarkerSet | None = None
         self.side_by_side = False
+        self.articulators = False               # the model's markers are articulograph sensors
         self.show_surface = True
         self.show_original = True
         self.show_synth = True
@@ -197,6 +199,7 @@ class FaceView(QWidget):
         self.preset = "three-quarter"
         self._orig = self._syn = None
         self._offset = np.zeros(3)
+        self._fit: tuple[np.ndarray, float] | None = None   # what the camera was fitted to
         self.pins: list = []                    # the pinned results shown (app/pins.py: Pin)
         self._pin_sets: dict[str, MarkerSet] = {}   # by colour: made once, reused
         self._pin_frames: list[np.ndarray] = []
@@ -208,6 +211,7 @@ class FaceView(QWidget):
         """Build the scene for ``model``'s marker set; ``closed``: the talker's lips at closure
         (``facetraj_engine.analysis.lips.closed_lips``, made here if not given), where the mouth shuts."""
         self.model = model
+        self.articulators = is_articulograph(model)     # sensors drawn as articulators, no face
         self.ahead = -1
         self.plotter.clear()
         # one light that follows the camera plus a key light from above: shading that shows
@@ -219,28 +223,39 @@ class FaceView(QWidget):
         neutral = model.neutral_face()
         self.neutral = neutral
         self.contours = lip_contours(neutral, model.upper_lip, model.lower_lip, list(model.lip_corners))
-        tri = stored_face_triangles(neutral, self.contours)
-        closed = closed if closed is not None else closed_lips(model)
-        mouth = Mouth.between(neutral, self.contours, closed.markers) if self.closed_mouth else None
-        self._tri, self._mouth = tri, mouth     # the pinned faces' too
+        self._tri = self._mouth = None          # the faces' surface and lips (the pins' too)
+        if not self.articulators:
+            self._tri = stored_face_triangles(neutral, self.contours)
+            closed = closed if closed is not None else closed_lips(model)
+            if self.closed_mouth:
+                self._mouth = Mouth.between(neutral, self.contours, closed.markers)
         self._pin_sets = {}
-        self.synth = MarkerSet(self.plotter, "synthesized", SYNTH_COLOR, neutral, self.contours, tri,
-                               mouth)
+        self.synth = self._new_set("synthesized", SYNTH_COLOR)
         # the original markers have a surface too: shown when the synthesized ones are hidden
-        self.original = MarkerSet(self.plotter, "original", ORIGINAL_COLOR, neutral, self.contours,
-                                  tri, mouth)
-        width = float(np.ptp(neutral[:, 0]))
-        self._half_gap = np.array([0.55 * width + 10.0, 0.0, 0.0])
+        self.original = self._new_set("original", ORIGINAL_COLOR)
+        axis = gap_axis(model)
+        self._half_gap = np.zeros(3)
+        self._half_gap[axis] = 0.55 * float(np.ptp(neutral[:, axis])) + 10.0
         # no VTK text (legend, caption): re-rasterizing text costs more than the whole scene on a
         # software renderer; the window shows the legend and the time in Qt widgets instead
         self._update_visibility()
         self.set_camera(self.preset, render=False)
         self.request_render()       # once: the meshes were added without a render each
 
+    def _new_set(self, name: str, color: str) -> MarkerSet | ArticulatorSet:
+        """A marker set of the model in the scene: a face (points, lip lines, surface) or, for
+        articulograph sensors, the articulators (``app/articulators.py``)."""
+        if self.articulators:
+            return ArticulatorSet(self.plotter, name, color, self.neutral, self.model.roles)
+        return MarkerSet(self.plotter, name, color, self.neutral, self.contours, self._tri,
+                         self._mouth)
+
     def set_view(self, view: UtteranceView) -> None:
         self.view = view
         self._syn = _fill_nan(view.shown, self.neutral)
         self._orig = None if view.original is None else _fill_nan(view.original, self.neutral)
+        if self.articulators:                    # the recording's palate trace, if it has one
+            self.original.set_palate(view.original)
         self._update_visibility()
         self.frame = -1
 
@@ -253,9 +268,7 @@ class FaceView(QWidget):
         self.pins = list(pins)
         for pin in self.pins:
             if pin.color not in self._pin_sets:
-                self._pin_sets[pin.color] = MarkerSet(self.plotter, f"pin-{pin.color}", pin.color,
-                                                      self.neutral, self.contours, self._tri,
-                                                      self._mouth)
+                self._pin_sets[pin.color] = self._new_set(f"pin-{pin.color}", pin.color)
         for pin in self.pins:
             self._pin_sets[pin.color].name = pin.name     # the hover's "UL_C (pin 1)"
         self._pin_frames = [_fill_nan(p.view.shown, self.neutral) for p in self.pins]
@@ -358,21 +371,39 @@ class FaceView(QWidget):
         if self.model is None:
             return
         self.preset = preset
+        # articulators in a parallel projection: the midsagittal profile true to scale
+        self.plotter.renderer.GetActiveCamera().SetParallelProjection(self.articulators)
         direction, up = CAMERA_PRESETS[preset]
         d = np.asarray(direction, float)
         d /= np.linalg.norm(d)
-        pts = [self.neutral + self._offset, self.neutral - self._offset]
-        pts += [self.neutral + self._pin_offset(i) for i in range(len(self.pins))]
+        # the articulators fitted with room for their motion, the reference sensors left out
+        # (faint, far off: the nose bridge); a face fitted close
+        fit = self.neutral[list(self.model.roles.moving)] if self.articulators else self.neutral
+        margin = 10.0 if self.articulators else 5.0
+        pts = [fit + self._offset, fit - self._offset]
+        pts += [fit + self._pin_offset(i) for i in range(len(self.pins))]
         allp = np.concatenate(pts)
         centre = (allp.min(axis=0) + allp.max(axis=0)) / 2
         self.plotter.camera_position = [tuple(centre + 400 * d), tuple(centre), up]
-        lo, hi = allp.min(axis=0) - 5, allp.max(axis=0) + 5
+        lo, hi = allp.min(axis=0) - margin, allp.max(axis=0) + margin
         self.plotter.renderer.ResetCamera(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
-        self.plotter.camera.zoom(1.45)
+        self._fit = (allp, margin)
+        if self.articulators:           # the view filled: the extent across and up the screen
+            fit_parallel(self.plotter, allp, margin, (self.width(), self.height()))
+        else:
+            self.plotter.camera.zoom(1.45)
         if render:
             self.plotter.render()
         else:
             self.ahead = -1                     # a frame rendered ahead has the old camera
+
+    def resizeEvent(self, event) -> None:
+        """Articulators fill the resized view (their parallel projection fitted again)."""
+        super().resizeEvent(event)
+        if self.articulators and self._fit is not None:
+            fit_parallel(self.plotter, *self._fit, (self.width(), self.height()))
+            self.ahead = -1
+            self.request_render()
 
     # ------------------------------------------------------------------ hover
     def _project(self, pts: np.ndarray) -> np.ndarray:

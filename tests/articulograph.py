@@ -279,3 +279,44 @@ def write_folder(kind: str, toy: Path, out: Path, ids=IDS) -> Path:
             writer(out / f"{utt}.mat", mview_entries(NAMES, at_rate(m, 60, 100)[:, :, [2, 0, 1]], 100.0,
                                                      audio, rate, phones, [], "toy sentence"))
     return out
+
+
+# --------------------------------------------------------------------------- MVIEW from MOCHA
+#: HPRC's sensors (Haskins' MVIEW files) and the MOCHA-TIMIT coil each is made of: the tongue
+#: rear, body and tip, the lips and the jaw (MOCHA's lower incisor)
+HPRC_FROM_MOCHA = {"TR": "TD", "TB": "TB", "TT": "TT", "UL": "UL", "LL": "LL", "JAW": "LI"}
+#: the two HPRC sensors MOCHA has no coil for, made up from the lips and the jaw (mm, facetraj's
+#: axes x right, y up, z forward): the mouth's left corner 24 mm to the left of the lips' midpoint
+#: and 12 mm behind it, the jaw's left sensor 30 mm left of JAW, 6 mm up and 38 mm back
+ML_FROM_LIPS = np.array([-24.0, 0.0, -12.0])
+JAWL_FROM_JAW = np.array([-30.0, 6.0, -38.0])
+HPRC_NAMES = ["TR", "TB", "TT", "UL", "LL", "ML", "JAW", "JAWL"]
+
+
+def mview_from_mocha(mocha: Path, out: Path, rate: float = 100.0) -> Path:
+    """An MVIEW ``.mat`` file in HPRC's layout made from the MOCHA-TIMIT sample ``mocha``
+    (``fsew0_001``): the audio with its phones (MOCHA's labels mapped onto ARPAbet, upper case as
+    HPRC writes them) and sentence inside, the sensors of :data:`HPRC_NAMES` at ``rate`` Hz in
+    MVIEW's axes (x forward, y lateral, z up); ML and JAWL are made up (:data:`ML_FROM_LIPS`,
+    :data:`JAWL_FROM_JAW`), so the file is 3-D as HPRC's are. Written as ``out/fsew0_001.mat``;
+    nothing is written beside the sample."""
+    import soundfile as sf
+
+    from facetraj_engine.evaluation.label_accuracy import merged
+    from facetraj_engine.io.labelfiles import read_lab
+    from facetraj_engine.io.markerformats.mocha import read_mocha_text
+    from facetraj_engine.labels.labelmap import read_label_map
+
+    rec = read_mocha_text(mocha / "fsew0_001.ema")
+    coil = {n: rec.markers[:, i] for i, n in enumerate(rec.names)}
+    xyz = {name: coil[src] for name, src in HPRC_FROM_MOCHA.items()}
+    xyz["ML"] = (xyz["UL"] + xyz["LL"]) / 2 + ML_FROM_LIPS
+    xyz["JAWL"] = xyz["JAW"] + JAWL_FROM_JAW
+    sensors = at_rate(np.stack([xyz[n] for n in HPRC_NAMES], axis=1), rec.rate, rate)
+    audio, audio_rate = sf.read(mocha / "fsew0_001.wav")
+    phones = [PhoneSegment(p.start, p.end, p.label.upper())
+              for p in merged(read_lab(mocha / "fsew0_001.lab"), read_label_map("mocha"))]
+    out.mkdir(parents=True, exist_ok=True)
+    return write_mview_v5(out / "fsew0_001.mat", mview_entries(
+        HPRC_NAMES, sensors[:, :, [2, 0, 1]], rate, audio, audio_rate, phones, [],
+        "This was easy for us."))

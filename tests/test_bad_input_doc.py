@@ -300,6 +300,9 @@ def model_detail_cases(f: BadInputs) -> dict[str, Callable[[], object]]:
                                                 load_corpus(f.tmp)),
     "a corpus.json whose data folder is missing": lambda: (f.write("corpus.json", json.dumps(
         {**f.info.to_json(), "data_dir": "gone"})), load_corpus(f.tmp)),
+    "a corpus.json whose sensor_roles name a marker it does not have": lambda: (f.write(
+        "corpus.json", json.dumps({**f.info.to_json(), "sensor_roles": {"tongue": ["XX"]}})),
+        load_corpus(f.tmp)),
     }
 
 

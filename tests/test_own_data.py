@@ -8,7 +8,7 @@ import pytest
 from conftest import MOCHA
 
 from facetraj_engine.config import SynthConfig
-from facetraj_engine.errors import InputError
+from facetraj_engine.errors import FILE_WARNINGS, InputError
 from facetraj_engine.io.corpus import init_corpus, load_corpus
 from facetraj_engine.io.markerfiles import MOCHA_COILS, read_markers, read_mocha_ema, write_c3d
 from facetraj_engine.labels.labelmap import MOCHA_TO_ARPABET, read_label_map
@@ -66,6 +66,7 @@ def mocha_corpus(tmp_path_factory):
 def test_mocha_as_a_corpus(mocha_corpus, caplog):
     assert mocha_corpus.info.dimensions == 2 and mocha_corpus.info.data_dir
     assert not list(MOCHA.glob("corpus.json"))                 # nothing written into shared/
+    FILE_WARNINGS.clear()            # logged once per file and process: another test may have read it
     with caplog.at_level(logging.WARNING):
         utt = mocha_corpus.utterance("fsew0_001")
     assert "markers end at 1.92 s but the audio at 2.22 s" in caplog.text

@@ -19,6 +19,7 @@ SECTIONS = (
     "## Figure 5: correlation against N",
     "## Figure 4: an example",
     "## Comparisons on the same split",
+    "## Per sensor",
     "## Table 1: the three visually most similar phones",
     "## Discussion: where and why we differ from the paper",
     "## Reproducing",
@@ -62,6 +63,29 @@ def test_markdown_has_every_section(report: Path, small_corpus: Path) -> None:
     assert f'"{FIGURE4_TEXT}.' in text and "not in the corpus" not in text
     for name in ("figure4", "figure5", "comparison"):
         assert f"(figures/results_{name}.png)" in text
+
+
+def test_per_sensor_section(report: Path) -> None:
+    """r and RMSE (mm) per sensor coordinate for each method, the baselines beside the paper's
+    method; a long table cut to the coordinates that move most (all of them in the JSON)."""
+    data = json.loads((report.parent / "results.json").read_text())["sensors"]
+    assert data["split"] == "test" and [m["method"] for m in data["methods"]] == [
+        "phonetic (N = 3)", "acoustic-only", "acoustic-only, indexed", "viseme lookup",
+        "ridge regression"]
+    keys = [f"{c['sensor']} {c['axis']}" for c in data["methods"][0]["coordinates"]]
+    assert "LL_C y" in keys and "UL_C y" in keys and len(keys) > 15
+    for m in data["methods"]:
+        assert [f"{c['sensor']} {c['axis']}" for c in m["coordinates"]] == keys
+        assert all(0 < c["rmse_mm"] < 50 and -1 <= c["r"] <= 1 for c in m["coordinates"])
+    text = report.read_text()
+    section = text[text.index("## Per sensor"):].split("\n## ")[0]
+    rows = [ln for ln in section.splitlines() if ln.startswith("| ") and not ln.startswith("| Coord")]
+    most = sorted(keys, key=lambda k: -data["sd_mm"][k])[:15]
+    assert [r.split(" | ")[0][2:] for r in rows[:-1]] == most
+    assert rows[-1].startswith("| articulators (mean)")
+    ll = next(c for c in data["methods"][0]["coordinates"] if c["sensor"] == "LL_C" and c["axis"] == "y")
+    if "LL_C y" in most:
+        assert f"{ll['r']:.3f} / {ll['rmse_mm']:.2f}" in section
 
 
 def test_json_holds_all_numbers(report: Path) -> None:

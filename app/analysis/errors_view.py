@@ -45,6 +45,7 @@ from facetraj_engine.analysis.errors import (
 from facetraj_engine.io.corpus import Corpus
 from facetraj_engine.method.model import Model
 
+from ..tier_labels import Span, StackedLabels
 from .common import (
     Canvas,
     NumberItem,
@@ -133,6 +134,8 @@ class ErrorView(QWidget):
 
         self.splits = QComboBox()
         self.splits.addItems(list(SPLITS))
+        if not corpus.info.test:                # a corpus without a test split: its training one
+            self.splits.setCurrentText("train")
         self.per_split = QSpinBox()
         self.per_split.setRange(0, 10000)
         self.per_split.setSpecialValueText("all")
@@ -306,6 +309,7 @@ class LipErrorPanel:
         self.model = model
         self.worst = worst
         self.last_segments = []
+        self.labels: StackedLabels | None = None     # the worst segments' labels of the last draw
 
     def draw(self, ax, view) -> None:
         ax.set_ylabel("lip error\n(mm)", fontsize=8)
@@ -322,8 +326,9 @@ class LipErrorPanel:
         self.last_segments = segs
         for s in segs:
             ax.axvspan(s.start, s.end, color="#e03131", alpha=0.15, lw=0)
-            ax.text(0.5 * (s.start + s.end), 0.97, f"{s.label} {s.error:.1f}",
-                    transform=ax.get_xaxis_transform(), ha="center", va="top", fontsize=7,
-                    color="#c92a2a", clip_on=True)
+        # each label whole, over its segment, a row lower where it would touch another
+        self.labels = StackedLabels(ax, [Span(s.start, s.end, f"{s.label} {s.error:.1f}", 0.0,
+                                              "#c92a2a") for s in segs])
+        ax.add_artist(self.labels)
         top = float(np.nanmax(err)) if np.isfinite(err).any() else 1.0
         ax.set_ylim(0, 1.35 * max(top, 0.1))    # the worst segments' labels above the curves

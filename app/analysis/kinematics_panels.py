@@ -83,6 +83,11 @@ class LipMeasurePanel:
 
     def draw(self, ax, view) -> None:
         syn = getattr(model_lip_measures(self.model, view.synthesis.markers), self.measure)
+        ax.set_ylabel(MEASURES[self.measure][1], fontsize=8)
+        if not np.isfinite(syn).any():          # the lip width of a set without two corners
+            ax.text(0.5, 0.5, f"no {self.title}: the markers have no pair of lip corners",
+                    transform=ax.transAxes, ha="center", va="center", color="#888888", fontsize=8)
+            return
         t = view.times[: len(syn)]
         ax.plot(t, syn, color=SYNTH_COLOR, lw=1.3, label="synthesized (3-D view's)")
         if view.original is not None:
@@ -91,7 +96,6 @@ class LipMeasurePanel:
                     label="original")
         if self.closed is not None:
             closed_line(ax, self.closed)
-        ax.set_ylabel(MEASURES[self.measure][1], fontsize=8)
 
 
 class KinematicsControls(QWidget):

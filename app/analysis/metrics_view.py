@@ -1,6 +1,9 @@
 """Metrics: the paper's Table 2 (train / test x triangular / spline; whole face, lower lip, upper
 lip) plus acoustic-only rows, and the N sweep (Figure 5), each computed by the engine in a
-background worker with progress. Export CSV (Table 2, sweep) and PNG (the two plots).
+background worker with progress; with Table 2 the per-sensor table (r and RMSE in mm of every
+sensor coordinate, as articulatory-inversion papers tabulate them, with the viseme and ridge
+baselines beside the method: :mod:`facetraj_engine.evaluation.sensors`). Export CSV (Table 2, per
+sensor, sweep) and PNG (the two plots).
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ from PyQt6.QtCore import pyqtSignal
 from PyQt6.QtGui import QColor
 from PyQt6.QtWidgets import (
     QCheckBox,
+    QComboBox,
     QGridLayout,
     QGroupBox,
     QHBoxLayout,
@@ -22,6 +26,7 @@ from PyQt6.QtWidgets import (
     QProgressBar,
     QPushButton,
     QSpinBox,
+    QStackedWidget,
     QTableWidget,
     QVBoxLayout,
     QWidget,
@@ -31,11 +36,14 @@ from facetraj_engine.analysis.common import subset_corpus
 from facetraj_engine.analysis.metrics import (
     SweepCurve,
     Table2Row,
+    sensor_rows,
     sweep_curves,
     table2_rows,
+    write_sensor_csv,
     write_sweep_csv,
     write_table2_csv,
 )
+from facetraj_engine.evaluation.baselines import fit_and_score
 from facetraj_engine.evaluation.paper import TABLE2_N, table2_value
 from facetraj_engine.evaluation.scores import METRICS, EvalResult, sweep_n, table2
 from facetraj_engine.io.corpus import Corpus
@@ -126,6 +134,7 @@ class MetricsView(QWidget):
         self.window_ = window
         self.tasks = task_runner(self, window)
         self.table2_result: EvalResult | None = None
+        self.baseline_result: EvalResult | None = None
         self.sweep_result: EvalResult | None = None
         self.rows: list[Table2Row] = []
         self.curves: list[SweepCurve] = []
@@ -136,6 +145,10 @@ class MetricsView(QWidget):
         self.per_split.setToolTip("utterances per split (all: the whole corpus)")
         self.acoustic = QCheckBox("acoustic-only rows")
         self.acoustic.setChecked(True)
+        self.baselines = QCheckBox("baselines")
+        self.baselines.setChecked(True)
+        self.baselines.setToolTip("the viseme lookup and the ridge regression, fitted on the "
+                                  "training split, in the per-sensor table")
         self.max_n = QSpinBox()
         self.max_n.setRange(1, 30)
         self.max_n.setValue(10)
@@ -147,18 +160,33 @@ class MetricsView(QWidget):
         self.progress.setRange(0, 1000)
         self.status = QLabel("")
         self.status.setWordWrap(True)
-        exp = [("Table 2 CSV…", self._export_table2), ("N sweep CSV…", self._export_sweep),
-               ("PNG…", self._export_png)]
+        exp = [("Table 2 CSV…", self._export_table2), ("per sensor CSV…", self._export_sensors),
+               ("N sweep CSV…", self._export_sweep), ("PNG…", self._export_png)]
 
         self.table = QTableWidget()
         self.table.setSortingEnabled(False)             # ours, each followed by the paper's
         self.table.verticalHeader().setVisible(False)
         self.table.verticalHeader().setDefaultSectionSize(self.table.fontMetrics().height() + 6)
+        self.sensor_table = QTableWidget()          # r and RMSE per sensor coordinate
+        self.sensor_table.setSortingEnabled(False)
+        self.sensor_table.verticalHeader().setVisible(False)
+        self.sensor_table.verticalHeader().setDefaultSectionSize(self.table.fontMetrics().height() + 6)
+        # Table 2 or the per-sensor table in the same place, chosen beside the status line (tabs
+        # took height the plots need on a laptop screen)
+        self.tables = QStackedWidget()
+        self.tables.addWidget(self.table)
+        self.tables.addWidget(self.sensor_table)
+        self.table_choice = QComboBox()
+        self.table_choice.addItems(["Table 2", "per sensor"])
+        self.table_choice.setToolTip("Table 2, or r and RMSE (mm) of every sensor coordinate "
+                                     "(triangular smoothing)")
+        self.table_choice.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToContents)
+        self.table_choice.currentIndexChanged.connect(self.tables.setCurrentIndex)
         self.canvas = Canvas(6, 5.2)
         self.canvas.setMinimumHeight(260)
         lay = QVBoxLayout(self)
         lay.addWidget(self._options(exp))
-        lay.addWidget(vertical_split(self.table, self.canvas, (300, 520)), 1)
+        lay.addWidget(vertical_split(self.tables, self.canvas, (300, 520)), 1)
         self._draw()
 
     def _options(self, exports: list) -> QGroupBox:
@@ -167,12 +195,14 @@ class MetricsView(QWidget):
         g = QGridLayout(opts)
         g.addWidget(QLabel("utterances per split:"), 0, 0)
         g.addWidget(self.per_split, 0, 1)
-        g.addWidget(self.acoustic, 0, 2, 1, 2)
+        g.addWidget(self.acoustic, 0, 2)
+        g.addWidget(self.baselines, 0, 3)
         g.addWidget(self.run_table2, 1, 0)
         g.addWidget(self.run_sweep, 1, 1, 1, 2)
         g.addWidget(self.max_n, 1, 3)
         g.addWidget(self.progress, 2, 0, 1, 4)
-        g.addWidget(self.status, 3, 0, 1, 4)
+        g.addWidget(self.status, 3, 0, 1, 3)
+        g.addWidget(self.table_choice, 3, 3)
         buttons = QHBoxLayout()
         buttons.addWidget(QLabel("export:"))
         for text, slot in exports:
@@ -201,10 +231,21 @@ class MetricsView(QWidget):
         report_error(self, "Metrics", exc)
 
     def start_table2(self) -> None:
+        """Table 2 (and the baselines, when asked) in the background."""
         corpus, model, acoustic = self._subset(), self.model, self.acoustic.isChecked()
+        baselines = self.baselines.isChecked()
+
+        def work(p) -> tuple[EvalResult, EvalResult | None]:
+            share = 0.7 if baselines else 1.0
+            res = table2(model, corpus, acoustic=acoustic, progress=lambda f, m: p(share * f, m))
+            if not baselines:
+                return res, None
+            _, scores = fit_and_score(model, corpus, progress=lambda f, m: p(share + 0.3 * f, m))
+            return res, EvalResult(scores)
+
         self._busy(True)
-        self.tasks.run(lambda p: table2(model, corpus, acoustic=acoustic, progress=p),
-                       self._table2_done, "Table 2", on_progress=self._on_progress, on_error=self._failed)
+        self.tasks.run(work, self._table2_done, "Table 2", on_progress=self._on_progress,
+                       on_error=self._failed)
 
     def start_sweep(self) -> None:
         corpus, model = self._subset(), self.model
@@ -213,9 +254,9 @@ class MetricsView(QWidget):
         self.tasks.run(lambda p: sweep_n(model, corpus, ns, progress=p),
                        self._sweep_done, "N sweep", on_progress=self._on_progress, on_error=self._failed)
 
-    def _table2_done(self, result: EvalResult) -> None:
+    def _table2_done(self, results: tuple[EvalResult, EvalResult | None]) -> None:
         self._busy(False)
-        self.set_table2(result)
+        self.set_table2(*results)
         self.table2Done.emit()
 
     def _sweep_done(self, result: EvalResult) -> None:
@@ -224,10 +265,12 @@ class MetricsView(QWidget):
         self.sweepDone.emit()
 
     # ------------------------------------------------------------------ display
-    def set_table2(self, result: EvalResult) -> None:
+    def set_table2(self, result: EvalResult, baselines: EvalResult | None = None) -> None:
         """Our Table 2 rows, each phonetic N = 3 row followed by the paper's (grey): six columns
-        that fit the dock (the paper's values had three columns of their own, past its edge)."""
-        self.table2_result = result
+        that fit the dock (the paper's values had three columns of their own, past its edge);
+        the per-sensor table of the same conditions and the ``baselines``."""
+        self.table2_result, self.baseline_result = result, baselines
+        self._fill_sensors()
         self.rows = table2_rows(result)
         head = ["condition", "whole face r", "lower lip r", "upper lip r", "N", "utterances"]
         rows = []
@@ -255,6 +298,32 @@ class MetricsView(QWidget):
         self.status.setText(f"Table 2: {len(self.rows)} conditions (grey: the paper's)")
         self._draw()
 
+    def sensor_split(self) -> str:
+        """The split of the per-sensor table: the test split, else the training one."""
+        has_test = self.table2_result is not None and any(
+            s.split == "test" for s in self.table2_result.scores)
+        return "test" if has_test else "train"
+
+    def _results(self) -> list[EvalResult]:
+        return [r for r in (self.table2_result, self.baseline_result) if r is not None]
+
+    def _fill_sensors(self) -> None:
+        """The per-sensor table (triangular smoothing): a row per coordinate, r and RMSE (mm)
+        per condition; the paper's three correlations first."""
+        names, rows = sensor_rows(self._results(), self.sensor_split())
+        head = ["row", "role", *(f"{n}\n{w}" for n in names for w in ("r", "RMSE mm"))]
+        def r_item(value: float, role: str):        # a reference sensor's r is noise: no heat
+            return (NumberItem(value, "{:.3f}") if role == "reference"
+                    else heat_item(value, 0.4, 1.0, "{:.3f}", "RdYlGn"))
+
+        items = [[text_item(r.name), text_item(r.role),
+                  *(item for rv, ev in zip(r.r, r.rmse_mm, strict=True)
+                    for item in (r_item(rv, r.role), NumberItem(ev, "{:.2f}")))]
+                 for r in rows]
+        fill_table(self.sensor_table, head, items)
+        self.sensor_table.resizeColumnsToContents()
+        self.table_choice.setItemText(1, f"per sensor ({self.sensor_split()})")
+
     def set_sweep(self, result: EvalResult) -> None:
         self.sweep_result = result
         self.curves = sweep_curves(result)
@@ -275,6 +344,11 @@ class MetricsView(QWidget):
             raise ValueError("compute Table 2 first")
         return write_table2_csv(path, self.table2_result)
 
+    def export_sensor_csv(self, path: str | Path) -> Path:
+        if self.table2_result is None:
+            raise ValueError("compute Table 2 first")
+        return write_sensor_csv(path, self._results(), self.sensor_split())
+
     def export_sweep_csv(self, path: str | Path) -> Path:
         if self.sweep_result is None:
             raise ValueError("run the N sweep first")
@@ -286,6 +360,10 @@ class MetricsView(QWidget):
 
     def _export_table2(self) -> None:
         export_with_dialog(self, "Export Table 2", "table2.csv", "CSV (*.csv)", self.export_table2_csv)
+
+    def _export_sensors(self) -> None:
+        export_with_dialog(self, "Export the per-sensor table", "per_sensor.csv", "CSV (*.csv)",
+                           self.export_sensor_csv)
 
     def _export_sweep(self) -> None:
         export_with_dialog(self, "Export N sweep", "n_sweep.csv", "CSV (*.csv)", self.export_sweep_csv)

@@ -7,6 +7,11 @@ lips closing where they meet, as in the main view) and displacement arrows; besi
 as in Figure 2 (circles: neutral, arrows: displacement) and the variance share of every PC.
 "Animate" sweeps the mode back and forth. All shapes come from ``model.mode_shape``.
 
+For articulograph sensors (``model.roles.articulograph``) the mode is shown as articulators move
+(``app/articulators.py``): in 3-D the neutral articulators (grey) and the displaced ones (orange:
+tongue curve, lips, jaw), seen in profile; in 2-D the midsagittal profile (z-y), where the tongue
+shows, with the displaced articulators drawn at the arrows' scale and every sensor named.
+
 The view opens at once and builds its 3-D scene and its plots in the passes of the event loop
 that follow (``ready`` when done), so that the window does not freeze while it opens.
 """
@@ -33,6 +38,7 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
+from facetraj_app.articulators import ArticulatorSet, ProfileDrawing, fit_parallel, is_articulograph
 from facetraj_app.plotter_widget import make_plotter
 from facetraj_app.style import BACKGROUND, SYNTH_COLOR
 from facetraj_app.surface import Mouth, lip_contours, stored_face_triangles
@@ -65,6 +71,15 @@ PROJECTIONS = {"front (x-y)": (0, 1), "profile (z-y)": (2, 1)}
 NEUTRAL_COLOR = "#8c8c8c"
 
 
+def _fit_limits(ax, points: np.ndarray, axes2d: tuple[int, int]) -> None:
+    """``ax``'s limits around ``points`` in the plane ``axes2d``, with 15 % of their extent to
+    spare."""
+    h, v = axes2d
+    pad = 0.15 * np.ptp(points[:, [h, v]], axis=0).max()
+    ax.set_xlim(points[:, h].min() - pad, points[:, h].max() + pad)
+    ax.set_ylim(points[:, v].min() - pad, points[:, v].max() + pad)
+
+
 class PCModeExplorer(QWidget):
     """Explore one PC at a time: slider over +-3 SD, 3-D view, Figure 2 projection, variance."""
 
@@ -84,6 +99,8 @@ class PCModeExplorer(QWidget):
         self.component = 0
         self.value = 0.0
         self._phase = 0.0
+        self.articulators = is_articulograph(model)    # shown as articulators, in profile
+        self.profile: ProfileDrawing | None = None      # the displaced articulators in 2-D
         rows = self._build_controls()
 
         self.plotter = None                  # made in the first pass after the view opens
@@ -134,11 +151,13 @@ class PCModeExplorer(QWidget):
         self.description.setWordWrap(True)
         self.projection = QComboBox()
         self.projection.addItems(list(PROJECTIONS))
+        if self.articulators or self.model.is_planar:   # the midsagittal profile shows a tongue
+            self.projection.setCurrentText("profile (z-y)")
         self.projection.setToolTip("the 2-D projection of Figure 2")
         self.projection.currentIndexChanged.connect(self._projection_changed)
         self.arrow_scale = QSpinBox()
         self.arrow_scale.setRange(1, 20)
-        self.arrow_scale.setValue(3)
+        self.arrow_scale.setValue(1 if self.articulators else 3)   # articulators: true to scale
         self.arrow_scale.setPrefix("arrows x")
         self.arrow_scale.setToolTip("lengthen the 2-D arrows for legibility (the 3-D view is true to scale)")
         self.arrow_scale.valueChanged.connect(lambda _v: self.set_value(self.value, move_slider=False))
@@ -185,7 +204,13 @@ class PCModeExplorer(QWidget):
     # ------------------------------------------------------------------ scene
     def _build_scene(self) -> None:
         """The displaced face: its points, lip contours and surface as the main view draws them
-        (``MarkerSet``: opaque, under the points; a translucent one cost a transparency pass)."""
+        (``MarkerSet``: opaque, under the points; a translucent one cost a transparency pass);
+        articulograph sensors as articulators (``ArticulatorSet``)."""
+        if self.articulators:
+            self.face_set = ArticulatorSet(self.plotter, "displaced", SYNTH_COLOR, self.neutral,
+                                           self.model.roles)
+            self.displaced = self.face_set.points
+            return
         contours = lip_contours(self.neutral, self.model.upper_lip, self.model.lower_lip,
                                 list(self.model.lip_corners))
         try:
@@ -205,26 +230,50 @@ class PCModeExplorer(QWidget):
         self.neutral_poly.verts = np.column_stack([np.ones(n, int), np.arange(n)]).ravel()
         self.arrows = pv.PolyData(np.vstack([self.neutral, self.neutral]))
         self.arrows.lines = np.column_stack([np.full(n, 2), np.arange(n), np.arange(n) + n]).ravel()
-        self.plotter.add_mesh(self.neutral_poly, color=NEUTRAL_COLOR, render_points_as_spheres=True,
-                              point_size=11, style="points", name="neutral", pickable=False,
-                              reset_camera=False, render=False)
+        if self.articulators:           # the neutral articulators, grey
+            ArticulatorSet(self.plotter, "neutral", NEUTRAL_COLOR, self.neutral, self.model.roles)
+        else:
+            self.plotter.add_mesh(self.neutral_poly, color=NEUTRAL_COLOR, point_size=11,
+                                  render_points_as_spheres=True, style="points", name="neutral",
+                                  pickable=False, reset_camera=False, render=False)
         self.plotter.add_mesh(self.arrows, color="#222222", line_width=2.5, name="arrows",
                               pickable=False, reset_camera=False, render=False)
-        self.set_camera("three-quarter", render=False)
+        self.set_camera("profile" if self.articulators else "three-quarter", render=False)
 
     def set_camera(self, name: str, render: bool = True) -> None:
         """Look at the face from the ``front``, in ``profile`` or at ``three-quarter``."""
         if self.plotter is None:
             return
         direction, up = CAMERAS[name]
-        centre = self.neutral.mean(axis=0)
-        dist = 3.0 * float(np.ptp(self.neutral, axis=0).max())
+        self.plotter.renderer.GetActiveCamera().SetParallelProjection(self.articulators)
+        pts = self._articulators() if self.articulators else self.neutral
+        centre = pts.mean(axis=0)
+        dist = 3.0 * float(np.ptp(pts, axis=0).max())
         d = np.asarray(direction, dtype=float)
         d /= np.linalg.norm(d)
         self.plotter.camera_position = [tuple(centre + dist * d), tuple(centre), up]
-        self.plotter.renderer.reset_camera(render=False)
+        if self.articulators:           # fitted to the articulators and their motion
+            lo, hi = pts.min(axis=0) - 15.0, pts.max(axis=0) + 15.0
+            self.plotter.renderer.ResetCamera(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
+            fit_parallel(self.plotter, pts, 15.0, self._scene_size())
+        else:
+            self.plotter.renderer.reset_camera(render=False)
         if render:
             self.plotter.render()
+
+    def _scene_size(self) -> tuple[int, int]:
+        return self.scene_box.width(), self.scene_box.height()
+
+    def resizeEvent(self, event) -> None:
+        """Articulators fill the resized 3-D view (the parallel projection fitted again)."""
+        super().resizeEvent(event)
+        if self.articulators and self.plotter is not None:
+            fit_parallel(self.plotter, self._articulators(), 15.0, self._scene_size())
+            self.plotter.render()
+
+    def _articulators(self) -> np.ndarray:
+        """The neutral sensors on the articulators (the reference sensors, far off, left out)."""
+        return self.neutral[list(self.model.roles.moving)]
 
     def _build_plots(self, fig: Figure, axes2d: tuple[int, int]) -> None:
         """The 2-D projection and the variance of each PC (built in the drawing thread:
@@ -254,6 +303,12 @@ class PCModeExplorer(QWidget):
         ax.clear()
         h, v = axes2d
         ax.plot(self.neutral[:, h], self.neutral[:, v], "o", mfc="none", mec="#333333", ms=6)
+        self.profile = None
+        if self.articulators:           # neutral (grey, named) and displaced articulators
+            ProfileDrawing(ax, self.model.roles, self.neutral, NEUTRAL_COLOR, axes2d,
+                           label="neutral", names=True)
+            self.profile = ProfileDrawing(ax, self.model.roles, self.neutral, SYNTH_COLOR, axes2d,
+                                          label="displaced (at the arrows' scale)", lw=2.0)
         self.quiver = ax.quiver(self.neutral[:, h], self.neutral[:, v], np.zeros(len(self.neutral)),
                                 np.zeros(len(self.neutral)), angles="xy", scale_units="xy", scale=1,
                                 color=SYNTH_COLOR, width=0.006)
@@ -261,9 +316,7 @@ class PCModeExplorer(QWidget):
         ax.set_xlabel(f"{'xyz'[h]} (mm)", fontsize=8)
         ax.set_ylabel(f"{'xyz'[v]} (mm)", fontsize=8)
         ax.tick_params(labelsize=7)
-        pad = 0.15 * np.ptp(self.neutral[:, [h, v]], axis=0).max()
-        ax.set_xlim(self.neutral[:, h].min() - pad, self.neutral[:, h].max() + pad)
-        ax.set_ylim(self.neutral[:, v].min() - pad, self.neutral[:, v].max() + pad)
+        _fit_limits(ax, self._articulators() if self.articulators else self.neutral, (h, v))
 
     def _projection_changed(self) -> None:
         if hasattr(self, "ax_face") or self.canvas.busy:
@@ -334,6 +387,12 @@ class PCModeExplorer(QWidget):
         h, v = self._axes2d()
         scale = int(self.arrow_scale.value())
         self.quiver.set_UVC(scale * disp[:, h], scale * disp[:, v])
+        if self.profile is not None:        # in view over the whole slider (+-3 SD)
+            self.profile.set(self.neutral + scale * disp)
+            ends = [self.neutral + scale * mode_displacement(self.model, k, e * sd) for e in (-3, 3)]
+            moving = list(self.model.roles.moving)
+            _fit_limits(self.ax_face, np.concatenate([e[moving] for e in (self.neutral, *ends)]),
+                        (h, v))
         self.ax_face.set_title(f"PC{k + 1} = {self.value:+.1f} ({self.value / sd:+.1f} SD)"
                                + (f", arrows x{scale}" if scale != 1 else ""), fontsize=9)
         self.canvas.draw_idle()

@@ -24,11 +24,11 @@ from ..evaluation.closed_lips import (
 )
 from ..evaluation.scores import pearson, speech_mask, trajectory_correlations
 from ..io.corpus import Corpus
-from ..labels.phoneset import SILENCE
 from ..method.context import segment_index
 from ..method.model import Model
 from ..method.pipeline import Synthesis, synthesize
 from ..progress import Progress
+from .apertures import SILENT_LABELS
 from .common import write_csv
 
 
@@ -78,17 +78,19 @@ def segment_errors(phones: Sequence[PhoneSegment], times: np.ndarray, error: np.
 
 
 def worst_segments(errors: Sequence[SegmentError], count: int = 5,
-                   exclude: Sequence[str] = (SILENCE,)) -> list[SegmentError]:
-    """The ``count`` segments with the largest mean error (silence left out by default).
+                   exclude: Sequence[str] = SILENT_LABELS) -> list[SegmentError]:
+    """The ``count`` segments with the largest mean error (silences left out by default: ``sil``,
+    ``sp``, ``pau``, ... in any case, as HPRC's ``SIL`` and ``sp``).
 
     Examples
     --------
     >>> segs = [SegmentError("u", "m", 0, 1, 2.0), SegmentError("u", "sil", 1, 2, 9.0),
-    ...         SegmentError("u", "aa", 2, 3, 3.0)]
+    ...         SegmentError("u", "aa", 2, 3, 3.0), SegmentError("u", "SP", 3, 4, 9.4)]
     >>> [s.label for s in worst_segments(segs, 2)]
     ['aa', 'm']
     """
-    keep = [s for s in errors if s.label not in exclude]
+    left_out = {e.lower() for e in exclude}
+    keep = [s for s in errors if s.label.lower() not in left_out]
     return sorted(keep, key=lambda s: -s.error)[:count]
 
 

@@ -1,5 +1,7 @@
 """The metrics view's numbers: the paper's Table 2 and the N sweep (Figure 5) as rows and CSV,
-from an :class:`~facetraj_engine.evaluation.scores.EvalResult`."""
+from an :class:`~facetraj_engine.evaluation.scores.EvalResult`; the per-sensor table (r and RMSE of
+every sensor coordinate of the method and the baselines side by side,
+:mod:`facetraj_engine.evaluation.sensors`)."""
 
 from __future__ import annotations
 
@@ -10,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..evaluation.scores import ConditionScores, EvalResult
+from ..evaluation.sensors import TableRow, condition_columns, table_rows
 from .common import write_csv
 
 SMOOTHING_NAMES = {"triangular": "Triang.", "spline": "Spline", "none": "None"}
@@ -103,5 +106,22 @@ def write_sweep_csv(path: str | os.PathLike[str], result: EvalResult, overwrite:
     return write_csv(path, ["split", "N", "whole_face", "lower_lip", "upper_lip"], rows, overwrite)
 
 
-__all__ = ["SMOOTHING_NAMES", "SweepCurve", "Table2Row", "condition_name", "sweep_curves",
-           "table2_rows", "write_sweep_csv", "write_table2_csv"]
+def sensor_rows(results: list[EvalResult], split: str, smoothing: str = "triangular"
+                ) -> tuple[list[str], list[TableRow]]:
+    """The per-sensor table of ``results`` (the method's and the baselines') on ``split``: the
+    conditions' names, and the rows (:func:`facetraj_engine.evaluation.sensors.table_rows`)."""
+    cols = condition_columns(results, split, smoothing)
+    return [c[0] for c in cols], table_rows(cols)
+
+
+def write_sensor_csv(path: str | os.PathLike[str], results: list[EvalResult], split: str,
+                     smoothing: str = "triangular", overwrite: bool = True) -> Path:
+    """Write the per-sensor table as CSV: a row per coordinate, r and RMSE (mm) per condition."""
+    names, rows = sensor_rows(results, split, smoothing)
+    header = ["row", "role", *(f"{n} {what}" for n in names for what in ("r", "rmse_mm"))]
+    return write_csv(path, header, ([r.name, r.role, *(v for pair in zip(r.r, r.rmse_mm, strict=True)
+                                                        for v in pair)] for r in rows), overwrite)
+
+
+__all__ = ["SMOOTHING_NAMES", "SweepCurve", "Table2Row", "condition_name", "sensor_rows",
+           "sweep_curves", "table2_rows", "write_sensor_csv", "write_sweep_csv", "write_table2_csv"]

@@ -2,6 +2,8 @@
 
 - ``scores``: speech-only frames (energy, 112 ms median filter), the correlations of Table 2,
   the N sweep of Figure 5;
+- ``sensors``: per sensor coordinate, r and RMSE in mm, as articulatory-inversion papers
+  tabulate them; ``correlation``: the Pearson correlation both use;
 - ``baselines``: a viseme lookup and a ridge regression, scored the same way;
 - ``tuning``: the robust mode's settings cross-validated on the training split;
 - ``label_accuracy``, ``label_eval``: automatic labels, their accuracy and every mode with them;
@@ -19,7 +21,8 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "scores": "METRICS EvalConfig speech_mask pearson "
               "moving_coordinates trajectory_correlations ConditionScores UtteranceScore EvalResult "
               "evaluate_utterance default_workers evaluate table2 sweep_n format_table2",
-    "baselines": "fit_baselines evaluate_baselines",
+    "sensors": "CoordinateScore SensorTable sensor_scores pooled format_sensor_report",
+    "baselines": "fit_baselines evaluate_baselines fit_and_score",
     "tuning": "cross_validate",
     "label_eval": "evaluate_labels",
     "voice_eval": "evaluate_voices",

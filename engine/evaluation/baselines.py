@@ -24,13 +24,17 @@ import numpy as np
 
 from ..config import EvalConfig
 from ..data import Utterance
+from ..fanout import fan_out
+from ..io.corpus import Corpus
 from ..labels.phoneset import normalise_label
 from ..method.closure_detector import stacked
 from ..method.context import segment_index
 from ..method.model import Model
 from ..method.moments import Moments
 from ..method.smoothing import smooth
+from ..threads import one_blas_thread
 from .scores import UtteranceScore, speech_mask, trajectory_correlations
+from .sensors import sensor_scores
 
 log = logging.getLogger(__name__)
 
@@ -350,8 +354,10 @@ def score_baseline(model: Model, fd: FrameData, pcs: np.ndarray, split: str, nam
     """
     markers = model.to_markers(smooth(pcs, model.marker_rate, smoothing, triangle_s, knot_s))
     c = trajectory_correlations(fd.original, markers, fd.speech, model, eval_config)
-    return UtteranceScore(split=split, mode=name, smoothing=smoothing, n_context_phones=0, **c,
-                          utterance=fd.name, speech_frames=int(fd.speech.sum()))
+    score = UtteranceScore(split=split, mode=name, smoothing=smoothing, n_context_phones=0, **c,
+                           utterance=fd.name, speech_frames=int(fd.speech.sum()))
+    score.sensors = tuple(sensor_scores(fd.original, markers, fd.speech, model))
+    return score
 
 
 def evaluate_baselines(model: Model, baselines: Baselines,
@@ -381,3 +387,33 @@ def score_baselines(model: Model, baselines: Baselines, fd: FrameData, split: st
         out.extend(score_baseline(model, fd, pcs, split, name, sm, eval_config)
                    for sm in smoothings)
     return out
+
+
+def fit_and_score(model: Model, corpus: Corpus, splits: Sequence[str] = ("train", "test"),
+                  progress: Callable[[float, str], None] | None = None, workers: int = 1
+                  ) -> tuple[Baselines, list[UtteranceScore]]:
+    """Fit the two baselines on ``corpus``'s training split and score them on ``splits``: the
+    corpus streamed twice (fitted from the training utterances' frames an utterance at a time,
+    then each utterance scored), in ``workers`` processes, BLAS on one thread as in the
+    evaluation. ``progress`` from 0 to 1."""
+    progress = progress or (lambda f, m: None)
+    train_ids = list(corpus.info.train)
+    ids = [(sp, u) for sp in splits for u in getattr(corpus.info, sp)]
+
+    def fitting(utt_id: str) -> FrameData:
+        return frame_data(model, corpus.utterance(utt_id), keep_original=False)
+
+    def scoring(pair: tuple[str, str]) -> list[UtteranceScore]:
+        return score_baselines(model, base, frame_data(model, corpus.utterance(pair[1])), pair[0])
+
+    gather = BaselineGather(model, len(train_ids))
+    scores: list[UtteranceScore] = []
+    with one_blas_thread():
+        for _, fd in fan_out(fitting, train_ids, workers, describe=lambda u: f"baselines: {u}",
+                             progress=lambda f, m: progress(0.35 * f, m)):
+            gather.add(fd)
+        base = gather.baselines()
+        for _, utt_scores in fan_out(scoring, ids, workers, describe=lambda pair: f"baselines: {pair[1]}",
+                                     progress=lambda f, m: progress(0.35 + 0.65 * f, m)):
+            scores.extend(utt_scores)
+    return base, scores

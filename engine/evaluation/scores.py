@@ -7,6 +7,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass, field, replace
+from typing import ClassVar
 
 import numpy as np
 
@@ -28,28 +29,12 @@ from .closed_lips import (
     talker_closed,
     talker_lips,
 )
+from .correlation import pearson
+from .sensors import SensorTable, pooled, sensor_scores
 
 log = logging.getLogger(__name__)
 
 METRICS = ("whole_face", "lower_lip", "upper_lip")
-
-
-def pearson(a: np.ndarray, b: np.ndarray) -> float:
-    """Pearson correlation of two 1-D series; NaN when either is constant or shorter than 3.
-
-    Examples
-    --------
-    >>> round(pearson(np.array([1.0, 2, 3, 4]), np.array([2.0, 4, 6, 8.5])), 4)
-    0.9984
-    """
-    a = np.asarray(a, dtype=np.float64)
-    b = np.asarray(b, dtype=np.float64)
-    if len(a) < 3:
-        return float("nan")
-    a = a - a.mean()
-    b = b - b.mean()
-    den = np.sqrt((a * a).sum() * (b * b).sum())
-    return float((a * b).sum() / den) if den > 0 else float("nan")
 
 
 def moving_coordinates(model: Model, fraction: float = 0.1) -> np.ndarray:
@@ -98,13 +83,17 @@ class UtteranceScore(ConditionScores):
     """Correlations of one utterance under one condition, on its ``speech_frames`` frames; and on
     the same frames the synthesized closures against the talker's own lips
     (:mod:`facetraj_engine.evaluation.closed_lips`: frames closed in the original, in the synthesis,
-    in both; counted once the talker's closed value is known, :func:`evaluate`)."""
+    in both; counted once the talker's closed value is known, :func:`evaluate`); ``sensors``:
+    every sensor coordinate's r and RMSE (:func:`~facetraj_engine.evaluation.sensors.sensor_scores`,
+    set by the evaluation; not a field, so not in a score's JSON: :meth:`EvalResult.sensor_table`
+    pools them)."""
 
     utterance: str
     speech_frames: int
     closed_frames: int = 0
     synthesized_closed_frames: int = 0
     both_closed_frames: int = 0
+    sensors: ClassVar[tuple] = ()
 
     @property
     def closures(self) -> ClosureAgreement:
@@ -142,6 +131,13 @@ class EvalResult:
         return {**{m: _nanmean([getattr(r, m) for r in rows]) for m in METRICS},
                 "closure_precision": pooled.precision, "closure_recall": pooled.recall}
 
+    def sensor_table(self, split: str, smoothing: str, mode: str = "phonetic",
+                     n: int | None = None) -> SensorTable:
+        """Per-sensor r and RMSE (mm) of one condition over its utterances
+        (:func:`~facetraj_engine.evaluation.sensors.pooled`)."""
+        return pooled(r.sensors for r in self.scores if r.split == split and r.smoothing == smoothing
+                      and r.mode == mode and (n is None or r.n_context_phones == n))
+
     def conditions(self) -> list[tuple[str, str, str, int]]:
         seen: dict[tuple[str, str, str, int], None] = {}
         for r in self.scores:
@@ -159,7 +155,10 @@ class EvalResult:
                 **({"talker_closed": self.talker.to_json()} if self.talker is not None else {}),
                 "utterances": [{"utterance": r.utterance, **asdict(r),
                                 "closure_precision": r.closures.precision,
-                                "closure_recall": r.closures.recall} for r in self.scores]}
+                                "closure_recall": r.closures.recall} for r in self.scores],
+                "sensors": [{"split": sp, "mode": mo, "smoothing": sm, "n_context_phones": n,
+                             **self.sensor_table(sp, sm, mo, n).to_json()}
+                            for sp, mo, sm, n in self.conditions()]}
 
 
 def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
@@ -203,6 +202,7 @@ def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
         out.append(UtteranceScore(split=split, mode=config.mode, smoothing=sm,
                                   n_context_phones=config.n_context_phones, **c,
                                   utterance=utt.name, speech_frames=int(mask.sum())))
+        out[-1].sensors = tuple(sensor_scores(original, markers, mask, model))
     return out
 
 

@@ -24,6 +24,7 @@ from .hash_memo import folder_key, memoized_hash
 from .labelfiles import LABEL_SUFFIXES, held_labels, label_file_provenance, read_labels, read_textgrid
 from .markerfiles import read_markers
 from .markerformats import NAMES_FILE, check_names, format_for, marker_suffixes, read_names_file
+from .sensor_roles import overrides_problem
 
 log = logging.getLogger(__name__)
 
@@ -62,6 +63,9 @@ class CorpusInfo:
     channel_names : how the marker files' channels map onto the names used here: ``OLD=NEW``
         renames (``NEW`` = ``-`` leaves a channel out), a plain list names every channel in file
         order (:mod:`facetraj_engine.io.markerformats.channels`); ``[]``: the files' own names.
+    sensor_roles : articulograph sensors' roles where their names do not say them (tongue tip to
+        rear, jaw, palate, velum, reference, other: :mod:`facetraj_engine.io.sensor_roles`);
+        ``{}``: from the names.
     name, description : free text.
     """
 
@@ -83,6 +87,7 @@ class CorpusInfo:
     dimensions: int = 3
     head_corrected: bool = False
     channel_names: list[str] = field(default_factory=list)
+    sensor_roles: dict[str, list[str]] = field(default_factory=dict)
     name: str = ""
     description: str = ""
 
@@ -142,6 +147,9 @@ class CorpusInfo:
                                    + ("" if info.head_corrected else
                                       " (none for data already head-corrected: head_corrected)"))
         check_names(info.channel_names, path)
+        problem = overrides_problem(info.sensor_roles, info.marker_names)
+        if problem:
+            raise InputError(path, problem)
         return info
 
 
@@ -184,6 +192,7 @@ SCHEMA: dict[str, tuple] = {
     "dimensions": (lambda v: v in (2, 3) and not isinstance(v, bool), "2 or 3"),
     "head_corrected": (lambda v: isinstance(v, bool), "true or false"),
     "channel_names": (_names, "a list of channel names (OLD=NEW, or one per channel)"),
+    "sensor_roles": (lambda v: isinstance(v, dict), "an object of role lists (tongue, jaw, ...)"),
     "name": (_text, "text"),
     "description": (_text, "text"),
 }

@@ -30,6 +30,7 @@ from ..data import LABEL_KINDS
 from ..errors import ModelFileError
 from ..labels.phoneset import SILENCE
 from .c3d_check import MAX_RATE, MIN_RATE
+from .sensor_roles import overrides_problem
 
 #: Largest single array a model file may hold (a codebook of about 10^7 codewords).
 MAX_ARRAY_BYTES = 1 << 30
@@ -193,6 +194,9 @@ def check_meta(path: Path, meta: dict, newest: int, fmt: str) -> None:
         raise bad("closure_closed", "a lip aperture in mm")
     if d0 is not None and (not _is_num(d0) or not 0 < d0 < 1e6):
         raise bad("voice_distance", "a positive number")
+    problem = overrides_problem(meta.get("sensor_roles", {}), meta["marker_names"])
+    if problem:
+        raise ModelFileError(path, f"metadata {problem}")
     kinds = meta.get("trained_labels", {})
     if not isinstance(kinds, dict) or not all(k in LABEL_KINDS and _is_int(n) and n >= 0
                                               for k, n in kinds.items()):

@@ -21,6 +21,7 @@ from ..config import TrainConfig
 from ..errors import ModelFileError
 from ..io.files import atomic_write, write_npz
 from ..io.model_file import read_model_file
+from ..io.sensor_roles import SensorRoles, sensor_roles
 from .chain import join_scale
 from .closure import ClosureStats
 from .closure_detector import ClosureDetector
@@ -72,6 +73,8 @@ class Model:
     detector : the bilabial-closure detector (:mod:`facetraj_engine.method.closure_detector`):
         where the lips close without phone labels; ``None`` in older model files (their
         acoustic-only synthesis closes no lips, as before).
+    sensor_roles : the training corpus's ``sensor_roles`` (articulograph sensors' roles where
+        their names do not say them); :attr:`roles` resolves them with the names.
     """
 
     config: TrainConfig
@@ -97,6 +100,7 @@ class Model:
     closure: ClosureStats | None = None
     voice_distance: float = float("nan")
     detector: ClosureDetector | None = None
+    sensor_roles: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         # no fixed markers (head-corrected data) is an empty index array, not numpy's float []
@@ -124,6 +128,13 @@ class Model:
     def is_planar(self) -> bool:
         """Whether the markers are midsagittal (2-D: every x coordinate of the neutral face is 0)."""
         return not self.neutral_face()[:, 0].any()
+
+    @cached_property
+    def roles(self) -> SensorRoles:
+        """Which marker is which articulator (:func:`facetraj_engine.io.sensor_roles.sensor_roles`):
+        ``roles.articulograph`` for articulograph sensors (a tongue among them)."""
+        return sensor_roles(self.marker_names, self.upper_lip, self.lower_lip, self.lip_corners,
+                            self.fixed.tolist(), self.sensor_roles)
 
     def phone_id(self, label: str) -> int:
         return self.phones.index(label)
@@ -219,6 +230,7 @@ class Model:
             "corpus_fingerprint": self.corpus_fingerprint,
             "tuned": self.tuned,
             "trained_labels": self.trained_labels,
+            "sensor_roles": self.sensor_roles,
             "voice_distance": self.voice_distance if np.isfinite(self.voice_distance) else None,
         }
         if self.closure is not None:
@@ -273,6 +285,7 @@ class Model:
                 corpus_fingerprint=meta.get("corpus_fingerprint", ""), index=index,
                 tuned=dict(meta.get("tuned") or {}),
                 trained_labels=dict(meta.get("trained_labels") or {}),
+                sensor_roles=dict(meta.get("sensor_roles") or {}),
                 closure=ClosureStats(float(meta["closure_closed"]), a["closure_direction"],
                                      a["rest_pcs"]) if "closure_closed" in meta else None,
                 voice_distance=float(meta.get("voice_distance") or "nan"),

@@ -354,7 +354,8 @@ def train(utterances: Iterable[Utterance] | Corpus, setup: MarkerSetup | None = 
                   train_utterances=[r.name for r in reads],
                   corpus_fingerprint=source.fingerprint,
                   index=build_index(cb.lsf, config.index_cells),
-                  trained_labels=dict(Counter(r.kind for r in reads)))
+                  trained_labels=dict(Counter(r.kind for r in reads)),
+                  sensor_roles=dict(source.setup.sensor_roles))
     progress(0.95, "closure and voice statistics")
     model.closure = closure.stats()
     position = np.full(len(reads), -1)

@@ -27,6 +27,8 @@ class MarkerSetup:
     upper_lip: str
     lower_lip: str
     lip_corners: list[str] = field(default_factory=list)
+    #: articulograph sensors' roles where their names do not say them (``corpus.json``)
+    sensor_roles: dict[str, list[str]] = field(default_factory=dict)
 
 
 @dataclass
@@ -54,7 +56,7 @@ class TrainingSet:
         if isinstance(utterances, Corpus):
             info = utterances.info
             setup = setup or MarkerSetup(info.fixed_markers, info.upper_lip, info.lower_lip,
-                                         info.lip_corners)
+                                         info.lip_corners, dict(info.sensor_roles))
             return cls(list(info.train), setup, list(info.marker_names), float(info.marker_rate),
                        utterances.fingerprint(), corpus=utterances)
         if setup is None:

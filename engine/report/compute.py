@@ -14,7 +14,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from ..config import SynthConfig
-from ..evaluation.baselines import BaselineGather, Baselines, FrameData, frame_data, score_baselines
+from ..evaluation.baselines import Baselines, fit_and_score
 from ..evaluation.paper import FIGURE4_TEXT, paper_table1
 from ..evaluation.scores import (
     EvalResult,
@@ -27,16 +27,16 @@ from ..evaluation.scores import (
     table2,
     trajectory_correlations,
 )
-from ..fanout import Skips, fan_out
+from ..fanout import Skips
 from ..io.corpus import Corpus, load_corpus
 from ..method.model import Model
 from ..method.pipeline import resmooth, synthesize
 from ..method.similarity import top_similar
 from ..method.training import train
 from ..progress import Progress
-from ..threads import one_blas_thread
 from .data import Figure4Data, ReportData
 from .rows import ComparisonRow, CorpusSummary, ModelSummary, summarise, sweep_table
+from .sensors import sensor_section
 
 log = logging.getLogger(__name__)
 
@@ -102,30 +102,9 @@ def _timed(timings: dict[str, float], stage: str) -> Iterator[None]:
 
 def _baselines(model: Model, corpus: Corpus, progress: Progress, workers: int = 1
                ) -> tuple[Baselines, list[UtteranceScore]]:
-    """Fit the two baselines on the training split and score them on both splits: the corpus
-    streamed twice (fitted from the training utterances' frames an utterance at a time, then
-    each utterance scored), in ``workers`` processes, BLAS on one thread as in the
-    evaluation."""
-    train_ids = list(corpus.info.train)
-    ids = [(sp, u) for sp in ("train", "test") for u in getattr(corpus.info, sp)]
-
-    def fitting(utt_id: str) -> FrameData:
-        return frame_data(model, corpus.utterance(utt_id), keep_original=False)
-
-    def scoring(pair: tuple[str, str]) -> list[UtteranceScore]:
-        return score_baselines(model, base, frame_data(model, corpus.utterance(pair[1])), pair[0])
-
-    gather = BaselineGather(model, len(train_ids))
-    scores: list[UtteranceScore] = []
-    with one_blas_thread():
-        for _, fd in fan_out(fitting, train_ids, workers, progress=_stage(progress, 0.8, 0.85),
-                             describe=lambda u: f"baselines: {u}"):
-            gather.add(fd)
-        base = gather.baselines()
-        for _, utt_scores in fan_out(scoring, ids, workers, progress=_stage(progress, 0.85, 0.95),
-                                     describe=lambda pair: f"baselines: {pair[1]}"):
-            scores.extend(utt_scores)
-    return base, scores
+    """The two baselines fitted on the training split and scored on both
+    (:func:`facetraj_engine.evaluation.baselines.fit_and_score`)."""
+    return fit_and_score(model, corpus, ("train", "test"), _stage(progress, 0.8, 0.95), workers)
 
 
 def comparison_rows(paper_modes: EvalResult, indexed: EvalResult, indexed_config: SynthConfig,
@@ -232,6 +211,7 @@ def compute_report(corpus_dir: str | os.PathLike[str], model: Model | None = Non
         progress(0.96, "Figure 4")
         fig4 = figure4_data(model, corpus)
     comparisons = comparison_rows(res2, res_ix, indexed, base, base_scores)
+    sensors = sensor_section(model, res2, res_ix, base_scores, "test" if corpus.info.test else "train")
     labels = None
     if labels_section and corpus.info.test and (corpus.data_root / f"{corpus.info.test[0]}.txt").exists():
         with _timed(timings, "automatic_labels"):
@@ -243,7 +223,8 @@ def compute_report(corpus_dir: str | os.PathLike[str], model: Model | None = Non
                       paper_table1=paper_table1(),
                       table2=[r for r in comparisons if r.mode == "phonetic"],
                       comparisons=comparisons, sweep=sweep_table(res5, ns), figure4=fig4,
-                      labels=labels, timings=timings, created=f"{dt.datetime.now(dt.UTC):%Y-%m-%d %H:%M} UTC")
+                      labels=labels, timings=timings, sensors=sensors,
+                      created=f"{dt.datetime.now(dt.UTC):%Y-%m-%d %H:%M} UTC")
 
 
 __all__ = ["comparison_rows", "compute_report", "corpus_summary", "figure4_data", "find_utterance",

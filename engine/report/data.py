@@ -101,6 +101,7 @@ class ReportData:
     voice_eval: VoiceEval | None = None    # acoustic-only from a second voice
                                            # (facetraj_engine.evaluation.voice_eval)
     closure_eval: dict | None = None       # lips that close (facetraj_engine.evaluation.closure_eval)
+    sensors: dict | None = None            # per sensor coordinate (facetraj_engine.report.sensors)
 
     def row(self, mode: str, split: str = "test", smoothing: str = "triangular") -> ComparisonRow | None:
         """The comparison row of one mode (``phonetic``, ``acoustic``, ``acoustic-indexed``,
@@ -131,7 +132,7 @@ class ReportData:
             "timings_s": self.timings, "figures": self.figures, "labels": self.labels,
             "automatic_labels": self.label_eval.to_json()["summary"] if self.label_eval else None,
             "second_voice": self.voice_eval.to_json()["summary"] if self.voice_eval else None,
-            "closure": self.closure_eval,
+            "closure": self.closure_eval, "sensors": self.sensors,
         })
 
 

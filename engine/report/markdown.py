@@ -14,6 +14,7 @@ from ..evaluation.voice_eval import format_markdown as voice_markdown
 from .data import ReportData, at_a_glance
 from .discussion import discussion
 from .rows import table1_agreement
+from .sensors import sensors_section
 from .text import fmt, mean_sd
 
 
@@ -206,7 +207,7 @@ def reproducing_section(data: ReportData) -> list[str]:
 
 #: the sections of ``results.md``, in order
 SECTIONS = (header_section, glance_section, table2_section, figure5_section, figure4_section,
-            comparisons_section, labels_section, table1_section, automatic_labels_section,
+            comparisons_section, sensors_section, labels_section, table1_section, automatic_labels_section,
             second_voice_section, closure_section, discussion_section, reproducing_section)
 
 

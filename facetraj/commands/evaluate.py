@@ -55,8 +55,22 @@ def log_modes(res) -> None:
                                            for m, n in modes.items()))
 
 
+def baselines_result(args: argparse.Namespace, model, corpus, splits, skipped):
+    """The viseme and ridge baselines fitted on the training split and scored on ``splits``
+    (the utterances the evaluation skipped left out), or ``None`` with ``--no-baselines``."""
+    if args.no_baselines:
+        return None
+    from facetraj_engine.evaluation.baselines import fit_and_score
+    from facetraj_engine.evaluation.scores import EvalResult
+
+    used = corpus.without(skipped.bad if skipped else ())
+    _, scores = fit_and_score(model, used, splits, TerminalProgress("baselines"), jobs(args))
+    return EvalResult(scores)
+
+
 def cmd_eval(args: argparse.Namespace) -> int:
     from facetraj_engine.evaluation.scores import evaluate, format_table2
+    from facetraj_engine.evaluation.sensors import format_sensor_report
     from facetraj_engine.io.corpus import load_corpus
     from facetraj_engine.method.model import Model
 
@@ -71,7 +85,15 @@ def cmd_eval(args: argparse.Namespace) -> int:
     res = evaluate(model, corpus, splits, configs, ("triangular", "spline"), eval_config,
                    progress=TerminalProgress("eval"), workers=jobs(args), skip=skipped)
     log_modes(res)
-    print(json.dumps(res.to_json(), indent=2) if args.json else format_table2(res))
+    base = baselines_result(args, model, corpus, splits, skipped)
+    if args.json:
+        out = res.to_json()
+        if base is not None:
+            out["baselines"] = {k: v for k, v in base.to_json().items() if k != "utterances"}
+        print(json.dumps(out, indent=2))
+    else:
+        print(format_table2(res) + "\n")
+        print(format_sensor_report([res] if base is None else [res, base], splits))
     return finish(skipped)
 
 
@@ -114,12 +136,15 @@ def cmd_similarity(args: argparse.Namespace) -> int:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("eval", help="correlations on a corpus (Table 2)")
+    p = sub.add_parser("eval", help="correlations on a corpus (Table 2) and per-sensor r and RMSE")
     p.add_argument("model", type=Path)
     p.add_argument("corpus", type=Path)
     p.add_argument("--split", choices=["train", "test", "all"], default="all")
     p.add_argument("--acoustic", action="store_true", help="add acoustic-only rows")
-    p.add_argument("--json", action="store_true", help="JSON output with per-utterance scores")
+    p.add_argument("--json", action="store_true",
+                   help="JSON output with per-utterance scores and the per-sensor tables")
+    p.add_argument("--no-baselines", action="store_true",
+                   help="leave out the viseme and ridge baselines (fitted on the training split)")
     add_corpus_work_options(p)
     add_synth_options(p)
     p.set_defaults(func=cmd_eval)
