@@ -258,7 +258,7 @@ def audio_cases(ws: Workspace, rng: random.Random) -> Iterator[Case]:
 def damaged_wav(rng: random.Random, wav: bytes) -> tuple[bytes, str]:
     """``wav`` (16-bit PCM, the 44-byte header) cut short or with a header that no longer matches
     its data: every one a file facetraj must refuse, naming it (issue 38)."""
-    kind = rng.choice(["cut", "cut", "data size", "riff size", "fmt field", "chunk id"])
+    kind = rng.choice(["cut", "cut", "data size", "riff size", "fmt field", "chunk id", "rate"])
     if kind == "cut":
         n = rng.randrange(1, len(wav) - 45)
         return wav[:len(wav) - n], f"cut short by {n} bytes"
@@ -272,6 +272,12 @@ def damaged_wav(rng: random.Random, wav: bytes) -> tuple[bytes, str]:
         size = struct.unpack("<I", wav[4:8])[0]
         m[4:8] = struct.pack("<I", max(1, size + rng.choice([-1, 1]) * rng.randrange(2, 5000)))
         return bytes(m), f"RIFF size {size} -> {struct.unpack('<I', m[4:8])[0]}"
+    if kind == "rate":                  # a header right in itself but for the rate (issue 46)
+        rate = struct.unpack("<I", wav[24:28])[0]
+        block = struct.unpack("<H", wav[32:34])[0]
+        new_rate = rng.choice([rate // 2, rate * 2])
+        m[24:32] = struct.pack("<II", new_rate, new_rate * block)
+        return bytes(m), f"rate {rate} -> {new_rate} Hz, the byte rate with it"
     if kind == "fmt field":
         at, what, values = rng.choice([(22, "channels", [0, 2, 3, 255]), (24, "rate", [8000, 44100, 7]),
                                        (28, "byte rate", [1, 32001, 64000]),

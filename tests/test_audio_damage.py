@@ -122,8 +122,9 @@ def test_a_batch_counts_damaged_audio_as_failed(wav, model_file, tmp_path, capsy
 def test_a_header_with_the_wrong_rate_is_named_beside_the_labels(wav, model_file, tmp_path, kind,
                                                                  capsys):
     """A header that is consistent in itself but gives half the rate (the audio lasts twice as
-    long as its labels, issue 46): the message names the label file and the audio, the rate and
-    samples its header gives, and the rate at which they would fit."""
+    long as its labels, issue 46): the message blames the audio, with the rate and samples its
+    header gives, names its labels, and the rate at which they would fit; labels that fit no
+    common rate are blamed themselves, naming the audio."""
     if kind == "wav":
         data = bytearray(wav.read_bytes())
         data[24:32] = struct.pack("<II", 8000, 16000)      # rate and byte rate, consistently
@@ -137,6 +138,14 @@ def test_a_header_with_the_wrong_rate_is_named_beside_the_labels(wav, model_file
     err = capsys.readouterr().err
     assert code == 2 and not (tmp_path / "o.tsv").exists()
     assert err.splitlines() == [
-        f"facetraj: error: {tmp_path / 's001.TextGrid'}: labels end at 3.400 s but the audio "
-        f"{audio.name} lasts 6.800 s by its header (54397 samples at 8000 Hz; at 16000 Hz it "
-        f"would last 3.400 s, as the labels do: is the rate in its header wrong?)"]
+        f"facetraj: error: {audio}: lasts 6.800 s by its header (54397 samples at 8000 Hz) but its "
+        f"labels s001.TextGrid end at 3.400 s; at 16000 Hz it would last 3.400 s, as the labels "
+        f"do: is the rate in its header wrong?"]
+    lab = tmp_path / "other.lab"                       # labels of another length: blamed
+    lab.write_text("0.0 2.0 sil\n2.0 5.1 aa\n")
+    assert main(["synth", str(model_file), str(audio), "--labels", str(lab), "-o",
+                 str(tmp_path / "o.tsv")]) == 2
+    err = capsys.readouterr().err
+    assert err.splitlines() == [
+        f"facetraj: error: {lab}: labels end at 5.100 s but the audio {audio.name} lasts 6.800 s "
+        f"by its header (54397 samples at 8000 Hz)"]

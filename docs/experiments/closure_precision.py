@@ -14,11 +14,14 @@ non-labial consonants (their middle half) -- issue 46's bar on real voices.
 
     python docs/experiments/closure_precision.py
 
-Measured (2026-11-29): the training voice with the search's part 0.98 at 3 % (threshold 0.12);
-the other voices, the acoustic part, at most 2 % of consonants: recall 0.25-0.46 whichever the
-training voices, weights, threshold or closing from a run's first or second frame. The detector's
-features (the energy dip and the formants' place, docs/algorithm.md) separate /p b m/ from /n ng g
-d dh/ on a voice it was trained on, not on another; it is off by default.
+Measured (2026-11-29; the acoustic part, as every voice but the training voice gets it): at most
+2 % of the consonants shut, the training voice 0.29-0.34 of its /p b m/, the voices the detector
+was not fitted on 0.22-0.41 (the longer tract 0.22-0.25), the second voice 0.47 when fitted on it
+too -- whichever the voices fitted on, the consonants' weight, the threshold, or closing from a
+run's first or second frame. (The search's part lifts the training voice to 0.98 at 3 %: it knows
+its codewords.) The features (the energy dip and the formants' place, docs/algorithm.md) do not
+separate /p b m/ from /n ng g d dh/ well enough on a voice they were not fitted on; the detector
+is off by default.
 """
 
 from __future__ import annotations

@@ -198,7 +198,7 @@ def _resolve(audio_path: Path, audio: np.ndarray, rate: int, request: LabelReque
     progress settings)."""
     duration = len(audio) / float(rate)
     detect = not request.label_map
-    extent = AudioExtent(audio_path.name, len(audio), int(rate))
+    extent = AudioExtent(audio_path, len(audio), int(rate))
     if request.labels is not None:
         return FoundLabels(read_label_file(request.labels, rate, duration, request.declared, detect,
                                            extent),

@@ -24,11 +24,11 @@ COMMON_RATES = (8000, 11025, 16000, 22050, 24000, 32000, 44100, 48000, 88200, 96
 
 @dataclass(frozen=True)
 class AudioExtent:
-    """The recording labels are checked against, as its file's header gives it: its ``name``,
+    """The recording labels are checked against, as its file's header gives it: its ``path``,
     ``samples`` and ``rate`` (issue 46: labels that do not fit a header with the wrong rate name
-    the audio too)."""
+    the audio too, and blame it where a common rate would make them fit)."""
 
-    name: str
+    path: Path
     samples: int
     rate: int
 
@@ -36,25 +36,43 @@ class AudioExtent:
     def duration(self) -> float:
         return self.samples / float(self.rate)
 
-    def lasts(self, labels_end: float) -> str:
-        """What the audio lasts by its header, and the common rate at which it would last as
-        long as the labels, if there is one.
+    def fitting_rate(self, labels_end: float) -> int | None:
+        """The common rate (:data:`COMMON_RATES`) at which the audio would last as long as labels
+        ending at ``labels_end``, if there is one other than its header's.
 
-        >>> AudioExtent("r0.wav", 54400, 8000).lasts(3.4)[:72]
-        'the audio r0.wav lasts 6.800 s by its header (54400 samples at 8000 Hz; '
-        >>> AudioExtent("r0.wav", 54400, 8000).lasts(3.4)[72:]
-        'at 16000 Hz it would last 3.400 s, as the labels do: is the rate in its header wrong?)'
-        >>> AudioExtent("r0.wav", 54400, 16000).lasts(1.0)
-        'the audio r0.wav lasts 3.400 s by its header (54400 samples at 16000 Hz)'
+        >>> AudioExtent(Path("r0.wav"), 54400, 8000).fitting_rate(3.4)
+        16000
+        >>> AudioExtent(Path("r0.wav"), 54400, 16000).fitting_rate(1.0) is None
+        True
         """
-        note = f"{self.samples} samples at {self.rate} Hz"
-        if labels_end > 0:
-            fits = [r for r in COMMON_RATES if r != self.rate and
-                    abs(self.samples / r - labels_end) <= max(0.05, 0.02 * labels_end)]
-            if fits:
-                note += (f"; at {fits[0]} Hz it would last {self.samples / fits[0]:.3f} s, as the "
-                         f"labels do: is the rate in its header wrong?")
-        return f"the audio {self.name} lasts {self.duration:.3f} s by its header ({note})"
+        if labels_end <= 0:
+            return None
+        return next((r for r in COMMON_RATES if r != self.rate and
+                     abs(self.samples / r - labels_end) <= max(0.05, 0.02 * labels_end)), None)
+
+    def lasts(self) -> str:
+        """What the audio lasts by its header.
+
+        >>> AudioExtent(Path("r0.wav"), 54400, 16000).lasts()
+        'lasts 3.400 s by its header (54400 samples at 16000 Hz)'
+        """
+        return f"lasts {self.duration:.3f} s by its header ({self.samples} samples at {self.rate} Hz)"
+
+
+def _labels_off_the_end(path, end: float, duration: float, audio: AudioExtent | None) -> InputError:
+    """The error for labels ending at ``end`` but audio of ``duration``: blaming the audio where
+    its header's rate looks wrong (a common rate would make them fit), else the labels, naming
+    the audio."""
+    if audio is None:
+        return InputError(path, f"labels end at {end:.3f} s but the audio lasts {duration:.3f} s")
+    fit = audio.fitting_rate(end)
+    if fit is None:
+        return InputError(path, f"labels end at {end:.3f} s but the audio {audio.path.name} "
+                                f"{audio.lasts()}")
+    return InputError(audio.path, f"{audio.lasts()} but its labels {Path(path).name} end at "
+                                  f"{end:.3f} s; at {fit} Hz it would last "
+                                  f"{audio.samples / fit:.3f} s, as the labels do: is the rate in "
+                                  f"its header wrong?")
 
 
 def read_textgrid_tiers(path: str | os.PathLike[str]) -> dict[str, list[PhoneSegment]]:
@@ -180,7 +198,8 @@ def validate_phones(phones: Sequence[PhoneSegment], duration: float,
     Gaps between segments are filled with ``sil``; slivers shorter than 1 ms (rounding left-overs)
     are absorbed by the segment before; the first segment is extended to 0 and the last to
     ``duration`` when they fall short by at most ``tolerance`` seconds. Labels that end elsewhere
-    are refused naming ``path`` and, when given, the ``audio`` file with its header's rate.
+    are refused naming ``path`` and, when given, the ``audio`` file with its header's rate (the
+    audio first where that rate looks wrong).
     """
     if not phones:
         raise InputError(path, "the label file holds no segments")
@@ -201,9 +220,7 @@ def validate_phones(phones: Sequence[PhoneSegment], duration: float,
     if out[0].start > tolerance:
         raise InputError(path, f"labels start at {out[0].start:.3f} s, not at 0")
     if abs(out[-1].end - duration) > max(tolerance, 0.02 * duration):
-        lasts = audio.lasts(out[-1].end) if audio is not None else \
-            f"the audio lasts {duration:.3f} s"
-        raise InputError(path, f"labels end at {out[-1].end:.3f} s but {lasts}")
+        raise _labels_off_the_end(path, out[-1].end, duration, audio)
     out[0] = PhoneSegment(0.0, out[0].end, out[0].label)
     out[-1] = PhoneSegment(out[-1].start, max(duration, out[-1].start + 1e-3), out[-1].label)
     return out
