@@ -91,8 +91,8 @@ def write_marker_tsv(path: str | os.PathLike[str], markers: np.ndarray, rate: fl
     if labels:
         columns = [[str(v).replace(sep, " ").replace("\n", " ") for v in col]
                    for col in labels.values()]
-        text = "".join(sep.join([row, *(c[i] for c in columns)]) + "\n"
-                       for i, row in enumerate(text.decode().splitlines())).encode()
+        tails = [(sep + sep.join(cells) + "\n").encode() for cells in zip(*columns, strict=True)]
+        text = b"".join(row + tail for row, tail in zip(text.split(b"\n")[:n], tails, strict=True))
     with atomic_write(path, overwrite) as tmp:
         write_bytes(tmp, (sep.join(header) + "\n").encode() + text)
 

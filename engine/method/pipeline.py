@@ -24,10 +24,10 @@ from ..io.labelfiles import validate_phones
 from ..labels.phoneset import SILENCE, map_labels, normalise_label
 from ..threads import above_blas, frame_threads
 from .closure import ClosurePlan, aperture_functional, apply_closure, closure_intervals, closure_strengths
-from .closure_detector import beside, closure_runs, input_probability
+from .closure_detector import beside, closure_runs, frame_energy_db, input_probability
 from .closure_search import search_rows
 from .context import segment_index
-from .model import Model
+from .model import Model, analysed_frames
 from .modes import mode_of
 from .search import SearchInput, SegmentChoice
 from .selection import mean_normalise
@@ -134,8 +134,9 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     """
     config = config or SynthConfig()
     mode = mode_of(config)
-    times, w, warp, analysed = _input(model, audio, sample_rate, n_frames, lsf, config,
-                                      audio_source or source)
+    times, w, warp, analysed, energy_db = _input(model, audio, sample_rate, n_frames, lsf, config,
+                                                 audio_source or source,
+                                                 detector_may_run(model, config, provenance))
     energy = SpeechEnergy(audio, sample_rate)
     ratio = _voice_ratio(model, energy, times, w, config, provenance, voice)
     job = SearchInput(model, w, times, config, voice_ratio=ratio)
@@ -149,7 +150,7 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     found = mode.search(job)
     plan = plan_closure(model, audio, sample_rate, times, job.segs, provenance,
                         voice_match(ratio, 1.0), config, energy.filtered if config.closure else None,
-                        analysed, found.frames)
+                        analysed, found.frames, energy_db)
     res = _finish(model, times, w, found.frames, config, found.segments, found.frame_segment,
                   warp, plan)
     res.voice_match, res.voice_ratio = voice_match(ratio, 1.0), ratio
@@ -157,21 +158,25 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
 
 
 def _input(model: Model, audio: np.ndarray, sample_rate: int, n_frames: int | None,
-           lsf: np.ndarray | None, config: SynthConfig, source: str | None
-           ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray | None]:
+           lsf: np.ndarray | None, config: SynthConfig, source: str | None, detecting: bool
+           ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray | None, np.ndarray | None]:
     """The frame times, the input LSFs w of eq 5 (computed here unless given; speaker-normalised),
     the speaker warp, and the LSFs before the normalisation for the closure detector: those
     computed here, or the given ones when no normalisation changed them (``None`` otherwise: the
     detector analyses the audio itself, inside :func:`synthesize`'s BLAS limit, and a caller's
-    LSFs may differ from those to rounding)."""
+    LSFs may differ from those to rounding); with ``detecting``, the detector's frame energies
+    of the LSFs computed here (:func:`~facetraj_engine.method.closure_detector.frame_energy_db`
+    of the same analysis frames), else ``None``."""
     rate = model.marker_rate
     if n_frames is None:
         n_frames = frame_count(len(audio), sample_rate, rate)
     check_length(model, len(audio), sample_rate, source, n_frames)
     times = np.arange(n_frames) / rate
     order = model.config.lpc_order
+    energy_db = None
     if lsf is None:
-        raw = model.input_lsf(audio, sample_rate, times, frame_threads())
+        raw, energy_db = analysed_frames(model.config, audio, sample_rate, times, frame_threads(),
+                                         frame_energy_db if detecting else None)
     elif lsf.shape != (n_frames, order):
         raise ValueError(f"lsf must be ({n_frames}, {order}) for these frames, got {lsf.shape}")
     else:
@@ -179,7 +184,7 @@ def _input(model: Model, audio: np.ndarray, sample_rate: int, n_frames: int | No
     w, warp = normalise_speaker(model, raw, config)
     if mode_of(config).weighs_labels and config.mean_normalise:
         w = mean_normalise(w, model.lsf_mean)
-    return times, w, warp, raw if lsf is None or w is lsf else None
+    return times, w, warp, raw if lsf is None or w is lsf else None, energy_db
 
 
 def _model_phones(model: Model, phones: Sequence[PhoneSegment], duration: float,
@@ -227,8 +232,8 @@ def _smoothed(model: Model, raw: np.ndarray, times: np.ndarray, config: SynthCon
 def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
                  segs: Sequence[PhoneSegment] | None, provenance: Provenance | None,
                  match: float, config: SynthConfig, filtered: np.ndarray | None = None,
-                 lsf: np.ndarray | None = None, frames: FrameWeights | None = None
-                 ) -> ClosurePlan | None:
+                 lsf: np.ndarray | None = None, frames: FrameWeights | None = None,
+                 energy_db: np.ndarray | None = None) -> ClosurePlan | None:
     """Where the closure step acts (``None``: off, or a model file without its statistics): the
     labelled /p b m/, trusted as :func:`~facetraj_engine.method.closure.closure_strengths` says (for
     recognized labels by the voice ``match``; NaN: unknown, untrusted), and beside recognized
@@ -236,7 +241,8 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
     (``config.closure_second_opinion``); without labels, the closures the model's detector finds
     (``config.closure_detector``, fully trusted; ``lsf``: the input's LSFs at ``times`` before
     any speaker warp or mean normalisation, when computed; ``frames``: the acoustic-only
-    search's, whose opinion counts by the voice ``match``); and the pauses by energy (``filtered``:
+    search's, whose opinion counts by the voice ``match``; ``energy_db``: the detector's frame
+    energies of ``lsf``'s analysis, when computed with it); and the pauses by energy (``filtered``:
     :func:`~facetraj_engine.method.speech.filtered_energy_db` of the audio, when already
     computed)."""
     if not config.closure or model.closure is None:
@@ -249,12 +255,14 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
         intervals, strengths = closure_intervals(segs, trust)
         if detecting and kind == "recognized" and config.closure_second_opinion and \
                 np.isfinite(match) and match > 0:
-            p, runs = _detected(model, audio, sample_rate, times, lsf, None, match, config)
+            p, runs = _detected(model, audio, sample_rate, times, lsf, None, match, config,
+                                energy_db)
             added = beside(runs, intervals)
             intervals = np.concatenate([intervals, added])
             strengths = np.concatenate([strengths, np.full(len(added), match)])
     elif detecting:
-        p, intervals = _detected(model, audio, sample_rate, times, lsf, frames, match, config)
+        p, intervals = _detected(model, audio, sample_rate, times, lsf, frames, match, config,
+                                 energy_db)
         strengths = np.ones(len(intervals))
         log.info("closure step: the lips close at %d closures the detector found", len(intervals))
     return ClosurePlan(intervals, strengths, pauses(audio, sample_rate, times, config.rest_pause_s,
@@ -263,20 +271,33 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
 
 def _detected(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
               lsf: np.ndarray | None, frames: FrameWeights | None, match: float,
-              config: SynthConfig) -> tuple[np.ndarray, np.ndarray]:
+              config: SynthConfig, energy_db: np.ndarray | None = None
+              ) -> tuple[np.ndarray, np.ndarray]:
     """The detector's probabilities and closures of an input (:func:`plan_closure`); the
     acoustic-only search is made here when its opinion counts (``match`` above 0) and ``frames``
-    is not that search's."""
+    is not that search's (``energy_db``: the frame energies of ``lsf``'s analysis, when known)."""
     det = model.detector
     if lsf is None:
-        lsf = model.input_lsf(audio, sample_rate, times, frame_threads())
+        lsf, energy_db = model.input_lsf(audio, sample_rate, times, frame_threads()), None
     counts = det.search is not None and np.isfinite(match) and match > 0
     if frames is None and counts:
         acoustic = config.with_(mode="acoustic")
         frames = mode_of(acoustic).search(SearchInput(model, lsf, times, acoustic)).frames
     search = search_rows(model, frames) if frames is not None and counts else None
-    p = input_probability(det, model.config, audio, sample_rate, times, lsf, search, match)
+    p = input_probability(det, model.config, audio, sample_rate, times, lsf, search, match,
+                          energy_db)
     return p, closure_runs(p, times, config.closure_threshold, det.spec.min_frames)
+
+
+def detector_may_run(model: Model, config: SynthConfig, provenance: Provenance | None) -> bool:
+    """Whether :func:`plan_closure` may run the model's closure detector on an input of this
+    ``config`` and labels' ``provenance``: without labels, or beside recognized ones (it then
+    runs unless the voice match is 0); the input's analysis computes its frame energies then."""
+    if not (config.closure and model.closure is not None and config.closure_detector and
+            model.detector is not None):
+        return False
+    recognized = (provenance or Provenance()).kind == "recognized"
+    return not mode_of(config).needs_labels or (recognized and config.closure_second_opinion)
 
 
 class SpeechEnergy:
