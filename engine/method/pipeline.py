@@ -138,7 +138,8 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                                                  audio_source or source,
                                                  detector_may_run(model, config, provenance))
     energy = SpeechEnergy(audio, sample_rate)
-    ratio = _voice_ratio(model, energy, times, w, config, provenance, voice)
+    ratio = _voice_ratio(model, energy, times, w, config, provenance, voice) \
+        if mode.weighs_labels else float("nan")             # the search weighs by it
     job = SearchInput(model, w, times, config, voice_ratio=ratio)
     if mode.needs_labels:
         if not phones:
@@ -148,6 +149,8 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         if mode.weighs_labels:
             job.confidence = frame_confidence(list(phones), confidence, times)
     found = mode.search(job)
+    if not mode.weighs_labels:                     # after the search: it may find the nearest
+        ratio = _voice_ratio(model, energy, times, w, config, provenance, voice, found.nearest)
     plan = plan_closure(model, audio, sample_rate, times, job.segs, provenance,
                         voice_match(ratio, 1.0), config, energy.filtered if config.closure else None,
                         analysed, found.frames, energy_db)
@@ -313,26 +316,30 @@ class SpeechEnergy:
 
 
 def _voice_ratio(model: Model, energy: SpeechEnergy, times: np.ndarray, w: np.ndarray,
-                 config: SynthConfig, provenance: Provenance | None, wanted: bool) -> float:
+                 config: SynthConfig, provenance: Provenance | None, wanted: bool,
+                 nearest: np.ndarray | None = None) -> float:
     """The input's voice distance ratio when the synthesis weighs by it (a mode that weighs its
     labels by the voice, the closure step's trust in recognized labels) or it is ``wanted``,
-    else NaN (not computed)."""
+    else NaN (not computed); ``nearest``: each frame's nearest codeword, when the search found
+    it as the voice match does."""
     recognized = provenance is not None and provenance.kind == "recognized"
     detector = model.detector is not None and model.detector.search is not None and \
         config.closure_detector and not mode_of(config).needs_labels
     if not (wanted or (mode_of(config).weighs_labels and config.label_weight_by_voice) or
             (config.closure and (recognized or detector))):
         return float("nan")
-    return input_voice_ratio(model, energy.audio, energy.sample_rate, times, w, energy.filtered)
+    return input_voice_ratio(model, energy.audio, energy.sample_rate, times, w, energy.filtered,
+                             nearest)
 
 
 def input_voice_ratio(model: Model, audio: np.ndarray, sample_rate: int,
                       times: np.ndarray | None = None, w: np.ndarray | None = None,
-                      filtered: np.ndarray | None = None) -> float:
+                      filtered: np.ndarray | None = None, nearest: np.ndarray | None = None
+                      ) -> float:
     """``D / D0`` (:mod:`facetraj_engine.method.voice_match`): how far an input's voice is from the
     codebook's, relative to the training voice's own figure, from the audio alone (its LSFs ``w``
-    at ``times`` and its filtered energy when already computed; NaN for a model file without
-    ``D0``)."""
+    at ``times``, its filtered energy and its frames' nearest codewords when already computed;
+    NaN for a model file without ``D0``)."""
     if not np.isfinite(model.voice_distance):
         return float("nan")
     if times is None or w is None:
@@ -340,7 +347,8 @@ def input_voice_ratio(model: Model, audio: np.ndarray, sample_rate: int,
             / model.marker_rate
         w = model.input_lsf(audio, sample_rate, times)
     speech = speech_mask(audio, sample_rate, times, filtered=filtered)
-    return voice_distance(w, speech, model.codebook.lsf, model.lsf_index()) / model.voice_distance
+    return voice_distance(w, speech, model.codebook.lsf, model.lsf_index(),
+                          nearest=nearest) / model.voice_distance
 
 
 def input_voice_match(model: Model, audio: np.ndarray, sample_rate: int,

@@ -1,7 +1,9 @@
-"""The closure detector reads its frame energies from the input's LSF analysis (issue 48) instead
-of framing the audio a second time: the same energies (to the bit at the analysis rate; by a
-constant that its relative energy cancels where the input is resampled), the same synthesis to
-the bit, and the second framing gone."""
+"""What synthesis computes once (issue 48). The closure detector reads its frame energies from
+the input's LSF analysis instead of framing the audio a second time: the same energies (to the
+bit at the analysis rate; by a constant that its relative energy cancels where the input is
+resampled), the same synthesis to the bit, and the second framing gone. The voice match reads
+each frame's nearest codeword from the acoustic-only search instead of searching the index
+again: the same voice match to the bit."""
 
 from __future__ import annotations
 
@@ -13,11 +15,12 @@ import pytest
 from facetraj_engine.config import SynthConfig
 from facetraj_engine.data import Provenance
 from facetraj_engine.level import unit_exponent
-from facetraj_engine.method import closure_detector, pipeline
+from facetraj_engine.method import closure_detector, pipeline, voice_match
 from facetraj_engine.method.closure_detector import frame_energy_db, input_energy_db, relative_energy
 from facetraj_engine.method.lsf import lsf_at, lsf_frames_at, resample_audio
 from facetraj_engine.method.model import analysed_frames
-from facetraj_engine.method.pipeline import detector_may_run, synthesize
+from facetraj_engine.method.pipeline import detector_may_run, input_voice_ratio, synthesize
+from facetraj_engine.method.search import finds_voice_nearest
 
 ACOUSTIC = SynthConfig(mode="acoustic")
 
@@ -124,3 +127,40 @@ def test_when_the_detector_may_run(default_model):
     assert not detector_may_run(default_model, ACOUSTIC.with_(closure=False), None)
     assert not detector_may_run(default_model, ACOUSTIC.with_(closure_detector=False), None)
     assert not detector_may_run(dataclasses.replace(default_model, detector=None), ACOUSTIC, None)
+
+
+def test_the_voice_match_reads_the_acoustic_search(default_model, held_out, monkeypatch):
+    """Acoustic-only, the voice match's nearest codewords come from the search (the index is not
+    searched again) and the figure is the one of its own search, to the bit; on another voice
+    too (a held-out sentence played slower: its formants lower)."""
+    searched = []
+    real = voice_match.indexed_distances
+
+    def spy(w, cb_lsf, index, near=None):
+        searched.append(near is None)
+        return real(w, cb_lsf, index, near)
+
+    monkeypatch.setattr(voice_match, "indexed_distances", spy)
+    for u in held_out[:3]:
+        for audio in (u.audio, _resampled(u.audio, u.sample_rate, 18000)):
+            searched.clear()
+            res = synthesize(default_model, audio, u.sample_rate, None, ACOUSTIC, voice=True)
+            assert searched == [False]
+            times = np.arange(len(res.times)) / default_model.marker_rate
+            lsf = default_model.input_lsf(audio, u.sample_rate, times)
+            assert res.voice_ratio == input_voice_ratio(default_model, audio, u.sample_rate,
+                                                        times, lsf)
+            assert searched[-1] and np.isfinite(res.voice_ratio)
+
+
+def test_the_voice_match_searches_itself_when_the_search_probes_otherwise(default_model,
+                                                                          held_out):
+    """An acoustic search that opens other cells than the voice match's (``acoustic_probe``
+    2, or the whole codebook) leaves the voice match to its own search: the same figure."""
+    u = held_out[0]
+    want = synthesize(default_model, u.audio, u.sample_rate, None, ACOUSTIC, voice=True).voice_ratio
+    assert finds_voice_nearest(default_model, ACOUSTIC)
+    for config in (ACOUSTIC.with_(acoustic_probe=2), ACOUSTIC.with_(acoustic_probe=None)):
+        assert not finds_voice_nearest(default_model, config)
+        res = synthesize(default_model, u.audio, u.sample_rate, None, config, voice=True)
+        assert res.voice_ratio == want
