@@ -188,6 +188,7 @@ def test_the_search_finds_the_nearest_alone_on_its_way():
         assert ix.probes(count, probe) == ix.probes(1, ix.probes(count, probe))
         one = ix.nearest(w, lsf, 1, ix.probes(count, probe))[:, 0]
         np.testing.assert_array_equal(first, one)
+        assert all(f in row for f, row in zip(first, few, strict=True))        # the nearest kept
         np.testing.assert_array_equal(few, ix.nearest(w, lsf, count, probe))   # as without it
 
 
@@ -213,3 +214,5 @@ def test_rows_grouped_by_width_select_what_the_whole_rows_select(seed):
     for t, n in enumerate(widths):
         d[t, :n] = rng.integers(0, 30, n)                  # many equal values
     np.testing.assert_array_equal(_smallest(d, count, widths), _smallest(d, count))
+    want = np.array([np.sort(np.argsort(row, kind="stable")[:count]) for row in d])
+    np.testing.assert_array_equal(_smallest(d, count), want)

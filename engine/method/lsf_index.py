@@ -248,6 +248,8 @@ def _smallest(d: np.ndarray, count: int, widths: np.ndarray | None = None) -> np
     [[1], [2]]
     >>> _smallest(np.array([[5.0, 1.0, 3.0, 1.0], [9.0, 0.0, np.inf, np.inf]]), 2, [4, 2]).tolist()
     [[1, 3], [0, 1]]
+    >>> _smallest(np.array([[3.0, 3.0, 3.0, 1.0], [2.0, 2.0, 0.0, 2.0]]), 2).tolist()
+    [[0, 3], [0, 2]]
     """
     rows, width = d.shape
     if count >= width:
@@ -262,10 +264,14 @@ def _smallest(d: np.ndarray, count: int, widths: np.ndarray | None = None) -> np
         return out
     kth = np.partition(d, count - 1, axis=1)[:, count - 1]
     at = np.flatnonzero(d <= kth[:, None])                     # flat: faster than row and column
-    if len(at) > rows * count:                                 # ties at the edge: the first ones
+    if len(at) > rows * count:          # ties at the edge: all below it, the first ones at it
         r = at // width
-        first = np.searchsorted(r, np.arange(rows))
-        at = at[np.arange(len(at)) - first[r] < count]
+        edge = d.ravel()[at] == kth[r]
+        first = np.searchsorted(r[edge], np.arange(rows))       # each row's first at the edge
+        rank = np.zeros(len(at), dtype=np.int64)
+        rank[edge] = np.arange(int(edge.sum())) - first[r[edge]]
+        below = np.bincount(r[~edge], minlength=rows)
+        at = at[~edge | (rank < count - below[r])]
     return at.reshape(rows, count) - np.arange(0, rows * width, width)[:, None]
 
 
