@@ -46,24 +46,45 @@ def fixed_point_lines(table: np.ndarray, decimals: Sequence[int], sep: str = "\t
         return b"\n" * rows
     dec = np.asarray(decimals, dtype=np.int64)
     finite = np.isfinite(v)
-    with np.errstate(invalid="ignore", over="ignore"):
-        scaled = np.abs(v) * 10.0 ** dec
-        q = np.rint(scaled)
-        # a half within the margin, or too large: Python's (|scaled - q| is exact, as is 0.5 - it)
-        python = (scaled >= _EXACT_LIMIT) | (np.abs(scaled - q) > 0.5 - _TIE_MARGIN)
-    python &= finite
-    q[python | ~finite] = 0.0
-    q = q.astype(np.int64)
-    slots = [_run_slots(q[:, a:b], np.signbit(v[:, a:b]), finite[:, a:b], v[:, a:b], int(dec[a]),
-                        sep) for a, b in _runs(dec)]
-    slots[-1][:, -1] = ord("\n")
-    chars = np.concatenate(slots, axis=1) if len(slots) > 1 else slots[0]
+    q, python = _rounded(v, dec, finite)
+    runs = [(a, b, _width(q[:, a:b], int(dec[a]))) for a, b in _runs(dec)]
+    chars = np.zeros((rows, sum((b - a) * width for a, b, width in runs)), dtype=np.uint8)
+    at = 0
+    for a, b, width in runs:                  # each run's fields in its columns of the lines
+        _fill(chars[:, at:at + (b - a) * width].reshape(rows, b - a, width), q[:, a:b],
+              np.signbit(v[:, a:b]), finite[:, a:b], v[:, a:b], int(dec[a]), sep)
+        at += (b - a) * width
+    chars[:, -1] = ord("\n")
     pieces, at = [], 0
     for r in np.flatnonzero(python.any(axis=1)).tolist():   # the few rows Python formats
         pieces += [chars[at:r].tobytes().translate(None, b"\0"), _python_line(v[r], decimals, sep)]
         at = r + 1
     pieces.append(chars[at:].tobytes().translate(None, b"\0"))
     return b"".join(pieces) if len(pieces) > 1 else pieces[0]
+
+
+def _rounded(v: np.ndarray, dec: np.ndarray, finite: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each number times ``10**dec`` rounded to an integer (0 where Python writes it, and for
+    NaN and the infinities; int32 when every one fits), and where Python writes it: a half
+    within the margin, or too large (``|scaled - q|`` is exact, as is ``0.5`` minus it)."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        scaled = np.abs(v) * 10.0 ** dec
+        python = scaled >= _EXACT_LIMIT
+        q = np.rint(scaled)
+        np.subtract(scaled, q, out=scaled)
+        np.abs(scaled, out=scaled)
+        python |= scaled > 0.5 - _TIE_MARGIN
+    python &= finite
+    q[python | ~finite] = 0.0
+    small = q.max(initial=0.0) < 2.0 ** 31 and int(dec.max()) <= 8
+    return q.astype(np.int32 if small else np.int64), python
+
+
+def _width(q: np.ndarray, dec: int) -> int:
+    """The slot of a field of ``dec`` decimals whose rounded numbers are ``q``: the sign, the
+    integer part's groups of four digits, the point, the decimals' groups, the separator."""
+    g_whole = max(1, -(-len(str(int(q.max(initial=0)) // 10 ** dec)) // 4))
+    return 1 + 4 * g_whole + 1 + 4 * -(-dec // 4) + 1
 
 
 def _runs(dec: np.ndarray) -> list[tuple[int, int]]:
@@ -76,12 +97,19 @@ def _runs(dec: np.ndarray) -> list[tuple[int, int]]:
 def _digit_words() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``"0000"`` to ``"9999"`` as 4-byte words (four digits written by one gather); the same
     with leading zeros NUL, ``"0"`` kept for 0 (the integer part's first group); and with every
-    zero NUL for 0 (a first group above others)."""
-    full = np.array([f"{i:04d}" for i in range(10000)], dtype="S4")
-    lead = np.array([f"{i:4d}".replace(" ", "\0") for i in range(10000)], dtype="S4")
+    zero NUL for 0 (a first group above others).
+
+    >>> [bytes(w[[0, 7, 120, 9999]]).replace(b"\\0", b"_") for w in _digit_words()]
+    [b'0000000701209999', b'___0___7_1209999', b'_______7_1209999']
+    """
+    i = np.arange(10000)
+    digits = (i[:, None] // np.array([1000, 100, 10, 1]) % 10 + ord("0")).astype(np.uint8)
+    full = np.ascontiguousarray(digits).view(np.uint32)[:, 0]
+    lead = digits.copy()
+    lead[:, :3][i[:, None] < np.array([1000, 100, 10])] = 0         # leading zeros, not the last
     inner = lead.copy()
-    inner[0] = b"\0"
-    return full.view(np.uint32), lead.view(np.uint32), inner.view(np.uint32)
+    inner[0] = 0
+    return full, lead.view(np.uint32)[:, 0], inner.view(np.uint32)[:, 0]
 
 
 def _words(slots: np.ndarray, at: int, words: np.ndarray) -> None:
@@ -89,19 +117,19 @@ def _words(slots: np.ndarray, at: int, words: np.ndarray) -> None:
     slots[:, :, at:at + 4].view(np.uint32)[..., 0] = words
 
 
-def _run_slots(q: np.ndarray, negative: np.ndarray, finite: np.ndarray, v: np.ndarray, dec: int,
-               sep: str) -> np.ndarray:
-    """The fields of a run of columns of ``dec`` decimals as slots ``(rows, cols * width)`` of
-    bytes: the sign (``negative``), the integer digits and ``dec`` decimals of ``q`` (the
-    numbers ``v`` times ``10**dec``, rounded), the point, then ``sep``, right aligned in the
-    slot, NUL where not part of the field; NaN and the infinities (not ``finite``) by name."""
-    rows, cols = q.shape
-    whole, frac = np.divmod(q, 10 ** dec)
-    g_whole = max(1, -(-len(str(int(whole.max()))) // 4))
+def _fill(slots: np.ndarray, q: np.ndarray, negative: np.ndarray, finite: np.ndarray,
+          v: np.ndarray, dec: int, sep: str) -> None:
+    """Write the fields of a run of columns of ``dec`` decimals into ``slots`` ``(rows, cols,
+    width)`` (zeros, :func:`_width` wide): the sign (``negative``), the integer digits and
+    ``dec`` decimals of ``q`` (the numbers ``v`` times ``10**dec``, rounded), the point, then
+    ``sep``, right aligned, NUL where not part of the field; NaN and the infinities (not
+    ``finite``) by name."""
+    width = slots.shape[2]
     g_frac = -(-dec // 4)
-    w_whole, w_frac = 4 * g_whole, 4 * g_frac
-    width = 1 + w_whole + 1 + w_frac + 1
-    slots = np.zeros((rows, cols, width), dtype=np.uint8)
+    w_frac = 4 * g_frac
+    g_whole = (width - 3 - w_frac) // 4
+    w_whole = 4 * g_whole
+    whole, frac = np.divmod(q, 10 ** dec)
     np.multiply(negative, np.uint8(ord("-")), out=slots[:, :, 0])
     full, lead, inner = _digit_words()
     above_zero = None                         # the integer groups so far are all zero
@@ -126,7 +154,6 @@ def _run_slots(q: np.ndarray, negative: np.ndarray, finite: np.ndarray, v: np.nd
         slots[at[0], at[1], 1:-1] = 0
         slots[at[0], at[1], 0] *= ~nan                  # -inf's sign, not -nan's
         slots[at[0], at[1], 2:5] = np.where(nan[:, None], _NAN, _INF)
-    return slots.reshape(rows, cols * width)
 
 
 def _python_line(row: np.ndarray, decimals: Sequence[int], sep: str) -> bytes:

@@ -19,7 +19,6 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..config import SynthConfig
-from ..fanout import fan_out
 from .lsf_index import LsfIndex
 from .synthesis import lsf_distances, perceptual_weights
 
@@ -92,6 +91,8 @@ def training_voice_distance(lsf: Sequence[np.ndarray], speech: Sequence[np.ndarr
     """``D0``: the median over training utterances of :func:`voice_distance`, each with its own
     codewords left out (``codeword_utterance`` ``(5L,)``: the index, in ``lsf``'s order, of the
     utterance each codeword comes from), in ``workers`` processes."""
+    from ..fanout import fan_out  # training's: not for a synthesis's start
+
     def one(k: int) -> float:
         return voice_distance(lsf[k], speech[k], cb_lsf, exclude=codeword_utterance == k)
 
