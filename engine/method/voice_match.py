@@ -20,6 +20,7 @@ import numpy as np
 
 from ..config import SynthConfig
 from .lsf_index import LsfIndex
+from .quantiles import median
 from .synthesis import lsf_distances, perceptual_weights
 
 #: The voice match is 1 up to ``MATCH_FULL`` times the training voice's distance, 0 from
@@ -71,8 +72,7 @@ def voice_distance(w: np.ndarray, speech: np.ndarray, cb_lsf: np.ndarray,
     if index is None:
         d = nearest_distances(w, cb_lsf, exclude)
         return float(np.median(d)) if np.isfinite(d).all() else float("nan")
-    return float(np.median(indexed_distances(w, cb_lsf, index,
-                                             None if nearest is None else nearest[frames])))
+    return median(indexed_distances(w, cb_lsf, index, None if nearest is None else nearest[frames]))
 
 
 def indexed_distances(w: np.ndarray, cb_lsf: np.ndarray, index: LsfIndex,
