@@ -73,6 +73,36 @@ def test_many_columns_of_mixed_decimals_equal_savetxt(seed):
     assert fixed_point_lines(t, decimals, ",") == _savetxt(t, decimals, ",")
 
 
+def test_line_ends_one_per_row_after_the_numbers():
+    """``ends``: each line's own end (a labelled table's text columns); numbers Python writes (a
+    half at the last decimal, one too long for any slot) in lines that end so too."""
+    t = np.array([[0.125, 1.0], [2.0, 1e300], [np.nan, -0.0]])
+    ends = [b",x\n", b",yy\n", b"\n"]
+    want = b"".join(line + end for line, end in zip(_savetxt(t, [2, 1], ",").split(b"\n"), ends,
+                                                      strict=False))
+    assert fixed_point_lines(t, [2, 1], ",", ends) == want
+    with pytest.raises(ValueError, match="2 line ends for 3 rows"):
+        fixed_point_lines(t, [2, 1], ",", ends[:2])
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_blocks_side_by_side_are_the_joined_tables_lines(seed):
+    """A trajectory table's time and coordinates as two blocks (not copied into one), an empty
+    block among them, NaN: the lines of the table they make."""
+    from facetraj_engine.io.numtext import fixed_point_blocks
+
+    rng = np.random.default_rng(seed)
+    t = np.arange(50)[:, None] / 60.0
+    m = rng.standard_normal((50, 9)) * 10.0 ** rng.integers(-2, 6)
+    m[rng.random(m.shape) < 0.05] = np.nan
+    ends = [f",{i}\n".encode() for i in range(50)]
+    for sep in ("\t", ","):
+        want = fixed_point_lines(np.column_stack([t, m]), [6] + [4] * 9, sep)
+        assert fixed_point_blocks([(t, 6), (np.zeros((50, 0)), 2), (m, 4)], sep) == want
+        assert fixed_point_blocks([(t, 6), (m, 4)], sep, ends) == fixed_point_lines(
+            np.column_stack([t, m]), [6] + [4] * 9, sep, ends)
+
+
 def test_one_ascii_character_between_fields():
     with pytest.raises(ValueError, match="one ASCII character"):
         fixed_point_lines(np.zeros((2, 2)), [1, 1], ", ")
@@ -103,6 +133,8 @@ def test_label_columns_are_the_reference_bytes(tmp_path, suffix):
     m[4, 1] = np.nan
     m[7, 0, 2] = 0.00005
     phones = ["sil", "p", "a,b", "c\td", "", "e\nf", "ʃ", "aɪ"] * 6 + ["sil", "sil"]
+    if suffix == ".tsv":
+        phones[9] = "nul\0in it"                   # the writer's padding byte, kept as it was
     words = [f"word{i // 7}" if i % 9 else "" for i in range(50)]
     path = tmp_path / f"take{suffix}"
     write_marker_tsv(path, m, 60.0, NAMES, labels={"phone": phones, "word": words})

@@ -28,47 +28,81 @@ _TIE_MARGIN = 1e-6
 _NAN, _INF = np.frombuffer(b"nan", np.uint8), np.frombuffer(b"inf", np.uint8)
 
 
-def fixed_point_lines(table: np.ndarray, decimals: Sequence[int], sep: str = "\t") -> bytes:
+def fixed_point_lines(table: np.ndarray, decimals: Sequence[int], sep: str = "\t",
+                      ends: Sequence[bytes] | None = None) -> bytes:
     """The rows of ``table`` ``(rows, columns)`` as text lines: column ``j`` formatted as
     ``%.{decimals[j]}f``, fields separated by ``sep`` (one character), each line ending in a
     newline (what ``numpy.savetxt(f, table, fmt=[...], delimiter=sep)`` writes, tested byte for
-    byte).
+    byte), or in its own of ``ends`` (one per row: e.g. its text columns, then a newline).
 
     >>> fixed_point_lines(np.array([[0.5, -0.00004, 12.34567], [1.0, np.nan, -3.0]]), [2, 4, 0])
     b'0.50\\t-0.0000\\t12\\n1.00\\tnan\\t-3\\n'
+    >>> fixed_point_lines(np.array([[0.5], [2.0]]), [1], ",", [b",a\\n", b",b\\n"])
+    b'0.5,a\\n2.0,b\\n'
     """
     v = np.asarray(table, dtype=np.float64)
-    if v.ndim != 2 or v.shape[1] != len(decimals) or len(sep) != 1 or not sep.isascii():
-        raise ValueError(f"table must be (rows, {len(decimals)}) and sep one ASCII character, got "
-                         f"{v.shape} and {sep!r}")
-    rows, cols = v.shape
-    if rows == 0 or cols == 0:
-        return b"\n" * rows
+    if v.ndim != 2 or v.shape[1] != len(decimals):
+        raise ValueError(f"table must be (rows, {len(decimals)}), got {v.shape}")
     dec = np.asarray(decimals, dtype=np.int64)
-    finite = np.isfinite(v)
-    q, python = _rounded(v, dec, finite)
-    runs = [(a, b, _width(q[:, a:b], int(dec[a]))) for a, b in _runs(dec)]
-    chars = np.zeros((rows, sum((b - a) * width for a, b, width in runs)), dtype=np.uint8)
-    at = 0
-    for a, b, width in runs:                  # each run's fields in its columns of the lines
-        _fill(chars[:, at:at + (b - a) * width].reshape(rows, b - a, width), q[:, a:b],
-              np.signbit(v[:, a:b]), finite[:, a:b], v[:, a:b], int(dec[a]), sep)
-        at += (b - a) * width
-    chars[:, -1] = ord("\n")
+    return fixed_point_blocks([(v[:, a:b], int(dec[a])) for a, b in _runs(dec)], sep, ends,
+                              rows=len(v))
+
+
+def fixed_point_blocks(blocks: Sequence[tuple[np.ndarray, int]], sep: str = "\t",
+                       ends: Sequence[bytes] | None = None, rows: int | None = None) -> bytes:
+    """:func:`fixed_point_lines` of the columns of ``blocks`` side by side, each ``(table,
+    decimals)``: a table ``(rows, k)`` whose columns have these decimals (a trajectory table's
+    time and its coordinates, without copying them into one; ``rows``: when there is no block).
+
+    >>> fixed_point_blocks([(np.array([[0.0], [0.5]]), 3), (np.array([[1.0, -2.0], [3.0, 4.0]]), 1)])
+    b'0.000\\t1.0\\t-2.0\\n0.500\\t3.0\\t4.0\\n'
+    """
+    tables = [np.asarray(t, dtype=np.float64) for t, _ in blocks]
+    rows = len(tables[0]) if tables else (rows or 0)
+    if len(sep) != 1 or not sep.isascii() or any(t.ndim != 2 or len(t) != rows for t in tables):
+        raise ValueError(f"blocks must be tables of {rows} rows and sep one ASCII character, got "
+                         f"{[t.shape for t in tables]} and {sep!r}")
+    if ends is not None and len(ends) != rows:
+        raise ValueError(f"{len(ends)} line ends for {rows} rows")
+    if rows == 0 or not any(t.shape[1] for t in tables):
+        return b"".join(ends) if ends is not None else b"\n" * rows
+    if ends is not None and b"\0" in b"".join(ends):  # NUL is the padding: line by line
+        lines = fixed_point_blocks(blocks, sep).split(b"\n")[:rows]
+        return b"".join(line + end for line, end in zip(lines, ends, strict=True))
+    found = [(v, int(d), *_rounded(v, int(d), np.isfinite(v)))
+             for v, (_, d) in zip(tables, blocks, strict=True) if v.shape[1]]
+    widths = [_width(q, d) * v.shape[1] for v, d, q, _ in found]
+    end_bytes = 0 if ends is None else max(map(len, ends))
+    chars = np.zeros((rows, sum(widths) + end_bytes), dtype=np.uint8)
+    spliced, at = set(), 0
+    for (v, d, q, python), width in zip(found, widths, strict=True):   # each block's columns
+        slots = chars[:, at:at + width].reshape(rows, v.shape[1], -1)
+        _fill(slots, q, np.signbit(v), np.isfinite(v), v, d, sep)
+        spliced |= _python_fields(slots, python, v, d)
+        at += width
+    if ends is None:                          # the last separator: the line's end
+        chars[:, -1] = ord("\n")
+    else:                                     # or the line's own end, NUL-padded
+        chars[:, at - 1] = 0
+        chars[:, at:] = np.array(ends, dtype=f"S{end_bytes}").view(np.uint8).reshape(
+            rows, end_bytes)
     pieces, at = [], 0
-    for r in np.flatnonzero(python.any(axis=1)).tolist():   # the few rows Python formats
-        pieces += [chars[at:r].tobytes().translate(None, b"\0"), _python_line(v[r], decimals, sep)]
+    for r in sorted(spliced):                 # rows with a number too long for its slot
+        pieces += [chars[at:r].tobytes().translate(None, b"\0"),
+                   _python_line([(v[r], d) for v, d, _, _ in found], sep)
+                   + (b"\n" if ends is None else ends[r])]
         at = r + 1
     pieces.append(chars[at:].tobytes().translate(None, b"\0"))
     return b"".join(pieces) if len(pieces) > 1 else pieces[0]
 
 
-def _rounded(v: np.ndarray, dec: np.ndarray, finite: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _rounded(v: np.ndarray, dec: int, finite: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Each number times ``10**dec`` rounded to an integer (0 where Python writes it, and for
     NaN and the infinities; int32 when every one fits), and where Python writes it: a half
     within the margin, or too large (``|scaled - q|`` is exact, as is ``0.5`` minus it)."""
     with np.errstate(invalid="ignore", over="ignore"):
-        scaled = np.abs(v) * 10.0 ** dec
+        scaled = np.abs(v)
+        scaled *= 10.0 ** dec
         python = scaled >= _EXACT_LIMIT
         q = np.rint(scaled)
         np.subtract(scaled, q, out=scaled)
@@ -76,7 +110,7 @@ def _rounded(v: np.ndarray, dec: np.ndarray, finite: np.ndarray) -> tuple[np.nda
         python |= scaled > 0.5 - _TIE_MARGIN
     python &= finite
     q[python | ~finite] = 0.0
-    small = q.max(initial=0.0) < 2.0 ** 31 and int(dec.max()) <= 8
+    small = q.max(initial=0.0) < 2.0 ** 31 and dec <= 8
     return q.astype(np.int32 if small else np.int64), python
 
 
@@ -156,6 +190,22 @@ def _fill(slots: np.ndarray, q: np.ndarray, negative: np.ndarray, finite: np.nda
         slots[at[0], at[1], 2:5] = np.where(nan[:, None], _NAN, _INF)
 
 
-def _python_line(row: np.ndarray, decimals: Sequence[int], sep: str) -> bytes:
-    return (sep.join(f"%.{d}f" % x for x, d in zip(row.tolist(), decimals, strict=True))
-            + "\n").encode()
+def _python_fields(slots: np.ndarray, python: np.ndarray, v: np.ndarray, dec: int) -> set[int]:
+    """Write the numbers of a run that Python formats (``python``: a half within the margin, or
+    too large) into their slots as Python writes them; the rows of those too long for their
+    slot (spliced in whole by the caller)."""
+    too_long = set()
+    width = slots.shape[2]
+    for r, c in zip(*np.nonzero(python), strict=True):
+        text = (f"%.{dec}f" % v[r, c]).encode()
+        if len(text) < width:
+            slots[r, c, :-1] = 0
+            slots[r, c, width - 1 - len(text):-1] = np.frombuffer(text, np.uint8)
+        else:
+            too_long.add(int(r))
+    return too_long
+
+
+def _python_line(fields: Sequence[tuple[np.ndarray, int]], sep: str) -> bytes:
+    """A line's numbers as Python writes them: ``fields`` its blocks' values and decimals."""
+    return sep.join(f"%.{d}f" % x for values, d in fields for x in values.tolist()).encode()
