@@ -200,9 +200,8 @@ def _worker_run(pair: tuple[Path, Path]) -> Outcome:
 
 def import_synthesis() -> None:
     """Import what every input's synthesis imports (the audio reader, the label readers, the
-    writers, and ``numpy.ma``, which ``numpy.percentile`` imports on its first call): paid once
-    before a batch's workers fork, not in each worker (and the benchmarks' start-up)."""
-    import numpy.ma  # noqa: F401
+    writers): paid once before a batch's workers fork, not in each worker (and the benchmarks'
+    start-up)."""
     import soundfile  # noqa: F401
 
     import facetraj_engine.io.export

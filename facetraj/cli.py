@@ -8,6 +8,7 @@ Bad input gives a one-line message naming the file and the problem, and exit sta
 from __future__ import annotations
 
 import argparse
+import gc
 import logging
 import sys
 from collections.abc import Sequence
@@ -99,7 +100,19 @@ def configure_logging(verbose: int = 0, quiet: bool = False) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    argv = sys.argv[1:] if argv is None else list(argv)
+    """The command with ``argv`` (``None``: this program's arguments, as the console command and
+    ``python -m facetraj`` run it); its exit status. As the program, it then freezes what is
+    left for the garbage collector (``gc.freeze``): the interpreter's teardown, which otherwise
+    walks every object of the modules and the run again while it exits, is left with what it
+    frees by their counts (issue 48)."""
+    code = run(sys.argv[1:] if argv is None else list(argv))
+    if argv is None:
+        gc.freeze()
+    return code
+
+
+def run(argv: Sequence[str]) -> int:
+    """The command with ``argv``; its exit status (bad input: 2, a one-line message)."""
     args = build_parser().parse_args(argv)
     configure_logging(args.verbose, args.quiet)
     if args.command is None:                    # the app on the default corpus

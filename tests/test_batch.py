@@ -69,9 +69,8 @@ def test_a_folder_with_a_corrupt_file_finishes_the_others_and_names_it(model_pat
 
 
 def test_one_files_npz_is_the_batchs_to_the_bit(model_path, folder, tmp_path):
-    """``synth`` on one file in a new process (BLAS on its default threads until synthesis
-    runs it on one) writes the bytes a batch's worker (one BLAS thread) writes for that file:
-    full float64, not a rounded table."""
+    """``synth`` on one file in a new process writes the bytes a batch's worker (one BLAS thread)
+    writes for that file: full float64, not a rounded table."""
     single = tmp_path / "single.npz"
     subprocess.run([sys.executable, "-m", "facetraj", "-q", "synth", str(model_path),
                     str(folder / "s001.flac"), "-o", str(single)], check=True, cwd=tmp_path)

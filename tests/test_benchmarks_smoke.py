@@ -101,8 +101,11 @@ def test_smoke_command_rows(toy: Path) -> None:
     ctx = load_context(toy, smoke=True)
     rows = cli.one_file(ctx) + cli.batch(ctx)
     names = [r.name for r in rows]
-    for want in ("facetraj synth, phonetic, 2 s to .npz", "facetraj synth, acoustic, 2 s to .npz",
-                 "facetraj synth, phonetic, 2 s to .tsv", "cold start: facetraj --version",
+    for want in ("facetraj synth, phonetic, 2 s to .npz: main()",
+                 "facetraj synth, acoustic, 2 s to .npz: main()",
+                 *(f"facetraj synth, {mode}, 2 s to .{fmt}: the whole process"
+                   for mode in ("phonetic", "acoustic") for fmt in ("npz", "tsv", "csv", "c3d")),
+                 "text writer: 121 frames x ", "cold start: facetraj --version",
                  "batch of 6 files of 3-5 s, 1 worker", "batch of 6 files of 3-5 s, 2 workers",
                  "batch of 6 files: 2 workers against 1", "batch of 6 files: peak memory"):
         assert any(n.startswith(want) for n in names), want

@@ -138,3 +138,46 @@ def test_every_subcommand_takes_verbosity_after_it_too():
     for argv, (verbose, quiet) in cases.items():
         args = parser.parse_args(list(argv))
         assert (args.verbose, args.quiet) == (verbose, quiet), argv
+
+
+
+def test_the_command_starts_no_blas_thread_per_core():
+    """facetraj makes every matrix product on one BLAS thread (facetraj_engine.threads), so as a
+    program it tells OpenBLAS to start no thread per core, unless the environment says
+    otherwise (issue 48)."""
+    import os
+    import subprocess
+    import sys
+
+    code = ("import facetraj.cli, numpy\n"
+            "from threadpoolctl import threadpool_info\n"
+            "print(max(i['num_threads'] for i in threadpool_info() if i['user_api'] == 'blas'))")
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    for setting, threads in ((None, 1), ("2", 2)):
+        if setting:
+            env["OPENBLAS_NUM_THREADS"] = setting
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                             env=env, check=True)
+        assert int(out.stdout.split()[-1]) == threads
+
+
+def test_as_the_program_it_freezes_its_objects_before_exiting(tmp_path):
+    """Run as the program (no arguments given to main: sys.argv), the command freezes what is
+    left for the garbage collector before the interpreter's teardown; called with arguments
+    (a caller's process, these tests) it leaves the collector alone (issue 48)."""
+    import gc
+    import subprocess
+    import sys
+
+    argv = ["facetraj", "-q", "synth", str(tmp_path / "no.npz"), str(tmp_path / "no.wav"), "-o",
+            str(tmp_path / "out.tsv")]
+    code = ("import gc, sys, facetraj.cli\n"
+            f"sys.argv = {argv!r}\n"
+            "code = facetraj.cli.main()\n"
+            "print(code, gc.get_freeze_count())")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    status, frozen = map(int, out.stdout.split())
+    assert status == 2 and frozen > 1000
+    before = gc.get_freeze_count()
+    assert main(argv[1:]) == 2
+    assert gc.get_freeze_count() == before

@@ -53,3 +53,20 @@ def test_a_corpus_repeated_gives_its_first_copies_and_scores_no_more(default_mod
     assert scored[2] == scored[1] <= 3 * scored[0]
     by_centre = sum(int((once[:, 3] == c).sum()) for c in q[:, 3])     # every context of its centre
     assert scored[0] < by_centre / 4
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_unique_rows_are_numpys(seed):
+    """Rows as base-(max+1) integers (issue 48): numpy's unique rows, places and counts, for
+    few and many phones, short and long contexts, and rows too long for 63 bits (numpy's)."""
+    from facetraj_engine.method.context_index import unique_rows
+
+    rng = np.random.default_rng(seed)
+    n, k = int(rng.integers(1, 3000)), int(rng.choice([1, 3, 7, 13, 31]))
+    a = rng.integers(0, int(rng.choice([2, 40, 300, 5000])), (n, k))
+    a = np.concatenate([a, a[rng.integers(0, n, n // 3)]])          # repeated rows
+    want = np.unique(a, axis=0, return_inverse=True, return_counts=True)
+    got = unique_rows(a)
+    for x, y in zip(got, want, strict=True):
+        np.testing.assert_array_equal(x, y.reshape(x.shape))
+    assert got[1].shape == (len(a),)

@@ -172,3 +172,47 @@ def test_the_layout_is_the_grouped_codebook_transposed_in_float32():
     want = np.ascontiguousarray(ix.grouped(lsf).astype(np.float32).T)
     got = ix.layout(lsf)
     assert got.dtype == np.float32 and got.flags.c_contiguous and np.array_equal(got, want)
+
+
+def test_the_search_finds_the_nearest_alone_on_its_way():
+    """``first``: each frame's nearest codeword as count=1 finds it when it opens as many cells
+    (``probes``), from the search of the nearest 128 (the voice match reads it, issue 48); with
+    duplicated codewords (ties: the first) and frames far from every cell."""
+    lsf = random_lsf(3000, seed=8)
+    lsf[1500:1600] = lsf[100:200]                        # equal distances: the first wins
+    ix = build_index(lsf)
+    w = np.concatenate([random_lsf(400, seed=9), lsf[100:140] + 1e-4])
+    for count, probe in ((128, 8), (40, 3), (5, 1)):
+        first = np.full(len(w), -1)
+        few = ix.nearest(w, lsf, count, probe, first=first)
+        assert ix.probes(count, probe) == ix.probes(1, ix.probes(count, probe))
+        one = ix.nearest(w, lsf, 1, ix.probes(count, probe))[:, 0]
+        np.testing.assert_array_equal(first, one)
+        assert all(f in row for f, row in zip(first, few, strict=True))        # the nearest kept
+        np.testing.assert_array_equal(few, ix.nearest(w, lsf, count, probe))   # as without it
+
+
+def test_probes_grow_with_the_count():
+    """A cell-poor index opens more cells for more codewords (the voice match's nearest then
+    comes from its own search)."""
+    lsf = random_lsf(500, seed=10)
+    ix = build_index(lsf, 50)
+    assert ix.probes(1, 8) == 8 and ix.probes(10_000, 8) == ix.n_cells
+    assert ix.probes(200, 8) == max(8, ix.min_probe(200)) > 8
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_rows_grouped_by_width_select_what_the_whole_rows_select(seed):
+    """The partition by groups of like widths (inf past each row's width) gives the columns of
+    the whole rows', ties at the edge to the first columns."""
+    from facetraj_engine.method.lsf_index import _smallest
+
+    rng = np.random.default_rng(seed)
+    rows, count = int(rng.integers(8, 300)), int(rng.integers(2, 40))
+    widths = rng.integers(count, count + 200, rows)
+    d = np.full((rows, int(widths.max())), np.inf, dtype=np.float32)
+    for t, n in enumerate(widths):
+        d[t, :n] = rng.integers(0, 30, n)                  # many equal values
+    np.testing.assert_array_equal(_smallest(d, count, widths), _smallest(d, count))
+    want = np.array([np.sort(np.argsort(row, kind="stable")[:count]) for row in d])
+    np.testing.assert_array_equal(_smallest(d, count), want)

@@ -175,10 +175,12 @@ def atomic_write(path: str | os.PathLike[str], overwrite: bool = True) -> Iterat
                 tmp_path.unlink()
 
 
-def write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
-    """``data`` written to ``path`` (the temporary file of :func:`atomic_write`)."""
+def write_bytes(path: str | os.PathLike[str], *data: bytes) -> None:
+    """``data`` (one or more pieces, one after the other) written to ``path`` (the temporary file
+    of :func:`atomic_write`)."""
     with open(path, "wb") as handle:
-        handle.write(data)
+        for piece in data:
+            handle.write(piece)
 
 
 def write_npz(handle: BinaryIO, arrays: Mapping[str, np.ndarray]) -> None:

@@ -19,7 +19,7 @@ from .markerformats.c3d import read_c3d
 from .markerformats.common import resample_markers
 from .markerformats.mocha import MOCHA_COILS, MOCHA_RATE
 from .markerformats.table import read_marker_table
-from .numtext import fixed_point_lines
+from .numtext import fixed_point_blocks
 
 log = logging.getLogger(__name__)
 
@@ -83,18 +83,23 @@ def write_marker_tsv(path: str | os.PathLike[str], markers: np.ndarray, rate: fl
     for key, column in labels.items():
         if len(column) != n:
             raise ValueError(f"{key}: {len(column)} labels for {n} frames")
-    t = np.arange(n) / rate
     header = ["time"] + [f"{m}_{a}" for m in names for a in "xyz"] + list(labels)
-    table = np.column_stack([t, markers.reshape(n, -1)])
     sep = "," if Path(path).suffix.lower() == ".csv" else "\t"
-    text = fixed_point_lines(table, [6] + [4] * (table.shape[1] - 1), sep)   # what savetxt wrote
+    ends = None                                # each line's labels after its numbers
     if labels:
-        columns = [[str(v).replace(sep, " ").replace("\n", " ") for v in col]
-                   for col in labels.values()]
-        text = "".join(sep.join([row, *(c[i] for c in columns)]) + "\n"
-                       for i, row in enumerate(text.decode().splitlines())).encode()
+        columns = [_label_text(col, sep) for col in labels.values()]
+        ends = [(sep + sep.join(cells) + "\n").encode() for cells in zip(*columns, strict=True)]
+    text = fixed_point_blocks([((np.arange(n) / rate)[:, None], 6),       # what savetxt wrote
+                               (np.asarray(markers, dtype=np.float64).reshape(n, -1), 4)], sep, ends)
     with atomic_write(path, overwrite) as tmp:
-        write_bytes(tmp, (sep.join(header) + "\n").encode() + text)
+        write_bytes(tmp, (sep.join(header) + "\n").encode(), text)
+
+
+def _label_text(column: Sequence[str], sep: str) -> list[str]:
+    """A label column as text, the separator and newlines in a label replaced by spaces (each
+    distinct label once)."""
+    text = {v: str(v).replace(sep, " ").replace("\n", " ") for v in set(column)}
+    return [text[v] for v in column]
 
 
 def __getattr__(name: str):

@@ -392,15 +392,17 @@ def utterance_inputs(config: TrainConfig, audio: np.ndarray, sample_rate: int,
 
 def input_probability(detector: ClosureDetector, config: TrainConfig, audio: np.ndarray,
                       sample_rate: int, times: np.ndarray, lsf: np.ndarray | None = None,
-                      search: np.ndarray | None = None,
-                      match: float | np.ndarray = 0.0) -> np.ndarray:
+                      search: np.ndarray | None = None, match: float | np.ndarray = 0.0,
+                      energy_db: np.ndarray | None = None) -> np.ndarray:
     """``p(t)`` of an input's frames at ``times`` (``lsf``: its input LSFs there, unwarped, when
     already computed; ``search``, ``match``: the search's rows and the voice match, one or one
-    per frame, step 6)."""
+    per frame, step 6; ``energy_db``: the frame energies of those LSFs' analysis frames, when
+    computed with them)."""
     w = lsf if lsf is not None else lsf_at(audio, sample_rate, times, config.lpc_order,
                                            config.window_s, config.audio_rate, config.preemphasis)
-    return detector.frame_probability(w, input_energy_db(config, audio, sample_rate, times),
-                                      search, match)
+    if energy_db is None:
+        energy_db = input_energy_db(config, audio, sample_rate, times)
+    return detector.frame_probability(w, energy_db, search, match)
 
 
 # --------------------------------------------------------------------------- the closures

@@ -67,12 +67,10 @@ class ContextIndex:
         """
         codebook = np.asarray(codebook, dtype=np.int64)
         full = (codebook.shape[1] - 1) // 2
-        rows, inverse, size = np.unique(codebook, axis=0, return_inverse=True,
-                                        return_counts=True)
-        tokens = np.argsort(inverse.ravel(), kind="stable")
+        rows, inverse, size = unique_rows(codebook)
+        tokens = np.argsort(inverse, kind="stable")
         keys = rows[:, [full, full - 1, full + 1]]
-        groups, of_group = np.unique(keys, axis=0, return_inverse=True)
-        of_group = of_group.ravel()
+        groups, of_group, _ = unique_rows(keys)
         distinct = np.argsort(of_group, kind="stable")
         group_size = np.bincount(of_group, minlength=len(groups))
         centre = groups[:, 0]
@@ -146,6 +144,30 @@ def _expand(owner: np.ndarray, start: np.ndarray, size: np.ndarray
     size = np.asarray(size, dtype=np.int64)
     offsets = np.arange(size.sum()) - np.repeat(np.cumsum(size) - size, size)
     return np.repeat(owner, size), np.repeat(start, size) + offsets
+
+
+def unique_rows(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``numpy.unique(a, axis=0, return_inverse=True, return_counts=True)`` of phone ids ``(n, k)``
+    (the rows in lexicographic order, each row's place among them ``(n,)``, their counts), each
+    row taken as one integer of ``k`` digits in base ``max + 1`` when it fits in 63 bits (a
+    sort of integers, not of rows).
+
+    >>> rows, inverse, counts = unique_rows(np.array([[1, 0], [0, 5], [1, 0]]))
+    >>> rows.tolist(), inverse.tolist(), counts.tolist()
+    ([[0, 5], [1, 0]], [1, 0, 1], [1, 2])
+    """
+    a = np.asarray(a, dtype=np.int64)
+    base = int(a.max(initial=0)) + 1
+    if a.size == 0 or a.min() < 0 or a.shape[1] * np.log2(base) >= 62:
+        rows, inverse, counts = np.unique(a, axis=0, return_inverse=True, return_counts=True)
+        return rows, inverse.ravel(), counts
+    key = np.zeros(len(a), dtype=np.int64)
+    for column in a.T:
+        key *= base
+        key += column
+    _, first, inverse, counts = np.unique(key, return_index=True, return_inverse=True,
+                                          return_counts=True)
+    return a[first], inverse.ravel(), counts
 
 
 def _tau(sizes: np.ndarray, p: np.ndarray, tokens: np.ndarray, count: int) -> np.ndarray:

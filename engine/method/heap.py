@@ -8,14 +8,14 @@ size; with glibc, ``malloc_trim`` returns the free pages to the system. Elsewher
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import functools
 
 
 @functools.cache
 def _trim():
     """glibc's ``malloc_trim``, or ``None`` where there is none."""
+    import ctypes.util  # training's (it starts subprocess's import): not for a synthesis's start
+
     try:
         return ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").malloc_trim
     except (OSError, AttributeError):

@@ -4,6 +4,7 @@ from the roots of the sum and difference polynomials.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import lru_cache
 from itertools import pairwise
 
@@ -468,7 +469,6 @@ def frame_lsf(frames: np.ndarray, order: int) -> np.ndarray:
     return poly2lsf(lpc(frames, order))
 
 
-@above_blas
 def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
            window_s: float = 0.025, audio_rate: int = 16000,
            preemphasis: float = 0.97, threads: int | None = 1) -> np.ndarray:
@@ -487,6 +487,20 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     >>> lsf_at(rng.standard_normal(16000), 16000, np.array([0.5]), order=10).shape
     (1, 10)
     """
+    return lsf_frames_at(audio, rate, times, order, window_s, audio_rate, preemphasis, threads)[0]
+
+
+@above_blas
+def lsf_frames_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
+                  window_s: float = 0.025, audio_rate: int = 16000, preemphasis: float = 0.97,
+                  threads: int | None = 1,
+                  per_frame: Callable[[np.ndarray], np.ndarray] | None = None
+                  ) -> tuple[np.ndarray, np.ndarray | None]:
+    """:func:`lsf_at`, and ``per_frame`` of its windowed frames (a function of frames ``(n, N)``
+    giving ``(n, ...)``, run in each span beside the LSFs: e.g. the closure detector's frame
+    energies, from the frames already made; ``None``: not asked). The frames are those of the
+    input brought to a peak in [0.5, 1) by a power of two before any resampling (the resampled
+    signal's peak may then lie just outside it)."""
     x = np.asarray(audio, dtype=np.float64)
     # to a peak in [0.5, 1) by a power of 2 (facetraj_engine.level): exact, and LPC is scale-free,
     # so huge samples cannot overflow to inf; up after the pre-emphasis (padded_signal), down or
@@ -497,5 +511,9 @@ def lsf_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 18,
     x = resample_audio(x, rate, audio_rate)
     times = np.asarray(times, dtype=np.float64)
     frames = analysis_frames(x, audio_rate, times, window_s, preemphasis, exponent)
-    return np.concatenate(map_spans(lambda a, b: frame_lsf(frames[a:b], order), len(frames),
-                                    threads))
+    if per_frame is None:
+        return np.concatenate(map_spans(lambda a, b: frame_lsf(frames[a:b], order), len(frames),
+                                        threads)), None
+    spans = map_spans(lambda a, b: (per_frame(frames[a:b]), frame_lsf(frames[a:b], order)),
+                      len(frames), threads)
+    return np.concatenate([lsf for _, lsf in spans]), np.concatenate([f for f, _ in spans])

@@ -128,7 +128,8 @@ class LsfIndex:
         return np.take(np.asarray(cb_lsf).T.astype(np.float32), self.order, axis=1)
 
     def nearest(self, w: np.ndarray, cb_lsf: np.ndarray, count: int, probe: int,
-                chunk: int | None = None, grouped: np.ndarray | None = None) -> np.ndarray:
+                chunk: int | None = None, grouped: np.ndarray | None = None,
+                first: np.ndarray | None = None) -> np.ndarray:
         """The ``count`` codewords nearest to each frame by eq 5, among the members of the
         ``probe`` cells whose centroids are nearest by eq 5; ``(T, count)`` codebook indices,
         ascending.
@@ -140,7 +141,9 @@ class LsfIndex:
         laid out ``(P, size)`` so that the innermost loops run along the cell's codewords, and in
         float32 (half the memory traffic of the search's largest arrays; the distances only rank
         the codewords: eqs 5-8 are computed again in float64 on the ``count`` found). ``grouped``
-        may pass :meth:`grouped` of ``cb_lsf``, computed once.
+        may pass :meth:`grouped` of ``cb_lsf``, computed once. ``first`` ``(T,)``: where to write
+        each frame's nearest of those distances, what ``count=1`` finds when it probes as many
+        cells (:meth:`probes`).
 
         Examples
         --------
@@ -154,83 +157,121 @@ class LsfIndex:
             raise ValueError(f"the index covers {self.n_codewords} codewords, the codebook has "
                              f"{cb_lsf.shape[0]}: rebuild it (build_index)")
         count = min(count, self.n_codewords)
-        probe = min(max(probe, self.min_probe(count)), self.n_cells)
+        probe = self.probes(count, probe)
         cell_lsf = self._cell_lsf(cb_lsf, grouped)                        # (P, 5L) by cell
-        return self._search(w, cell_lsf, count, probe, chunk)
+        return self._search(w, cell_lsf, count, probe, chunk, first)
+
+    def probes(self, count: int, probe: int) -> int:
+        """The cells :meth:`nearest` opens for ``count`` codewords when asked for ``probe``."""
+        return min(max(probe, self.min_probe(min(count, self.n_codewords))), self.n_cells)
 
     def _search(self, w: np.ndarray, cell_lsf: np.ndarray, count: int, probe: int,
-                chunk: int | None) -> np.ndarray:
+                chunk: int | None, first: np.ndarray | None = None) -> np.ndarray:
         """:meth:`nearest`, chunk by chunk of frames."""
         n_frames, order = w.shape[0], w.shape[1]
-        sizes = self.sizes
-        width_max = int(np.sort(sizes)[-probe:].sum())
+        width_max = int(np.sort(self.sizes)[-probe:].sum())
         chunk = chunk or max(1, min(1024, int(4e6 // max(self.n_cells * order, width_max))))
         out = np.empty((n_frames, count), dtype=np.int64)
         centroids = np.ascontiguousarray(self.centroids.T, dtype=np.float32)     # (P, C)
         for a in range(0, n_frames, chunk):
             b = min(a + chunk, n_frames)
-            h = perceptual_weights(np.asarray(w[a:b], dtype=np.float64)).astype(np.float32)
-            wc = np.asarray(w[a:b], dtype=np.float32)                            # eq 5
-            dc = wc[:, :, None] - centroids                                      # (t, P, C)
-            np.abs(dc, out=dc)
-            dc = np.matmul(h[:, None, :], dc)[:, 0]                              # eq 5, (t, C)
-            cells = (np.argpartition(dc, probe - 1, axis=1)[:, :probe] if probe < self.n_cells
-                     else np.broadcast_to(np.arange(self.n_cells), dc.shape))
-            sz = sizes[cells]                                                    # (t, probe)
-            ends = np.cumsum(sz, axis=1)               # each opened cell's block in its row ends
-            starts = ends - sz                          # and starts here
-            width = int(ends[:, -1].max())
-            # row t: its cells side by side; a cell's block starts at t * width + starts[t, slot]
-            at = (np.arange(b - a)[:, None] * width + starts).ravel()
-            d = np.full((b - a) * width, np.inf, dtype=np.float32)
-            flat = cells.ravel()
-            by_cell = np.argsort(flat, kind="stable")
-            bounds = np.searchsorted(flat[by_cell], np.arange(self.n_cells + 1))
-            offsets, bounds = self.offsets.tolist(), bounds.tolist()      # Python ints: cheap
-            for c in np.flatnonzero((np.diff(bounds) > 0) & (sizes > 0)).tolist():   # opened
-                lo, hi = offsets[c], offsets[c + 1]
-                step = max(1, int(4e6 // ((hi - lo) * order)))   # bound the (f, P, size) temporary
-                for r0 in range(bounds[c], bounds[c + 1], step):
-                    pairs = by_cell[r0:min(r0 + step, bounds[c + 1])]
-                    rows = pairs // probe
-                    diff = wc[rows, :, None] - cell_lsf[:, lo:hi]                # (f, P, size)
-                    np.abs(diff, out=diff)
-                    block = np.matmul(h[rows, None, :], diff)[:, 0]              # eq 5, (f, size)
-                    d[at[pairs][:, None] + np.arange(hi - lo)] = block
-            d = d.reshape(b - a, width)
-            cols = _smallest(d, count)
-            # column -> (which opened cell, place in it) -> codebook index: the block ends of all
-            # rows, each row shifted by its offset, ascend, so one search finds every column's cell
-            rows = np.arange(b - a)[:, None]
-            slot = np.searchsorted((ends + rows * width).ravel(), (cols + rows * width).ravel(),
-                                   side="right").reshape(cols.shape) - rows * probe
-            within = cols - starts[rows, slot]
-            out[a:b] = self.order[self.offsets[cells[rows, slot]] + within]
+            d, cells, ends = self._distances(w[a:b], cell_lsf, centroids, probe)
+            out[a:b] = self._codewords(_smallest(d, count, ends[:, -1]), cells, ends)
+            if first is not None:
+                first[a:b] = self._codewords(d.argmin(axis=1)[:, None], cells, ends)[:, 0]
         out.sort(axis=1)            # in codebook order: the same whatever frames share a call
         return out
 
+    def _distances(self, w: np.ndarray, cell_lsf: np.ndarray, centroids: np.ndarray, probe: int
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Eq 5 from each frame of ``w`` ``(t, P)`` to the members of its ``probe`` nearest cells
+        ``(t, width)``: row t holds its cells ``cells[t]`` side by side, each a block ending at
+        ``ends[t, slot]``, then inf; the cells and the ends."""
+        order, sizes = w.shape[1], self.sizes
+        h = perceptual_weights(np.asarray(w, dtype=np.float64)).astype(np.float32)
+        wc = np.asarray(w, dtype=np.float32)                                     # eq 5
+        dc = wc[:, :, None] - centroids                                          # (t, P, C)
+        np.abs(dc, out=dc)
+        dc = np.matmul(h[:, None, :], dc)[:, 0]                                  # eq 5, (t, C)
+        cells = (np.argpartition(dc, probe - 1, axis=1)[:, :probe] if probe < self.n_cells
+                 else np.broadcast_to(np.arange(self.n_cells), dc.shape))
+        sz = sizes[cells]                                                        # (t, probe)
+        ends = np.cumsum(sz, axis=1)                   # each opened cell's block in its row ends
+        width = int(ends[:, -1].max())
+        # row t: its cells side by side; a cell's block starts at t * width + its start in the row
+        at = (np.arange(len(w))[:, None] * width + ends - sz).ravel()
+        d = np.full(len(w) * width, np.inf, dtype=np.float32)
+        flat = cells.ravel()
+        by_cell = np.argsort(flat, kind="stable")
+        bounds = np.searchsorted(flat[by_cell], np.arange(self.n_cells + 1))
+        offsets, bounds = self.offsets.tolist(), bounds.tolist()          # Python ints: cheap
+        for c in np.flatnonzero((np.diff(bounds) > 0) & (sizes > 0)).tolist():       # opened
+            lo, hi = offsets[c], offsets[c + 1]
+            step = max(1, int(4e6 // ((hi - lo) * order)))       # bound the (f, P, size) temporary
+            for r0 in range(bounds[c], bounds[c + 1], step):
+                pairs = by_cell[r0:min(r0 + step, bounds[c + 1])]
+                rows = pairs // probe
+                diff = wc[rows, :, None] - cell_lsf[:, lo:hi]                    # (f, P, size)
+                np.abs(diff, out=diff)
+                block = np.matmul(h[rows, None, :], diff)[:, 0]                  # eq 5, (f, size)
+                d[at[pairs][:, None] + np.arange(hi - lo)] = block
+        return d.reshape(len(w), width), cells, ends
 
-def _smallest(d: np.ndarray, count: int) -> np.ndarray:
+    def _codewords(self, cols: np.ndarray, cells: np.ndarray, ends: np.ndarray) -> np.ndarray:
+        """The codebook indices of columns ``cols`` ``(t, k)`` of :meth:`_distances`' rows: the
+        block ends of all rows, each row shifted by its offset, ascend, so one search finds
+        every column's cell, then its place in it."""
+        rows = np.arange(len(cols))[:, None]
+        width = int(ends[:, -1].max())
+        probe = cells.shape[1]
+        slot = np.searchsorted((ends + rows * width).ravel(), (cols + rows * width).ravel(),
+                               side="right").reshape(cols.shape) - rows * probe
+        sz = self.sizes[cells]
+        within = cols - (ends - sz)[rows, slot]
+        return self.order[self.offsets[cells[rows, slot]] + within]
+
+
+#: rows of a search grouped by their number of values, for the partition (:func:`_smallest`)
+WIDTH_GROUPS = 4
+
+
+def _smallest(d: np.ndarray, count: int, widths: np.ndarray | None = None) -> np.ndarray:
     """Columns of the ``count`` smallest values of each row of ``d``, ascending (of equal values
     at the edge, the first columns): the ``count``-th smallest value of each row by a partition
-    (values only: faster than ``argpartition``), then the columns at or below it.
+    (values only: faster than ``argpartition``), then the columns at or below it. ``widths``:
+    each row's values are its first ``widths[t]`` (at least ``count``; the rest inf, left out):
+    the rows are taken in :data:`WIDTH_GROUPS` groups of like widths, each as wide as its widest.
 
     >>> _smallest(np.array([[5.0, 1.0, 3.0, 1.0], [0.0, 9.0, 9.0, 9.0]]), 2).tolist()
     [[1, 3], [0, 1]]
     >>> _smallest(np.array([[5.0, 1.0, 3.0, 1.0], [9.0, 9.0, 0.0, 0.0]]), 1).tolist()
     [[1], [2]]
+    >>> _smallest(np.array([[5.0, 1.0, 3.0, 1.0], [9.0, 0.0, np.inf, np.inf]]), 2, [4, 2]).tolist()
+    [[1, 3], [0, 1]]
+    >>> _smallest(np.array([[3.0, 3.0, 3.0, 1.0], [2.0, 2.0, 0.0, 2.0]]), 2).tolist()
+    [[0, 3], [0, 2]]
     """
     rows, width = d.shape
     if count >= width:
         return np.broadcast_to(np.arange(width), (rows, width))
     if count == 1:                    # the nearest alone (the voice match): the first smallest
         return d.argmin(axis=1)[:, None]
+    if widths is not None and rows >= 2 * WIDTH_GROUPS:
+        out = np.empty((rows, count), dtype=np.int64)
+        by_width = np.argsort(widths, kind="stable")
+        for group in np.array_split(by_width, WIDTH_GROUPS):
+            out[group] = _smallest(d[group, :int(np.max(widths[group]))], count)
+        return out
     kth = np.partition(d, count - 1, axis=1)[:, count - 1]
     at = np.flatnonzero(d <= kth[:, None])                     # flat: faster than row and column
-    if len(at) > rows * count:                                 # ties at the edge: the first ones
+    if len(at) > rows * count:          # ties at the edge: all below it, the first ones at it
         r = at // width
-        first = np.searchsorted(r, np.arange(rows))
-        at = at[np.arange(len(at)) - first[r] < count]
+        edge = d.ravel()[at] == kth[r]
+        first = np.searchsorted(r[edge], np.arange(rows))       # each row's first at the edge
+        rank = np.zeros(len(at), dtype=np.int64)
+        rank[edge] = np.arange(int(edge.sum())) - first[r[edge]]
+        below = np.bincount(r[~edge], minlength=rows)
+        at = at[~edge | (rank < count - below[r])]
     return at.reshape(rows, count) - np.arange(0, rows * width, width)[:, None]
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import logging
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -27,7 +28,7 @@ from .closure import ClosureStats
 from .closure_detector import ClosureDetector
 from .codebook import Codebook
 from .context_index import ContextIndex
-from .lsf import lsf_at
+from .lsf import lsf_frames_at
 from .lsf_index import LsfIndex, build_index
 from .markers import fill_gaps, remove_head_motion
 from .pca import PCA
@@ -300,5 +301,15 @@ def analysed_lsf(config: TrainConfig, audio: np.ndarray, sample_rate: int, times
                  threads: int | None = 1) -> np.ndarray:
     """The input LSF vectors w (eq 5) at ``times``, analysed by ``config``'s settings (order,
     window, rate, pre-emphasis) as a model trained with them analyses its training audio."""
-    return lsf_at(audio, sample_rate, times, config.lpc_order, config.window_s,
-                  config.audio_rate, config.preemphasis, threads)
+    return analysed_frames(config, audio, sample_rate, times, threads)[0]
+
+
+def analysed_frames(config: TrainConfig, audio: np.ndarray, sample_rate: int, times: np.ndarray,
+                    threads: int | None = 1,
+                    per_frame: Callable[[np.ndarray], np.ndarray] | None = None
+                    ) -> tuple[np.ndarray, np.ndarray | None]:
+    """:func:`analysed_lsf`, and ``per_frame`` of the same analysis frames
+    (:func:`~facetraj_engine.method.lsf.lsf_frames_at`: the closure detector's frame energies
+    without framing the audio again)."""
+    return lsf_frames_at(audio, sample_rate, times, config.lpc_order, config.window_s,
+                         config.audio_rate, config.preemphasis, threads, per_frame)

@@ -164,11 +164,9 @@ class Acoustic(Mode):
     )
 
     def search(self, job: SearchInput) -> SearchResult:
-        from .search import SearchResult, acoustic_candidates, weighted
+        from .search import acoustic_search
 
-        model, w, config = job.model, job.w, job.config
-        return SearchResult(weighted(model, w, lambda a, b: acoustic_candidates(model, w[a:b], config),
-                                     config))
+        return acoustic_search(job.model, job.w, job.config)
 
     def describe(self, config: SynthConfig) -> str:
         return "acoustic-only (indexed)" if config.acoustic_prefilter else "acoustic-only (whole codebook)"

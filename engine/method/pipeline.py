@@ -24,10 +24,10 @@ from ..io.labelfiles import validate_phones
 from ..labels.phoneset import SILENCE, map_labels, normalise_label
 from ..threads import above_blas, frame_threads
 from .closure import ClosurePlan, aperture_functional, apply_closure, closure_intervals, closure_strengths
-from .closure_detector import beside, causal_closures, closure_runs, input_probability
+from .closure_detector import beside, causal_closures, closure_runs, frame_energy_db, input_probability
 from .closure_search import search_rows
 from .context import segment_index
-from .model import Model
+from .model import Model, analysed_frames
 from .modes import mode_of
 from .search import SearchInput, SegmentChoice
 from .selection import mean_normalise
@@ -134,10 +134,12 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     """
     config = config or SynthConfig()
     mode = mode_of(config)
-    times, w, warp, analysed = _input(model, audio, sample_rate, n_frames, lsf, config,
-                                      audio_source or source)
+    times, w, warp, analysed, energy_db = _input(model, audio, sample_rate, n_frames, lsf, config,
+                                                 audio_source or source,
+                                                 detector_may_run(model, config, provenance))
     energy = SpeechEnergy(audio, sample_rate)
-    ratio = _voice_ratio(model, energy, times, w, config, provenance, voice)
+    ratio = _voice_ratio(model, energy, times, w, config, provenance, voice) \
+        if mode.weighs_labels else float("nan")             # the search weighs by it
     job = SearchInput(model, w, times, config, voice_ratio=ratio)
     if mode.needs_labels:
         if not phones:
@@ -147,9 +149,11 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         if mode.weighs_labels:
             job.confidence = frame_confidence(list(phones), confidence, times)
     found = mode.search(job)
+    if not mode.weighs_labels:                     # after the search: it may find the nearest
+        ratio = _voice_ratio(model, energy, times, w, config, provenance, voice, found.nearest)
     plan = plan_closure(model, audio, sample_rate, times, job.segs, provenance,
                         voice_match(ratio, 1.0), config, energy.filtered if config.closure else None,
-                        analysed, found.frames)
+                        analysed, found.frames, energy_db)
     res = _finish(model, times, w, found.frames, config, found.segments, found.frame_segment,
                   warp, plan)
     res.voice_match, res.voice_ratio = voice_match(ratio, 1.0), ratio
@@ -157,21 +161,25 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
 
 
 def _input(model: Model, audio: np.ndarray, sample_rate: int, n_frames: int | None,
-           lsf: np.ndarray | None, config: SynthConfig, source: str | None
-           ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray | None]:
+           lsf: np.ndarray | None, config: SynthConfig, source: str | None, detecting: bool
+           ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray | None, np.ndarray | None]:
     """The frame times, the input LSFs w of eq 5 (computed here unless given; speaker-normalised),
     the speaker warp, and the LSFs before the normalisation for the closure detector: those
     computed here, or the given ones when no normalisation changed them (``None`` otherwise: the
     detector analyses the audio itself, inside :func:`synthesize`'s BLAS limit, and a caller's
-    LSFs may differ from those to rounding)."""
+    LSFs may differ from those to rounding); with ``detecting``, the detector's frame energies
+    of the LSFs computed here (:func:`~facetraj_engine.method.closure_detector.frame_energy_db`
+    of the same analysis frames), else ``None``."""
     rate = model.marker_rate
     if n_frames is None:
         n_frames = frame_count(len(audio), sample_rate, rate)
     check_length(model, len(audio), sample_rate, source, n_frames)
     times = np.arange(n_frames) / rate
     order = model.config.lpc_order
+    energy_db = None
     if lsf is None:
-        raw = model.input_lsf(audio, sample_rate, times, frame_threads())
+        raw, energy_db = analysed_frames(model.config, audio, sample_rate, times, frame_threads(),
+                                         frame_energy_db if detecting else None)
     elif lsf.shape != (n_frames, order):
         raise ValueError(f"lsf must be ({n_frames}, {order}) for these frames, got {lsf.shape}")
     else:
@@ -179,7 +187,7 @@ def _input(model: Model, audio: np.ndarray, sample_rate: int, n_frames: int | No
     w, warp = normalise_speaker(model, raw, config)
     if mode_of(config).weighs_labels and config.mean_normalise:
         w = mean_normalise(w, model.lsf_mean)
-    return times, w, warp, raw if lsf is None or w is lsf else None
+    return times, w, warp, raw if lsf is None or w is lsf else None, energy_db
 
 
 def _model_phones(model: Model, phones: Sequence[PhoneSegment], duration: float,
@@ -227,8 +235,8 @@ def _smoothed(model: Model, raw: np.ndarray, times: np.ndarray, config: SynthCon
 def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
                  segs: Sequence[PhoneSegment] | None, provenance: Provenance | None,
                  match: float, config: SynthConfig, filtered: np.ndarray | None = None,
-                 lsf: np.ndarray | None = None, frames: FrameWeights | None = None
-                 ) -> ClosurePlan | None:
+                 lsf: np.ndarray | None = None, frames: FrameWeights | None = None,
+                 energy_db: np.ndarray | None = None) -> ClosurePlan | None:
     """Where the closure step acts (``None``: off, or a model file without its statistics): the
     labelled /p b m/ (``config.closure_labels``), trusted as
     :func:`~facetraj_engine.method.closure.closure_strengths` says (for recognized labels by the
@@ -238,9 +246,10 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
     (``config.closure_detector``, fully trusted, closed as a stream closes them; ``lsf``: the
     input's LSFs at ``times`` before any speaker warp or mean normalisation, when computed;
     ``frames``: the acoustic-only search's, whose opinion counts by the voice ``match`` from the
-    frame a stream would have measured it); and the silent frames by energy, where the face rests
-    (``config.rest``; ``filtered``: :func:`~facetraj_engine.method.speech.filtered_energy_db` of
-    the audio, when already computed)."""
+    frame a stream would have measured it; ``energy_db``: the detector's frame energies of
+    ``lsf``'s analysis, when computed with it); and the silent frames by energy, where the face
+    rests (``config.rest``; ``filtered``: :func:`~facetraj_engine.method.speech.filtered_energy_db`
+    of the audio, when already computed)."""
     if not config.closure or model.closure is None:
         return None
     intervals, strengths, p = np.zeros((0, 2)), np.zeros(0), None
@@ -256,13 +265,15 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
             causal = np.zeros(len(intervals), dtype=bool)
         if model.detector is not None and kind == "recognized" and \
                 config.closure_second_opinion and np.isfinite(match) and match > 0:
-            p, runs = _detected(model, audio, sample_rate, times, lsf, None, match, heard, config)
+            p, runs = _detected(model, audio, sample_rate, times, lsf, None, match, heard, config,
+                                energy_db)
             added = beside(runs, intervals)
             intervals = np.concatenate([intervals, added])
             strengths = np.concatenate([strengths, np.full(len(added), match)])
             causal = np.concatenate([causal, np.ones(len(added), dtype=bool)])
     elif detecting:
-        p, intervals = _detected(model, audio, sample_rate, times, lsf, frames, match, heard, config)
+        p, intervals = _detected(model, audio, sample_rate, times, lsf, frames, match, heard, config,
+                                 energy_db)
         strengths, causal = np.ones(len(intervals)), np.ones(len(intervals), dtype=bool)
         log.debug("closure step: the lips close at %d closures the detector found", len(intervals))
     silent = ~speech & ranged if config.rest else np.zeros(len(times), dtype=bool)
@@ -271,24 +282,37 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
 
 def _detected(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
               lsf: np.ndarray | None, frames: FrameWeights | None, match: float, heard: int,
-              config: SynthConfig) -> tuple[np.ndarray, np.ndarray]:
+              config: SynthConfig, energy_db: np.ndarray | None = None
+              ) -> tuple[np.ndarray, np.ndarray]:
     """The detector's probabilities and closures of an input (:func:`plan_closure`; the closures
     from each run's confirming frame, :func:`~facetraj_engine.method.closure_detector.causal_closures`);
     the voice ``match`` counts from frame ``heard`` on (before it a stream has not measured the
     voice: :func:`~facetraj_engine.method.voice_match.match_from`); the acoustic-only search is
-    made here when its opinion counts and ``frames`` is not that search's."""
+    made here when its opinion counts and ``frames`` is not that search's (``energy_db``: the
+    frame energies of ``lsf``'s analysis, when known)."""
     det = model.detector
     if lsf is None:
-        lsf = model.input_lsf(audio, sample_rate, times, frame_threads())
+        lsf, energy_db = model.input_lsf(audio, sample_rate, times, frame_threads()), None
     m = frame_matches(match, len(times), heard)
     counts = det.search is not None and bool((m > 0).any())
     if frames is None and counts:
         acoustic = config.with_(mode="acoustic")
         frames = mode_of(acoustic).search(SearchInput(model, lsf, times, acoustic)).frames
     search = search_rows(model, frames) if frames is not None and counts else None
-    p = input_probability(det, model.config, audio, sample_rate, times, lsf, search, m)
+    p = input_probability(det, model.config, audio, sample_rate, times, lsf, search, m, energy_db)
     runs = closure_runs(p, times, config.closure_threshold, det.spec.min_frames)
     return p, causal_closures(runs, model.marker_rate, det.spec.min_frames)
+
+
+def detector_may_run(model: Model, config: SynthConfig, provenance: Provenance | None) -> bool:
+    """Whether :func:`plan_closure` may run the model's closure detector on an input of this
+    ``config`` and labels' ``provenance``: without labels, or beside recognized ones (it then
+    runs unless the voice match is 0); the input's analysis computes its frame energies then."""
+    if not (config.closure and model.closure is not None and model.detector is not None):
+        return False
+    if not mode_of(config).needs_labels:
+        return config.closure_detector
+    return (provenance or Provenance()).kind == "recognized" and config.closure_second_opinion
 
 
 class SpeechEnergy:
@@ -304,26 +328,30 @@ class SpeechEnergy:
 
 
 def _voice_ratio(model: Model, energy: SpeechEnergy, times: np.ndarray, w: np.ndarray,
-                 config: SynthConfig, provenance: Provenance | None, wanted: bool) -> float:
+                 config: SynthConfig, provenance: Provenance | None, wanted: bool,
+                 nearest: np.ndarray | None = None) -> float:
     """The input's voice distance ratio when the synthesis weighs by it (a mode that weighs its
     labels by the voice, the closure step's trust in recognized labels) or it is ``wanted``,
-    else NaN (not computed)."""
+    else NaN (not computed); ``nearest``: each frame's nearest codeword, when the search found
+    it as the voice match does."""
     recognized = provenance is not None and provenance.kind == "recognized"
     detector = model.detector is not None and model.detector.search is not None and \
         config.closure_detector and not mode_of(config).needs_labels
     if not (wanted or (mode_of(config).weighs_labels and config.label_weight_by_voice) or
             (config.closure and (recognized or detector))):
         return float("nan")
-    return input_voice_ratio(model, energy.audio, energy.sample_rate, times, w, energy.filtered)
+    return input_voice_ratio(model, energy.audio, energy.sample_rate, times, w, energy.filtered,
+                             nearest)
 
 
 def input_voice_ratio(model: Model, audio: np.ndarray, sample_rate: int,
                       times: np.ndarray | None = None, w: np.ndarray | None = None,
-                      filtered: np.ndarray | None = None) -> float:
+                      filtered: np.ndarray | None = None, nearest: np.ndarray | None = None
+                      ) -> float:
     """``D / D0`` (:mod:`facetraj_engine.method.voice_match`): how far an input's voice is from the
     codebook's, relative to the training voice's own figure, from the audio alone (its LSFs ``w``
-    at ``times`` and its filtered energy when already computed; NaN for a model file without
-    ``D0``)."""
+    at ``times``, its filtered energy and its frames' nearest codewords when already computed;
+    NaN for a model file without ``D0``)."""
     if not np.isfinite(model.voice_distance):
         return float("nan")
     if times is None or w is None:
@@ -331,7 +359,8 @@ def input_voice_ratio(model: Model, audio: np.ndarray, sample_rate: int,
             / model.marker_rate
         w = model.input_lsf(audio, sample_rate, times)
     speech = speech_mask(audio, sample_rate, times, filtered=filtered)
-    return voice_distance(w, speech, model.codebook.lsf, model.lsf_index()) / model.voice_distance
+    return voice_distance(w, speech, model.codebook.lsf, model.lsf_index(),
+                          nearest=nearest) / model.voice_distance
 
 
 def input_voice_match(model: Model, audio: np.ndarray, sample_rate: int,

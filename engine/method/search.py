@@ -19,6 +19,7 @@ from .model import Model
 from .selection import robust_frames
 from .similarity import top_context_phones
 from .synthesis import FrameWeights, gamma_grid, nearest_codewords, weight_frames
+from .voice_match import PROBE as VOICE_PROBE
 
 
 @dataclass
@@ -56,6 +57,9 @@ class SearchResult:
     frames: FrameWeights
     segments: list[SegmentChoice] = field(default_factory=list)
     frame_segment: np.ndarray | None = None
+    #: each frame's nearest codeword as the voice match finds it (through the LSF index), when
+    #: the acoustic-only search found it on its way (else ``None``)
+    nearest: np.ndarray | None = None
 
 
 def eq4(model: Model, segs: list[PhoneSegment], times: np.ndarray, config: SynthConfig
@@ -111,13 +115,36 @@ def gammas(config: SynthConfig) -> np.ndarray:
 
 
 def acoustic_candidates(model: Model, w: np.ndarray, config: SynthConfig,
-                        grouped: np.ndarray | None = None) -> np.ndarray:
+                        grouped: np.ndarray | None = None, first: np.ndarray | None = None
+                        ) -> np.ndarray:
     """Acoustic-only candidates ``(T, I)`` of frames ``w``: the ``config.acoustic_prefilter``
     codewords nearest by eq 5 through the model's LSF index (``acoustic_probe`` cells), or exactly,
     or every codeword (``acoustic_prefilter=None``, as the paper does). ``grouped``: the index's
-    :meth:`~facetraj_engine.method.lsf_index.LsfIndex.grouped` codebook, when the caller keeps it."""
+    :meth:`~facetraj_engine.method.lsf_index.LsfIndex.grouped` codebook, when the caller keeps it;
+    ``first`` ``(T,)``: where the index writes each frame's nearest codeword
+    (:func:`finds_voice_nearest` says when that is the voice match's)."""
     cb = model.codebook
     if config.acoustic_prefilter is not None and config.acoustic_probe is not None:
         return model.lsf_index().nearest(w, cb.lsf, config.acoustic_prefilter,
-                                         config.acoustic_probe, grouped=grouped)
+                                         config.acoustic_probe, grouped=grouped, first=first)
     return nearest_codewords(w, cb.lsf, config.acoustic_prefilter)   # every one, or exact K
+
+
+def acoustic_search(model: Model, w: np.ndarray, config: SynthConfig) -> SearchResult:
+    """The acoustic-only mode's search: eqs 5-8 on :func:`acoustic_candidates`, with each
+    frame's nearest codeword when the index finds it as the voice match does."""
+    first = np.empty(len(w), dtype=np.int64) if finds_voice_nearest(model, config) else None
+    fw = weighted(model, w, lambda a, b: acoustic_candidates(
+        model, w[a:b], config, first=None if first is None else first[a:b]), config)
+    return SearchResult(fw, nearest=first)
+
+
+def finds_voice_nearest(model: Model, config: SynthConfig) -> bool:
+    """Whether :func:`acoustic_candidates` finds each frame's nearest codeword as the voice match
+    does (:func:`facetraj_engine.method.voice_match.indexed_distances`): through the index,
+    opening as many cells."""
+    if config.acoustic_prefilter is None or config.acoustic_probe is None:
+        return False
+    index = model.lsf_index()
+    return index.probes(config.acoustic_prefilter, config.acoustic_probe) == \
+        index.probes(1, VOICE_PROBE)

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..config import EvalConfig
 from ..level import peak_scaling
+from .quantiles import percentiles
 
 
 @functools.lru_cache(maxsize=8)
@@ -135,7 +136,7 @@ def speech_mask(audio: np.ndarray, rate: int, times: np.ndarray,
     config = config or EvalConfig()
     if filtered is None:
         filtered = filtered_energy_db(audio, rate, config)
-    return _above(filtered, times, config, *np.percentile(filtered, [5, 99]))
+    return _above(filtered, times, config, *percentiles(filtered, [5, 99]))
 
 
 def _above(filtered: np.ndarray, times: np.ndarray, config: EvalConfig, floor: float,
@@ -170,7 +171,7 @@ def ranged_speech(audio: np.ndarray, rate: int, times: np.ndarray, min_range_db:
     nor its silence is told (``filtered``: :func:`filtered_energy_db` when already computed)."""
     if filtered is None:
         filtered = filtered_energy_db(audio, rate, config)
-    floor, peak = np.percentile(filtered, [5, 99])
+    floor, peak = percentiles(filtered, [5, 99])
     return _above(filtered, times, config or EvalConfig(), floor, peak), bool(peak - floor >= min_range_db)
 
 

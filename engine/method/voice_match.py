@@ -19,8 +19,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..config import SynthConfig
-from ..fanout import fan_out
 from .lsf_index import LsfIndex
+from .quantiles import median
 from .synthesis import lsf_distances, perceptual_weights
 
 #: The voice match is 1 up to ``MATCH_FULL`` times the training voice's distance, 0 from
@@ -28,6 +28,8 @@ from .synthesis import lsf_distances, perceptual_weights
 MATCH_FULL, MATCH_NONE = 1.5, 3.0
 #: Speech frames a recording's figure is computed on, at most (evenly spaced).
 MAX_FRAMES = 400
+#: The LSF index's cells probed for a frame's nearest codeword.
+PROBE = 8
 #: Speech frames heard before a voice is measured (0.5 s of speech at 60 Hz): a stream's running
 #: match counts from then (:mod:`facetraj_engine.streaming.voice`), and so does the detector's
 #: use of the match offline (:func:`match_from`), so that both treat the first half second alike.
@@ -88,10 +90,11 @@ def nearest_distances(w: np.ndarray, cb_lsf: np.ndarray, exclude: np.ndarray | N
 
 def voice_distance(w: np.ndarray, speech: np.ndarray, cb_lsf: np.ndarray,
                    index: LsfIndex | None = None, exclude: np.ndarray | None = None,
-                   max_frames: int = MAX_FRAMES) -> float:
+                   max_frames: int = MAX_FRAMES, nearest: np.ndarray | None = None) -> float:
     """The median, over (at most ``max_frames`` evenly spaced) speech frames, of eq 5's distance
-    to the nearest codeword; through the model's LSF ``index`` when given (8 cells probed), else
-    exact. NaN without speech frames."""
+    to the nearest codeword; through the model's LSF ``index`` when given (:data:`PROBE` cells
+    probed; ``nearest``: every frame's nearest codeword found so already, by the acoustic
+    search), else exact. NaN without speech frames."""
     frames = np.flatnonzero(np.asarray(speech, bool))
     if frames.size == 0:
         return float("nan")
@@ -100,13 +103,16 @@ def voice_distance(w: np.ndarray, speech: np.ndarray, cb_lsf: np.ndarray,
     if index is None:
         d = nearest_distances(w, cb_lsf, exclude)
         return float(np.median(d)) if np.isfinite(d).all() else float("nan")
-    return float(np.median(indexed_distances(w, cb_lsf, index)))
+    return median(indexed_distances(w, cb_lsf, index, None if nearest is None else nearest[frames]))
 
 
-def indexed_distances(w: np.ndarray, cb_lsf: np.ndarray, index: LsfIndex) -> np.ndarray:
+def indexed_distances(w: np.ndarray, cb_lsf: np.ndarray, index: LsfIndex,
+                      near: np.ndarray | None = None) -> np.ndarray:
     """Per frame of ``w`` ``(T, P)``, eq 5's distance to the nearest codeword found through the
-    model's LSF ``index`` (8 cells probed): what :func:`voice_distance` takes the median of."""
-    near = index.nearest(np.asarray(w, dtype=np.float64), cb_lsf, 1, 8)[:, 0]
+    model's LSF ``index`` (:data:`PROBE` cells probed; ``near``: those codewords, when found
+    already): what :func:`voice_distance` takes the median of."""
+    if near is None:
+        near = index.nearest(np.asarray(w, dtype=np.float64), cb_lsf, 1, PROBE)[:, 0]
     return lsf_distances(w, cb_lsf[near][:, None, :])[:, 0]
 
 
@@ -116,6 +122,8 @@ def training_voice_distance(lsf: Sequence[np.ndarray], speech: Sequence[np.ndarr
     """``D0``: the median over training utterances of :func:`voice_distance`, each with its own
     codewords left out (``codeword_utterance`` ``(5L,)``: the index, in ``lsf``'s order, of the
     utterance each codeword comes from), in ``workers`` processes."""
+    from ..fanout import fan_out  # training's: not for a synthesis's start
+
     def one(k: int) -> float:
         return voice_distance(lsf[k], speech[k], cb_lsf, exclude=codeword_utterance == k)
 
