@@ -22,7 +22,7 @@ from facetraj_engine.method.model import analysed_frames
 from facetraj_engine.method.pipeline import detector_may_run, input_voice_ratio, synthesize
 from facetraj_engine.method.search import finds_voice_nearest
 
-ACOUSTIC = SynthConfig(mode="acoustic")
+ACOUSTIC = SynthConfig(mode="acoustic", closure_detector=True)      # the detector asked for
 
 
 @pytest.fixture(scope="module")
@@ -88,7 +88,8 @@ def test_synthesis_frames_the_audio_once_and_gives_the_same_face(default_model, 
     then twice the detector's own), the probabilities equal to rounding, the rest to the bit."""
     config, provenance = ACOUSTIC, None
     if case == "recognized":
-        config, provenance = SynthConfig(mode="robust"), Provenance("recognized")
+        config, provenance = SynthConfig(mode="robust", closure_second_opinion=True), \
+            Provenance("recognized")
     for u in held_out[:3]:
         audio, rate = u.audio, u.sample_rate
         if case in ("resampled", "rescaled"):
@@ -114,16 +115,18 @@ def test_synthesis_frames_the_audio_once_and_gives_the_same_face(default_model, 
 
 
 def test_when_the_detector_may_run(default_model):
-    """Without labels, or beside recognized ones; never with the closure step or the detector
-    off, nor for a model without one (its analysis then computes no energies)."""
+    """Without labels when the detector is asked for, or beside recognized ones when its second
+    opinion is (both off by default, issue 46); never with the closure step off, nor for a model
+    without one (its analysis then computes no energies)."""
     recognized, hand = Provenance("recognized"), Provenance("hand-checked")
+    second = SynthConfig(closure_second_opinion=True)
     assert detector_may_run(default_model, ACOUSTIC, None)
-    assert detector_may_run(default_model, SynthConfig(mode="robust"), recognized)
-    assert detector_may_run(default_model, SynthConfig(mode="phonetic"), recognized)
-    assert not detector_may_run(default_model, SynthConfig(mode="phonetic"), hand)
-    assert not detector_may_run(default_model, SynthConfig(mode="robust"), None)
-    assert not detector_may_run(default_model, SynthConfig(mode="robust",
-                                                           closure_second_opinion=False), recognized)
+    assert not detector_may_run(default_model, SynthConfig(mode="acoustic"), None)    # default
+    assert detector_may_run(default_model, second.with_(mode="robust"), recognized)
+    assert detector_may_run(default_model, second.with_(mode="phonetic"), recognized)
+    assert not detector_may_run(default_model, SynthConfig(mode="robust"), recognized)  # default
+    assert not detector_may_run(default_model, second.with_(mode="phonetic"), hand)
+    assert not detector_may_run(default_model, second.with_(mode="robust"), None)
     assert not detector_may_run(default_model, ACOUSTIC.with_(closure=False), None)
     assert not detector_may_run(default_model, ACOUSTIC.with_(closure_detector=False), None)
     assert not detector_may_run(dataclasses.replace(default_model, detector=None), ACOUSTIC, None)
