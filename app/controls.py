@@ -104,15 +104,6 @@ class ViewBar(QWidget):
             w.setFocusPolicy(Qt.FocusPolicy.NoFocus)
             lay.addWidget(w)
         lay.addStretch(1)
-        # the 3-D view over the panels' room too (a laptop screen: the faces two or three times
-        # as tall); the window connects it (``PanelSplit.enlarge``)
-        self.enlarge = QToolButton()
-        self.enlarge.setText("⤢")
-        self.enlarge.setCheckable(True)
-        self.enlarge.setFocusPolicy(Qt.FocusPolicy.NoFocus)
-        self.enlarge.setToolTip("enlarge: the 3-D view takes the panels' room too (press again for "
-                                "the panels)")
-        lay.addWidget(self.enlarge)
 
     def set_has_original(self, has: bool) -> None:
         """An utterance without original markers (a recording opened for synthesis): the
@@ -275,6 +266,16 @@ class TransportBar(QWidget):
         self.loop_box.setFocusPolicy(Qt.FocusPolicy.NoFocus)
         self.loop_box.setToolTip("loop the selected range (drag on the panels to select; Esc clears)")
         lay.addWidget(self.loop_box)
+        # the 3-D view over the panels' room too, as a video player's full-screen button (a
+        # laptop screen: the faces two or three times as tall); the window connects it
+        # (``PanelSplit.enlarge``)
+        self.enlarge = QToolButton()
+        self.enlarge.setText("⤢")
+        self.enlarge.setCheckable(True)
+        self.enlarge.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+        self.enlarge.setToolTip("enlarge the 3-D view: it takes the panels' room too (press again "
+                                "for the panels)")
+        lay.addWidget(self.enlarge)
 
     def _button(self, lay: QHBoxLayout, icon: QStyle.StandardPixmap, tip: str, slot) -> QToolButton:
         b = QToolButton()

@@ -208,7 +208,7 @@ class MainWindow(QMainWindow):
         self.setCentralWidget(self.splitter)
         # panels left out for lack of room: more of the height for them; kept through resizes
         self.panel_split = PanelSplit(self.splitter, self.timeline, most=PANELS_SHARE)
-        self.view_bar.enlarge.toggled.connect(self.panel_split.enlarge)
+        self.transport.enlarge.toggled.connect(self.panel_split.enlarge)
         self.utteranceChanged.connect(self.notice.utterance_shown)
         self.modelReady.connect(lambda: self.notice.utterance_shown(""))    # another corpus
         self.browser = UtteranceBrowser(self)

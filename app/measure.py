@@ -44,6 +44,8 @@ from facetraj_engine.analysis.phone_compare import (
 from .analysis.common import NumberItem, export_with_dialog, fill_table, text_item
 from .measure_model import TABLE_COLUMNS, Measure
 
+#: the table's columns up to the minima's (the pins' columns follow them)
+MIN_COLUMNS = 1 + max(i for i, c in enumerate(TABLE_COLUMNS) if c[1].startswith("min_"))
 #: the splits a corpus-wide comparison runs over
 RUN_SPLITS = {"test": ("test",), "train": ("train",), "train + test": ("test", "train")}
 
@@ -89,17 +91,21 @@ class ApertureTable(QWidget):
             for _head, attribute, fmt in TABLE_COLUMNS:
                 v = getattr(r, attribute)
                 row.append(text_item(v) if isinstance(v, str) else NumberItem(v, fmt))
-            for m in mins:                      # each pin's least aperture, and this minus it
-                row += [NumberItem(m, "{:.1f}"), NumberItem(r.min_synthesized - m, "{:+.1f}")]
+            pinned = [item for m in mins for item in (NumberItem(m, "{:.1f}"),       # each pin's least
+                                                      NumberItem(r.min_synthesized - m, "{:+.1f}"))]
+            row[MIN_COLUMNS:MIN_COLUMNS] = pinned      # aperture, and this minus it, by the minima
             row[0].setData(Qt.ItemDataRole.UserRole + 1, r.min_time)
             items.append(row)
-        fill_table(self.table, [c[0] for c in TABLE_COLUMNS] + self.measure.pin_columns(), items)
+        heads = [c[0] for c in TABLE_COLUMNS]
+        heads[MIN_COLUMNS:MIN_COLUMNS] = self.measure.pin_columns()
+        fill_table(self.table, heads, items)
         view = self.measure.view
         has_original = view is not None and view.original is not None
         pins = ("; pins: their least aperture over the same segment, and this minus it"
                 if self.measure.pins else "; pin a result (Ctrl+P) to compare: a column each")
         self.note.setText("Lip aperture (mm, upper to lower lip centre) at each phone's minimum "
-                          "and midpoint; error = synthesized − original" + pins + ". A click on "
+                          "and midpoint, original (orig.) and synthesized (synth.); error = "
+                          "synthesized − original" + pins + ". A click on "
                           "a row goes to its minimum." + ("" if has_original or view is None else
                                                           " No original markers here."))
 
@@ -133,17 +139,21 @@ class CorpusRun(QGroupBox):
         self.count = QSpinBox()
         self.count.setRange(0, 10000)
         self.count.setValue(10)
-        self.count.setSpecialValueText("all")
+        self.count.setSuffix(" utterances")
+        self.count.setSpecialValueText("all utterances")
         self.count.setToolTip("utterances of each split (all: the whole split)")
         self.run_button = QPushButton("Run")
         self.run_button.clicked.connect(self.run)
         self.export_button = QPushButton("Export CSV…")
         self.export_button.clicked.connect(self._export)
         self.export_button.setEnabled(False)
-        top = QHBoxLayout()
-        for w in (self.split, QLabel("utterances:"), self.count, self.run_button, self.export_button):
+        top = QHBoxLayout()                 # short rows: the dock of a laptop shows them whole
+        for w in (self.split, self.count, self.run_button):
             top.addWidget(w)
         top.addStretch(1)
+        bottom = QHBoxLayout()
+        bottom.addStretch(1)
+        bottom.addWidget(self.export_button)
         self.summary = QTableWidget()
         self.summary.verticalHeader().setVisible(False)
         self.summary.setMinimumHeight(4 * self.summary.fontMetrics().height() + 30)
@@ -154,6 +164,7 @@ class CorpusRun(QGroupBox):
         lay.addLayout(top)
         lay.addWidget(self.note)
         lay.addWidget(self.summary)
+        lay.addLayout(bottom)
 
     def ids(self) -> list[tuple[str, str]]:
         info, n = self.window.corpus.info, self.count.value() or None
@@ -174,6 +185,8 @@ class CorpusRun(QGroupBox):
             self.rows, self.recipes = rows, recipes
             self.export_button.setEnabled(bool(rows))
             self.show_summary()
+            w.show_status(f"compared {len(recipes)} results at {len(rows)} phone segments of "
+                          f"{len({r.utterance for r in rows})} utterances")
 
         def failed(exc: BaseException) -> None:
             self.run_button.setEnabled(True)

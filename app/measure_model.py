@@ -37,11 +37,11 @@ from .provenance import settings_text
 from .state import UtteranceView
 
 #: the per-phone table's columns: (heading, value of a PhoneAperture, format)
-TABLE_COLUMNS: tuple[tuple[str, str, str], ...] = (
+TABLE_COLUMNS: tuple[tuple[str, str, str], ...] = (      # short: a laptop's dock shows the minima
     ("phone", "phone", "{}"), ("word", "word", "{}"), ("start (s)", "start", "{:.3f}"),
-    ("min: original", "min_original", "{:.1f}"), ("min: synthesized", "min_synthesized", "{:.1f}"),
-    ("min: error", "min_error", "{:+.1f}"), ("mid: original", "mid_original", "{:.1f}"),
-    ("mid: synthesized", "mid_synthesized", "{:.1f}"), ("mid: error", "mid_error", "{:+.1f}"),
+    ("min: orig.", "min_original", "{:.1f}"), ("min: synth.", "min_synthesized", "{:.1f}"),
+    ("min: error", "min_error", "{:+.1f}"), ("mid: orig.", "mid_original", "{:.1f}"),
+    ("mid: synth.", "mid_synthesized", "{:.1f}"), ("mid: error", "mid_error", "{:+.1f}"),
 )
 
 

@@ -386,8 +386,12 @@ class AudioOpener(QObject):
         corpus, name = self.window.corpus, view.utterance.name
         text = self.window.state.texts.get(name, "")
         held = (corpus.data_root / f"{name}.txt").is_file()
-        return corpus_sources(view.utterance, audio_path(corpus.data_root, name), view.origin,
-                              text, f"{name}.txt" if held else "the sentence of its marker file")
+        try:
+            path = audio_path(corpus.data_root, name)
+        except FacetrajError:       # the audio held in its marker file (MVIEW): a name for messages
+            path = corpus.data_root / f"{name}.wav"
+        return corpus_sources(view.utterance, path, view.origin, text,
+                              f"{name}.txt" if held else "the sentence of its marker file")
 
     def switch(self, source: str) -> None:
         """Synthesize the utterance on screen again with labels from ``source`` (its time and

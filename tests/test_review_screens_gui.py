@@ -295,10 +295,10 @@ def test_the_close_up_of_the_lips_and_the_enlarged_view_show_a_mouth_to_judge(sc
     assert all(not shut and dark > 0 for shut, dark in at_oy), at_oy
     w.seek(middle(w, "b"))
     height = w.plotter.height()
-    w.view_bar.enlarge.setChecked(True)
+    w.transport.enlarge.setChecked(True)
     qtbot.waitUntil(lambda: w.plotter.height() > 1.8 * height, timeout=10_000)
     qtbot.waitUntil(lambda: min(mouths()) >= 1.3 * min(close), timeout=10_000)
     assert not w.timeline.isVisible()
-    w.view_bar.enlarge.setChecked(False)
+    w.transport.enlarge.setChecked(False)
     qtbot.waitUntil(lambda: w.timeline.isVisible() and abs(w.plotter.height() - height) <= 2,
                     timeout=10_000)

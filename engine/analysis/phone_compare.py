@@ -28,7 +28,6 @@ from ..errors import FacetrajError
 from ..io.corpus import Corpus, audio_path
 from ..progress import Progress
 from .apertures import NAN, SILENT_LABELS, aperture, label_at
-from .common import write_csv
 
 log = logging.getLogger(__name__)
 
@@ -198,6 +197,8 @@ def write_comparison_csv(path: str | os.PathLike[str], rows: Sequence[ComparedPh
                          recipes: Sequence[Recipe], overwrite: bool = True) -> Path:
     """The rows as CSV (:data:`COMPARISON_COLUMNS`), one line per segment and result, with the
     result's settings and its labels' phone there; ``difference_mm``: result − original."""
+    from .common import write_csv  # (the csv writer's package: not for the first frame)
+
     settings = {r.name: r.settings for r in recipes}
     lines = ([r.utterance, r.split, r.phone, r.word, r.start, r.end, x.name, settings.get(x.name, ""),
               x.phone, x.min_mm, r.min_original, x.min_mm - r.min_original]
