@@ -276,6 +276,8 @@ class FaceScene:
         self._pin_frames: list[np.ndarray] = []
         self._pin_offsets: list[np.ndarray] = []
         self._keep: np.ndarray | None = None    # the markers drawn (None: all; the close-up's)
+        # the close-up's grid laid out for another view's aspect (its camera's: set_camera_state)
+        self._grid_aspect: float | None = None
 
     # ------------------------------------------------------------------ scene
     def set_model(self, model: Model, closed: ClosedLips | None = None) -> None:
@@ -392,7 +394,7 @@ class FaceScene:
         aspect = 1e9
         if self.preset == CLOSE_UP and self.plotter is not None:
             w, h = self.plotter.renderer.GetSize()
-            aspect = w / max(h, 1)
+            aspect = self._grid_aspect or w / max(h, 1)
         columns = grid_columns(n, self._cell, aspect) if self.preset == CLOSE_UP else n
         across, up = np.eye(3)[self._across], np.eye(3)[1]
         cells = [(k % columns) * self._cell[0] * across - (k // columns) * self._cell[1] * up
@@ -484,6 +486,7 @@ class FaceScene:
             return
         keep = self._lips if preset == CLOSE_UP else None
         self.preset = preset
+        self._grid_aspect = None                # the grid fitted to this view
         if (keep is None) != (self._keep is None):
             self._build_sets(keep)
         self._layout()
@@ -546,8 +549,13 @@ class FaceScene:
     def set_camera_state(self, state: tuple) -> None:
         """The camera of another view (:meth:`camera_state`): in a view narrower than that one,
         the view angle (a parallel projection's scale) widened so that it shows at least the
-        same width (and more height)."""
+        same width (and more height); the close-up's faces in that view's grid (the camera
+        looks at them there)."""
         position, focal, up, angle, aspect, scale = state
+        self._grid_aspect = aspect
+        self._layout()
+        if self.frame >= 0:
+            self.move_points(self.frame)
         cam = self.plotter.camera
         cam.position, cam.focal_point, cam.up = position, focal, up
         w, h = self.plotter.renderer.GetSize()

@@ -213,6 +213,34 @@ def test_the_video_is_what_the_screen_shows(screen, win, qtbot, tmp_path, monkey
     assert_placed_as_in(window, scene, [style.ORIGINAL_COLOR, style.SYNTH_COLOR, pin.color])
 
 
+def test_the_video_of_the_close_up_is_what_the_screen_shows(screen, win, qtbot):
+    """The close-up of the lips side by side with a pin: the video's faces in the window's grid
+    under the window's camera, each where the window has it (the video laid its narrower half's
+    grid out, two rows where the window had one, and showed it through the window's camera:
+    the pin's face under the original's, the faces small and off centre)."""
+    import facetraj_app.own_data as own_data
+    from facetraj_app.video import VideoFrames
+
+    w = win
+    w.view_bar.side_by_side.setChecked(True)
+    w.extension("compare").pin()
+    resynthesize(w, qtbot, lambda: w.set_synth_config(w.synth_config.with_(n_context_phones=1)), WAIT_MS)
+    w.view_bar.set_camera("lips")
+    w.seek(middle(w, "b"))
+    qtbot.waitUntil(lambda: w.settled, timeout=WAIT_MS)
+    caption, screen_state = own_data.screen_of(w)
+    video = VideoFrames(w.model, w.view.synthesis, view=w.view, pins=w.pins, caption=caption,
+                        screen=screen_state)
+    try:
+        x0, y0, x1, y1 = video.layout.scene
+        scene = video.frame(middle(w, "b"))[y0:y1, x0:x1]
+    finally:
+        video.close()
+    w.face.rerender()
+    assert_placed_as_in(face_image(w.plotter), scene,
+                        [style.ORIGINAL_COLOR, style.SYNTH_COLOR, w.pins.pins[0].color])
+
+
 # ---------------------------------------------------------------------- 9: the laptop's docks
 def test_the_labels_box_and_the_pins_stay_in_view(screen, win, qtbot):
     """In the robust search (its long note shown) the labels box is in view in the settings
