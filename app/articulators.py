@@ -16,9 +16,11 @@ synthesized, each pin) in its colour, as VisArtico and MVIEW draw such data:
 
 The window looks at it in profile (the midsagittal plane: front to the right, up up) with a
 parallel projection, so that 2-D (midsagittal) data is drawn true to scale; 3-D data can be turned
-with the other cameras. :class:`ArticulatorSet` has :class:`facetraj_app.view3d.MarkerSet`'s
-interface (``set_points``, ``set_visible``, ``current``, ``actor``, ``name``), so that playback,
-pins, side by side and hover work unchanged.
+with the other cameras; the close-up of the lips shows the lip sensors alone (:func:`lip_sensors`),
+in profile. :class:`ArticulatorSet` has :class:`facetraj_app.face_scene.MarkerSet`'s interface
+(``set_points``, ``set_visible``, ``current``, ``actor``, ``name``, ``keep``), so that
+``app/face_scene.py: FaceScene`` draws them in the window and in the video with playback, pins,
+side by side, the close-up and hover unchanged.
 """
 
 from __future__ import annotations
@@ -69,36 +71,45 @@ def link_segments(roles: SensorRoles) -> list[list[int]]:
     return segs
 
 
+def lip_sensors(roles: SensorRoles) -> np.ndarray:
+    """The lips' sensors (indices): the upper and lower lip and the lip corners (the close-up of
+    the lips draws them alone)."""
+    return np.array(sorted({roles.upper_lip, roles.lower_lip, *roles.lip_corners}), dtype=int)
+
+
 def _verts(indices) -> np.ndarray:
     return np.column_stack([np.ones(len(indices), int), np.asarray(indices, int)]).ravel()
 
 
 class ArticulatorSet:
     """One set of articulograph sensors in a scene (see the module docstring): points, the tongue
-    curve, the lip and jaw lines, the faint reference sensors; adding it renders nothing."""
+    curve, the lip and jaw lines, the faint reference sensors; ``keep``: the sensors drawn (the
+    close-up of the lips: :func:`lip_sensors`; default all), a line only where all its sensors
+    are; adding it renders nothing."""
 
     def __init__(self, plotter: pv.BasePlotter, name: str, color: str, neutral: np.ndarray,
-                 roles: SensorRoles):
+                 roles: SensorRoles, keep: np.ndarray | None = None):
         self.name = name
         self.roles = roles
         self.n_markers = len(neutral)
         self.current = np.array(neutral, dtype=np.float64)
+        kept = set(range(len(neutral))) if keep is None else {int(i) for i in keep}
         faint = set(roles.reference) | set(roles.palate)
         self.points = pv.PolyData(self.current.copy())
-        self.points.verts = _verts([i for i in range(len(neutral)) if i not in faint])
+        self.points.verts = _verts([i for i in sorted(kept) if i not in faint])
         common = dict(reset_camera=False, pickable=False, render=False)
         self.actor = plotter.add_mesh(self.points, color=color, render_points_as_spheres=True,
                                       point_size=POINT_SIZE, style="points", name=f"{name}-points",
                                       ambient=0.3, diffuse=0.8, specular=0.0, **common)
         self.reference = pv.PolyData()
         self.reference.SetPoints(self.points.GetPoints())
-        self.reference.verts = _verts(sorted(roles.reference))
+        self.reference.verts = _verts(sorted(set(roles.reference) & kept))
         self.reference_actor = plotter.add_mesh(self.reference, color=REFERENCE_COLOR, style="points",
                                                 point_size=6, render_points_as_spheres=True,
                                                 name=f"{name}-reference", **common)
         self.links = pv.PolyData()
         self.links.SetPoints(self.points.GetPoints())
-        self.links.lines = _lines(link_segments(roles))
+        self.links.lines = _lines([seg for seg in link_segments(roles) if set(seg) <= kept])
         self.link_actor = plotter.add_mesh(self.links, color=color, line_width=2.0,
                                            name=f"{name}-links", **common)
         self.tongue = pv.PolyData(tongue_curve(self.current[list(roles.tongue)]))
@@ -107,12 +118,16 @@ class ArticulatorSet:
         self.tongue_actor = plotter.add_mesh(self.tongue, color=color, line_width=TONGUE_WIDTH,
                                              render_lines_as_tubes=True, name=f"{name}-tongue",
                                              ambient=0.35, diffuse=0.7, specular=0.0, **common)
+        tongue_kept = set(roles.tongue) <= kept     # else no curve (its points neither)
         self.palate = pv.PolyData()
         self.palate_actor = plotter.add_mesh(pv.PolyData(np.zeros((1, 3))), color=PALATE_COLOR,
                                              line_width=3.0, name=f"{name}-palate", **common)
         self.palate_actor.SetVisibility(False)
         self.has_palate = False
-        self._actors = [self.actor, self.reference_actor, self.link_actor, self.tongue_actor]
+        self._palate_kept = set(roles.palate) <= kept
+        self._actors = [self.actor, self.reference_actor, self.link_actor,
+                        *([self.tongue_actor] if tongue_kept else [])]
+        self.tongue_actor.SetVisibility(tongue_kept)
 
     def tongue_points(self) -> np.ndarray:
         """The tongue curve as drawn, ``(n, 3)``."""
@@ -131,7 +146,7 @@ class ArticulatorSet:
         """Draw the palate trace: every position the palate sensor took in ``frames``
         ``(T, M, 3)``, front to back (None, or no palate sensor: none)."""
         trace = np.zeros((0, 3))
-        if frames is not None and self.roles.palate:
+        if frames is not None and self.roles.palate and self._palate_kept:
             trace = np.asarray(frames, dtype=np.float64)[:, self.roles.palate[0]]
             trace = trace[np.isfinite(trace).all(axis=1)]
         self.has_palate = len(trace) >= 2
@@ -216,4 +231,5 @@ __all__ = [
     "fit_parallel",
     "gap_axis",
     "is_articulograph",
+    "lip_sensors",
 ]

@@ -10,12 +10,18 @@ and a panel draws the difference of the lip aperture, this result minus each pin
 
 from __future__ import annotations
 
+from html import escape
+
 import numpy as np
-from PyQt6.QtCore import QObject, pyqtSignal
+from PyQt6.QtCore import QObject, QSize, Qt, pyqtSignal
 from PyQt6.QtGui import QKeySequence
 from PyQt6.QtWidgets import QLabel
 
-from .pins import aperture_difference
+from .pins import aperture_difference, distinct_settings
+
+#: the widest the pins' list asks to be in the toolbar (it dropped into the toolbar's overflow
+#: menu on a laptop screen); the legend row and the tooltip name each pin in full
+PIN_LIST_PX = 380
 
 
 class PinDifferencePanel:
@@ -45,6 +51,36 @@ class PinDifferencePanel:
         ax.set_ylabel("aperture\n− pin (mm)", fontsize=8)
 
 
+class PinList(QLabel):
+    """The pins shown, in the toolbar: each one's colour, name and how it differs from the
+    others (``distinct_settings``), never asking for more than :data:`PIN_LIST_PX`."""
+
+    def __init__(self):
+        super().__init__("")
+        self.setTextFormat(Qt.TextFormat.RichText)
+        self.setStyleSheet("padding-left: 6px; color: #444444;")
+
+    def sizeHint(self) -> QSize:
+        hint = super().sizeHint()
+        return QSize(min(hint.width(), PIN_LIST_PX), hint.height())
+
+    def minimumSizeHint(self) -> QSize:
+        return QSize(min(super().minimumSizeHint().width(), 120), super().minimumSizeHint().height())
+
+    def show_pins(self, shown: list, view, note: str) -> None:
+        """``shown``: the pins drawn with ``view``; else ``note`` says why none is."""
+        if not shown:
+            self.setText(escape(note))
+            self.setToolTip(note)
+            return
+        from .provenance import settings_text
+
+        parts = distinct_settings([settings_text(view, short=True)] + [p.settings for p in shown])[1:]
+        self.setText("  ".join(f'<span style="color:{p.color}">■</span> {p.name}: {escape(part)}'
+                               for p, part in zip(shown, parts, strict=True)))
+        self.setToolTip("\n".join(f"{p.name}: {p.settings}" for p in shown))
+
+
 class Compare(QObject):
     """The pins' toolbar (*Pin this result*, *Clear pins*, what is pinned), the difference panel
     and the pinned faces in 3-D, following the window's result. ``changed`` after the pins shown
@@ -63,8 +99,7 @@ class Compare(QObject):
         self.pin_action.setToolTip("keep the result on screen to compare the next one with it "
                                    "(another search, labels, N, smoothing or model) (Ctrl+P)")
         self.clear_action = bar.addAction("Clear pins", self.clear)
-        self.label = QLabel("")
-        self.label.setStyleSheet("padding-left: 6px; color: #444444;")
+        self.label = PinList()
         bar.addWidget(self.label)
         menu = window.menu("View")
         menu.addSeparator()
@@ -80,8 +115,13 @@ class Compare(QObject):
         if view is None:
             self.window.show_status("nothing to pin yet", 4000)
             return
+        kept = self.window.pins.pinned(view)
+        if kept is not None:
+            self.window.show_status(f"this result is pinned already ({kept.name})", 6000)
+            return
         pin = self.window.pins.pin(view)
-        self.window.show_status(f"{pin.name} kept: {pin.settings}; change a setting to compare", 8000)
+        self.window.show_status(f"{pin.name} kept: {pin.settings}; change a setting (labels, "
+                                "search, N, smoothing) to compare", 8000)
         self.refresh()
 
     def clear(self) -> None:
@@ -96,8 +136,7 @@ class Compare(QObject):
         shown = w.pins.shown(w.view)
         changed, self._shown = shown != self._shown, shown
         self.clear_action.setEnabled(len(w.pins) > 0)
-        self.label.setText("  ".join(f"{p.name}: {p.settings}" for p in shown) if shown else
-                           (f"{len(w.pins)} pinned (another utterance)" if len(w.pins) else ""))
+        self.label.show_pins(shown, w.view, self._note())
         w.face.set_pins(shown)
         tl = w.timeline
         if shown and self.panel not in tl.panels:
@@ -107,6 +146,19 @@ class Compare(QObject):
         elif changed and not new_result and tl.view is not None:
             tl.relayout(tl.xlim() if tl.axes else None, soon=True)
         self.changed.emit()
+
+
+    def _note(self) -> str:
+        """What the pins' list says when no pin is drawn with the result on screen."""
+        w = self.window
+        pins = w.pins
+        own = pins.pinned(w.view) if w.view is not None else None
+        if own is not None:
+            return (f"{own.name}: the result on screen; change a setting (labels, search, N, "
+                    "smoothing) to compare")
+        if len(pins):
+            return f"{len(pins)} pinned of another utterance or marker set"
+        return ""
 
 
 def install(window) -> Compare:

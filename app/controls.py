@@ -28,16 +28,21 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
+from .face_scene import CAMERA_PRESETS, CLOSE_UP
 from .style import ORIGINAL_COLOR, SYNTH_COLOR
 from .timeline import Timeline
 from .transport import PlaybackClock
-from .view3d import CAMERA_PRESETS, FaceView
+from .view3d import FaceView
 
 SPEEDS = (1.0, 0.5, 0.25)
 #: between the title's first line and the details (``facetraj_app.viewer_model.view_title``)
 TITLE_SEPARATOR = "    ·    "
 #: the camera buttons' texts (short: the bar fits a narrow 3-D view)
-CAMERA_LABELS = {"three-quarter": "¾ view"}
+CAMERA_LABELS = {"three-quarter": "¾", CLOSE_UP: "lips"}
+#: their tooltips
+CAMERA_TIPS = {"three-quarter": "camera: three-quarter view",
+               CLOSE_UP: "close-up of the lips, front on: each face's lips alone, as large as the "
+                         "view allows (a closure judged on a laptop screen too)"}
 #: the read-out the time label is sized for (``MainWindow._show_time`` writes it); a longer one
 #: (a file over 100 s) widens it once
 TIME_TEMPLATE = "00.000 / 00.000 s  frame 0000  /xxx/"
@@ -65,18 +70,19 @@ class ViewBar(QWidget):
         self.face = face
         lay = QHBoxLayout(self)
         lay.setContentsMargins(4, 0, 4, 0)
+        lay.setSpacing(3)                   # the bar is the 3-D view's least width: short
         self.camera_buttons: dict[str, QToolButton] = {}
         for name in CAMERA_PRESETS:
             b = QToolButton()
             b.setText(CAMERA_LABELS.get(name, name))
-            b.setToolTip(f"camera: {name}")
+            b.setToolTip(CAMERA_TIPS.get(name, f"camera: {name}"))
             b.setCheckable(True)
             b.setAutoExclusive(True)
             b.clicked.connect(lambda _c=False, n=name: face.set_camera(n))
             lay.addWidget(b)
             self.camera_buttons[name] = b
         self.camera_buttons[face.preset].setChecked(True)
-        lay.addSpacing(8)
+        lay.addSpacing(4)
         self.side_by_side = QCheckBox("side by side")
         self.side_by_side.toggled.connect(face.set_side_by_side)
         # the check boxes of the two point sets carry their colours: they are the legend too
@@ -175,8 +181,9 @@ class TitleBar(QWidget):
 
 
 class NoticeBar(QFrame):
-    """A hint over the panels that stays until closed (or replaced): a sentence, and a button
-    that does what it suggests (e.g. *Import its folder…* for markers the model cannot show)."""
+    """A hint over the panels that stays until closed (or replaced; a hint about one utterance,
+    its ``owner``, until another is shown): a sentence, and a button that does what it suggests
+    (e.g. *Import its folder…* for markers the model cannot show)."""
 
     def __init__(self, parent: QWidget | None = None):
         super().__init__(parent)
@@ -197,16 +204,24 @@ class NoticeBar(QFrame):
         lay.addWidget(self.button)
         lay.addWidget(close)
         self._action: Callable[[], object] | None = None
+        self.owner = ""
         self.button.clicked.connect(self._run)
         self.hide()
 
     def show_notice(self, text: str, action_text: str = "",
-                    action: Callable[[], object] | None = None) -> None:
+                    action: Callable[[], object] | None = None, owner: str = "") -> None:
         self.text.setText(text)
         self._action = action
+        self.owner = owner
         self.button.setText(action_text)
         self.button.setVisible(bool(action_text and action))
         self.show()
+
+    def utterance_shown(self, name: str) -> None:
+        """Another utterance is shown: a hint about the one before goes (MOCHA's note stayed up
+        over every utterance after it)."""
+        if self.owner and name != self.owner:
+            self.hide()
 
     def _run(self) -> None:
         self.hide()
@@ -253,6 +268,16 @@ class TransportBar(QWidget):
         self.loop_box.setFocusPolicy(Qt.FocusPolicy.NoFocus)
         self.loop_box.setToolTip("loop the selected range (drag on the panels to select; Esc clears)")
         lay.addWidget(self.loop_box)
+        # the 3-D view over the panels' room too, as a video player's full-screen button (a
+        # laptop screen: the faces two or three times as tall); the window connects it
+        # (``PanelSplit.enlarge``)
+        self.enlarge = QToolButton()
+        self.enlarge.setText("⤢")
+        self.enlarge.setCheckable(True)
+        self.enlarge.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+        self.enlarge.setToolTip("enlarge the 3-D view: it takes the panels' room too (press again "
+                                "for the panels)")
+        lay.addWidget(self.enlarge)
 
     def _button(self, lay: QHBoxLayout, icon: QStyle.StandardPixmap, tip: str, slot) -> QToolButton:
         b = QToolButton()

@@ -397,21 +397,22 @@ def laptop_figures(out: Path) -> list[Path]:
 
 
 def measure_figures(out: Path) -> list[Path]:
-    """The walk-through of docs/app.md: s002.flac opened (its labels and its markers beside it),
-    its labels aligned from s002.txt and pinned, then recognized, the Measure table filtered to
-    /b/ and its first row clicked: the cursor at the /b/ of "boy" (``measure_boy.png``); the two
-    faces side by side there (``side_by_side.png``); the panels exported as a figure
-    (``export_figure.png``) and a video frame of the same (``video_frame_compare.png``)."""
+    """The walk-through of docs/app.md on a 1366 x 768 laptop, on the corpus utterance itself:
+    "boy" typed in the filter, s002 clicked, its labels aligned from s002.txt and pinned, then
+    recognized, the Measure table filtered to /b/ and its first row clicked: the cursor at the
+    /b/ of "boy" (``measure_boy.png``); the close-up of the lips there, the faces side by side
+    (``measure_boy_lips.png``); the two faces side by side in front (``side_by_side.png``); the
+    comparison run over ten test utterances (``measure_corpus.png``); the panels exported as a
+    figure (``export_figure.png``) and a frame of the video of what the screen shows
+    (``video_frame_compare.png``)."""
     import imageio.v3 as iio
 
     from .analysis.figures import settle, wait_until
-    from .main import WINDOW_SIZE
-    from .own_data import export_figure
+    from .own_data import export_figure, screen_of
     from .plotter_widget import grab_with_3d
-    from .screen_export import caption_text
     from .video import VideoFrames, VideoSettings
 
-    win = _window(DEFAULT_CORPUS, WINDOW_SIZE, "s002")
+    win = _window(DEFAULT_CORPUS, LAPTOP)
 
     def labels(change) -> None:
         done = []
@@ -419,7 +420,8 @@ def measure_figures(out: Path) -> list[Path]:
         change()
         wait_until(lambda: bool(done) and win.settled, 600)
 
-    labels(lambda: win.open_audio(DEFAULT_CORPUS / "s002.flac"))
+    win.browser.filter.setText("boy")
+    labels(lambda: win.browser.tree.setCurrentItem(win.browser.items["s002"]))
     labels(lambda: win.audio_opener.switch("aligned"))
     win.extension("compare").pin()
     labels(lambda: win.audio_opener.switch("recognized"))
@@ -431,17 +433,20 @@ def measure_figures(out: Path) -> list[Path]:
     written = [_shoot(win, out / "measure_boy.png", at)]
     log.info("readout: %s", win.extension("measure").readout.text())
     win.view_bar.side_by_side.setChecked(True)
+    win.view_bar.set_camera("lips")
+    written.append(_shoot(win, out / "measure_boy_lips.png", at))
     win.view_bar.set_camera("front")
     settle(500)
     win.face.rerender()
     grab_with_3d(win.face).save(str(out / "side_by_side.png"))
     written.append(out / "side_by_side.png")
-    win.view_bar.side_by_side.setChecked(False)
+    table.corpus.run()
+    wait_until(lambda: bool(table.corpus.rows) and win.settled, 900)
+    written.append(_shoot(win, out / "measure_corpus.png", at))
     written.append(export_figure(win, out / "export_figure.png"))
-    view = win.view
-    frames = VideoFrames(win.model, view.synthesis, view.original, view.utterance.phones,
-                         VideoSettings(1280, 544), view=view, pins=win.pins,
-                         caption=caption_text(view, win.pins.shown(view)))
+    caption, screen = screen_of(win)
+    frames = VideoFrames(win.model, win.view.synthesis, view=win.view, pins=win.pins,
+                         caption=caption, settings=VideoSettings(1280, 544), screen=screen)
     try:
         iio.imwrite(out / "video_frame_compare.png", frames.frame(at))
     finally:
@@ -449,6 +454,7 @@ def measure_figures(out: Path) -> list[Path]:
     written.append(out / "video_frame_compare.png")
     for path in written:
         log.info("wrote %s", path)
+    win.extension("analysis").close()
     win.close()
     return written
 

@@ -111,10 +111,11 @@ from .viewer_model import (
     voice_match_tip,
 )
 from .window_frame import (
+    DockWidth,
+    PanelSplit,
     WindowDocks,
     WindowMenus,
     fit_to_screen,
-    give_room,
     share_left_docks,
     text_scroll,
 )
@@ -162,7 +163,7 @@ class MainWindow(QMainWindow):
         self._build_widgets()
         self.audio_opener = AudioOpener(self)       # "Open audio…" and its label sources
         self.settings.add_widget(self.audio_opener.box)
-        self._build_menus()
+        _build_menus(self)
         self._shortcuts = playback_shortcuts(self)
         if corpus_path is not None:
             self._open_first_corpus(Path(corpus_path), model_path)
@@ -186,23 +187,31 @@ class MainWindow(QMainWindow):
     def _build_widgets(self) -> None:
         self.face = FaceView(self)
         self.plotter = self.face.plotter
+        # a click on the 3-D view or the panels takes the keyboard focus from a spin box or a
+        # filter box (which keep the arrows, space, Home and End to themselves): the playback
+        # keys work again (the interactor passes it up to the view, VTK gets no key)
         self.plotter.interactor.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+        self.face.setFocusPolicy(Qt.FocusPolicy.ClickFocus)
         self.timeline = Timeline(self)
+        self.timeline.canvas.setFocusPolicy(Qt.FocusPolicy.ClickFocus)
         for panel in (WaveformPanel(), SpectrogramPanel(), PhoneTierPanel(self),
                       LipPanel(self, "upper"), LipPanel(self, "lower")):
             self.timeline.panels.append(panel)
         self.timeline.seekRequested.connect(self.seek)
-        # panels left out for lack of room: more of the height for them
-        self.timeline.laidOut.connect(lambda: give_room(self.splitter, self.timeline, PANELS_SHARE))
         self.marker_panels = MarkerPanels(self.timeline)
         self.view_bar = ViewBar(self.face)
         self.camera_buttons = self.view_bar.camera_buttons
-        self.transport = self._build_transport()
+        self.transport = _build_transport(self)
         self.title = TitleBar()
         self.notice = NoticeBar()
         self.splitter = _split(_column([self.view_bar, self.face, self.transport], 2, stretch=self.face),
                                _column([self.notice, self.title, self.timeline], 0, stretch=self.timeline))
         self.setCentralWidget(self.splitter)
+        # panels left out for lack of room: more of the height for them; kept through resizes
+        self.panel_split = PanelSplit(self.splitter, self.timeline, most=PANELS_SHARE)
+        self.transport.enlarge.toggled.connect(self.panel_split.enlarge)
+        self.utteranceChanged.connect(self.notice.utterance_shown)
+        self.modelReady.connect(lambda: self.notice.utterance_shown(""))    # another corpus
         self.browser = UtteranceBrowser(self)
         self.browser.utteranceSelected.connect(self.set_utterance)
         self.browser_dock = self.docks.dock(self.browser, "Utterances", Qt.DockWidgetArea.LeftDockWidgetArea)
@@ -211,50 +220,17 @@ class MainWindow(QMainWindow):
         self.settings.searchChosen.connect(lambda cfg: self.set_synth_config(cfg, explicit=True))
         self.settings_dock = self.docks.dock(text_scroll(self.settings), "Synthesis settings",
                                         Qt.DockWidgetArea.LeftDockWidgetArea)
-        self.resizeDocks([self.browser_dock], [400], Qt.Orientation.Horizontal)
+        self.dock_width = DockWidth(self, self.browser_dock, 400)
         self.status = StatusArea(self.statusBar(), self.tasks)
         self.status_label, self.progress = self.status.label, self.status.progress
         self.dimensions_label = self.status.dimensions_label
         self.scores = BrowserScores(self.browser, self.tasks, self.playback.idle)
 
-    def _build_transport(self) -> TransportBar:
-        bar = TransportBar()
-        bar.playClicked.connect(self.toggle_play)
-        bar.stopClicked.connect(self.stop)
-        bar.stepClicked.connect(self.step_frames)
-        bar.speedChanged.connect(self.clock.set_speed)
-        bar.slider.valueChanged.connect(self._on_slider)
-        self.slider, self.speed, self.loop_box = bar.slider, bar.speed, bar.loop_box
-        self.loop = LoopRange(self.clock, self.timeline, bar.loop_box, self.seek)
-        return bar
-
-    def _build_menus(self) -> None:
-        self.action_open_corpus = self.menus.action("File", "Open &corpus folder…",
-                                               lambda: _given(ask_corpus_folder(self), self.open_corpus))
-        self.action_open_audio = self.menus.action("File", "Open &audio for synthesis…",
-                                              lambda: self.audio_opener.ask())
-        self.action_screenshot = self.menus.action(
-            "File", "Save &screenshot…",
-            lambda: _given(ask_screenshot_path(self),
-                           lambda p: self.show_status(f"wrote {self.save_screenshot(p)}")))
-        self.menu("File").addSeparator()
-        self.menus.action("File", "&Quit", self.close).setShortcut(QKeySequence.StandardKey.Quit)
-        self.view_menu = self.menu("View")
-        self.view_menu.addAction(self.browser_dock.toggleViewAction())
-        self.view_menu.addAction(self.settings_dock.toggleViewAction())
-        self.menus.action("View", "Show the whole utterance", self.timeline.reset_zoom)
-        self.view_menu.addSeparator()
-        self.action_add_marker_panel = self.menus.action("View", "Add a marker trajectory panel…",
-                                                    lambda: self.marker_panels.ask(self.model, self))
-        self.menus.action("View", "Remove the marker trajectory panels", self.marker_panels.clear)
-        self.analysis_menu = self.menu("Analysis")
-        self.menus.action("Help", "Keys", lambda: QMessageBox.information(self, "Keys", KEYS_HELP))
-
     def place_on_screen(self, wanted: tuple[int, int]) -> None:
         """``wanted`` size where the screen has room, else its free area, centred (``fit_to_screen``);
         the browser dock a quarter of the width (at most 400 px): a laptop keeps room for the face."""
         width = fit_to_screen(self, wanted)[2]
-        self.resizeDocks([self.browser_dock], [min(400, width // 4)], Qt.Orientation.Horizontal)
+        self.dock_width.place(min(400, width // 4))
         share_left_docks(self, self.browser_dock, self.settings_dock, self.settings)
 
     # ================================================================== public contract
@@ -297,9 +273,11 @@ class MainWindow(QMainWindow):
         """A message in the status bar (a temporary one with ``timeout_ms``)."""
         self.status.show(text, timeout_ms)
 
-    def show_notice(self, text: str, action_text: str = "", action: Callable[[], Any] | None = None) -> None:
-        """A hint over the panels until closed, with a button doing ``action``."""
-        self.notice.show_notice(text, action_text, action)
+    def show_notice(self, text: str, action_text: str = "", action: Callable[[], Any] | None = None,
+                    owner: str = "") -> None:
+        """A hint over the panels until closed (or, given an ``owner`` utterance, until another
+        is shown), with a button doing ``action``."""
+        self.notice.show_notice(text, action_text, action, owner)
 
     def add_extension(self, name: str, extension: object) -> None:
         self._extensions[name] = extension
@@ -432,7 +410,8 @@ class MainWindow(QMainWindow):
         self.title.setText(view_title(view))
         self.settings.show_used(view.synthesis.config, self.synth_config, view.mode_reason)
         self.browser.set_current(view.utterance.name)
-        self.scores.score(view, self.model)
+        if not self.state.relabelled:           # the browser's scores: the corpus's labels
+            self.scores.score(view, self.model)
         self.status_label.setText(view_summary(view))
         self.status_label.setToolTip(voice_match_tip(view))     # the voice match in words
 
@@ -510,12 +489,21 @@ class MainWindow(QMainWindow):
         ``acoustic_only=True`` or beside it; markers beside it: ``AudioOpener.open``)."""
         return self.audio_opener.open(Path(audio_path), labels_path, **kw)
 
-    def show_external(self, utt: Utterance, origin: LabelOrigin | None = None) -> None:
-        """Show an utterance opened from files (listed under "opened" in the browser); ``origin``:
-        where its labels came from (the file, the transcript aligned)."""
+    def show_external(self, utt: Utterance, origin: LabelOrigin | None = None, show: bool = True) -> None:
+        """Show an utterance opened from files (listed under "opened" in the browser; only
+        listed without ``show``); ``origin``: where its labels came from (the file, the
+        transcript aligned)."""
         name = self.state.add_external(utt, origin)
         self.browser.add_external(name)
-        self.set_utterance(name)
+        if show:
+            self.set_utterance(name)
+
+    def show_labels(self, utt: Utterance, origin: LabelOrigin, own: bool = False) -> None:
+        """Synthesize the utterance on screen again with the labels of ``utt`` (another label
+        source, ``app/label_sources.py``; ``own``: its own again), the time and zoom kept."""
+        request = self.state.request_labels(utt, origin, own)
+        if request is not None:
+            self._synthesize(request)
 
     def save_screenshot(self, path: Path) -> Path:
         """Render the whole window (with every 3-D view shown, the PC modes' too, as on screen:
@@ -530,6 +518,41 @@ class MainWindow(QMainWindow):
         self.tasks.close()
         self.face.close_view()
         super().closeEvent(event)
+
+
+def _build_transport(w: MainWindow) -> TransportBar:
+    """The transport bar, wired to the window's clock and playback."""
+    bar = TransportBar()
+    bar.playClicked.connect(w.toggle_play)
+    bar.stopClicked.connect(w.stop)
+    bar.stepClicked.connect(w.step_frames)
+    bar.speedChanged.connect(w.clock.set_speed)
+    bar.slider.valueChanged.connect(w._on_slider)
+    w.slider, w.speed, w.loop_box = bar.slider, bar.speed, bar.loop_box
+    w.loop = LoopRange(w.clock, w.timeline, bar.loop_box, w.seek)
+    return bar
+
+
+def _build_menus(w: MainWindow) -> None:
+    """The window's own menu entries (File, View, Help)."""
+    w.action_open_corpus = w.menus.action("File", "Open &corpus folder…",
+                                          lambda: _given(ask_corpus_folder(w), w.open_corpus))
+    w.action_open_audio = w.menus.action("File", "Open &audio for synthesis…", lambda: w.audio_opener.ask())
+    w.action_screenshot = w.menus.action(
+        "File", "Save &screenshot…",
+        lambda: _given(ask_screenshot_path(w), lambda p: w.show_status(f"wrote {w.save_screenshot(p)}")))
+    w.menu("File").addSeparator()
+    w.menus.action("File", "&Quit", w.close).setShortcut(QKeySequence.StandardKey.Quit)
+    w.view_menu = w.menu("View")
+    w.view_menu.addAction(w.browser_dock.toggleViewAction())
+    w.view_menu.addAction(w.settings_dock.toggleViewAction())
+    w.menus.action("View", "Show the whole utterance", w.timeline.reset_zoom)
+    w.view_menu.addSeparator()
+    w.action_add_marker_panel = w.menus.action("View", "Add a marker trajectory panel…",
+                                               lambda: w.marker_panels.ask(w.model, w))
+    w.menus.action("View", "Remove the marker trajectory panels", w.marker_panels.clear)
+    w.analysis_menu = w.menu("Analysis")
+    w.menus.action("Help", "Keys", lambda: QMessageBox.information(w, "Keys", KEYS_HELP))
 
 
 def _write_png(image, path: Path) -> Path:
@@ -583,6 +606,7 @@ left / right\tone frame back / forward
 shift + left / right\tprevious / next phone
 home / end\tstart / end of the utterance
 esc\tclear the loop range
+ctrl+p\tpin the result on screen (Compare)
 
 On the panels: click to seek, drag to select a loop range,
 wheel to zoom the time axis, right-drag to pan, double-click to show all.

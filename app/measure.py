@@ -5,8 +5,12 @@ window; the numbers from ``app/measure_model.py`` and the engine).
   there, the upper and lower lip y and the aperture of the synthesis in 3-D, the original's and
   the difference, and each pinned result's, in mm.
 * **Analysis → Measure: lip aperture per phone…** opens a dock with each phone's aperture at its
-  minimum and its midpoint, original, synthesized and error: sortable, filtered by phone
-  (``b p m``), exported as CSV; a click goes to the phone's minimum.
+  minimum and its midpoint, original, synthesized and error, and a column per pinned result (its
+  least aperture over the same segment, and this minus it): sortable, filtered by phone
+  (``b p m``), exported as CSV; a click goes to the phone's minimum. Under it, **across the
+  corpus**: the result on screen and each pin made again (their settings and label sources) on
+  every utterance of a split, summed up per phone and written as CSV
+  (``facetraj_engine.analysis.phone_compare``).
 """
 
 from __future__ import annotations
@@ -15,11 +19,14 @@ from pathlib import Path
 
 from PyQt6.QtCore import QSize, Qt
 from PyQt6.QtWidgets import (
+    QComboBox,
+    QGroupBox,
     QHBoxLayout,
     QLabel,
     QLineEdit,
     QPushButton,
     QSizePolicy,
+    QSpinBox,
     QTableWidget,
     QToolBar,
     QVBoxLayout,
@@ -27,15 +34,27 @@ from PyQt6.QtWidgets import (
 )
 
 from facetraj_engine.analysis.articulators import jaw_top
+from facetraj_engine.analysis.phone_compare import (
+    ComparedPhone,
+    Recipe,
+    corpus_comparison,
+    phone_means,
+    write_comparison_csv,
+)
 
 from .analysis.common import NumberItem, export_with_dialog, fill_table, text_item
 from .measure_model import TABLE_COLUMNS, Measure
+
+#: the table's columns up to the minima's (the pins' columns follow them)
+MIN_COLUMNS = 1 + max(i for i, c in enumerate(TABLE_COLUMNS) if c[1].startswith("min_"))
+#: the splits a corpus-wide comparison runs over
+RUN_SPLITS = {"test": ("test",), "train": ("train",), "train + test": ("test", "train")}
 
 
 class ApertureTable(QWidget):
     """The per-phone apertures of the utterance on screen: a filter, the table, CSV export."""
 
-    def __init__(self, measure: Measure, seek, parent: QWidget | None = None):
+    def __init__(self, measure: Measure, seek, window=None, parent: QWidget | None = None):
         super().__init__(parent)
         self.measure = measure
         self.seek = seek
@@ -43,12 +62,12 @@ class ApertureTable(QWidget):
         self.filter.setPlaceholderText("phones to show, e.g. b p m (empty: all)")
         self.filter.setClearButtonEnabled(True)
         self.filter.textChanged.connect(lambda _t: self.refresh())
-        export = QPushButton("Export CSV…")
-        export.clicked.connect(self._export)
+        self.export_button = QPushButton("Export CSV…")
+        self.export_button.clicked.connect(self._export)
         top = QHBoxLayout()
         top.addWidget(QLabel("phones:"))
         top.addWidget(self.filter, 1)
-        top.addWidget(export)
+        top.addWidget(self.export_button)
         self.note = QLabel("")
         self.note.setWordWrap(True)
         self.table = QTableWidget()
@@ -56,27 +75,40 @@ class ApertureTable(QWidget):
         self.table.verticalHeader().setVisible(False)
         self.table.setSelectionBehavior(QTableWidget.SelectionBehavior.SelectRows)
         self.table.cellClicked.connect(self._clicked)
+        self.corpus = CorpusRun(measure, self.filter, window) if window is not None else None
         lay = QVBoxLayout(self)
         lay.addLayout(top)
         lay.addWidget(self.note)
         lay.addWidget(self.table, 1)
+        if self.corpus is not None:
+            lay.addWidget(self.corpus)
+            self.filter.textChanged.connect(lambda _t: self.corpus.show_summary())
 
     def refresh(self) -> None:
         items = []
-        for r in self.measure.rows(self.filter.text()):
+        rows = self.measure.rows(self.filter.text())
+        for r, mins in zip(rows, self.measure.pin_minima(rows), strict=True):
             row = []
             for _head, attribute, fmt in TABLE_COLUMNS:
                 v = getattr(r, attribute)
                 row.append(text_item(v) if isinstance(v, str) else NumberItem(v, fmt))
+            pinned = [item for m in mins for item in (NumberItem(m, "{:.1f}"),       # each pin's least
+                                                      NumberItem(r.min_synthesized - m, "{:+.1f}"))]
+            row[MIN_COLUMNS:MIN_COLUMNS] = pinned      # aperture, and this minus it, by the minima
             row[0].setData(Qt.ItemDataRole.UserRole + 1, r.min_time)
             items.append(row)
-        fill_table(self.table, [c[0] for c in TABLE_COLUMNS], items)
+        heads = [c[0] for c in TABLE_COLUMNS]
+        heads[MIN_COLUMNS:MIN_COLUMNS] = self.measure.pin_columns()
+        fill_table(self.table, heads, items)
         view = self.measure.view
         has_original = view is not None and view.original is not None
-        self.note.setText("Lip aperture (mm, upper to lower lip centre marker) of each phone at its "
-                          "minimum and midpoint; error = synthesized − original. Click a row to go "
-                          "to the phone's minimum." + ("" if has_original or view is None else
-                                                       " This recording has no original markers."))
+        pins = ("; pins: their least aperture over the same segment, and this minus it"
+                if self.measure.pins else "; pin a result (Ctrl+P) to compare: a column each")
+        self.note.setText("Lip aperture (mm, upper to lower lip centre) at each phone's minimum "
+                          "and midpoint, original (orig.) and synthesized (synth.); error = "
+                          "synthesized − original" + pins + ". A click on "
+                          "a row goes to its minimum." + ("" if has_original or view is None else
+                                                          " No original markers here."))
 
     def _clicked(self, row: int, _col: int) -> None:
         item = self.table.item(row, 0)
@@ -90,6 +122,108 @@ class ApertureTable(QWidget):
     def _export(self) -> None:
         export_with_dialog(self, "Export the apertures per phone", "apertures.csv", "CSV (*.csv)",
                            self.export_csv)
+
+
+class CorpusRun(QGroupBox):
+    """The per-phone comparison across the corpus: the result on screen and each pin made again
+    (their settings and label sources: ``Measure.recipes``) on the utterances of a split, in the
+    window's worker with progress; per phone (the filter's), the mean least aperture of the
+    original and of each result; the rows exported as CSV."""
+
+    def __init__(self, measure: Measure, phone_filter: QLineEdit, window):
+        super().__init__("Across the corpus: this result and the pins, per phone")
+        self.measure, self.phone_filter, self.window = measure, phone_filter, window
+        self.rows: list[ComparedPhone] = []
+        self.recipes: list[Recipe] = []
+        self.split = QComboBox()
+        self.split.addItems(list(RUN_SPLITS))
+        self.count = QSpinBox()
+        self.count.setRange(0, 10000)
+        self.count.setValue(10)
+        self.count.setSuffix(" utterances")
+        self.count.setSpecialValueText("all utterances")
+        self.count.setToolTip("utterances of each split (all: the whole split)")
+        self.run_button = QPushButton("Run")
+        self.run_button.clicked.connect(self.run)
+        self.export_button = QPushButton("Export CSV…")
+        self.export_button.clicked.connect(self._export)
+        self.export_button.setEnabled(False)
+        top = QHBoxLayout()                 # short rows: the dock of a laptop shows them whole
+        for w in (self.split, self.count, self.run_button):
+            top.addWidget(w)
+        top.addStretch(1)
+        bottom = QHBoxLayout()
+        bottom.addStretch(1)
+        bottom.addWidget(self.export_button)
+        self.summary = QTableWidget()
+        self.summary.verticalHeader().setVisible(False)
+        self.summary.setMinimumHeight(4 * self.summary.fontMetrics().height() + 30)
+        self.note = QLabel("Run: this result and each pin made again, with their settings and "
+                           "labels, on each utterance")
+        self.note.setWordWrap(True)
+        lay = QVBoxLayout(self)
+        lay.addLayout(top)
+        lay.addWidget(self.note)
+        lay.addWidget(self.summary)
+        lay.addLayout(bottom)
+
+    def ids(self) -> list[tuple[str, str]]:
+        info, n = self.window.corpus.info, self.count.value() or None
+        return [(s, u) for s in RUN_SPLITS[self.split.currentText()] for u in getattr(info, s)[:n]]
+
+    def run(self) -> None:
+        """Compare the results on the chosen utterances (in a worker; the status bar shows it)."""
+        w = self.window
+        recipes, ids = self.measure.recipes(), self.ids() if w.corpus is not None else []
+        if not recipes or not ids:
+            w.show_status("nothing to compare: no result shown or no corpus", 6000)
+            return
+        model, corpus, texts = w.model, w.corpus, dict(w.state.texts)
+        self.run_button.setEnabled(False)
+
+        def done(rows: list[ComparedPhone]) -> None:
+            self.run_button.setEnabled(True)
+            self.rows, self.recipes = rows, recipes
+            self.export_button.setEnabled(bool(rows))
+            self.show_summary()
+            w.show_status(f"compared {len(recipes)} results at {len(rows)} phone segments of "
+                          f"{len({r.utterance for r in rows})} utterances")
+
+        def failed(exc: BaseException) -> None:
+            self.run_button.setEnabled(True)
+            w.report_error(exc)
+
+        w.run_task(lambda p: list(corpus_comparison(model, corpus, recipes, ids, texts, p)), done,
+                   "comparing the results across the corpus", on_error=failed)
+
+    def wanted(self) -> list[str]:
+        return self.phone_filter.text().lower().replace(",", " ").replace("/", " ").split()
+
+    def shown_rows(self) -> list[ComparedPhone]:
+        wanted = set(self.wanted())
+        return [r for r in self.rows if not wanted or r.phone in wanted]
+
+    def show_summary(self) -> None:
+        """Per phone of the filter (all without one): segments, and the mean least aperture of
+        the original and of each result."""
+        if not self.recipes:
+            return
+        means = phone_means(self.rows, self.wanted())
+        items = [[text_item(m.phone), NumberItem(m.segments, "{:.0f}"), NumberItem(m.original, "{:.1f}"),
+                  *(NumberItem(v, "{:.1f}") for v in m.results)] for m in means]
+        fill_table(self.summary, ["phone", "segments", "original", *(r.name for r in self.recipes)],
+                   items)
+        utts = len({r.utterance for r in self.rows})
+        self.note.setText(f"Mean least aperture (mm) at each phone of {utts} utterances (their own "
+                          "labels); the results' settings: hover the table")
+        self.summary.setToolTip("\n".join(f"{r.name}: {r.settings}" for r in self.recipes))
+
+    def export_csv(self, path: str | Path) -> Path:
+        return write_comparison_csv(path, self.shown_rows(), self.recipes)
+
+    def _export(self) -> None:
+        export_with_dialog(self, "Export the comparison across the corpus", "phone_comparison.csv",
+                           "CSV (*.csv)", self.export_csv)
 
 
 class _Readout(QLabel):
@@ -157,7 +291,7 @@ class MeasureTools:
     def open_table(self) -> ApertureTable:
         """Show the per-phone table's dock (made on first use)."""
         if self.table is None:
-            self.table = ApertureTable(self.measure, self.window.seek)
+            self.table = ApertureTable(self.measure, self.window.seek, self.window)
             self.dock = self.window.add_dock(self.table, "Measure")
         self.table.refresh()
         self.dock.show()

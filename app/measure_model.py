@@ -8,7 +8,10 @@ words them.
   sensors the tongue tip height, the lip aperture and the jaw opening instead
   (:mod:`facetraj_engine.analysis.articulators`).
 * :meth:`Measure.rows`: the per-phone table (each phone's aperture at its minimum and at its
-  midpoint, original, synthesized, error), filtered by phone; :meth:`Measure.write_csv`.
+  midpoint, original, synthesized, error), filtered by phone, and :meth:`Measure.pin_minima`: a
+  column per pinned result (its least aperture over the same segment); :meth:`Measure.write_csv`.
+* :meth:`Measure.recipes`: how the result on screen and each pin were made, for the same
+  comparison across the corpus (``facetraj_engine.analysis.phone_compare``).
 """
 
 from __future__ import annotations
@@ -24,33 +27,38 @@ from facetraj_engine.analysis import articulators as art
 from facetraj_engine.analysis.apertures import (
     LipReadout,
     PhoneAperture,
+    aperture,
     frame_labels,
     phone_apertures,
     readout_at,
     write_phone_apertures_csv,
 )
+from facetraj_engine.analysis.phone_compare import LABEL_SOURCES, Recipe, minimum_within
 from facetraj_engine.io.sensor_roles import SensorRoles
 
 from .pins import Pin
+from .provenance import settings_text
 from .state import UtteranceView
 
 #: the per-phone table's columns: (heading, value of a PhoneAperture, format)
-TABLE_COLUMNS: tuple[tuple[str, str, str], ...] = (
+TABLE_COLUMNS: tuple[tuple[str, str, str], ...] = (      # short: a laptop's dock shows the minima
     ("phone", "phone", "{}"), ("word", "word", "{}"), ("start (s)", "start", "{:.3f}"),
-    ("min: original", "min_original", "{:.1f}"), ("min: synthesized", "min_synthesized", "{:.1f}"),
-    ("min: error", "min_error", "{:+.1f}"), ("mid: original", "mid_original", "{:.1f}"),
-    ("mid: synthesized", "mid_synthesized", "{:.1f}"), ("mid: error", "mid_error", "{:+.1f}"),
+    ("min: orig.", "min_original", "{:.1f}"), ("min: synth.", "min_synthesized", "{:.1f}"),
+    ("min: error", "min_error", "{:+.1f}"), ("mid: orig.", "mid_original", "{:.1f}"),
+    ("mid: synth.", "mid_synthesized", "{:.1f}"), ("mid: error", "mid_error", "{:+.1f}"),
 )
 
 
 def mm(value: float, signed: bool = False) -> str:
     """A length in mm for the readout ("—" when there is none).
 
-    >>> mm(11.234), mm(-0.26, signed=True), mm(float("nan"))
-    ('11.2 mm', '-0.3 mm', '—')
+    >>> mm(11.234), mm(-0.26, signed=True), mm(-0.04, signed=True), mm(float("nan"))
+    ('11.2 mm', '-0.3 mm', '0.0 mm', '—')
     """
     if not math.isfinite(value):
         return "—"
+    if signed and abs(value) < 0.05:          # no "-0.0 mm"
+        return "0.0 mm"
     return f"{value:+.1f} mm" if signed else f"{value:.1f} mm"
 
 
@@ -134,7 +142,7 @@ class Measure:
         where = f"{t:.3f} s"
         if r.phone:
             where += f"  /{r.phone}/" + (f" in “{r.word}”" if r.word else "")
-        parts = [where, f"upper lip y {r.upper_y:.1f}, lower {r.lower_y:.1f}",
+        parts = [where, f"upper lip y {mm(r.upper_y)}, lower lip y {mm(r.lower_y)}",
                  f"aperture {mm(r.aperture)}"]
         if r.has_original:
             parts.append(f"original {mm(r.original_aperture)} (synthesized − original "
@@ -157,12 +165,48 @@ class Measure:
         wanted = set(phone_filter.lower().replace(",", " ").replace("/", " ").split())
         return [r for r in self._rows if not wanted or r.phone.lower() in wanted]
 
+    def pin_minima(self, rows: list[PhoneAperture]) -> list[list[float]]:
+        """Per row, each pin's least aperture over the row's segment (mm; the pin's own frames:
+        a column per pin beside the result on screen's)."""
+        tracks = [(p.view.times, aperture(p.view.shown, self.upper, self.lower)) for p in self.pins]
+        return [[minimum_within(t, ap, r.start, r.end) for t, ap in tracks] for r in rows]
+
+    def pin_columns(self) -> list[str]:
+        """The table's headings of the pins' columns (two a pin)."""
+        return [head for p in self.pins for head in (f"min: {p.name}", f"min: this − {p.name}")]
+
     def write_csv(self, path: str | os.PathLike[str], phone_filter: str = "") -> Path:
-        return write_phone_apertures_csv(path, self.rows(phone_filter))
+        """The rows shown as CSV (``APERTURE_COLUMNS``, then each pin's least aperture and this
+        minus it: ``min_pin1_mm``, ``min_this_minus_pin1_mm``)."""
+        rows = self.rows(phone_filter)
+        mins = np.array(self.pin_minima(rows), dtype=float).reshape(len(rows), len(self.pins))
+        this = np.array([r.min_synthesized for r in rows])
+        extra = {}
+        for k, pin in enumerate(self.pins):
+            slug = pin.name.replace(" ", "")
+            extra[f"min_{slug}_mm"] = mins[:, k]
+            extra[f"min_this_minus_{slug}_mm"] = this - mins[:, k]
+        return write_phone_apertures_csv(path, rows, extra=extra)
+
+    def recipes(self) -> list[Recipe]:
+        """How the result on screen (``this``) and each pin were made: their search and
+        settings, and where their labels came from."""
+        if self.view is None:
+            return []
+        return [Recipe("this", self.view.synthesis.config, label_key(self.view),
+                       settings_text(self.view, short=True)),
+                *(Recipe(p.name, p.view.synthesis.config, label_key(p.view), p.settings)
+                  for p in self.pins)]
 
     def frame_labels(self) -> dict[str, list[str]]:
         """The phone and word of each frame (the trajectory table's label columns)."""
         return {} if self.view is None else view_frame_labels(self.view)
+
+
+def label_key(view: UtteranceView) -> str:
+    """The label source of ``view`` as a recipe names it (``file``: the utterance's own)."""
+    source = view.label_origin.source
+    return source if source in LABEL_SOURCES else "file"
 
 
 def view_frame_labels(view: UtteranceView, times: np.ndarray | None = None) -> dict[str, list[str]]:
@@ -173,4 +217,4 @@ def view_frame_labels(view: UtteranceView, times: np.ndarray | None = None) -> d
             "word": frame_labels(view.utterance.words, t)}
 
 
-__all__ = ["TABLE_COLUMNS", "Measure", "mm", "view_frame_labels"]
+__all__ = ["TABLE_COLUMNS", "Measure", "label_key", "mm", "view_frame_labels"]

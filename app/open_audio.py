@@ -5,15 +5,16 @@
 empty = recognize the phones; or no labels, acoustic-only). Alignment runs in a worker with the
 window's busy indicator; words missing from the dictionary are asked for
 (:class:`MissingWordsDialog`) and the alignment retried. The :class:`LabelSourceBox` in the settings
-panel switches the same audio between its label file, aligned, recognized and no labels, so the
-lips of each can be compared.
+panel switches the utterance on screen, a recording opened so or a corpus utterance, between its
+label file, aligned, recognized and no labels (``app/label_sources.py``), so that the lips of
+each can be compared.
 """
 
 from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
@@ -31,28 +32,24 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
-from facetraj_engine.data import Provenance, Utterance
-from facetraj_engine.errors import FacetrajError, InputError
+from facetraj_engine.data import Utterance
+from facetraj_engine.errors import FacetrajError
 from facetraj_engine.io.audio import read_audio
 from facetraj_engine.io.markers_beside import MarkersBeside, read_markers_beside
 from facetraj_engine.labels.phoneset import ARPABET
 
+from .label_sources import SOURCE_CHOICES, LabelSources, corpus_sources
 from .provenance import LabelOrigin
 
 if TYPE_CHECKING:   # the labelling engine is imported when audio is opened (issue #15: cold start)
     import numpy as np
 
     from facetraj_engine.io.corpus import Corpus
-    from facetraj_engine.labels.provenance import Labels
     from facetraj_engine.method.model import Model
 
-    from .viewer_model import UtteranceView
+    from .viewer_model import UtteranceView, ViewerModel
 
 log = logging.getLogger(__name__)
-
-#: Label sources the user can switch between, as (combo text, source).
-SOURCE_CHOICES = (("from the label file", "file"), ("aligned from the sentence", "aligned"),
-                  ("recognized (no text)", "recognized"), ("none: acoustic only", "none"))
 
 
 # --------------------------------------------------------------------------- dialogs
@@ -139,71 +136,10 @@ class MissingWordsDialog(QDialog):
                              "every word needs its phones" if empty else "")
 
 
-# --------------------------------------------------------------------------- the opened recording
-@dataclass
-class OpenedAudio:
-    """A recording opened for synthesis and the labels computed for it so far (by source)."""
-
-    name: str
-    path: Path
-    audio: object
-    rate: int
-    text: str = ""
-    text_from: str = ""                 # where the sentence came from: "s001.txt", "the sentence typed"
-    label_file: Path | None = None
-    extra_dict: dict[str, list[str]] = field(default_factory=dict)
-    labels: dict[str, Labels | None] = field(default_factory=dict)
-    beside: MarkersBeside | None = None    # the marker file beside it (its markers: the original)
-    beside_error: str = ""                 # why that file could not be read
-
-    def labels_for(self, source: str) -> Labels | None:
-        """Labels of ``source`` (computed on the first call: run in a worker), by the one rule
-        (``facetraj_engine.io.label_rule.resolve_labels``) asked for that source."""
-        from facetraj_engine.io.label_rule import LabelRequest, resolve_labels
-
-        if source not in self.labels:
-            if source == "none":
-                self.labels[source] = None
-                return None
-            if source == "file" and self.label_file is None:
-                raise InputError(self.path, "no label file beside the audio")
-            if source == "aligned" and not self.text:
-                raise InputError(self.path, "no sentence to align: give one with Open audio…")
-            request = {"file": LabelRequest(labels=self.label_file),
-                       "aligned": LabelRequest(text=self.text, extra_dict=self.extra_dict)
-                       }.get(source, LabelRequest(recognize=True))
-            found = resolve_labels(self.path, self.audio, self.rate, request)
-            if source == "aligned" and found.labels is not None and self.text_from:
-                found.labels.provenance = replace(found.labels.provenance, origin=self.text_from)
-            self.labels[source] = found.labels
-        return self.labels[source]
-
-    def origin(self, source: str) -> LabelOrigin:
-        """Where the labels of ``source`` (a :data:`SOURCE_CHOICES` key) came from."""
-        labels = self.labels.get(source)
-        found = labels.source if labels is not None else "none"
-        if source == "file" and self.label_file is not None:
-            return LabelOrigin(found, file=self.label_file.name)
-        if source == "aligned":
-            return LabelOrigin(found, transcript=self.text_from or "the sentence typed")
-        return LabelOrigin(found)
-
-    def utterance(self, source: str, marker_rate: float, marker_names: list[str]) -> Utterance:
-        labels = self.labels_for(source)
-        return Utterance(name=self.name, audio=self.audio, sample_rate=self.rate,
-                         phones=list(labels.phones) if labels else [],
-                         words=list(labels.words) if labels else [],
-                         markers=self.beside.markers if self.beside is not None else None,
-                         marker_rate=marker_rate, marker_names=list(marker_names),
-                         text=self.text or "",
-                         label_source=labels.source if labels else "none",
-                         provenance=labels.provenance if labels else Provenance(),
-                         confidence=labels.trust() if labels else None)
-
-
+# --------------------------------------------------------------------------- the labels box
 class LabelSourceBox(QWidget):
-    """The label source of an opened recording (settings panel): file, aligned, recognized,
-    none. Disabled for corpus utterances."""
+    """The label source of the utterance on screen (settings panel): file, aligned, recognized,
+    none; a choice that is not available says why in its tooltip."""
 
     sourceChosen = pyqtSignal(str)
 
@@ -212,23 +148,33 @@ class LabelSourceBox(QWidget):
         self.combo = QComboBox()
         for text, source in SOURCE_CHOICES:
             self.combo.addItem(text, source)
-        self.combo.setToolTip("Phone labels of the opened audio: switch to compare the lips "
-                              "synthesized from each (phonetic search needs labels).")
+        # as narrow as the settings' other boxes (the left dock's width is the 3-D view's loss)
+        self.combo.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon)
+        self.combo.setMinimumContentsLength(16)
         lay = QFormLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
         lay.addRow("labels", self.combo)
         self.combo.activated.connect(lambda i: self.sourceChosen.emit(self.combo.itemData(i)))
         self.show_for(None, "file")
 
-    def show_for(self, opened: OpenedAudio | None, source: str) -> None:
-        """Show the choices of ``opened`` (``None``: a corpus utterance) with ``source`` current."""
+    def show_for(self, sources: LabelSources | None, source: str, why_not: str = "") -> None:
+        """Show the choices of ``sources`` (the utterance on screen) with ``source`` current;
+        without them the box is off and ``why_not`` says why."""
         model = self.combo.model()
         for i, (_, src) in enumerate(SOURCE_CHOICES):
-            ok = opened is not None and (src != "file" or opened.label_file is not None) \
-                and (src != "aligned" or bool(opened.text))
-            model.item(i).setEnabled(ok)
-        self.combo.setEnabled(opened is not None)
+            why = sources.unavailable(src) if sources is not None else why_not
+            model.item(i).setEnabled(not why)
+            model.item(i).setToolTip(why)
+        self.combo.setEnabled(sources is not None)
         self.combo.setCurrentIndex(max(0, self.combo.findData(source)))
+        if sources is None:
+            self.combo.setToolTip(why_not)
+            return
+        off = [f"{text}: {sources.unavailable(src)}" for text, src in SOURCE_CHOICES
+               if sources.unavailable(src)]
+        self.combo.setToolTip("The phone labels the face is synthesized from: switch to compare "
+                              f"the lips each gives (pin one first, Ctrl+P) for {sources.name}."
+                              + "".join(f"\nnot available, {line}" for line in off))
 
 
 # --------------------------------------------------------------------------- the controller
@@ -236,29 +182,40 @@ class AudioHost(Protocol):
     """What :class:`AudioOpener` needs of the window it serves (the main window)."""
 
     utteranceChanged: pyqtBoundSignal
+    synthesisChanged: pyqtBoundSignal
     model: Model | None
     corpus: Corpus | None
     view: UtteranceView | None
+    state: ViewerModel
 
     def show_error(self, message: str) -> None: ...
     def show_status(self, text: str, timeout_ms: int = 0) -> None: ...
-    def show_notice(self, text: str, action_text: str = "", action: Callable | None = None) -> None: ...
+    def show_notice(self, text: str, action_text: str = "", action: Callable | None = None,
+                    owner: str = "") -> None: ...
     def extension(self, name: str) -> object: ...
     def run_task(self, fn: Callable, on_done: Callable | None, label: str, **options) -> object: ...
-    def show_external(self, utt: Utterance, origin: LabelOrigin | None = None) -> None: ...
+    def show_external(self, utt: Utterance, origin: LabelOrigin | None = None,
+                      show: bool = True) -> None: ...
+    def show_labels(self, utt: Utterance, origin: LabelOrigin, own: bool = False) -> None: ...
 
 
 class AudioOpener(QObject):
     """"Open audio…" for the main window (an :class:`AudioHost`): finds or asks for the labels,
-    aligns in a worker, shows the result, and switches label sources."""
+    aligns in a worker, shows the result; and the labels box, which switches the label source
+    of the utterance on screen (a recording opened so, or a corpus utterance).
+
+    ``finished(path, ok)`` after a recording opened (shown, or only listed) or failed."""
+
+    finished = pyqtSignal(str, bool)
 
     def __init__(self, window: AudioHost):
         super().__init__(window)  # the main window, a QObject
         self.window = window
-        self.opened: dict[str, OpenedAudio] = {}
+        self.opened: dict[str, LabelSources] = {}     # recordings opened from files, by name
+        self.corpus_sources: LabelSources | None = None    # the corpus utterance shown
         self.box = LabelSourceBox()
         self.box.sourceChosen.connect(self.switch)
-        window.utteranceChanged.connect(self._on_utterance)
+        window.synthesisChanged.connect(self._refresh_box)
 
     # -- asking
     def ask(self) -> None:
@@ -303,114 +260,171 @@ class AudioOpener(QObject):
     # -- opening
     def open(self, audio_path: Path, labels_path: Path | None = None, text: str | None = None,
              recognize: bool = False, acoustic_only: bool = False,
-             extra_dict: dict[str, list[str]] | None = None) -> bool:
+             extra_dict: dict[str, list[str]] | None = None, show: bool = True) -> bool:
         """Open ``audio_path`` for synthesis; labels by ``facetraj_engine.io.label_rule.resolve_labels``
-        (alignment or recognition in a worker), none with ``acoustic_only``. False when the
-        audio cannot be read (the error is shown)."""
+        (alignment or recognition in a worker), none with ``acoustic_only``; shown, or with
+        ``show=False`` only listed in the browser. False when the audio cannot be read (the
+        error is shown)."""
         read = self._read(audio_path)
         if read is not None:
-            self._open(audio_path, read, labels_path, text, recognize, acoustic_only, extra_dict)
+            self._open(audio_path, read, labels_path, text, recognize, acoustic_only, extra_dict,
+                       show)
+        else:
+            self.finished.emit(str(audio_path), False)
         return read is not None
+
+    def _recording(self, audio_path: Path, read: tuple[np.ndarray, int], labels_path: Path | None,
+                   text: str | None, extra_dict: dict[str, list[str]] | None) -> LabelSources:
+        """The label sources of a recording (no labels made yet, no markers read yet): the
+        label file given or beside it, the sentence typed or the ``.txt`` beside it (also when
+        a label file is used first: "aligned" is then one choice of the labels box). Raises
+        the transcript's error."""
+        from facetraj_engine.io.label_rule import beside, read_transcript
+
+        win, (audio, rate) = self.window, read
+        label_file, txt = beside(audio_path)
+        base = Utterance(name=win.state.external_name(audio_path.stem, audio_path.suffix),
+                         audio=audio, sample_rate=rate, phones=[], markers=None,
+                         marker_rate=win.model.marker_rate, marker_names=list(win.model.marker_names))
+        sources = LabelSources(base, audio_path, label_file=labels_path or label_file,
+                               extra_dict=dict(extra_dict or {}))
+        if text:
+            sources.text, sources.text_from = text, "the sentence typed"
+        elif txt is not None:
+            sources.text, sources.text_from = read_transcript(txt), txt.name
+        return sources
 
     def _open(self, audio_path: Path, read: tuple[np.ndarray, int],
               labels_path: Path | None = None, text: str | None = None, recognize: bool = False,
               acoustic_only: bool = False,
-              extra_dict: dict[str, list[str]] | None = None) -> None:
-        from facetraj_engine.io.label_rule import LabelRequest, beside, read_transcript, resolve_labels
+              extra_dict: dict[str, list[str]] | None = None, show: bool = True) -> None:
+        from facetraj_engine.io.label_rule import LabelRequest, resolve_labels
         from facetraj_engine.labels.alignment import MissingWordsError
 
         win = self.window
-        audio, rate = read
-        name = audio_path.stem
-        while name in (win.corpus.info.ids if win.corpus else []):
-            name += "'"
-        label_file, txt = beside(audio_path)
-        opened = OpenedAudio(name, audio_path, audio, rate, label_file=labels_path or label_file,
-                             extra_dict=dict(extra_dict or {}))
-        # the sentence to align: the one typed, else the .txt beside the audio (also when a label
-        # file is used first: "aligned" is then one choice of the labels box)
-        if text:
-            opened.text, opened.text_from = text, "the sentence typed"
-        elif txt is not None:
-            try:
-                opened.text, opened.text_from = read_transcript(txt), txt.name
-            except FacetrajError as exc:
-                win.show_error(str(exc))
-                return
-
+        try:
+            sources = self._recording(audio_path, read, labels_path, text, extra_dict)
+        except FacetrajError as exc:
+            win.show_error(str(exc))
+            self.finished.emit(str(audio_path), False)
+            return
         model = win.model
 
-        def work(progress) -> tuple[OpenedAudio, str]:
+        def work(progress) -> tuple[LabelSources, str, MarkersBeside | None, str]:
+            found, why = None, ""
             try:
-                opened.beside = read_markers_beside(audio_path, model.marker_names,
-                                                    model.marker_rate, len(audio) / rate)
+                found = read_markers_beside(audio_path, model.marker_names, model.marker_rate,
+                                            sources.base.duration)
             except FacetrajError as exc:     # the recording opens without them, saying why
-                opened.beside_error = str(exc)
+                why = str(exc)
+            if found is not None and found.usable:
+                sources.base = replace(sources.base, markers=found.markers)
             if acoustic_only:
-                return opened, "none"
+                return sources, "none", found, why
             progress(0.1, f"labelling {audio_path.name}")
-            found = resolve_labels(audio_path, audio, rate, LabelRequest(
-                labels=labels_path, text=text, recognize=recognize, extra_dict=opened.extra_dict),
+            found_labels = resolve_labels(audio_path, *read, LabelRequest(
+                labels=labels_path, text=text, recognize=recognize, extra_dict=sources.extra_dict),
                 progress=lambda f, m: progress(0.1 + 0.8 * f, m))     # each decoding pass
-            log.info("%s: labels %s", audio_path.name, found.describe())
-            labels = found.labels
+            log.info("%s: labels %s", audio_path.name, found_labels.describe())
+            labels = found_labels.labels
             source = labels.source if labels else "none"
-            opened.labels[source] = labels
-            return opened, source
+            sources.labels[source] = labels
+            sources.shown = source
+            return sources, source, found, why
 
         def failed(exc: BaseException) -> None:
             if isinstance(exc, MissingWordsError):
                 dialog = MissingWordsDialog(exc.words, win)
                 if dialog.exec() == QDialog.DialogCode.Accepted:
                     self.open(audio_path, labels_path, text, recognize, acoustic_only,
-                              {**opened.extra_dict, **dialog.pronunciations()})
+                              {**sources.extra_dict, **dialog.pronunciations()}, show)
+                    return
+            else:
+                win.show_error(str(exc) if isinstance(exc, FacetrajError)
+                               else f"internal error: {type(exc).__name__}: {exc}")
+            self.finished.emit(str(audio_path), False)
+
+        win.run_task(work, lambda r: self._show(*r, show=show), "aligning the phones",
+                     on_error=failed)
+
+    def _show(self, sources: LabelSources, source: str, beside: MarkersBeside | None,
+              beside_error: str, show: bool = True) -> None:
+        win = self.window
+        self.opened[sources.name] = sources
+        win.show_external(sources.utterance(source), sources.origin(source), show=show)
+        name, path = sources.name, sources.path
+        if not show:
+            pass
+        elif beside_error:
+            win.show_notice(f"{beside_error}: {path.name} opens without original markers",
+                            owner=name)
+        elif beside is not None and not beside.usable:     # MOCHA's .ema beside its .wav
+            win.show_notice(beside.hint(path.name, len(win.model.marker_names)), "Import its folder…",
+                            lambda: win.extension("own_data").do_import(path.parent), owner=name)
+        elif beside is not None:
+            win.show_status(f"original markers from {beside.path.name}", 8000)
+        self.finished.emit(str(path), True)
+
+    # -- switching
+    def current(self) -> LabelSources | None:
+        """The label sources of the utterance on screen (None: nothing shown)."""
+        view = self.window.view
+        if view is None:
+            return None
+        name = view.utterance.name
+        if view.split == "external":
+            return self.opened.get(name)
+        if self.corpus_sources is None or self.corpus_sources.name != name \
+                or self.corpus_sources.base.audio is not view.utterance.audio:
+            self.corpus_sources = self._corpus_sources(view)
+        return self.corpus_sources
+
+    def _corpus_sources(self, view: UtteranceView) -> LabelSources:
+        """A corpus utterance as shown first (its own labels), and its sentence."""
+        from facetraj_engine.io.corpus import audio_path
+
+        corpus, name = self.window.corpus, view.utterance.name
+        text = self.window.state.texts.get(name, "")
+        held = (corpus.data_root / f"{name}.txt").is_file()
+        try:
+            path = audio_path(corpus.data_root, name)
+        except FacetrajError:       # the audio held in its marker file (MVIEW): a name for messages
+            path = corpus.data_root / f"{name}.wav"
+        return corpus_sources(view.utterance, path, view.origin, text,
+                              f"{name}.txt" if held else "the sentence of its marker file")
+
+    def switch(self, source: str) -> None:
+        """Synthesize the utterance on screen again with labels from ``source`` (its time and
+        zoom kept); pins of it stay shown beside it."""
+        sources = self.current()
+        if sources is None:
+            return
+        win = self.window
+        from facetraj_engine.labels.alignment import MissingWordsError
+
+        def work(progress) -> tuple[Utterance, LabelOrigin]:
+            progress(0.1, f"labels of {sources.name}: {source}")
+            return sources.utterance(source), sources.origin(source)
+
+        def failed(exc: BaseException) -> None:
+            self._refresh_box()
+            if isinstance(exc, MissingWordsError):
+                dialog = MissingWordsDialog(exc.words, win)
+                if dialog.exec() == QDialog.DialogCode.Accepted:
+                    sources.extra_dict.update(dialog.pronunciations())
+                    self.switch(source)
                 return
             win.show_error(str(exc) if isinstance(exc, FacetrajError)
                            else f"internal error: {type(exc).__name__}: {exc}")
 
-        win.run_task(work, lambda r: self._show(*r), "aligning the phones",
-                              on_error=failed)
+        def done(result: tuple[Utterance, LabelOrigin]) -> None:
+            sources.shown = source
+            win.show_labels(*result, own=source == "file" and sources.own_origin is not None)
 
-    def _show(self, opened: OpenedAudio, source: str) -> None:
-        win = self.window
-        self.opened[opened.name] = opened
-        utt = opened.utterance(source, win.model.marker_rate, win.model.marker_names)
-        win.show_external(utt, opened.origin(source))
-        beside = opened.beside
-        if opened.beside_error:
-            win.show_notice(f"{opened.beside_error}: {opened.path.name} opens without original markers")
-        elif beside is not None and not beside.usable:     # MOCHA's .ema beside its .wav
-            win.show_notice(beside.hint(opened.path.name), "Import its folder…",
-                            lambda: win.extension("own_data").do_import(opened.path.parent))
-        elif beside is not None:
-            win.show_status(f"original markers from {beside.path.name}", 8000)
+        win.run_task(work, done, f"labels: {source}", on_error=failed)
 
-    # -- switching
-    def switch(self, source: str) -> None:
-        """Re-synthesize the current opened recording with labels from ``source``."""
-        view = self.window.view
-        opened = self.opened.get(view.utterance.name) if view is not None else None
-        if opened is None:
-            return
-        win = self.window
-
-        def work(progress) -> tuple[Utterance, LabelOrigin]:
-            progress(0.1, f"labels: {source}")
-            return (opened.utterance(source, win.model.marker_rate, win.model.marker_names),
-                    opened.origin(source))
-
-        def failed(exc: BaseException) -> None:
-            self.box.show_for(opened, view.utterance.label_source)
-            win.show_error(str(exc))
-
-        win.run_task(work, lambda r: win.show_external(*r), f"labels: {source}", on_error=failed)
-
-    def _on_utterance(self, name: str) -> None:
-        view = self.window.view
-        opened = self.opened.get(name)
-        self.box.show_for(opened, view.utterance.label_source if view is not None else "file")
-
-    def current(self) -> OpenedAudio | None:
-        view = self.window.view
-        return self.opened.get(view.utterance.name) if view is not None else None
-
+    def _refresh_box(self) -> None:
+        sources = self.current()
+        why = ("open a corpus or a recording first" if self.window.view is None
+               else "no audio file to label for this utterance")
+        self.box.show_for(sources, sources.shown if sources is not None else "file", why)

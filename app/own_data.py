@@ -363,25 +363,41 @@ def export_figure(window, path: Path) -> Path:
     return path
 
 
+def screen_of(window) -> tuple[str, object]:
+    """What the window shows, for a video of it: the caption (with the pins, and the time range
+    when zoomed) and a ``video.Screen`` (copies of its panels shown, its 3-D scene's options and
+    camera, the time range shown)."""
+    import copy
+
+    from .screen_export import caption_text
+    from .video import Screen
+
+    view, tl = window.view, window.timeline
+    tl.ensure_drawn()      # panels being built finished: the ones shown are known
+    span = tl.xlim()
+    caption = caption_text(view, window.pins.shown(view))
+    if span[0] > 0.0 or span[1] < view.times[-1]:
+        caption += f"  ·  {span[0]:.2f}–{span[1]:.2f} s"
+    return caption, Screen(tuple(copy.copy(p) for p in tl.shown), window.face.options(),
+                           window.face.camera_state(), span)
+
+
 def export_video(window, path: Path) -> None:
-    """Render the current utterance to an MP4 in the background, with a progress bar."""
+    """Render what the window shows (:func:`screen_of`: its 3-D scene, its panels over the time
+    range shown, the sound of that range) to an MP4 in the background, with a progress bar."""
     from .video import render_video
 
     view, model = window.view, window.model
     if view is None:
         raise FacetrajError("no utterance is shown")
-    utt = view.utterance
-
-    from .screen_export import caption_text
-
-    pins = window.pins
-    caption = caption_text(view, pins.shown(view))
+    utt, pins = view.utterance, window.pins
+    caption, screen = screen_of(window)
 
     def work(progress):
         return render_video(model, view.synthesis, utt.audio, utt.sample_rate, path,
                             original=view.original, overwrite=True, progress=progress,
                             title=utt.text or utt.name, phones=utt.phones, view=view, pins=pins,
-                            caption=caption)
+                            caption=caption, screen=screen)
 
     window.run_task(work, lambda p: window.show_status(f"wrote {p}"), f"rendering {path.name}")
 

@@ -21,8 +21,10 @@ from facetraj_engine.analysis.apertures import aperture
 from .provenance import settings_text
 from .state import UtteranceView
 
-#: the pins' colours, in turn: apart from the original's blue and the synthesis's oranges
-PIN_COLORS = ("#2f9e44", "#9c36b5", "#0b7285")
+#: the pins' colours, in turn: apart from the original's blue, the synthesis's oranges, the
+#: cursor, the closed line and the loop range (a teal third was hard to tell from the original's
+#: blue dashes): green, purple, brown
+PIN_COLORS = ("#2f9e44", "#9c36b5", "#7c4a03")
 #: the most pins kept at once (the oldest goes)
 MAX_PINS = len(PIN_COLORS)
 
@@ -69,8 +71,15 @@ class PinBoard:
     marker_names: tuple[str, ...] = ()
     _count: int = 0
 
+    def pinned(self, view: UtteranceView) -> Pin | None:
+        """The pin of ``view`` itself (None: not pinned)."""
+        return next((p for p in self.pins if p.view is view), None)
+
     def pin(self, view: UtteranceView) -> Pin:
-        """Keep ``view`` (the result on screen) as a new pin."""
+        """Keep ``view`` (the result on screen) as a new pin (the same result is pinned once:
+        its pin is returned)."""
+        if (kept := self.pinned(view)) is not None:
+            return kept
         used = {p.color for p in self.pins}
         if len(self.pins) >= MAX_PINS:
             used.discard(self.pins.pop(0).color)
@@ -98,10 +107,24 @@ class PinBoard:
         return len(self.pins)
 
 
+def distinct_settings(texts: Sequence[str]) -> list[str]:
+    """Of each settings text (:func:`~facetraj_app.provenance.settings_text`, short), the parts
+    not common to all (how each result differs from the others), or the whole text where
+    nothing differs: the pins' list fits a laptop's toolbar.
+
+    >>> distinct_settings(["robust, N=3, triangular; labels: aligned",
+    ...                    "robust, N=3, triangular; labels: recognized"])
+    ['labels: aligned', 'labels: recognized']
+    """
+    parts = [[p.strip() for chunk in t.split("; ") for p in chunk.split(", ")] for t in texts]
+    common = set.intersection(*map(set, parts)) if parts else set()
+    return [", ".join(p for p in ps if p not in common) or t for ps, t in zip(parts, texts, strict=True)]
+
+
 def aperture_difference(view: UtteranceView, pin: Pin, upper: int, lower: int) -> np.ndarray:
     """Per frame, the lip aperture of ``view``'s synthesis (the 3-D view's) minus the pin's (mm)."""
     n = min(view.n_frames, pin.view.n_frames)
     return (aperture(view.shown[:n], upper, lower) - aperture(pin.view.shown[:n], upper, lower))
 
 
-__all__ = ["MAX_PINS", "PIN_COLORS", "Pin", "PinBoard", "aperture_difference"]
+__all__ = ["MAX_PINS", "PIN_COLORS", "Pin", "PinBoard", "aperture_difference", "distinct_settings"]

@@ -112,10 +112,14 @@ SMOOTHING_NAMES = {"triangular": "triangular", "spline": "spline", "none": "unsm
 def settings_text(view, short: bool = False) -> str:
     """How a view was synthesized: the smoothing, the search the synthesis used
     (``Synthesis.config``), N where labels are searched, and where the labels came from (in a
-    word or two with ``short``: a legend's entry). ``view``: an ``UtteranceView``."""
+    word or two with ``short``: a legend's entry); an acoustic-only search uses no labels, and
+    says so (an acoustic-only pin read "labels: label file"). ``view``: an ``UtteranceView``."""
     cfg, origin = view.synthesis.config, view.label_origin
-    n = f", N={cfg.n_context_phones}" if MODES[cfg.mode].needs_labels else ""
+    used = MODES[cfg.mode].needs_labels
+    n = f", N={cfg.n_context_phones}" if used else ""
     if short:
-        return f"{search_title(cfg)}{n}, {SMOOTHING_NAMES[cfg.smoothing]}; labels: {origin.short()}"
+        labels = origin.short() if used or origin.source in ("", "none") else "not used"
+        return f"{search_title(cfg)}{n}, {SMOOTHING_NAMES[cfg.smoothing]}; labels: {labels}"
+    unused = "" if used or origin.source in ("", "none") else " (not used by this search)"
     return (f"{SMOOTHING_NAMES[cfg.smoothing]} synthesis, {search_title(cfg)}{n};  "
-            f"labels: {origin.text()}")
+            f"labels: {origin.text()}{unused}")

@@ -1,6 +1,7 @@
 """Recordings opened from the command line (``facetraj gui speech.wav``, or a folder of recordings
 without face data): each synthesized with its labels by the same rules as ``facetraj synth``
-(a label file or ``.txt`` beside it, else recognized), one after another once the model is ready."""
+(a label file or ``.txt`` beside it, else recognized), one after another once the model is ready,
+the first shown."""
 
 from __future__ import annotations
 
@@ -26,25 +27,23 @@ def recordings_in(path: Path) -> list[Path]:
 
 
 class RecordingQueue:
-    """Opens ``paths`` in ``window`` one after another: the first once the model is ready, each
-    next once the one before is shown (or failed)."""
+    """Opens ``paths`` in ``window``, one after another once the model is ready: the first is
+    shown, the others only listed in the browser's "opened" group (each labelled in turn, the
+    next once the one before is done or failed), so that the window lands on the first (it
+    showed each in turn and ended on the last)."""
 
     def __init__(self, window, paths: list[Path]):
         self.window = window
         self.pending = list(paths)
-        self.waiting_for: str | None = None
+        self.shown = False
         window.state.show_default = False
         window.modelReady.connect(self.next)
-        window.utteranceChanged.connect(self._shown)
+        window.audio_opener.finished.connect(lambda _path, ok: self._done(ok))
 
-    def _shown(self, name: str) -> None:
-        if self.waiting_for is not None and name.startswith(self.waiting_for):
-            self.next()
+    def _done(self, ok: bool) -> None:
+        self.shown |= ok
+        self.next()
 
     def next(self) -> None:
-        while self.pending:                  # a file that cannot be read: its error, then the next
-            path = self.pending.pop(0)
-            self.waiting_for = path.stem
-            if self.window.open_audio(path):
-                return
-        self.waiting_for = None
+        if self.pending:             # a file that cannot be read: its error (finished), the next
+            self.window.open_audio(self.pending.pop(0), show=not self.shown)

@@ -131,8 +131,9 @@ class SynthSettingsPanel(QWidget):
         self.reset.clicked.connect(lambda: (self.set_config(SynthConfig()), self._changed()))
 
     def add_widget(self, widget: QWidget) -> None:
-        """Add a widget under the settings (e.g. the label source of an opened recording)."""
-        self._layout.insertWidget(self._layout.count() - 2, widget)
+        """Add a widget over the settings (the labels box: what the face is synthesized from,
+        first; under the robust search's long note it was scrolled out of a laptop's dock)."""
+        self._layout.insertWidget(0, widget)
 
     def _show_mode_note(self, *_args) -> None:
         """The line under the selector explains the search shown; the robust mode's settings

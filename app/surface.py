@@ -133,6 +133,26 @@ def stored_face_triangles(neutral: np.ndarray, contours: list[list[int]],
     return tri
 
 
+def mouth_region(neutral: np.ndarray, contours: list[list[int]],
+                 margin: tuple[float, float] = (0.15, 0.3)) -> np.ndarray:
+    """The markers around the lips (indices): within the lip contours' box on the neutral face
+    widened by ``margin`` (across, up and down) of the mouth's width (the close-up of the lips
+    shows their patch of the face alone: the lips, the skin above and below them to the nose's
+    base; no cheeks, no chin).
+
+    >>> face = np.array([[-20, 0, 0], [20, 0, 0], [0, 5, 0], [0, -5, 0], [0, 40, 0], [0, -9, 0],
+    ...                  [27, 0, 0]], float)
+    >>> mouth_region(face, [[0, 2, 1], [0, 3, 1]]).tolist()
+    [0, 1, 2, 3, 5]
+    """
+    lips = sorted({i for c in contours for i in c})
+    box = neutral[lips, :2]
+    pad = np.asarray(margin, float) * float(np.ptp(box[:, 0]))
+    lo, hi = box.min(axis=0) - pad, box.max(axis=0) + pad
+    inside = ((neutral[:, :2] >= lo) & (neutral[:, :2] <= hi)).all(axis=1)
+    return np.flatnonzero(inside)
+
+
 @dataclass(frozen=True)
 class Mouth:
     """The lips' surface from their markers to the mouth opening, which closes when they meet.
@@ -184,6 +204,13 @@ class Mouth:
         then the lower lip's."""
         return np.concatenate([_inner(markers, self.upper, self.partner_of_upper, self.half_closed_upper),
                                _inner(markers, self.lower, self.partner_of_lower, self.half_closed_lower)])
+
+    def shut(self, markers: np.ndarray, tol: float = 0.05) -> bool:
+        """Whether every pair of lip markers is no farther apart than at closure (within
+        ``tol`` mm): the mouth is shut all along (no opening anywhere to see into)."""
+        return all(bool((np.linalg.norm(markers[partner] - markers[own], axis=1) <= 2 * half + tol).all())
+                   for own, partner, half in ((self.upper, self.partner_of_upper, self.half_closed_upper),
+                                              (self.lower, self.partner_of_lower, self.half_closed_lower)))
 
     def opening_loop(self, n_markers: int) -> np.ndarray:
         """The mouth opening's outline as vertex ids of the surface (inner points numbered from

@@ -283,9 +283,13 @@ def draw_panel(panel: Panel, ax, view: UtteranceView, last: bool) -> None:
     try:
         panel.draw(ax, view)
     except Exception:  # a broken panel must not take the window down
-        log.exception("panel %r failed to draw", getattr(panel, "title", panel))
-        ax.text(0.5, 0.5, f"{getattr(panel, 'title', 'panel')}: drawing failed",
-                transform=ax.transAxes, ha="center", va="center", color="red")
+        try:
+            title = str(getattr(panel, "title", "panel"))
+        except Exception:           # a title read from a view's widgets, gone with the view
+            title = type(panel).__name__
+        log.exception("panel %r failed to draw", title)
+        ax.text(0.5, 0.5, f"{title}: drawing failed", transform=ax.transAxes, ha="center",
+                va="center", color="red")
     refit_ylabels([ax])                     # every panel's label placed the same way
     if last:
         ax.set_xlabel("time (s)", fontsize=8)
@@ -329,6 +333,7 @@ class Timeline(QWidget):
         self.view: UtteranceView | None = None
         self.cursor_time = 0.0
         self.loop: tuple[float, float] | None = None
+        self._range: tuple[float, float] | None = None    # the time range shown (s)
         self._cursor: Line2D | None = None     # the cursors of all panels (display pixels)
         self._cursor_rows: list[tuple[float, float]] = []   # each axes' bottom and top (pixels)
         self._cursor_columns: tuple[float, float] = (0.0, 0.0)  # the axes' left and right
@@ -358,7 +363,7 @@ class Timeline(QWidget):
             self.relayout(self.xlim() if self.axes else None, soon=soon)
 
     def set_view(self, view: UtteranceView | None, keep_zoom: bool = False) -> None:
-        xlim = self.axes[0].get_xlim() if (keep_zoom and self.axes) else None
+        xlim = self._range if keep_zoom else None
         self.view = view
         self.relayout(xlim)
 
@@ -432,6 +437,10 @@ class Timeline(QWidget):
             panels = list(self.panels)
             if not panels or self.view is None:
                 return
+            # the range to show, kept apart from the axes' limits: while the axes are built
+            # they autoscale with margins (-0.17 to 3.57 s for 0 to 3.40), and a relayout asked
+            # for then read those
+            self._range = tuple(map(float, xlim or (0.0, self.view.duration)))
             yield
             heights = self._heights(panels)
             self.shown = [p for p, h in zip(panels, heights, strict=True) if h is not None]
@@ -452,7 +461,7 @@ class Timeline(QWidget):
                                   transform=IdentityTransform())
             fig.add_artist(self._cursor)
             self._draw_loop_spans()
-            first.set_xlim(*(xlim or (0.0, self.view.duration)))
+            first.set_xlim(*self._range)
         finally:
             self.canvas.release()
 
@@ -572,11 +581,12 @@ class Timeline(QWidget):
         if not self.axes:
             return
         if follow:
-            lo, hi = self.axes[0].get_xlim()
+            lo, hi = self.xlim()
             if not lo <= t <= hi and self.view is not None:
                 width = hi - lo
                 lo = min(max(0.0, t - 0.1 * width), max(0.0, self.view.duration - width))
-                self.axes[0].set_xlim(lo, lo + width)
+                self._range = (lo, lo + width)
+                self.axes[0].set_xlim(*self._range)
                 self._request_draw()
                 return
         if self._bg is None or tuple(self.figure.bbox.bounds) != self._bg_bounds:
@@ -604,14 +614,16 @@ class Timeline(QWidget):
         self._request_draw()
 
     def xlim(self) -> tuple[float, float]:
-        return tuple(self.axes[0].get_xlim()) if self.axes else (0.0, 0.0)
+        """The time range shown (s): the one asked for, also while the axes are being built."""
+        return self._range if self._range is not None else (0.0, 0.0)
 
     def set_xlim(self, lo: float, hi: float) -> None:
         if self.axes and self.view is not None:
             dur = self.view.duration
             width = min(max(hi - lo, 0.02), dur)
             lo = min(max(0.0, lo), dur - width)
-            self.axes[0].set_xlim(lo, lo + width)
+            self._range = (float(lo), float(lo + width))
+            self.axes[0].set_xlim(*self._range)
             self._request_draw()
 
     def reset_zoom(self) -> None:
@@ -640,7 +652,7 @@ class Timeline(QWidget):
             ax = self.axes[0]
             inv = ax.transData.inverted()
             dx = inv.transform((event.x, 0))[0] - inv.transform((px0, 0))[0]
-            lo, hi = ax.get_xlim()
+            lo, hi = self.xlim()
             self.set_xlim(lo - dx, hi - dx)
             self._press = (x0, float(event.x), button)
 
@@ -664,6 +676,6 @@ class Timeline(QWidget):
         if event.xdata is None or not self.axes:
             return
         factor = 0.8 if event.button == "up" else 1.25
-        lo, hi = self.axes[0].get_xlim()
+        lo, hi = self.xlim()
         x = float(event.xdata)
         self.set_xlim(x - (x - lo) * factor, x + (hi - x) * factor)

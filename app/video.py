@@ -1,7 +1,10 @@
-"""Video export: the 3-D face (points and the app's face surface) beside the window's lip panels
-and phones (``app/screen_export.py``: the same curves, closed lines, speech dots and pins), with
-the speech muxed in; a caption naming the utterance, its labels and its settings, and one
-legend over both halves.
+"""Video export: the 3-D faces (``app/face_scene.py``: the window's scene, its camera, side by
+side or overlaid, the pinned faces, the close-up of the lips) beside the window's panels
+(``app/screen_export.py``: the same curves, closed lines, speech dots, phones, pins and every
+panel shown, over the time range shown), with the speech of that range muxed in; a caption
+naming the utterance, its labels and its settings, and one legend over both halves. From the
+window (*File → Export a video…*) a video is what the screen shows; ``facetraj video`` makes the
+window's default view of an utterance.
 
 Rendering is off screen (``pyvista.Plotter(off_screen=True)`` and matplotlib's Agg canvas), so
 it runs without a window; frames go to the ffmpeg binary shipped by ``imageio-ffmpeg`` as H.264
@@ -26,10 +29,9 @@ from facetraj_engine.io.files import atomic_write
 from facetraj_engine.method.model import Model
 from facetraj_engine.method.pipeline import Synthesis
 
-from .articulators import ArticulatorSet, is_articulograph
-from .style import BACKGROUND, CURSOR_COLOR, ORIGINAL_COLOR, SYNTH_COLOR
-from .surface import Mouth, face_triangles, lip_contours
-from .view3d import CAMERA_PRESETS, MarkerSet
+from .articulators import is_articulograph
+from .face_scene import FaceScene, SceneOptions
+from .style import BACKGROUND, CURSOR_COLOR
 
 log = logging.getLogger(__name__)
 
@@ -64,6 +66,8 @@ class VideoLayout:
     lips: tuple[Box, Box]       # upper and lower lip y panels
     tier: Box                   # the phone tier over the lip panels (as in the window)
     phone_labels: tuple[Box, ...]   # each phone label drawn in the tier
+    panels: tuple[str, ...] = ()    # the panels drawn, top down (their titles)
+    span: tuple[float, float] = (0.0, 0.0)     # the time range of the frames (s)
 
 
 def _box(bbox, fig_height: float, dx: int = 0, dy: int = 0) -> Box:
@@ -107,21 +111,23 @@ def _header(width: int, caption: str, entries) -> tuple[np.ndarray, Box | None, 
     return image, title_box, legend_box
 
 
-class _LipPanels:
-    """The window's phone tier and upper and lower lip panels (``screen_export.panels_figure``:
-    the same curves, closed lines, speech dots, phones and pins) on an Agg canvas; a moving
-    cursor is blitted over a background drawn once."""
+class _Panels:
+    """The window's panels (``panels``: by default its phone tier and upper and lower lip;
+    ``screen_export.panels_figure``: the same curves, closed lines, speech dots, phones and pins)
+    over the time range ``xlim`` on an Agg canvas; a moving cursor is blitted over a background
+    drawn once."""
 
-    def __init__(self, view, context, width: int, height: int):
+    def __init__(self, view, panels: list, width: int, height: int,
+                 xlim: tuple[float, float] | None = None):
         from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-        from .screen_export import main_panels, panels_figure
+        from .screen_export import panels_figure
 
         self.width, self.height = width, height
-        self.panels = main_panels(context)
+        self.panels = panels
         # a small frame's panels as small as they can be read (a 640 x 320 video keeps both lips)
         self.fig, self.layout = panels_figure(self.panels, view, (width, height), legend=False,
-                                              min_scale=float(np.clip(height / 420, 0.45, 1.0)))
+                                              xlim=xlim, min_scale=float(np.clip(height / 420, 0.45, 1.0)))
         self.canvas = FigureCanvasAgg(self.fig)
         self.cursors = [ax.axvline(view.times[0], color=CURSOR_COLOR, lw=1.2, animated=True)
                         for ax in self.layout.axes]
@@ -134,13 +140,18 @@ class _LipPanels:
 
         return legend_entries(self.layout.axes)
 
+    def titles(self) -> tuple[str, ...]:
+        return tuple(p.title for p in self.layout.shown)
+
     def boxes(self, dx: int, dy: int) -> tuple[tuple[Box, Box], Box, tuple[Box, ...]]:
         renderer = self.canvas.get_renderer()
-        axes = dict(zip([p.title for p in self.layout.shown], self.layout.axes, strict=True))
+        axes = dict(zip(self.titles(), self.layout.axes, strict=True))
         up, lo, tier = (_box(axes[name].get_window_extent(renderer), self.height, dx, dy)
+                        if name in axes else (0, 0, 0, 0)
                         for name in ("upper lip y", "lower lip y", "phones"))
-        tier_panel = self.panels[0]
-        labels = tuple(_box(extent, self.height, dx, dy) for fitted in tier_panel.labels[:1]
+        tier_panel = next((p for p in self.layout.shown if p.title == "phones"), None)
+        labels = tuple(_box(extent, self.height, dx, dy) for fitted in
+                       (tier_panel.labels[:1] if tier_panel is not None else [])
                        for _text, extent, _span in fitted.drawn)
         return (up, lo), tier, labels
 
@@ -153,24 +164,26 @@ class _LipPanels:
         return np.asarray(self.canvas.buffer_rgba())[:self.height, :self.width, :3]
 
 
-def _fit_camera(plotter, neutral: np.ndarray, planar: bool) -> None:
-    """The three-quarter view of the app's 3-D view (a profile for midsagittal data), fitted."""
-    direction, up = CAMERA_PRESETS["profile" if planar else "three-quarter"]
-    d = np.asarray(direction, float) / np.linalg.norm(direction)
-    lo, hi = neutral.min(axis=0) - 5, neutral.max(axis=0) + 5
-    centre = (lo + hi) / 2
-    plotter.camera_position = [tuple(centre + 400 * d), tuple(centre), up]
-    plotter.renderer.ResetCamera(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
-    plotter.camera.zoom(1.3)
+@dataclass(frozen=True)
+class Screen:
+    """What the window shows, for a video of it: its panels (copies of those shown), its 3-D
+    scene's options and camera (``FaceScene.options``, ``camera_state``) and the time range
+    shown (s)."""
+
+    panels: tuple = ()
+    options: SceneOptions | None = None
+    camera: tuple | None = None
+    span: tuple[float, float] | None = None
 
 
 class VideoFrames:
     """The frames of a video: a header with the caption (the utterance, its labels, how it was
-    synthesized) and one legend, the 3-D face (the app's face surface under the synthesized
-    points, the original points over it) on the left, and on the right the window's phone tier
-    and lip panels (the same curves, closed lines, speech dots and pinned results as on screen).
-    ``frame(t)`` is the RGB image at time ``t``; ``layout`` says where each part is. Call
-    ``close()`` when done.
+    synthesized) and one legend, the 3-D faces on the left (``app/face_scene.py``: the app's face
+    surface under the synthesized points, the original points over it, and the pinned faces;
+    with ``screen``, the window's scene options and camera), and on the right the window's
+    panels (the phone tier and lip panels by default, with ``screen`` every panel it shows, over
+    its time range). ``frame(t)`` is the RGB image at time ``t``; ``layout`` says where each part
+    is. Call ``close()`` when done.
 
     ``view``: the window's :class:`~facetraj_app.state.UtteranceView` (else made of
     ``synthesis``, ``audio`` and ``phones``); ``pins``: the window's
@@ -179,86 +192,76 @@ class VideoFrames:
     def __init__(self, model: Model, synthesis: Synthesis, original: np.ndarray | None = None,
                  phones: Sequence[PhoneSegment] | None = None, settings: VideoSettings | None = None,
                  title: str = "", *, audio: np.ndarray | None = None, sample_rate: int = 16000,
-                 view=None, pins=None, caption: str = ""):
+                 view=None, pins=None, caption: str = "", screen: Screen | None = None):
         from .pins import PinBoard
-        from .screen_export import PanelContext, caption_text, point_entries
+        from .screen_export import PanelContext, caption_text, main_panels, point_entries
         from .state import view_of_synthesis
 
-        settings = settings or VideoSettings()
+        settings, screen = settings or VideoSettings(), screen or Screen()
         view = view or view_of_synthesis(model, synthesis, audio, sample_rate, phones or (),
                                          original, text=title)
         self.model, self.view = model, view
         self.synthesis, self.original = view.synthesis, view.original
+        self.span = tuple(screen.span) if screen.span else (0.0, float(view.times[-1]))
         width = settings.width - settings.width % 16
         height = settings.height - settings.height % 16
-        context = PanelContext(model, closed_lips(model), pins if pins is not None else PinBoard())
+        pins = pins if pins is not None else PinBoard()
+        panels = list(screen.panels) or main_panels(PanelContext(model, closed_lips(model), pins))
         caption = caption or caption_text(view, heading=title or "")
         if width < 640:
             raise ValueError(f"video size {settings.width}x{settings.height} is too small "
                              "(at least 640x304)")
         half = width // 2
         self._half = half
-        self._scene(model, half, view.original is not None)
         entries = point_entries(view.original is not None)
         header_h = _header(width, caption, entries)[0].shape[0]        # the panels' entries below
         body = height - header_h
         if body < 240:
             raise ValueError(f"video size {settings.width}x{settings.height} is too small "
                              "(at least 640x304)")
-        self.panels = _LipPanels(view, context, width - half, body)
+        self.panels = _Panels(view, panels, width - half, body, self.span)
         header, title_box, legend_box = _header(width, caption, entries + self.panels.entries())
         if header.shape[0] != header_h:            # more legend rows: the panels a little lower
             body = height - header.shape[0]
-            self.panels = _LipPanels(view, context, width - half, body)
+            self.panels = _Panels(view, panels, width - half, body, self.span)
         self.header, self.size, self._body = header, (width, height), body
-        self.plotter.window_size = (half, body)
+        self._scene(model, (half, body), view, pins.shown(view), screen)
         lips, tier, labels = self.panels.boxes(half, header.shape[0])
         self.layout = VideoLayout(width, height, (0, header.shape[0], half, height), legend_box,
-                                  title_box, lips, tier, labels)
+                                  title_box, lips, tier, labels, self.panels.titles(), self.span)
 
-    def _scene(self, model: Model, half: int, original: bool) -> None:
-        """The off-screen 3-D scene: the synthesized face with its surface, mouth and lip
-        contours, and the original points over it."""
+    def _scene(self, model: Model, size: tuple[int, int], view, pins: list, screen: Screen) -> None:
+        """The off-screen 3-D scene: the window's (its options, its pinned faces, its camera),
+        else the synthesized face with its surface, mouth and lip contours and the original
+        points over it, in the three-quarter view (a profile for midsagittal data); articulograph
+        sensors as articulators (``app/articulators.py``), as the window draws them."""
         import pyvista as pv
 
-        neutral = model.neutral_face()
-        self.plotter = pv.Plotter(off_screen=True, window_size=(half, 300))
+        self.plotter = pv.Plotter(off_screen=True, window_size=size)
         self.plotter.set_background(BACKGROUND)
-        self.plotter.remove_all_lights()
-        self.plotter.add_light(pv.Light(light_type="headlight", intensity=0.75))
-        self.plotter.add_light(pv.Light(position=(0.4, 1.0, 0.6), light_type="camera light",
-                                        intensity=0.35))
-        if is_articulograph(model):      # articulators in profile, as the window draws them
-            self.synth_set = ArticulatorSet(self.plotter, "synthesized", SYNTH_COLOR, neutral, model.roles)
-            self.orig_set = (ArticulatorSet(self.plotter, "original", ORIGINAL_COLOR, neutral, model.roles)
-                             if original else None)
-            self.plotter.enable_parallel_projection()
-            _fit_camera(self.plotter, neutral[list(model.roles.moving)], True)
-            return
-        contours = lip_contours(neutral, model.upper_lip, model.lower_lip, list(model.lip_corners))
-        triangles = face_triangles(neutral, contours)
-        mouth = Mouth.between(neutral, contours, closed_lips(model).markers)   # it shuts at /p b m/
-        self.synth_set = MarkerSet(self.plotter, "synthesized", SYNTH_COLOR, neutral, contours,
-                                   triangles, mouth)
-        self.orig_set = None
-        if original:
-            self.orig_set = MarkerSet(self.plotter, "original", ORIGINAL_COLOR, neutral, contours, None)
-        _fit_camera(self.plotter, neutral, model.is_planar)
+        self.scene = FaceScene(self.plotter)
+        self.scene.set_model(model, closed_lips(model))          # the mouth shuts at /p b m/
+        self.scene.set_view(view)
+        self.scene.set_pins(pins)
+        profile = model.is_planar or is_articulograph(model)    # as the window looks at them
+        options = screen.options or SceneOptions(preset="profile" if profile else "three-quarter")
+        self.scene.set_options(options)
+        if screen.camera is not None:
+            self.scene.set_camera_state(screen.camera)
 
     def frame(self, t: float) -> np.ndarray:
         """The RGB frame ``(height, width, 3)`` at ``t`` seconds."""
-        times = self.synthesis.times
-        f = int(np.clip(round(t * self.model.marker_rate), 0, len(times) - 1))
-        self.synth_set.set_points(self.view.shown[f])
-        if self.orig_set is not None:
-            pts = self.original[min(f, len(self.original) - 1)]
-            if np.isfinite(pts).all():       # a frame with a marker not seen keeps the last one
-                self.orig_set.set_points(pts)
+        self.scene.show_frame(self.view.frame_at(t), render=False)
         self.plotter.render()
         left = np.asarray(self.plotter.screenshot(return_img=True))[:self._body, :self._half, :3]
         right = self.panels.image(t)
         return np.ascontiguousarray(
             np.concatenate([self.header, np.concatenate([left, right], axis=1)], axis=0))
+
+    def times(self, fps: float) -> np.ndarray:
+        """The times of the video's frames at ``fps``: its time range's."""
+        t0, t1 = self.span
+        return t0 + np.arange(int(np.floor((t1 - t0) * fps + 1e-9)) + 1) / fps
 
     def close(self) -> None:
         self.plotter.close()
@@ -269,12 +272,13 @@ def render_video(model: Model, synthesis: Synthesis, audio: np.ndarray, sample_r
                  settings: VideoSettings | None = None, overwrite: bool = False,
                  progress: Callable[[float, str], None] | None = None,
                  title: str = "", phones: Sequence[PhoneSegment] | None = None,
-                 view=None, pins=None, caption: str = "") -> Path:
+                 view=None, pins=None, caption: str = "", screen: Screen | None = None) -> Path:
     """Write an MP4 (H.264 + AAC) of the synthesized (and original) face points and lip panels.
 
     ``original`` is the head-normalised original ``(T, M, 3)`` or ``None``; ``phones`` the phone
     segments shown in the tier over the lip panels (none: the tier says so). From the window:
-    its ``view``, ``pins`` and ``caption`` (what is on screen; :class:`VideoFrames`).
+    its ``view``, ``pins``, ``caption`` and ``screen`` (what is on screen, over the time range
+    shown, its sound too; :class:`VideoFrames`).
     """
     import imageio_ffmpeg
 
@@ -285,12 +289,15 @@ def render_video(model: Model, synthesis: Synthesis, audio: np.ndarray, sample_r
         raise FileExistsError(f"{path}: already exists; choose to overwrite it (--overwrite) "
                               "or give another name")
     frames = VideoFrames(model, synthesis, original, phones, settings, title, audio=audio,
-                         sample_rate=sample_rate, view=view, pins=pins, caption=caption)
-    n_video = int(np.floor(synthesis.times[-1] * settings.fps)) + 1
+                         sample_rate=sample_rate, view=view, pins=pins, caption=caption,
+                         screen=screen)
+    times = frames.times(settings.fps)
+    n_video = len(times)
     try:
         with tempfile.TemporaryDirectory() as tmpdir:
             wav = Path(tmpdir) / "speech.wav"
-            write_audio(wav, *sound_for_frames(audio, sample_rate, n_video, settings.fps))
+            first = int(round(times[0] * sample_rate))
+            write_audio(wav, *sound_for_frames(audio[first:], sample_rate, n_video, settings.fps))
             with atomic_write(path, overwrite=True) as tmp:
                 # the sound exactly as long as the frames, and both cut there: every frame kept
                 # (``-shortest`` dropped the last, the AAC stream ending a few ms early)
@@ -300,8 +307,8 @@ def render_video(model: Model, synthesis: Synthesis, audio: np.ndarray, sample_r
                     ffmpeg_log_level="error", output_params=["-t", f"{n_video / settings.fps:.6f}"])
                 writer.send(None)
                 try:
-                    for k in range(n_video):
-                        writer.send(frames.frame(k / settings.fps))
+                    for k, t in enumerate(times):
+                        writer.send(frames.frame(float(t)))
                         if k % 10 == 0:
                             progress(k / n_video, f"frame {k + 1} of {n_video}")
                 finally:

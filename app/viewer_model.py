@@ -70,6 +70,7 @@ class SynthRequest:
     generation: int
     mode_chosen: bool = False
     origin: LabelOrigin | None = None      # the label file or transcript, when known
+    relabelled: bool = False               # other labels than the utterance's own (labels box)
 
     def run(self, progress: Progress | None = None) -> UtteranceView:
         """Load and synthesize (slow: run in a worker). Without phone labels the synthesis is
@@ -130,12 +131,20 @@ class ViewerModel:
                 return utt_id
         return (info.test or info.train or [None])[0]
 
+    def external_name(self, stem: str, suffix: str = "") -> str:
+        """The name a recording opened from a file is shown under: its ``stem``, or where a
+        corpus utterance has that name the file's name (``s002.flac`` beside the corpus's
+        ``s002``; a prime added only if that is taken too)."""
+        ids = set(self.corpus.info.ids) if self.corpus else set()
+        name = stem if stem not in ids else f"{stem}{suffix}"
+        while name in ids:
+            name += "'"
+        return name
+
     def add_external(self, utt: Utterance, origin: LabelOrigin | None = None) -> str:
         """Keep an utterance opened from files (and where its labels came from) under a name no
-        corpus utterance has; return it."""
-        name = utt.name
-        while name in (self.corpus.info.ids if self.corpus else []):
-            name += "'"
+        corpus utterance has (:meth:`external_name`); return it."""
+        name = self.external_name(utt.name)
         self.external[name] = replace(utt, name=name)
         self.external_origin[name] = origin or LabelOrigin(utt.label_source)
         return name
@@ -166,6 +175,20 @@ class ViewerModel:
             origin = LabelOrigin("file", file=f"{source.name}{' (PHONES)' if held else ''}")
         return self._new_request(lambda: corpus.utterance(utt_id), split, True, origin)
 
+    def request_labels(self, utt: Utterance, origin: LabelOrigin,
+                       own: bool = False) -> SynthRequest | None:
+        """A request for the utterance on screen with other labels (``utt``: the same audio and
+        markers, the labels of another source; ``own``: its own again; ``app/label_sources.py``):
+        not a new utterance (the clock and the zoom stay), its split kept; an opened recording
+        keeps them."""
+        if self.model is None or self.view is None or utt.name != self.view.utterance.name:
+            return None
+        if utt.name in self.external:
+            self.external[utt.name] = utt
+            self.external_origin[utt.name] = origin
+        return self._new_request(lambda: utt, self.view.split, False, origin,
+                                 relabelled=not own and self.view.split != "external")
+
     def set_config(self, config: SynthConfig, explicit: bool = False) -> tuple[bool, SynthRequest | None]:
         """Use new settings: (whether they changed, the re-synthesis of the latest request).
         ``explicit``: the user chose the search (``config.mode``): the labels' rule must not switch
@@ -191,15 +214,22 @@ class ViewerModel:
         if req is None:
             return changed, None
         # the utterance asked for last (it may still be on its way)
-        return changed, self._new_request(req.load, req.split, req.new_utterance, req.origin)
+        return changed, self._new_request(req.load, req.split, req.new_utterance, req.origin,
+                                          req.relabelled)
 
     def _new_request(self, load: Callable[[], Utterance], split: str, new_utterance: bool,
-                     origin: LabelOrigin | None = None) -> SynthRequest:
+                     origin: LabelOrigin | None = None, relabelled: bool = False) -> SynthRequest:
         assert self.model is not None
         self.generation += 1
         self.request = SynthRequest(load, split, new_utterance, self.model, self.synth_config,
-                                    self.generation, self.mode_chosen, origin)
+                                    self.generation, self.mode_chosen, origin, relabelled)
         return self.request
+
+    @property
+    def relabelled(self) -> bool:
+        """Whether the corpus utterance shown has other labels than its own (labels box): its
+        correlations are not the browser's."""
+        return self.request is not None and self.request.relabelled
 
     def is_current(self, request: SynthRequest) -> bool:
         """Whether ``request`` is still the latest (no newer request, the same model)."""

@@ -8,7 +8,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from PyQt6.QtCore import QEvent, QSize, Qt, QTimer
+from PyQt6.QtCore import QEvent, QObject, QSize, Qt, QTimer
 from PyQt6.QtGui import QAction, QGuiApplication
 from PyQt6.QtWidgets import QDockWidget, QFrame, QMainWindow, QMenu, QScrollArea, QWidget
 
@@ -92,6 +92,10 @@ def text_scroll(widget: QWidget) -> QScrollArea:
     scroll.setWidgetResizable(True)
     scroll.setFrameShape(QFrame.Shape.NoFrame)
     scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+    # never narrower than the panel's controls (a squeezed dock cut "model's" to "r" and hid
+    # the spin boxes' arrows)
+    scroll.setMinimumWidth(widget.minimumSizeHint().width()
+                           + scroll.verticalScrollBar().sizeHint().width())
     return scroll
 
 
@@ -187,17 +191,109 @@ def fit_to_screen(window: QWidget, wanted: tuple[int, int]) -> tuple[int, int, i
     return x, y, w, h
 
 
-def give_room(splitter, timeline, share: float) -> None:
-    """Panels the timeline left out for lack of room (analysis panels on a laptop screen): the
-    lower side of ``splitter`` (the panels) grows to show them, up to ``share`` of the height,
-    the 3-D view above giving it up; once per layout, the user's own split kept otherwise."""
-    if not timeline.hidden:
-        return
-    top, bottom = splitter.sizes()
-    total = top + bottom
-    want = min(bottom + int(timeline.needed_height() - timeline.height()), int(share * total))
-    if want > bottom + 8:
-        splitter.setSizes([total - want, want])
+def split_sizes(total: int, share: float, need: int, most: float) -> tuple[int, int]:
+    """The heights of the 3-D view (top) and the panels (bottom) in ``total`` px: the panels'
+    ``share`` of it, more if they ``need`` more to show every panel, but at most ``most`` of it.
+
+    >>> split_sizes(1000, 0.5, 300, 0.72), split_sizes(650, 0.5, 430, 0.72), split_sizes(650, 0.5, 600, 0.72)
+    ((500, 500), (220, 430), (182, 468))
+    """
+    bottom = min(max(int(round(share * total)), need), int(most * total))
+    return total - bottom, bottom
+
+
+class PanelSplit(QObject):
+    """The split of ``splitter`` between the 3-D view (top) and the panels (bottom, holding
+    ``timeline``), kept through resizes and relayouts (:func:`split_sizes`): the panels' share
+    the user left (``share``; dragging the handle sets it), grown to show every panel at its
+    least readable height, up to ``most`` of the height (a laptop screen with analysis docks:
+    the 3-D view gives up height). Made afresh from the size each time, so that a window made
+    smaller and larger again is laid out as before (it kept the squeezed split: a 3-D view 217
+    px tall instead of 375)."""
+
+    def __init__(self, splitter, timeline, share: float = 0.52, most: float = 0.72):
+        super().__init__(splitter)
+        self.splitter, self.timeline = splitter, timeline
+        self.share, self.most = share, most
+        self._applying = False
+        splitter.splitterMoved.connect(self._moved)
+        splitter.installEventFilter(self)
+        timeline.laidOut.connect(self.apply)
+
+    def need(self) -> int:
+        """The panels' side's height that shows every panel (the title and notes over the
+        timeline included)."""
+        column = self.splitter.widget(1)
+        return int(column.height() - self.timeline.height() + self.timeline.needed_height())
+
+    def enlarge(self, on: bool) -> None:
+        """The 3-D view over the whole height (the panels hidden), or the split as before."""
+        self.splitter.widget(1).setVisible(not on)
+        if not on:
+            QTimer.singleShot(0, self.apply)
+
+    def apply(self) -> None:
+        sizes = self.splitter.sizes()
+        total = sum(sizes)
+        if total <= 0 or self._applying or not self.splitter.widget(1).isVisible():
+            return
+        wanted = list(split_sizes(total, self.share, self.need(), self.most))
+        if abs(wanted[1] - sizes[1]) > 1:
+            self._applying = True
+            try:
+                self.splitter.setSizes(wanted)
+            finally:
+                self._applying = False
+
+    def _moved(self, _pos: int, _index: int) -> None:
+        top, bottom = self.splitter.sizes()
+        if top + bottom > 0 and bottom > 0:
+            self.share = bottom / (top + bottom)
+
+    def eventFilter(self, obj, event) -> bool:
+        if event.type() == QEvent.Type.Resize:
+            QTimer.singleShot(0, self.apply)        # once the splitter has its new size
+        return False
+
+
+class DockWidth(QObject):
+    """The width of ``dock`` (the left docks' column) kept through resizes of ``window``: the
+    width placed (or the user's, dragging its edge), but at most ``share`` of the window. A
+    window made smaller squeezes the dock; made larger again, the dock gets its width back (it
+    stayed squeezed, the settings clipped)."""
+
+    def __init__(self, window: QMainWindow, dock: QDockWidget, width: int, share: float = 0.25):
+        super().__init__(window)
+        self.window, self.dock, self.share = window, dock, share
+        self.width = width
+        self._window_width = window.width()
+        self._applying = False
+        dock.installEventFilter(self)
+        window.installEventFilter(self)
+
+    def place(self, width: int) -> None:
+        """The dock ``width`` px wide (what the window asks for when it is placed)."""
+        self.width = width
+        self.apply()
+
+    def apply(self) -> None:
+        self._window_width = self.window.width()
+        want = min(self.width, int(self.share * self.window.width()))
+        if abs(self.dock.width() - want) > 1:
+            self._applying = True
+            try:
+                self.window.resizeDocks([self.dock], [want], Qt.Orientation.Horizontal)
+            finally:
+                self._applying = False
+
+    def eventFilter(self, obj, event) -> bool:
+        if event.type() == QEvent.Type.Resize:
+            if obj is self.window:
+                QTimer.singleShot(0, self.apply)        # once the docks have their new size
+            elif not self._applying and self.window.width() == self._window_width \
+                    and self.dock.isVisible():
+                self.width = self.dock.width()          # the user's drag
+        return False
 
 
 def share_left_docks(window: QMainWindow, top: QDockWidget, bottom: QDockWidget,

@@ -307,3 +307,22 @@ def middle(w, label: str) -> float:
 def face_image(plotter) -> np.ndarray:
     """The 3-D view as rendered now, ``(h, w, 3)``."""
     return np.asarray(plotter.screenshot(return_img=True))[..., :3]
+
+
+def centre_x(image: np.ndarray, colour: str) -> float:
+    """The mean x of ``image``'s pixels near ``colour``, as a share of its width."""
+    _ys, xs = np.nonzero(np.linalg.norm(image.astype(float) - colour_of(colour), axis=-1) < 60)
+    assert len(xs) > 30, colour
+    return float(xs.mean()) / image.shape[1]
+
+
+def assert_placed_as_in(window: np.ndarray, scene: np.ndarray, colours: list[str]) -> None:
+    """Each colour's sets in ``scene`` (a video's 3-D half) where they are in ``window`` (the
+    window's 3-D view), within 4 % of the width, and ``colours`` left to right."""
+    (wx, wy), (vx, vy) = window.shape[1::-1], scene.shape[1::-1]
+    squeeze = min(1.0, (wx / wy) / (vx / vy))     # a view as wide as the window's, or narrower
+    for colour in colours:
+        expected = 0.5 + (centre_x(window, colour) - 0.5) * squeeze
+        assert abs(centre_x(scene, colour) - expected) <= 0.04, (colour, expected)
+    order = [centre_x(scene, c) for c in colours]
+    assert order == sorted(order)

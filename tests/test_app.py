@@ -141,7 +141,7 @@ def test_marker_name_on_hover(window, qtbot):
     win = window
     face = win.face
     k = win.model.upper_lip
-    x, y = face._project(face.synth.current)[k]          # VTK display pixels, origin bottom left
+    x, y = face.project(face.synth.current)[k]          # VTK display pixels, origin bottom left
     widget = face.plotter
     dpr = widget.devicePixelRatioF()
     qtbot.mouseMove(widget, pos=QPoint(int(x / dpr), int(widget.height() - y / dpr)))

@@ -20,7 +20,16 @@ if not os.environ.get("DISPLAY"):
 from articulograph import mview_from_mocha
 from conftest import MOCHA, shown_corpus_window
 from PyQt6.QtGui import QImage
-from screens import colour_of, image_array, near, place_in, project, resynthesize
+from screens import (
+    assert_placed_as_in,
+    colour_of,
+    face_image,
+    image_array,
+    near,
+    place_in,
+    project,
+    resynthesize,
+)
 
 from facetraj_app import style
 from facetraj_app.articulators import REFERENCE_COLOR, ArticulatorSet
@@ -267,9 +276,97 @@ def test_video_frame_of_articulators(corpora, qtbot, monkeypatch):
         scene = img[y0:y1, x0:x1].reshape(-1, 3)
     finally:
         frames.close()
-    assert isinstance(frames.synth_set, ArticulatorSet)
+    assert isinstance(frames.scene.synth, ArticulatorSet)      # the window's scene (FaceScene)
     assert near(scene, style.SURFACE_COLOR, 40) < SKIN_BAR
     assert near(scene, style.SYNTH_COLOR, 40) > 50 and near(scene, style.ORIGINAL_COLOR, 40) > 50
+    win.close()
+
+
+@pytest.mark.parametrize("which", ["mview", "mocha"])
+def test_the_close_up_of_articulators_shows_their_lips(which, corpora, qtbot, monkeypatch, tmp_path,
+                                                       capsys):
+    """Issue 49's close-up of the lips (the window's ``FaceScene``) on articulators, side by side:
+    each set's lip sensors alone (the upper and lower lip and the aperture line between them;
+    no tongue, no jaw), in profile in the parallel projection, the aperture taller on screen than
+    in the whole articulators' profile; back to the profile, the articulators whole again."""
+    win = window_on(qtbot, monkeypatch, corpora[which])
+    face, roles = win.face, win.model.roles
+    win.view_bar.side_by_side.setChecked(True)
+    qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
+    lips = [roles.upper_lip, roles.lower_lip]
+
+    def apertures() -> list[float]:
+        face.rerender()
+        return [float(np.ptp(project(win.plotter, m.current[lips])[:, 1]))
+                for m, shown in face.face_sets() if shown]
+
+    whole = apertures()
+    win.view_bar.set_camera("lips")
+    qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
+    close = apertures()
+    with capsys.disabled():
+        print(f"\n{which}: the aperture on screen {max(whole):.0f} px whole, {min(close):.0f} px in the "
+              "close-up")
+    assert len(close) == 2 and min(close) >= 1.2 * max(whole), (whole, close)
+    cam = win.plotter.camera
+    assert cam.GetParallelProjection() and np.allclose(cam.direction, (1.0, 0.0, 0.0))
+    area = three_d_area(win, tmp_path)
+    for mset, colour in ((face.synth, style.SYNTH_COLOR), (face.original, style.ORIGINAL_COLOR)):
+        assert isinstance(mset, ArticulatorSet)
+        pts = mset.current
+        up, low = project(win.plotter, pts[lips])
+        for name, xy in (("UL", up), ("LL", low), ("aperture", (up + low) / 2)):
+            assert drawn_in(area, xy, (colour,)), (mset.name, name)
+        tongue = mset.tongue_points()
+        hidden = [tongue[6], tongue[18], pts[roles.jaw[0]]]
+        for name, xy in zip(["tongue", "tongue", "jaw"], project(win.plotter, np.array(hidden)),
+                            strict=True):
+            assert not drawn_in(area, xy, (colour,), 40), (mset.name, name)
+    win.view_bar.set_camera("profile")
+    qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
+    assert apertures() == pytest.approx(whole, abs=1.0)
+    area = three_d_area(win, tmp_path)
+    curve = face.synth.tongue_points()
+    assert drawn_in(area, project(win.plotter, curve[[6]])[0], (style.SYNTH_COLOR,))
+    win.close()
+
+
+def test_the_video_of_articulators_is_what_the_screen_shows(corpora, qtbot, monkeypatch):
+    """Issue 49's video of the screen on articulators: side by side with a pin and the view
+    zoomed in by the user, the video's 3-D half draws the articulators (no skin) in the window's
+    parallel projection and its zoom (as wide a view: the scale of a narrower one widened), each
+    set where the window has it (the original left of the synthesis, the pin's beside)."""
+    import facetraj_app.own_data as own_data
+    from facetraj_app.video import VideoFrames
+
+    win = window_on(qtbot, monkeypatch, corpora["mview"])
+    win.view_bar.side_by_side.setChecked(True)
+    win.extension("compare").pin()
+    resynthesize(win, qtbot, lambda: win.set_synth_config(win.synth_config.with_(n_context_phones=1)))
+    win.seek(1.0)
+    qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
+    win.plotter.camera.zoom(1.25)                  # the wheel's zoom: a smaller parallel scale
+    caption, screen = own_data.screen_of(win)
+    video = VideoFrames(win.model, win.view.synthesis, view=win.view, pins=win.pins,
+                        caption=caption, screen=screen)
+    try:
+        img = video.frame(1.0)
+        x0, y0, x1, y1 = video.layout.scene
+        scene = img[y0:y1, x0:x1]
+        sets = [m for m, shown in video.scene.face_sets() if shown]
+        state = video.scene.camera_state()
+    finally:
+        video.close()
+    assert len(sets) == 3 and all(isinstance(m, ArticulatorSet) for m in sets)
+    mine = win.face.camera_state()
+    assert mine[5] is not None and state[5] is not None          # both parallel projections
+    np.testing.assert_allclose(np.array(state[:3]), np.array(mine[:3]), atol=1e-6)
+    assert state[5] == pytest.approx(mine[5] * max(1.0, mine[4] / state[4]), rel=1e-6)
+    assert near(scene.reshape(-1, 3), style.SURFACE_COLOR, 40) < SKIN_BAR
+    win.face.rerender()
+    window = face_image(win.plotter)
+    pin = win.pins.pins[0]
+    assert_placed_as_in(window, scene, [style.ORIGINAL_COLOR, style.SYNTH_COLOR, pin.color])
     win.close()
 
 

@@ -7,8 +7,10 @@ and how did the aligned and recognized labels differ there", answered from the w
 from __future__ import annotations
 
 import csv
+import logging
 import os
 import re
+import time
 
 import numpy as np
 import pytest
@@ -19,13 +21,13 @@ pytest.importorskip("pyvistaqt")
 if not os.environ.get("DISPLAY"):
     pytest.skip("the app tests need an X display (run under xvfb-run)", allow_module_level=True)
 
-from conftest import DEFAULT_CORPUS
 from screens import colour_of, face_image, middle, near, project, resynthesize, screen_window
 
 from facetraj_engine.analysis.apertures import aperture, phone_apertures, readout_at
 from facetraj_engine.io.markerfiles import read_marker_table
 
 pytestmark = pytest.mark.gui
+log = logging.getLogger(__name__)
 
 WAIT_MS = 240_000
 
@@ -33,6 +35,12 @@ WAIT_MS = 240_000
 @pytest.fixture
 def win(screen, qtbot, trained_cache):
     yield from screen_window(screen, qtbot, "s002", WAIT_MS)
+
+
+@pytest.fixture
+def opening(screen, qtbot, trained_cache):
+    """The window as it opens (the Figure 4 sentence)."""
+    yield from screen_window(screen, qtbot, None, WAIT_MS)
 
 
 def test_the_readout_and_the_table_give_the_lips_in_mm(screen, win, qtbot, tmp_path):
@@ -130,33 +138,67 @@ def test_a_pinned_result_is_drawn_beside_the_next(screen, win, qtbot):
 
 
 @pytest.mark.parametrize("screen", ["1366x768"], indirect=True)     # the smaller screen
-def test_the_b_of_boy_aligned_against_recognized_from_the_window(screen, win, qtbot):
-    """docs/app.md's walk-through: File > Open audio of data_samples/s002.flac (its labels, and
-    its markers as the original), labels aligned from s002.txt, pinned, then recognized: at the
-    /b/ of "boy" the readout gives the synthesized and original apertures and the pin's, and the
-    phone tier shows the recognized phones with the aligned ones (the pin's) under them."""
-    w = win
-    resynthesize(w, qtbot, lambda: w.open_audio(DEFAULT_CORPUS / "s002.flac"), WAIT_MS)
-    qtbot.waitUntil(lambda: w.view.split == "external" and w.settled, timeout=WAIT_MS)
-    assert w.view.original is not None
-    resynthesize(w, qtbot, lambda: w.audio_opener.switch("aligned"), WAIT_MS)
+def test_the_b_of_boy_aligned_against_recognized_from_the_window(screen, opening, qtbot):
+    """docs/app.md's walk-through on a 1366x768 screen, on the corpus utterance itself: the
+    filter finds "boy", a click shows s002; labels box: aligned, Ctrl+P, recognized; Analysis >
+    Measure, filter "b", a click on the /b/ of "boy": the cursor at its minimum, the readout
+    gives both results' apertures there (the engine's numbers), the table's pin column the
+    aligned result's least aperture over that /b/; the lips' close-up shows the three faces
+    shut; the phone tier shows the recognized phones with the aligned ones (the pin's)."""
+    from PyQt6.QtCore import Qt
+    from PyQt6.QtWidgets import QApplication
+
+    from facetraj_engine.analysis.phone_compare import minimum_within
+
+    w = opening
+    started = time.monotonic()
+    qtbot.keyClicks(w.browser.filter, "boy")                          # the utterance list
+    item = w.browser.items["s002"]
+    assert not item.isHidden()
+    resynthesize(w, qtbot, lambda: w.browser.tree.setCurrentItem(item), WAIT_MS)
+    assert (w.view.utterance.name, w.view.split) == ("s002", "train")
+    box = w.audio_opener.box.combo
+
+    def labels(source: str) -> None:
+        box.setCurrentIndex(box.findData(source))
+        box.activated.emit(box.currentIndex())
+
+    resynthesize(w, qtbot, lambda: labels("aligned"), WAIT_MS)
     assert w.view.utterance.label_source == "aligned"
-    w.extension("compare").pin()
-    resynthesize(w, qtbot, lambda: w.audio_opener.switch("recognized"), WAIT_MS)
+    w.activateWindow()
+    qtbot.waitUntil(lambda: QApplication.activeWindow() is w, timeout=10_000)
+    qtbot.keyClick(QApplication.focusWidget() or w, Qt.Key.Key_P, Qt.KeyboardModifier.ControlModifier)
+    assert len(w.pins) == 1
+    resynthesize(w, qtbot, lambda: labels("recognized"), WAIT_MS)
     view, pin = w.view, w.pins.pins[0]
     assert view.utterance.label_source == "recognized" and w.pins.shown(view) == [pin]
-    table = w.extension("measure").open_table()            # Measure: the /b/ rows
+    w.extension("measure").action.trigger()                           # Analysis > Measure
+    table = w.extension("measure").table
     table.filter.setText("b")
     table.table.sortItems(2)
-    first = min((r for r in table.measure.rows("b")), key=lambda r: r.start)
+    first = min(table.measure.rows("b"), key=lambda r: r.start)
     table.table.cellClicked.emit(0, 0)                      # the /b/ of "boy": its minimum
     qtbot.waitUntil(lambda: abs(w.current_time() - first.min_time) < 1.0 / 60, timeout=5000)
+    answered = time.monotonic() - started
+    model = w.model
+    up, lo = model.upper_lip, model.lower_lip
+    this = aperture(view.shown, up, lo)[view.frame_at(w.current_time())]
+    pinned = aperture(pin.view.shown, up, lo)[pin.view.frame_at(w.current_time())]
     text = w.extension("measure").readout.text()
-    assert "/b/" in text and f"aperture {first.min_synthesized:.1f} mm" in text
-    assert "original" in text and re.search(r"pin 1 /\w+/ \d+\.\d mm \(this − pin 1 [+-]\d", text), text
+    assert "/b/" in text and f"aperture {this:.1f} mm" in text and "original" in text
+    assert re.search(rf"pin 1 /\w+/ {pinned:.1f} mm \(this − pin 1 (0\.0|[+-]\d+\.\d) mm\)", text), text
+    heads = [table.table.horizontalHeaderItem(c).text() for c in range(table.table.columnCount())]
+    column = heads.index("min: pin 1")
+    least = minimum_within(pin.view.times, aperture(pin.view.shown, up, lo), first.start, first.end)
+    assert table.table.item(0, column).value == pytest.approx(least)
+    w.view_bar.side_by_side.setChecked(True)
+    w.view_bar.set_camera("lips")
+    w.face.rerender()
+    assert len([m for m, shown in w.face.face_sets() if shown]) == 3
     tl = w.timeline
     tl.canvas.finish()
     tier = next(p for p in tl.shown if p.title == "phones")
     rows = [label.get_text() for label in tl.axes_of(tier).get_yticklabels()]
     assert rows[0] == "phones (recognized)" and rows[1] == "pin 1: aligned", rows
     assert [d[0] for d in tier.labels[1].drawn]                 # the aligned phones drawn
+    log.info("the walk-through answered in %.1f s (the labels cached or not)", answered)

@@ -4,6 +4,8 @@ filter, the pins kept, shown and let go, and the panels' heights on a short time
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -52,7 +54,8 @@ def test_the_readout_at_the_b_of_boy(default_model, views):
 def test_pins_keep_three_in_distinct_colours_and_name_their_settings(default_model, views):
     n3, n1 = views
     pins = PinBoard(model_name="data_samples", marker_names=tuple(default_model.marker_names))
-    kept = [pins.pin(v) for v in (n3, n1, n3, n1)]
+    assert pins.pin(n3) is pins.pin(n3) and len(pins) == 1         # the same result: pinned once
+    kept = [pins.pins[0], *(pins.pin(v) for v in (n1, replace(n3), replace(n1)))]   # 4 results
     assert len(pins) == MAX_PINS and kept[0] not in pins.pins      # the oldest went
     assert sorted(p.color for p in pins.pins) == sorted(PIN_COLORS)
     assert kept[3].color == kept[0].color                          # its colour reused
@@ -76,3 +79,56 @@ def test_a_short_timeline_leaves_out_the_spectrogram_first():
     assert shorter[0] is None and shorter[1] is None
     assert all(h >= m for h, m in zip(shorter, least, strict=True) if h is not None)
     assert sum(h for h in shorter if h is not None) + 6 * 3 <= 260
+
+
+def test_the_table_has_a_column_per_pin_and_the_csv_too(default_model, views, tmp_path):
+    """Each pin's least aperture over the row's segment (the engine's minimum_within of its own
+    aperture track) beside the result on screen's, and this minus it; the CSV's columns
+    ``min_pin1_mm`` and ``min_this_minus_pin1_mm`` hold the same numbers; the recipes name how
+    each result was made (an acoustic-only result's labels are "not used")."""
+    import csv
+
+    from facetraj_app.provenance import settings_text
+    from facetraj_engine.analysis.apertures import phone_apertures
+
+    n3, n1 = views
+    up, lo = default_model.upper_lip, default_model.lower_lip
+    pins = PinBoard(model_name="data_samples", marker_names=tuple(default_model.marker_names))
+    pin = pins.pin(n3)
+    m = Measure()
+    m.set_view(n1, up, lo, pins.shown(n1))
+    rows = m.rows("b")
+    minima = m.pin_minima(rows)
+    pin_ap = aperture(n3.shown, up, lo)
+    for r, (value,) in zip(rows, minima, strict=True):
+        inside = (n3.times >= r.start) & (n3.times < r.end)
+        assert value == pytest.approx(float(pin_ap[inside].min()))
+    assert m.pin_columns() == ["min: pin 1", "min: this − pin 1"]
+    back = list(csv.DictReader(m.write_csv(tmp_path / "b.csv", "b").open()))
+    assert [float(b["min_pin1_mm"]) for b in back] == pytest.approx([v[0] for v in minima], abs=1e-4)
+    assert [float(b["min_this_minus_pin1_mm"]) for b in back] == pytest.approx(
+        [r.min_synthesized - v[0] for r, v in zip(rows, minima, strict=True)], abs=1e-4)
+    assert len(rows) == len([p for p in phone_apertures(n1.times, n1.shown, up, lo, n1.utterance.phones)
+                             if p.phone == "b"])
+    recipes = m.recipes()
+    assert [(r.name, r.labels, r.config) for r in recipes] == [
+        ("this", "file", n1.synthesis.config), ("pin 1", "file", n3.synthesis.config)]
+    assert recipes[1].settings == pin.settings
+    acoustic = replace(n1, synthesis=replace(n1.synthesis, config=n1.synthesis.config.with_(mode="acoustic")))
+    assert settings_text(acoustic, short=True).endswith("labels: not used")
+    assert "labels: label file" not in settings_text(acoustic, short=True)
+
+
+def test_the_readout_has_units_and_no_negative_zero(default_model, views):
+    from facetraj_app.measure_model import mm
+    from facetraj_app.pins import distinct_settings
+
+    _n3, n1 = views
+    m = Measure()
+    m.set_view(n1, default_model.upper_lip, default_model.lower_lip, [])
+    text = m.readout_text(0.5)
+    r = m.readout(0.5)
+    assert f"upper lip y {r.upper_y:.1f} mm, lower lip y {r.lower_y:.1f} mm" in text
+    assert mm(-0.04, signed=True) == "0.0 mm" and mm(-0.06, signed=True) == "-0.1 mm"
+    assert distinct_settings(["robust, N=3, triangular; labels: aligned",
+                              "robust, N=1, triangular; labels: aligned"]) == ["N=3", "N=1"]

@@ -68,6 +68,8 @@ def test_open_audio_with_a_sentence_shows_aligned_phones(window, qtbot, clip, tm
     assert "boy" in drawn and "oy" in drawn
     assert win.audio_opener.box.combo.currentData() == "aligned"
     assert win.audio_opener.box.combo.isEnabled()
+    first = win.audio_opener.box.combo.model().item(0)            # no label file beside it: why
+    assert not first.isEnabled() and "no label file for recording.flac" in first.toolTip()
     shot = win.save_screenshot(tmp_path / "aligned.png")
     assert shot.stat().st_size > 10_000
     aligned_lips = view.shown.copy()
@@ -86,10 +88,12 @@ def test_open_audio_with_a_sentence_shows_aligned_phones(window, qtbot, clip, tm
         box.combo.setCurrentIndex(box.combo.findData("none"))
         box.combo.activated.emit(box.combo.currentIndex())
     assert win.view.synthesis.config.mode == "acoustic" and not win.view.utterance.phones
-    # back to a corpus utterance: the box is off
+    # back to a corpus utterance: the box shows its own labels (the label file), every source
+    # of it available (issue 49: it was greyed on the corpus with no hint why)
     with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
         win.set_utterance(win.corpus.info.test[0])
-    assert not box.combo.isEnabled()
+    assert box.combo.isEnabled() and box.combo.currentData() == "file"
+    assert all(box.combo.model().item(i).isEnabled() for i in range(box.combo.count()))
     label_file = f"{win.view.utterance.name}.TextGrid"
     assert [t.get_text() for t in _phone_axis(win).get_yticklabels()] == ["phones (label file)", "words"]
     assert f"labels: label file {label_file}" in win.title.text()
@@ -146,8 +150,9 @@ def test_empty_sentence_recognizes_and_wrong_sentence_is_refused(window, qtbot, 
 
 def test_recordings_from_the_command_line_open_one_after_another(qtbot, trained_cache, tmp_path):
     """``facetraj gui FOLDER`` (a folder of recordings without face data): each recording is
-    synthesized with the default corpus's model, its phones recognized (nothing beside it), the
-    one after the other; an unreadable file is reported and skipped."""
+    opened with the default corpus's model, its phones recognized (nothing beside it), the one
+    after the other, the first shown and the others listed under "opened"; an unreadable file
+    is reported and skipped."""
     from facetraj_app.recordings import RecordingQueue, recordings_in
     from facetraj_engine.errors import InputError
 
@@ -169,8 +174,10 @@ def test_recordings_from_the_command_line_open_one_after_another(qtbot, trained_
     win.add_extension("recordings", RecordingQueue(win, recordings_in(folder)))
     win.resize(1600, 1000)
     win.show()
-    qtbot.waitUntil(lambda: "c" in shown, timeout=WAIT_MS)
-    assert shown == ["a", "c"]                           # no corpus utterance first
+    qtbot.waitUntil(lambda: "c" in win.browser.items and not win.busy, timeout=WAIT_MS)
+    assert shown == ["a"]                    # the first shown (no corpus utterance first), the
+    assert win.view.utterance.name == "a"    # others listed: it landed on the last (issue 49)
+    assert "a" in win.browser.items and "b" not in win.browser.items
     assert len(errors) == 1 and "b.wav" in errors[0]
     view = win.view
     assert view.split == "external" and view.original is None

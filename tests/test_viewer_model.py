@@ -76,6 +76,30 @@ def test_stale_results_are_dropped(state, toy_corpus, toy_model):
     assert state.view is None and state.request is None
 
 
+def test_other_labels_of_the_utterance_shown_keep_its_place(state, toy_corpus):
+    """A label source switched on a corpus utterance (the labels box): the same utterance, its
+    split kept, not a new utterance (the clock and the zoom stay), marked as relabelled (its
+    correlations are not the browser's) also when the settings change after; its own labels
+    again: not relabelled."""
+    from facetraj_app.provenance import LabelOrigin
+
+    utt_id = toy_corpus.info.test[0]
+    req = state.request_utterance(utt_id)
+    view = req.run()
+    assert state.accept(req, view) and not state.relabelled
+    other = replace(view.utterance, phones=[], label_source="none")
+    assert state.request_labels(replace(other, name="elsewhere"), LabelOrigin("none")) is None
+    again = state.request_labels(other, LabelOrigin("none"))
+    assert (again.split, again.new_utterance, again.relabelled) == ("test", False, True)
+    relabelled = again.run()
+    assert state.accept(again, relabelled) and state.relabelled
+    assert relabelled.synthesis.config.mode == "acoustic" and relabelled.utterance.name == utt_id
+    _, resynth = state.set_config(state.synth_config.with_(n_context_phones=1))
+    assert resynth.relabelled and resynth.load() is other
+    own = state.request_labels(view.utterance, LabelOrigin("file"), own=True)
+    assert not own.relabelled
+
+
 def test_new_settings_resynthesize_the_latest_request(state, toy_corpus):
     cfg = state.synth_config
     assert state.set_config(cfg) == (False, None)                 # unchanged: nothing to do
@@ -94,6 +118,9 @@ def test_opened_audio_without_labels_is_synthesized_acoustic_only(state, toy_cor
     utt = toy_corpus.utterance(toy_corpus.info.test[0])
     name = state.add_external(replace(utt, phones=[], markers=None))
     assert name == utt.name + "'"                   # the corpus already has that name
+    # a file of that name: shown under its file name (the prime only if that is taken too)
+    assert state.external_name(utt.name, ".flac") == f"{utt.name}.flac"
+    assert state.external_name("fresh", ".wav") == "fresh"
     req = state.request_utterance(name)
     assert isinstance(req, SynthRequest) and req.split == "external"
     view = req.run()

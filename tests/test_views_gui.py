@@ -172,7 +172,7 @@ def test_the_face_shows_the_mouth_closed_at_a_b_and_the_lip_panels_where_closed_
         shot = image_array(QImage(str(win.save_screenshot(tmp_path / f"{label}.png")))).astype(float)
         view = win.plotter.interactor
         pts = face.original.current
-        xy = face._project(pts[[model.upper_lip, model.lower_lip]])
+        xy = face.project(pts[[model.upper_lip, model.lower_lip]])
         origin = view.mapTo(win, view.rect().topLeft())
         x = origin.x() + int(round(xy[:, 0].mean()))
         y_top = origin.y() + view.height() - int(round(xy[0, 1])) + 8     # under the markers'

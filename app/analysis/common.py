@@ -110,7 +110,10 @@ class NumberItem(QTableWidgetItem):
 
     def __init__(self, value: float, fmt: str = "{:.3f}"):
         v = float(value)
-        super().__init__("" if not np.isfinite(v) else fmt.format(v))
+        text = "" if not np.isfinite(v) else fmt.format(v)
+        if text.startswith("-") and not text.strip("-+0.,"):     # no "-0.0": a zero
+            text = fmt.format(0.0)
+        super().__init__(text)
         self.value = v
         self.setData(Qt.ItemDataRole.UserRole, v)
         self.setTextAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
@@ -226,13 +229,18 @@ def report_error(parent: QWidget, title: str, exc: BaseException) -> None:
 def export_with_dialog(parent: QWidget, title: str, default: str, filters: str,
                        write: Callable[[Path], Any]) -> None:
     """Ask for a file name and ``write(path)``; a failure (``OSError``, ``ValueError``) is shown,
-    not raised. The export buttons of every view go through here."""
+    not raised, and a success said in the main window's status bar ("wrote …", as every export
+    of the File menu says it). The export buttons of every view go through here."""
     path = ask_save_path(parent, title, default, filters)
     if path:
         try:
-            write(path)
+            written = write(path)
         except (OSError, ValueError) as exc:
             report_error(parent, "Export failed", exc)
+            return
+        top = parent.window()
+        if hasattr(top, "show_status"):         # the main window (a view may stand alone)
+            top.show_status(f"wrote {written if isinstance(written, (str, Path)) else path}")
 
 
 def task_runner(owner: QWidget, window: Any = None) -> TaskRunner:

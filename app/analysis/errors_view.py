@@ -32,6 +32,7 @@ from PyQt6.QtWidgets import (
     QWidget,
 )
 
+from facetraj_app.window_frame import FillScrollArea
 from facetraj_engine.analysis.common import subset_corpus
 from facetraj_engine.analysis.errors import (
     MIN_CORRELATION_FRAMES,
@@ -64,6 +65,20 @@ log = logging.getLogger(__name__)
 #: the lip error panel's curves (not the original/synthesized colours: both are errors)
 UPPER_ERROR_COLOR, LOWER_ERROR_COLOR = "#7048e8", "#0c8599"
 SPLITS = {"test": ("test",), "train": ("train",), "train + test": ("train", "test")}
+
+
+#: the height of one bar of the per-phone chart (px): its label at 7-8 pt (a laptop's dock
+#: labelled every other bar at 6 px); the chart scrolls when its phones need more room
+BAR_PX = 14
+
+
+def chart_height(n_bars: int) -> int:
+    """The least height (px) of a per-phone chart of ``n_bars`` bars: every bar labelled.
+
+    >>> chart_height(34)
+    615
+    """
+    return int(n_bars * BAR_PX / 0.8) + 20
 
 
 def draw_phone_chart(fig: Figure, phones: list) -> None:
@@ -167,9 +182,11 @@ class ErrorView(QWidget):
         self.worst_table.cellClicked.connect(self._worst_clicked)
         self.tabs = QTabWidget()
         self.phone_chart = Canvas(5, 5)
+        chart_scroll = FillScrollArea()         # as tall as its bars need, scrolling in the dock
+        chart_scroll.setWidget(self.phone_chart)
         per_phone = QSplitter(Qt.Orientation.Vertical)     # the chart under the table
         per_phone.addWidget(self.phone_table)
-        per_phone.addWidget(self.phone_chart)
+        per_phone.addWidget(chart_scroll)
         per_phone.setStretchFactor(0, 2)
         per_phone.setStretchFactor(1, 3)
         per_phone.setSizes([240, 360])          # the table's rows in view, the chart under them
@@ -250,6 +267,7 @@ class ErrorView(QWidget):
 
     def _draw_phone_chart(self, report: ErrorReport) -> None:
         """Per-phone RMS error as horizontal bars (built and drawn off the GUI thread)."""
+        self.phone_chart.setMinimumHeight(chart_height(sum(p.rms == p.rms for p in report.phones)))
         self.phone_chart.rebuild(partial(draw_phone_chart, phones=list(report.phones)))
 
     def _utt_clicked(self, row: int, _col: int) -> None:

@@ -163,10 +163,12 @@ def make_figures(corpus_dir: Path, out: Path, per_split: int = 6,
             written.append(shoot(dock, out / "analysis_similarity_table.png"))
             w.tabs.setCurrentIndex(1)
             written.append(shoot(dock, out / "analysis_similarity_table1.png"))
-        if key == "metrics":                   # the per-sensor table
+        if key == "metrics":                   # the numbers' tab: the per-sensor table
+            w.tabs.setCurrentIndex(1)
             w.table_choice.setCurrentIndex(1)
             written.append(shoot(dock, out / "analysis_metrics_sensors.png"))
             w.table_choice.setCurrentIndex(0)
+            w.tabs.setCurrentIndex(0)
         if key == "errors":
             w.tabs.setCurrentIndex(1)
             written.append(shoot(dock, out / "analysis_errors_utterances.png"))

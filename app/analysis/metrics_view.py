@@ -28,6 +28,7 @@ from PyQt6.QtWidgets import (
     QSpinBox,
     QStackedWidget,
     QTableWidget,
+    QTabWidget,
     QVBoxLayout,
     QWidget,
 )
@@ -59,7 +60,6 @@ from .common import (
     stop_own_tasks,
     task_runner,
     text_item,
-    vertical_split,
 )
 
 log = logging.getLogger(__name__)
@@ -75,9 +75,10 @@ def _paper(row: Table2Row) -> tuple[float, float, float]:
 
 
 def _short(row: Table2Row) -> str:
-    """A compact bar label in lines: split, smoothing, acoustic-only."""
-    smooth = {"triangular": "triang.", "spline": "spline"}.get(row.smoothing, row.smoothing)
-    return f"{row.split}\n{smooth}" + ("\nacoustic" if row.mode != "phonetic" else "")
+    """A compact bar label in lines: split, smoothing, acoustic-only (eight of them fit a
+    laptop's dock: "acoustic" ran into its neighbours)."""
+    smooth = {"triangular": "tri.", "spline": "spl."}.get(row.smoothing, row.smoothing)
+    return f"{row.split}\n{smooth}" + ("\nac." if row.mode != "phonetic" else "")
 
 
 def draw_metrics(fig: Figure, rows: list[Table2Row], curves: list[SweepCurve]) -> None:
@@ -86,7 +87,7 @@ def draw_metrics(fig: Figure, rows: list[Table2Row], curves: list[SweepCurve]) -
     constrained layout keeps every label inside."""
     fig.clear()
     fig.set_layout_engine("constrained")
-    ax1, ax2 = fig.subplots(2, 1, height_ratios=[3, 2])
+    ax1, ax2 = fig.subplots(2, 1, height_ratios=[1, 1])
     if rows:
         x = np.arange(len(rows))
         width = 0.27
@@ -102,6 +103,8 @@ def draw_metrics(fig: Figure, rows: list[Table2Row], curves: list[SweepCurve]) -
                  color="#888888")
         ax1.set_title("Table 2: mean correlation on speech frames", fontsize=8)
     ax1.set_ylabel("correlation r", fontsize=8)
+    if rows:
+        ax1.set_xlabel("tri., spl.: triangular, spline smoothing; ac.: acoustic only", fontsize=7)
     ax1.tick_params(labelsize=7)
     figure5 = "Figure 5: correlation against N (triangular)"
     if curves:
@@ -171,8 +174,7 @@ class MetricsView(QWidget):
         self.sensor_table.setSortingEnabled(False)
         self.sensor_table.verticalHeader().setVisible(False)
         self.sensor_table.verticalHeader().setDefaultSectionSize(self.table.fontMetrics().height() + 6)
-        # Table 2 or the per-sensor table in the same place, chosen beside the status line (tabs
-        # took height the plots need on a laptop screen)
+        # Table 2 or the per-sensor table in the same place (the numbers' tab), chosen above it
         self.tables = QStackedWidget()
         self.tables.addWidget(self.table)
         self.tables.addWidget(self.sensor_table)
@@ -183,11 +185,29 @@ class MetricsView(QWidget):
         self.table_choice.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToContents)
         self.table_choice.currentIndexChanged.connect(self.tables.setCurrentIndex)
         self.canvas = Canvas(6, 5.2)
-        self.canvas.setMinimumHeight(260)
+        self.canvas.setMinimumHeight(300)
+        # the plots and the tables in tabs: each has the dock's height (in a laptop's dock the
+        # table took the room and Figure 5 was 30 px tall)
+        self.tabs = QTabWidget()
+        self.tabs.addTab(self.canvas, "Plots: Table 2, Figure 5")
+        self.tabs.addTab(self._numbers(), "Numbers: Table 2, per sensor")
         lay = QVBoxLayout(self)
         lay.addWidget(self._options(exp))
-        lay.addWidget(vertical_split(self.tables, self.canvas, (300, 520)), 1)
+        lay.addWidget(self.tabs, 1)
         self._draw()
+
+    def _numbers(self) -> QWidget:
+        """The numbers' tab: the table chooser over Table 2 or the per-sensor table."""
+        tab = QWidget()
+        row = QHBoxLayout()
+        row.addWidget(QLabel("table:"))
+        row.addWidget(self.table_choice)
+        row.addStretch(1)
+        lay = QVBoxLayout(tab)
+        lay.setContentsMargins(0, 2, 0, 0)
+        lay.addLayout(row)
+        lay.addWidget(self.tables, 1)
+        return tab
 
     def _options(self, exports: list) -> QGroupBox:
         """The run options in short rows (they fit a dock of 420 px), the progress and export."""
@@ -201,8 +221,7 @@ class MetricsView(QWidget):
         g.addWidget(self.run_sweep, 1, 1, 1, 2)
         g.addWidget(self.max_n, 1, 3)
         g.addWidget(self.progress, 2, 0, 1, 4)
-        g.addWidget(self.status, 3, 0, 1, 3)
-        g.addWidget(self.table_choice, 3, 3)
+        g.addWidget(self.status, 3, 0, 1, 4)
         buttons = QHBoxLayout()
         buttons.addWidget(QLabel("export:"))
         for text, slot in exports:
@@ -287,15 +306,8 @@ class MetricsView(QWidget):
                     item.setForeground(QColor("#666666"))
         fill_table(self.table, head, rows)
         self.table.resizeRowsToContents()
-        rows_height = sum(self.table.rowHeight(r) for r in range(self.table.rowCount()))
-        # every row in view (the rows needed scrolling), up to 30 % of the screen's height: on a
-        # laptop screen the table scrolls rather than push the plots (Figure 5's x label) out
-        # of the dock
-        screen = self.screen().availableGeometry().height() if self.screen() else 1000
-        self.table.setMinimumHeight(min(440, int(0.3 * screen),
-                                        rows_height + self.table.horizontalHeader().height()
-                                        + 2 * self.table.frameWidth() + 2))
-        self.status.setText(f"Table 2: {len(self.rows)} conditions (grey: the paper's)")
+        self.status.setText(f"Table 2: {len(self.rows)} conditions (its numbers: the second tab; "
+                            "grey: the paper's)")
         self._draw()
 
     def sensor_split(self) -> str:

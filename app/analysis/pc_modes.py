@@ -39,10 +39,10 @@ from PyQt6.QtWidgets import (
 )
 
 from facetraj_app.articulators import ArticulatorSet, ProfileDrawing, fit_parallel, is_articulograph
+from facetraj_app.face_scene import MarkerSet
 from facetraj_app.plotter_widget import make_plotter
 from facetraj_app.style import BACKGROUND, SYNTH_COLOR
 from facetraj_app.surface import Mouth, lip_contours, stored_face_triangles
-from facetraj_app.view3d import MarkerSet
 from facetraj_engine.analysis.lips import closed_lips
 from facetraj_engine.analysis.pc_modes import (
     describe_mode,
@@ -367,12 +367,13 @@ class PCModeExplorer(QWidget):
         self.valueChanged.emit(self.component, self.value)
 
     def readout(self) -> str:
-        """The coefficient with its unit and the lip aperture it gives, against closure."""
+        """The coefficient (a score on the PC: no unit of a marker's, so none shown) in SD, and
+        the lip aperture it gives (mm), against closure."""
         k, sd = self.component, self.sd[self.component]
         gap = float(mode_aperture(self.model, k, np.array([self.value / sd]))[0])
         beyond = gap - self.closed_aperture
         state = ("lips closed" if beyond <= 0 else f"open {beyond:.1f} mm beyond closure")
-        return (f"PC{k + 1} = {self.value:+.1f} mm ({self.value / sd:+.2f} SD) · lip aperture "
+        return (f"PC{k + 1} score {self.value:+.1f} ({self.value / sd:+.2f} SD) · lip aperture "
                 f"{gap:.1f} mm: {state} (the lips meet at {self.closed_aperture:.1f} mm)")
 
     def _update_plots(self) -> None:

@@ -200,12 +200,16 @@ def aperture_row(p: PhoneAperture) -> list:
 
 
 def write_phone_apertures_csv(path: str | os.PathLike[str], rows: Sequence[PhoneAperture],
-                              overwrite: bool = True) -> Path:
-    """Write the per-phone apertures (:data:`APERTURE_COLUMNS`) as CSV, atomically; NaN where
-    there is no original."""
+                              overwrite: bool = True,
+                              extra: dict[str, Sequence[float]] | None = None) -> Path:
+    """Write the per-phone apertures (:data:`APERTURE_COLUMNS`, then the ``extra`` columns: a
+    value per row each, e.g. a pinned result's) as CSV, atomically; NaN where there is no
+    original."""
     from .common import write_csv  # (the csv writer's package: not for the first frame)
 
-    return write_csv(path, APERTURE_COLUMNS, (aperture_row(p) for p in rows), overwrite)
+    extra = extra or {}
+    lines = ([*aperture_row(p), *(float(v[i]) for v in extra.values())] for i, p in enumerate(rows))
+    return write_csv(path, [*APERTURE_COLUMNS, *extra], lines, overwrite)
 
 
 __all__ = ["APERTURE_COLUMNS", "LipReadout", "PhoneAperture", "aperture", "aperture_row",

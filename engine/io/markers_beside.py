@@ -45,12 +45,19 @@ class MarkersBeside:
     def usable(self) -> bool:
         return self.markers is not None
 
-    def hint(self, audio_name: str) -> str:
-        """One sentence for the user when the markers cannot be used with this model."""
-        shown = ", ".join(self.names[:6]) + (" …" if len(self.names) > 6 else "")
-        return (f"{self.path.name} beside {audio_name} holds other markers than this model's "
-                f"({shown}: {self.difference}): to compare with them, import its folder "
-                "(File → Import your own recordings…) and open that corpus")
+    def hint(self, audio_name: str, model_markers: int | None = None) -> str:
+        """One sentence for the user when the markers cannot be used with this model (of
+        ``model_markers`` markers), in words (no list syntax).
+
+        >>> MarkersBeside(Path("a.ema"), ["UL", "LL", "TT"], None).hint("a.wav", 54).split(":")[0]
+        "a.ema beside a.wav holds 3 other markers (UL, LL and TT) than the model's 54"
+        """
+        names = self.names if len(self.names) <= 10 else [*self.names[:8], f"{len(self.names) - 8} more"]
+        listed = names[0] if len(names) == 1 else f"{', '.join(names[:-1])} and {names[-1]}"
+        model = f" the model's {model_markers}" if model_markers else " this model's"
+        return (f"{self.path.name} beside {audio_name} holds {len(self.names)} other markers "
+                f"({listed}) than{model}: to compare with them, import its folder (File → Import "
+                "your own recordings…) and open that corpus")
 
 
 def read_markers_beside(audio_path: str | os.PathLike[str], marker_names: Sequence[str],
