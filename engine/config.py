@@ -129,6 +129,10 @@ class SynthConfig:
         talkers its closures fell where their lips were open (issue 46, docs/labels.md).
     rest_pause_s, rest_taper_s : the face begins to rest once a pause has lasted this long, and
         reaches the rest face over the taper.
+    rest_end_s : a silence the input ends in (the talker has finished, however short the
+        silence) reaches the rest face at its last frame, rising over this long at most: the
+        frames a live stream's triangular smoothing still holds when its input ends (half its
+        window), so that live rests them as offline does (issue 49); 0: off.
     """
 
     n_context_phones: int = 3
@@ -160,6 +164,7 @@ class SynthConfig:
     closure_second_opinion: bool = False
     rest_pause_s: float = 0.15
     rest_taper_s: float = 0.05
+    rest_end_s: float = 0.05
 
     def with_(self, **changes) -> SynthConfig:
         """A copy with some fields changed."""

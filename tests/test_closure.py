@@ -94,3 +94,53 @@ def test_rest_reads_only_the_frames_before_each():
     assert rest_weights(starts_silent, 60.0, 0.15, 0.05).tolist() == [1.0] * 5 + [0.0] * 5
     assert rest_weights(starts_silent, 60.0, 0.15, 0.05, leading=False).max() == 0.0
     assert whole[~silent].max() == 0.0
+
+
+def test_a_silence_the_input_ends_in_reaches_the_rest_face_at_its_last_frame():
+    """Issue 49 (defect 7): a silence shorter than a pause at the input's end still rests: its
+    last ``end_frames`` rise to the rest face, the last at it; a pause's own weights stay, a
+    speech frame at the end stays, and a silence in the middle is untouched."""
+    ends_silent = np.array([True] * 20 + [False] * 30 + [True] * 6)
+    w = rest_weights(ends_silent, 60.0, 0.15, 0.05, end_frames=3)
+    plain = rest_weights(ends_silent, 60.0, 0.15, 0.05)
+    assert plain[-6:].max() == 0.0                         # 100 ms: no pause by itself
+    assert w[-1] == 1.0 and 0.0 < w[-3] < w[-2] < 1.0 and w[-4] == 0.0
+    assert np.array_equal(w[:-3], plain[:-3])
+    one = rest_weights(np.array([False] * 10 + [True]), 60.0, 0.15, 0.05, end_frames=3)
+    assert one.tolist() == [0.0] * 10 + [1.0]              # one silent frame: at rest
+    ends_in_speech = ends_silent.copy()
+    ends_in_speech[-1] = False
+    assert np.array_equal(rest_weights(ends_in_speech, 60.0, 0.15, 0.05, end_frames=3),
+                          rest_weights(ends_in_speech, 60.0, 0.15, 0.05))
+
+
+def test_arctic_files_rest_in_the_silences_they_begin_and_end_in(default_model):
+    """Issue 49 (defect 7) on the real voices: every ARCTIC sample's first frame, and the last
+    of each that ends in silence (100-200 ms of it), is at the rest face's lip aperture (the
+    acoustic search: the rule reads the silence, not the search; a stream's ends equal these,
+    tests/test_closure_detector.py)."""
+    from facetraj.paths import shared_path
+    from facetraj_engine.config import SynthConfig
+    from facetraj_engine.evaluation.closure import lip_aperture
+    from facetraj_engine.io.audio import read_audio
+    from facetraj_engine.method.closure import aperture_functional
+    from facetraj_engine.method.pipeline import synthesize
+    from facetraj_engine.method.speech import speech_mask
+
+    folder = shared_path("data/arctic_samples")
+    if not folder.is_dir():
+        pytest.skip(f"no {folder} (the CMU ARCTIC samples)")
+    m = default_model
+    a0, g = aperture_functional(m.pca, m.upper_lip, m.lower_lip)
+    rest = a0 + m.closure.rest @ g
+    ended_silent = 0
+    for wav in sorted(folder.glob("*.wav")):
+        audio, rate = read_audio(wav)
+        res = synthesize(m, audio, rate, config=SynthConfig(mode="acoustic"))
+        a = lip_aperture(res.markers, m.upper_lip, m.lower_lip)
+        assert a[0] == pytest.approx(rest, abs=1e-6), wav.name
+        if not speech_mask(audio, rate, res.times)[-1]:
+            ended_silent += 1
+            assert a[-1] == pytest.approx(rest, abs=1e-6), wav.name
+            assert a[-2] > a[-1] + 1.0, wav.name             # risen to it, not there before
+    assert ended_silent == 5

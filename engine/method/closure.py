@@ -339,18 +339,26 @@ def _support(times: np.ndarray, start: float, end: float, taper_s: float) -> sli
 
 
 def rest_weights(silent: np.ndarray, rate: float, min_s: float, taper_s: float,
-                 leading: bool = True) -> np.ndarray:
+                 leading: bool = True, end_frames: int = 0) -> np.ndarray:
     """Per frame t of ``silent`` (whether each frame is silent), how far the face rests, read from
     frame t and the frames before it alone (what a stream has decided when it shows frame t): 0
     on a speech frame and until a silence has lasted ``min_s``, then a raised-cosine rise over
     ``taper_s`` to 1. A silence from the input's start (``leading``: no speech before
     ``silent``'s first frame) counts as long already: the talker rests before speaking.
+    ``end_frames``: ``silent`` ends where the input ends, and a silence it ends in (the talker
+    has finished) reaches the rest face at its last frame, by a raised-cosine rise over its last
+    ``end_frames`` frames at most (the frames a stream still holds when its input ends:
+    :func:`end_rest_frames`).
 
     >>> s = np.array([1, 1, 0, 0, 1, 1, 1, 1, 1, 1, 0], dtype=bool)
     >>> rest_weights(s, 10.0, 0.15, 0.1).round(3).tolist()
     [1.0, 1.0, 0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0, 1.0, 0.0]
     >>> rest_weights(s, 10.0, 0.15, 0.1, leading=False)[:3].round(3).tolist()
     [0.0, 0.5, 0.0]
+    >>> rest_weights(np.array([0, 0, 1, 1, 1], dtype=bool), 100.0, 0.15, 0.1, end_frames=2).round(3).tolist()
+    [0.0, 0.0, 0.0, 0.5, 1.0]
+    >>> rest_weights(np.array([0, 1, 1, 1, 0], dtype=bool), 100.0, 0.15, 0.1, end_frames=2).tolist()
+    [0.0, 0.0, 0.0, 0.0, 0.0]
     """
     s = np.asarray(silent, dtype=bool)
     if not len(s):
@@ -362,13 +370,28 @@ def rest_weights(silent: np.ndarray, rate: float, min_s: float, taper_s: float,
         run[last_speech < 0] = np.inf
     lasted = run / float(rate)
     x = (lasted - min_s) / taper_s if taper_s > 0 else np.where(lasted > min_s, 1.0, 0.0)
-    return np.where(run > 0, ramp(np.where(np.isfinite(x), x, 1.0)), 0.0)
+    w = np.where(run > 0, ramp(np.where(np.isfinite(x), x, 1.0)), 0.0)
+    if end_frames > 0 and s[-1]:                          # the silence the input ends in
+        k = min(end_frames, len(s) - 1 - int(last_speech[-1]))
+        w[-k:] = np.maximum(w[-k:], ramp(np.arange(end_frames - k + 1, end_frames + 1) / end_frames))
+    return w
+
+
+def end_rest_frames(rest_end_s: float, rate: float) -> int:
+    """The frames over which a silence at the input's end reaches the rest face
+    (:func:`rest_weights`' ``end_frames``): ``rest_end_s`` at ``rate``, rounded.
+
+    >>> end_rest_frames(0.05, 60.0)
+    3
+    """
+    return max(0, int(round(rest_end_s * rate)))
 
 
 def rest_in_pauses(pcs: np.ndarray, plan: ClosurePlan, stats: ClosureStats, rate: float,
-                   min_s: float, taper_s: float) -> np.ndarray:
-    """Step 2: the PCs ``(T, K)`` of frames 0 .. T-1 blend towards the rest face with the weights
-    of :func:`rest_weights` (the plan's silent frames, from its first on).
+                   min_s: float, taper_s: float, end_frames: int = 0) -> np.ndarray:
+    """Step 2: the PCs ``(T, K)`` of frames 0 .. T-1 (the whole input) blend towards the rest
+    face with the weights of :func:`rest_weights` (the plan's silent frames, from its first on;
+    ``end_frames``: the rise of a silence the input ends in).
 
     >>> st = ClosureStats(1.0, np.array([1.0]), np.array([0.0]))
     >>> plan = ClosurePlan(np.zeros((0, 2)), np.zeros(0), np.array([0, 1, 1, 1, 1, 0], dtype=bool))
@@ -376,19 +399,20 @@ def rest_in_pauses(pcs: np.ndarray, plan: ClosurePlan, stats: ClosureStats, rate
     [2.0, 2.0, 1.0, 0.0, 0.0, 2.0]
     """
     pcs = np.asarray(pcs, dtype=np.float64)
-    b = frame_rest(plan, len(pcs), rate, min_s, taper_s)
+    b = frame_rest(plan, len(pcs), rate, min_s, taper_s, end_frames=end_frames)
     return pcs + b[:, None] * (stats.rest[None, :] - pcs)
 
 
 def frame_rest(plan: ClosurePlan, count: int, rate: float, min_s: float, taper_s: float,
-               first: int = 0) -> np.ndarray:
+               first: int = 0, end_frames: int = 0) -> np.ndarray:
     """The rest weights (:func:`rest_weights`) of frames ``first .. first + count - 1`` from the
-    plan's silent frames (undecided ones speech)."""
+    plan's silent frames (undecided ones speech); ``end_frames`` (the input ends at frame
+    ``first + count``): the rise of a silence it ends in."""
     stop = first + count
     silent = np.zeros(max(stop - plan.silent_from, 0), dtype=bool)
     known = plan.silent[:len(silent)]
     silent[:len(known)] = known
-    w = rest_weights(silent, rate, min_s, taper_s, plan.leading)
+    w = rest_weights(silent, rate, min_s, taper_s, plan.leading, end_frames)
     out = np.zeros(count)
     lo = max(first, plan.silent_from)
     out[lo - first:] = w[lo - plan.silent_from:]
@@ -397,8 +421,10 @@ def frame_rest(plan: ClosurePlan, count: int, rate: float, min_s: float, taper_s
 
 def apply_closure(pcs: np.ndarray, times: np.ndarray, plan: ClosurePlan, stats: ClosureStats,
                   a0: float, g: np.ndarray, rate: float, closure_taper_s: float = 0.05,
-                  rest_pause_s: float = 0.15, rest_taper_s: float = 0.05) -> np.ndarray:
-    """The whole step on smoothed PCs ``(T, K)`` of frames 0 .. T-1 at ``rate``: the lips close
-    (:func:`close_lips`), then the face rests in pauses (:func:`rest_in_pauses`)."""
+                  rest_pause_s: float = 0.15, rest_taper_s: float = 0.05,
+                  rest_end_s: float = 0.0) -> np.ndarray:
+    """The whole step on smoothed PCs ``(T, K)`` of frames 0 .. T-1 (the whole input) at
+    ``rate``: the lips close (:func:`close_lips`), then the face rests in pauses and in a silence
+    the input ends in (:func:`rest_in_pauses`)."""
     return rest_in_pauses(close_lips(pcs, times, plan, stats, a0, g, closure_taper_s), plan, stats,
-                          rate, rest_pause_s, rest_taper_s)
+                          rate, rest_pause_s, rest_taper_s, end_rest_frames(rest_end_s, rate))

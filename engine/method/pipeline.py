@@ -229,7 +229,8 @@ def _smoothed(model: Model, raw: np.ndarray, times: np.ndarray, config: SynthCon
         return pcs
     a0, g = aperture_functional(model.pca, model.upper_lip, model.lower_lip)
     return apply_closure(pcs, times, plan, model.closure, a0, g, model.marker_rate,
-                         config.closure_taper_s, config.rest_pause_s, config.rest_taper_s)
+                         config.closure_taper_s, config.rest_pause_s, config.rest_taper_s,
+                         config.rest_end_s)
 
 
 def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,

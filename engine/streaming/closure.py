@@ -24,7 +24,14 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from ..method.closure import ClosurePlan, ClosureStats, aperture_functional, closure_moves, frame_rest
+from ..method.closure import (
+    ClosurePlan,
+    ClosureStats,
+    aperture_functional,
+    closure_moves,
+    end_rest_frames,
+    frame_rest,
+)
 from ..method.model import Model
 from .speech import SILENT, SPEECH, UNRANGED
 
@@ -62,7 +69,8 @@ class ClosureStream:
     KEEP_S = 2.0
 
     def __init__(self, model: Model, hold: int = 0, closure_taper_s: float = 0.05,
-                 rest_taper_s: float = 0.05, rest_pause_s: float = 0.15):
+                 rest_taper_s: float = 0.05, rest_pause_s: float = 0.15,
+                 rest_end_s: float = 0.0):
         if model.closure is None:
             raise ValueError("the model has no closure statistics: train it again")
         self.stats: ClosureStats = model.closure
@@ -71,6 +79,7 @@ class ClosureStream:
         self.hold = hold
         self.closure_taper_s, self.rest_taper_s = closure_taper_s, rest_taper_s
         self.rest_pause_s = rest_pause_s
+        self.end_frames = end_rest_frames(rest_end_s, self.rate)
         self._pcs = np.zeros((0, len(self.g)))      # pre-closure PCs from frame self._first on
         self._first = 0
         self._emitted = 0
@@ -116,7 +125,7 @@ class ClosureStream:
         c = np.maximum(c, np.minimum(0.0, self.stats.closed - a[emit]))    # never past closed
         out = self._pcs[emit] + c[:, None] * self.stats.direction[None, :]
         b = frame_rest(plan, len(emit), self.rate, self.rest_pause_s, self.rest_taper_s,
-                       self._emitted)
+                       self._emitted, self.end_frames if final else 0)
         out = out + b[:, None] * (self.stats.rest[None, :] - out)
         self._emitted = stop
         drop = min(self._emitted, self.received - int(self.KEEP_S * self.rate)) - self._first

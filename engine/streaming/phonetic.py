@@ -122,7 +122,7 @@ class PhoneticSynthesizer:
         self._smoother = TriangularStream(self.rate, synth.triangle_s if synth.smoothing ==
                                           "triangular" else 0.0)
         self._closure = ClosureStream(model, self.timing.hold, synth.closure_taper_s,
-                                      synth.rest_taper_s, synth.rest_pause_s) \
+                                      synth.rest_taper_s, synth.rest_pause_s, synth.rest_end_s) \
             if synth.closure and model.closure else None
         self._gammas = gamma_grid(synth.gamma_min, synth.gamma_max, synth.gamma_steps)
         self._grouped = model.lsf_index().grouped(cb.lsf)

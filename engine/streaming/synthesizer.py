@@ -219,7 +219,7 @@ class StreamClosure:
         self.voice = VoiceTracker(model, self.speech) if searching else None
         self._bilabial = bilabial_codewords(model) if searching else None
         self.step = ClosureStream(model, 0, synth.closure_taper_s, synth.rest_taper_s,
-                                  synth.rest_pause_s)
+                                  synth.rest_pause_s, synth.rest_end_s)
         self._final = False
 
     @property
