@@ -93,6 +93,21 @@ class SynthSettingsPanel(QWidget):
         for combo in (self.mode, self.smoothing):      # the panel fits a narrow left dock
             combo.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon)
             combo.setMinimumContentsLength(16)
+        # the closure step, beyond the paper (issue 46): each part on or off, as the command's
+        # --no-closure-labels, --no-rest and --closure-detector
+        self.closure_labels = QCheckBox("lips close at /p b m/")
+        self.closure_labels.setToolTip(
+            "close the lips at the labelled /p b m/, trusting each label as its source says "
+            "(--no-closure-labels turns it off; docs/algorithm.md, the closure step)")
+        self.rest = QCheckBox("rest in pauses")
+        self.rest.setToolTip(
+            "the face rests in pauses of 150 ms or more, and in the silences a recording begins "
+            "and ends in (--no-rest turns it off)")
+        self.closure_detector = QCheckBox("closure detector (no labels)")
+        self.closure_detector.setToolTip(
+            "without phone labels, close the lips where the bilabial-closure detector finds a "
+            "closure (--closure-detector). Off by default: on real lips its closures lowered "
+            "the lip correlation (issue 46, docs/algorithm.md)")
         self.reset = QPushButton("Paper defaults")
         self.status = QLabel("")
         self.status.setWordWrap(True)
@@ -110,6 +125,11 @@ class SynthSettingsPanel(QWidget):
         form.addRow(self.mode_note)
         form.addRow(self.mode_reason)
         form.addRow("smoothing", self.smoothing)
+        lips = QVBoxLayout()
+        lips.setSpacing(0)
+        for box in (self.closure_labels, self.rest, self.closure_detector):
+            lips.addWidget(box)
+        form.addRow("closure step", lips)
         lay = QVBoxLayout(self)
         self._layout = lay
         lay.addLayout(form)
@@ -128,6 +148,8 @@ class SynthSettingsPanel(QWidget):
         self.mode.currentIndexChanged.connect(self._show_mode_note)
         self._show_mode_note()
         self.smoothing.currentIndexChanged.connect(self._changed)
+        for box in (self.closure_labels, self.rest, self.closure_detector):
+            box.toggled.connect(self._changed)
         self.reset.clicked.connect(lambda: (self.set_config(SynthConfig()), self._changed()))
 
     def add_widget(self, widget: QWidget) -> None:
@@ -201,7 +223,8 @@ class SynthSettingsPanel(QWidget):
     def set_config(self, cfg: SynthConfig) -> None:
         """Show ``cfg`` without emitting a change."""
         self._base = cfg
-        widgets = (self.n, self.c, self.xi, self.nu, self.nu_default, self.mode, self.smoothing)
+        widgets = (self.n, self.c, self.xi, self.nu, self.nu_default, self.mode, self.smoothing,
+                   self.closure_labels, self.rest, self.closure_detector)
         for w in widgets:
             w.blockSignals(True)
         self.n.setValue(cfg.n_context_phones)
@@ -214,6 +237,9 @@ class SynthSettingsPanel(QWidget):
         self._requested = search_key(cfg)
         self.mode.setCurrentIndex(max(0, self.mode.findData(self._requested)))
         self.smoothing.setCurrentIndex(max(0, self.smoothing.findData(cfg.smoothing)))
+        self.closure_labels.setChecked(cfg.closure and cfg.closure_labels)
+        self.rest.setChecked(cfg.closure and cfg.rest)
+        self.closure_detector.setChecked(cfg.closure and cfg.closure_detector)
         for w in widgets:
             w.blockSignals(False)
         self._show_mode_note()
@@ -233,7 +259,13 @@ class SynthSettingsPanel(QWidget):
         return self._base.with_(
             n_context_phones=self.n.value(), context=self.c.value(), xi=self.xi.value(),
             nu=None if self.nu_default.isChecked() else self.nu.value(), mode=search.mode,
-            smoothing=self.smoothing.currentData(), **changes)
+            smoothing=self.smoothing.currentData(), **changes, **self._closure_parts())
+
+    def _closure_parts(self) -> dict:
+        """The closure step's parts as the boxes say; the step is off when every part is."""
+        parts = {"closure_labels": self.closure_labels.isChecked(), "rest": self.rest.isChecked(),
+                 "closure_detector": self.closure_detector.isChecked()}
+        return {"closure": any(parts.values()), **parts}
 
     def _on_nu_default(self, checked: bool) -> None:
         self.nu.setEnabled(not checked)

@@ -188,6 +188,37 @@ def test_changing_n_resynthesizes(window, qtbot):
     assert win.view.utterance.name == other and win.settings.n.value() == 2
 
 
+def test_closure_parts_switched_from_the_settings(window, qtbot):
+    """The closure step's parts (issue 46) are boxes in the settings, as the command's
+    --no-closure-labels, --no-rest and --closure-detector: the defaults shown as the engine's,
+    each box resynthesizes, and with every box off the face is the paper's (no closure step)."""
+    win = window
+    s, default = win.settings, SynthConfig()
+    assert (s.closure_labels.isChecked(), s.rest.isChecked(), s.closure_detector.isChecked()) == \
+        (default.closure_labels, default.rest, default.closure_detector)
+    before = win.view
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        s.closure_labels.click()
+    cfg = win.view.synthesis.config
+    assert not cfg.closure_labels and cfg.rest and cfg.closure
+    assert not np.allclose(win.view.shown, before.shown)          # the /p b m/ no longer closed
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        s.rest.click()
+    assert not win.view.synthesis.config.closure
+    paper = win.view.synthesis
+    qtbot.waitUntil(lambda: win.settled, timeout=WAIT_MS)
+    from facetraj_engine.method.pipeline import synthesize
+
+    u = win.view.utterance
+    plain = synthesize(win.model, u.audio, u.sample_rate, u.phones,
+                       paper.config.with_(closure=True, closure_labels=False, rest=False),
+                       n_frames=u.n_frames)
+    np.testing.assert_allclose(paper.markers, plain.markers, atol=1e-9)
+    with qtbot.waitSignal(win.synthesisChanged, timeout=WAIT_MS):
+        s.reset.click()
+    assert s.closure_labels.isChecked() and s.rest.isChecked() and win.view.synthesis.config.closure
+
+
 def choose(combo, key) -> None:
     """Pick the entry of ``combo`` whose data is ``key``, as a user does (``activated``)."""
     combo.setCurrentIndex(combo.findData(key))
