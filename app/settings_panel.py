@@ -103,7 +103,7 @@ class SynthSettingsPanel(QWidget):
         self.rest.setToolTip(
             "the face rests in pauses of 150 ms or more, and in the silences a recording begins "
             "and ends in (--no-rest turns it off)")
-        self.closure_detector = QCheckBox("closure detector (no labels)")
+        self.closure_detector = QCheckBox("detector (no labels)")
         self.closure_detector.setToolTip(
             "without phone labels, close the lips where the bilabial-closure detector finds a "
             "closure (--closure-detector). Off by default: on real lips its closures lowered "
