@@ -458,7 +458,11 @@ def analysis_frames(audio: np.ndarray, rate: int, times: np.ndarray, window_s: f
                     preemphasis: float = 0.0, exponent: int = 0) -> np.ndarray:
     """Hamming-windowed frames of ``window_s`` centred on ``times`` (zero outside the signal;
     ``exponent`` as :func:`padded_signal`'s)."""
-    pad, starts, n = padded_signal(audio, rate, times, window_s, preemphasis, exponent)
+    return windowed(*padded_signal(audio, rate, times, window_s, preemphasis, exponent))
+
+
+def windowed(pad: np.ndarray, starts: np.ndarray, n: int) -> np.ndarray:
+    """The Hamming-windowed frames ``pad[s:s + n]`` of :func:`padded_signal` at ``starts``."""
     frames = np.lib.stride_tricks.sliding_window_view(pad, n)[starts]     # a copy: windowed in place
     frames *= np.hamming(n)
     return frames
@@ -510,10 +514,16 @@ def lsf_frames_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 
         x, exponent = np.ldexp(x, exponent), 0
     x = resample_audio(x, rate, audio_rate)
     times = np.asarray(times, dtype=np.float64)
-    frames = analysis_frames(x, audio_rate, times, window_s, preemphasis, exponent)
+    pad, starts, n = padded_signal(x, audio_rate, times, window_s, preemphasis, exponent)
+    # each span windows its own frames (:func:`windowed`), beside the others: the same values as
+    # :func:`analysis_frames` makes at once, without one thread gathering them all first
     if per_frame is None:
-        return np.concatenate(map_spans(lambda a, b: frame_lsf(frames[a:b], order), len(frames),
-                                        threads)), None
-    spans = map_spans(lambda a, b: (per_frame(frames[a:b]), frame_lsf(frames[a:b], order)),
-                      len(frames), threads)
+        return np.concatenate(map_spans(lambda a, b: frame_lsf(windowed(pad, starts[a:b], n), order),
+                                        len(starts), threads)), None
+
+    def span(a: int, b: int) -> tuple[np.ndarray, np.ndarray]:
+        frames = windowed(pad, starts[a:b], n)
+        return per_frame(frames), frame_lsf(frames, order)
+
+    spans = map_spans(span, len(starts), threads)
     return np.concatenate([lsf for _, lsf in spans]), np.concatenate([f for f, _ in spans])

@@ -205,13 +205,20 @@ class LsfIndex:
         by_cell = np.argsort(flat, kind="stable")
         bounds = np.searchsorted(flat[by_cell], np.arange(self.n_cells + 1))
         offsets, bounds = self.offsets.tolist(), bounds.tolist()          # Python ints: cheap
-        for c in np.flatnonzero((np.diff(bounds) > 0) & (sizes > 0)).tolist():       # opened
+        opened = np.flatnonzero((np.diff(bounds) > 0) & (sizes > 0)).tolist()
+        # one buffer for every cell's (f, P, size) differences: a block's memory is written again
+        # while the processor still holds it, not taken new from the allocator for each cell
+        most = max((min(bounds[c + 1] - bounds[c], max(1, int(BLOCK // (sizes[c] * order))))
+                    * sizes[c] for c in opened), default=0)
+        buffer = np.empty(int(most) * order, dtype=np.float32)
+        for c in opened:
             lo, hi = offsets[c], offsets[c + 1]
-            step = max(1, int(4e6 // ((hi - lo) * order)))       # bound the (f, P, size) temporary
+            step = max(1, int(BLOCK // ((hi - lo) * order)))     # bound the (f, P, size) temporary
             for r0 in range(bounds[c], bounds[c + 1], step):
                 pairs = by_cell[r0:min(r0 + step, bounds[c + 1])]
                 rows = pairs // probe
-                diff = wc[rows, :, None] - cell_lsf[:, lo:hi]                    # (f, P, size)
+                diff = buffer[:len(rows) * order * (hi - lo)].reshape(len(rows), order, hi - lo)
+                np.subtract(wc[rows, :, None], cell_lsf[:, lo:hi], out=diff)     # (f, P, size)
                 np.abs(diff, out=diff)
                 block = np.matmul(h[rows, None, :], diff)[:, 0]                  # eq 5, (f, size)
                 d[at[pairs][:, None] + np.arange(hi - lo)] = block
@@ -230,6 +237,9 @@ class LsfIndex:
         within = cols - (ends - sz)[rows, slot]
         return self.order[self.offsets[cells[rows, slot]] + within]
 
+
+#: the most values of one block of eq 5's differences in :meth:`LsfIndex._distances` (16 MB)
+BLOCK = 4e6
 
 #: rows of a search grouped by their number of values, for the partition (:func:`_smallest`)
 WIDTH_GROUPS = 4
