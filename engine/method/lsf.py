@@ -517,13 +517,10 @@ def lsf_frames_at(audio: np.ndarray, rate: int, times: np.ndarray, order: int = 
     pad, starts, n = padded_signal(x, audio_rate, times, window_s, preemphasis, exponent)
     # each span windows its own frames (:func:`windowed`), beside the others: the same values as
     # :func:`analysis_frames` makes at once, without one thread gathering them all first
-    if per_frame is None:
-        return np.concatenate(map_spans(lambda a, b: frame_lsf(windowed(pad, starts[a:b], n), order),
-                                        len(starts), threads)), None
-
-    def span(a: int, b: int) -> tuple[np.ndarray, np.ndarray]:
+    def span(a: int, b: int) -> tuple[np.ndarray | None, np.ndarray]:
         frames = windowed(pad, starts[a:b], n)
-        return per_frame(frames), frame_lsf(frames, order)
+        return None if per_frame is None else per_frame(frames), frame_lsf(frames, order)
 
     spans = map_spans(span, len(starts), threads)
-    return np.concatenate([lsf for _, lsf in spans]), np.concatenate([f for f, _ in spans])
+    lsf = np.concatenate([lsf for _, lsf in spans])
+    return lsf, None if per_frame is None else np.concatenate([f for f, _ in spans])

@@ -206,12 +206,13 @@ class LsfIndex:
         # row t: its cells side by side; a cell's block starts at t * width + its start in the row
         at = (np.arange(len(w))[:, None] * width + ends - sz).ravel()
         # d, then as many values more as the largest cell: every row of ``runs`` below is in it
-        padded = np.full(len(w) * width + int(sizes.max()), np.inf, dtype=np.float32)
+        widest = int(sizes.max())
+        padded = np.full(len(w) * width + widest, np.inf, dtype=np.float32)
         d = padded[:len(w) * width]
         # d's runs of the largest cell's length, one starting at each value: a frame's block of
         # a cell is the start of the run at its place in d (written a row at a time, not a
         # value at a time through indices)
-        runs = np.lib.stride_tricks.as_strided(padded, (len(d), int(sizes.max())),
+        runs = np.lib.stride_tricks.as_strided(padded, (len(d), widest),
                                                (padded.itemsize, padded.itemsize))
         flat = cells.ravel()
         by_cell = np.argsort(flat, kind="stable")
