@@ -17,7 +17,7 @@ from PyQt6.QtCore import QObject, QSize, Qt, pyqtSignal
 from PyQt6.QtGui import QKeySequence
 from PyQt6.QtWidgets import QLabel
 
-from .pins import aperture_difference, distinct_settings
+from .pins import aperture_difference
 
 #: the widest the pins' list asks to be in the toolbar (it dropped into the toolbar's overflow
 #: menu on a laptop screen); the legend row and the tooltip name each pin in full
@@ -67,15 +67,13 @@ class PinList(QLabel):
     def minimumSizeHint(self) -> QSize:
         return QSize(min(super().minimumSizeHint().width(), 120), super().minimumSizeHint().height())
 
-    def show_pins(self, shown: list, view, note: str) -> None:
-        """``shown``: the pins drawn with ``view``; else ``note`` says why none is."""
+    def show_pins(self, shown: list, parts: list[str], note: str) -> None:
+        """``shown``: the pins drawn with the result on screen, ``parts`` what tells each apart
+        (``PinBoard.describe``); else ``note`` says why none is."""
         if not shown:
             self.setText(escape(note))
             self.setToolTip(note)
             return
-        from .provenance import settings_text
-
-        parts = distinct_settings([settings_text(view, short=True)] + [p.settings for p in shown])[1:]
         self.setText("  ".join(f'<span style="color:{p.color}">■</span> {p.name}: {escape(part)}'
                                for p, part in zip(shown, parts, strict=True)))
         self.setToolTip("\n".join(f"{p.name}: {p.settings}" for p in shown))
@@ -136,7 +134,7 @@ class Compare(QObject):
         shown = w.pins.shown(w.view)
         changed, self._shown = shown != self._shown, shown
         self.clear_action.setEnabled(len(w.pins) > 0)
-        self.label.show_pins(shown, w.view, self._note())
+        self.label.show_pins(shown, w.pins.describe(w.view, shown) if shown else [], self._note())
         w.face.set_pins(shown)
         tl = w.timeline
         if shown and self.panel not in tl.panels:

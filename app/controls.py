@@ -295,7 +295,7 @@ class TransportBar(QWidget):
 
     def set_frames(self, n_frames: int) -> None:
         self.slider.blockSignals(True)
-        self.slider.setRange(0, n_frames - 1)
+        self.slider.setRange(0, max(n_frames - 1, 0))
         self.slider.blockSignals(False)
 
     def show_frame(self, frame: int, text: str) -> None:
@@ -370,6 +370,12 @@ class LoopRange:
 
 def ask_corpus_folder(parent: QWidget) -> tuple[Path] | None:
     path = QFileDialog.getExistingDirectory(parent, "Open a corpus folder")
+    return (Path(path),) if path else None
+
+
+def ask_recordings_folder(parent: QWidget) -> tuple[Path] | None:
+    path = QFileDialog.getExistingDirectory(parent, "Open a folder of recordings (synthesized with "
+                                                    "the model in use)")
     return (Path(path),) if path else None
 
 

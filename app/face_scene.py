@@ -285,7 +285,11 @@ class FaceScene:
         (``facetraj_engine.analysis.lips.closed_lips``, made here if not given), where the mouth shuts."""
         self.model = model
         self.articulators = is_articulograph(model)     # sensors drawn as articulators, no face
-        self.ahead = -1
+        # the previous model's view and pins are of its marker set, not this one's: forgotten
+        # (the window shows this model's first utterance next)
+        self.view, self._orig, self._syn = None, None, None
+        self.pins, self._pin_frames, self._pin_offsets = [], [], []
+        self.frame = self.ahead = -1
         self.plotter.clear()
         # one light that follows the camera plus a key light from above: shading that shows
         # the face's shape at little cost (each light is per-fragment work on a software renderer)

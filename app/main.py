@@ -104,6 +104,9 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
     mark("QApplication")
     with long_lived_objects():
         window = build_window(corpus, model=model, utterance=utterance, time=time)
+    from .exception_hook import install_exception_hook
+
+    hook = install_exception_hook(window)   # an exception in a slot: a dialog, never an abort
     if recordings:
         from .recordings import RecordingQueue
 
@@ -146,5 +149,6 @@ def run_app(corpus: Path | str, screenshot: str | None = None, utterance: str | 
         rc = app.exec()
     finally:
         window.close()
+        hook.restore()
     del xvfb   # it ends when this process disconnects
     return status["code"] or rc

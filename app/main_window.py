@@ -85,6 +85,7 @@ from .controls import (
     TransportBar,
     ViewBar,
     ask_corpus_folder,
+    ask_recordings_folder,
     ask_screenshot_path,
     playback_shortcuts,
 )
@@ -95,6 +96,7 @@ from .phases import mark
 from .playback import PlaybackScheduler
 from .plotter_widget import grab_with_3d
 from .provenance import LabelOrigin
+from .recordings import RecordingQueue, recordings_in
 from .settings_panel import SynthSettingsPanel
 from .state import UtteranceView
 from .status import StatusArea
@@ -158,6 +160,7 @@ class MainWindow(QMainWindow):
         self._error_handler: Callable[[str], None] | None = None
         self.closed_lips: ClosedLips | None = None      # the talker's lips at closure (per model)
         self._extensions: dict[str, object] = {}
+        self._after_model: list[Callable[[], Any]] = []   # asked for while a model loads
         self.menus = WindowMenus(self, self.report_error)
         self.docks = WindowDocks(self)
         self._build_widgets()
@@ -307,13 +310,37 @@ class MainWindow(QMainWindow):
 
     # ================================================================== corpus and model
     def open_corpus(self, path: Path, model_path: Path | None = None) -> None:
-        """Open a corpus folder; its model is loaded from ``model_path``, the cache, or trained."""
+        """Open a corpus folder; its model is loaded from ``model_path``, the cache, or trained.
+        A folder of recordings (audio, no ``corpus.json``) is opened as such
+        (:meth:`open_recordings`)."""
         try:
+            if recordings_in(Path(path)):
+                self.open_recordings(Path(path))
+                return
             corpus = load_corpus(path)
         except FacetrajError as exc:
             self.report_error(exc)
             return
         self._load_model(corpus, model_path)
+
+    def open_recordings(self, path: Path) -> None:
+        """Synthesize the recordings of a folder (or one audio file) with the model in use,
+        each with its labels by the one label rule (as ``facetraj gui folder/`` does): the first
+        shown, the others listed in the browser."""
+        try:
+            paths = recordings_in(Path(path))
+        except FacetrajError as exc:
+            self.report_error(exc)
+            return
+        if not paths:
+            self.report_error(FacetrajError(f"{path}: a corpus folder, not a folder of recordings "
+                                            "(File > Open corpus folder opens it)"))
+            return
+        if self.model is None and not self.state.loading:
+            self.report_error(FacetrajError("no model yet: open a corpus first"))
+            return
+        self.show_status(f"opening {len(paths)} recordings of {path} …")
+        self.add_extension("recordings", RecordingQueue(self, paths))     # kept while it works
 
     def _open_first_corpus(self, path: Path, model_path: Path | None) -> None:
         """The corpus given to the constructor: its model starts loading at once, beside the
@@ -327,14 +354,42 @@ class MainWindow(QMainWindow):
         self._load_model(corpus, model_path)
 
     def _load_model(self, corpus: Corpus, model_path: Path | None) -> None:
+        """Load or train ``corpus``'s model in the background; a model of a corpus opened
+        before the last one is dropped when it arrives (the last one opened is shown)."""
         mark("corpus index read")
         self.status_label.setText(f"opening {corpus.root} …")
-        self.run_task(lambda p: load_model(corpus, model_path, p, load_or_train),
-                      lambda r: self._on_model_ready(corpus, *r), "preparing the model (first run trains it)")
+        number = self.state.begin_model_load()
+
+        def failed(exc: BaseException) -> None:
+            self.state.end_model_load(number)
+            self.report_error(exc)
+            self._run_after_model()           # with the model in use, if any
+
+        def done(result: tuple[Model, dict[str, str]]) -> None:
+            if self.state.is_latest_load(number):
+                self._on_model_ready(corpus, *result)
+
+        self.run_task(lambda p: load_model(corpus, model_path, p, load_or_train), done,
+                      "preparing the model (first run trains it)", on_error=failed)
+
+    def when_model_ready(self, fn: Callable[[], Any]) -> None:
+        """``fn()`` now if a model is in use and none is on its way, else once the model on its
+        way is ready (a recording opened while a corpus loads is synthesized with that corpus's
+        model, the one the user will see)."""
+        if self.state.ready:
+            fn()
+        else:
+            self._after_model.append(fn)
+
+    def _run_after_model(self) -> None:
+        waiting, self._after_model = self._after_model, []
+        for fn in waiting:
+            fn()
 
     def _on_model_ready(self, corpus: Corpus, model: Model, texts: dict[str, str]) -> None:
         mark("model ready")
         self.stop()
+        self._forget_view()
         first = self.state.set_model(corpus, model, texts)
         self.closed_lips = closed_lips(model)     # the 3-D mouth shuts there; the lip panels' line
         self.face.set_model(model, self.closed_lips)
@@ -350,6 +405,17 @@ class MainWindow(QMainWindow):
         if first:
             self.set_utterance(first)
         self._start_sweep()
+        self._run_after_model()
+
+    def _forget_view(self) -> None:
+        """Before another model is used: the panels and the title drop the utterance shown (its
+        markers are of the old model's marker set; the 3-D scene drops it in ``set_model``), so
+        that nothing draws it with the new model's markers while the new first utterance is
+        synthesized."""
+        self.playback.set_frames(0, self.view.rate if self.view is not None else 60.0)
+        self.transport.set_frames(0)
+        self.timeline.set_view(None)
+        self.title.setText("")
 
     def set_correlation_sweep(self, on: bool) -> None:
         """Whether every corpus utterance's lip correlations are computed in the background (the
@@ -487,6 +553,9 @@ class MainWindow(QMainWindow):
     def open_audio(self, audio_path: Path, labels_path: Path | None = None, **kw) -> bool:
         """Synthesize from an audio file (its labels: ``labels_path``, ``text=``, ``recognize=True``,
         ``acoustic_only=True`` or beside it; markers beside it: ``AudioOpener.open``)."""
+        if not self.state.ready and self.state.loading:
+            self.when_model_ready(lambda: self.audio_opener.open(Path(audio_path), labels_path, **kw))
+            return True
         return self.audio_opener.open(Path(audio_path), labels_path, **kw)
 
     def show_external(self, utt: Utterance, origin: LabelOrigin | None = None, show: bool = True) -> None:
@@ -538,6 +607,8 @@ def _build_menus(w: MainWindow) -> None:
     w.action_open_corpus = w.menus.action("File", "Open &corpus folder…",
                                           lambda: _given(ask_corpus_folder(w), w.open_corpus))
     w.action_open_audio = w.menus.action("File", "Open &audio for synthesis…", lambda: w.audio_opener.ask())
+    w.action_open_recordings = w.menus.action("File", "Open a &folder of recordings…",
+                                              lambda: _given(ask_recordings_folder(w), w.open_recordings))
     w.action_screenshot = w.menus.action(
         "File", "Save &screenshot…",
         lambda: _given(ask_screenshot_path(w), lambda p: w.show_status(f"wrote {w.save_screenshot(p)}")))

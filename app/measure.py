@@ -132,7 +132,8 @@ class CorpusRun(QGroupBox):
 
     def __init__(self, measure: Measure, phone_filter: QLineEdit, window):
         super().__init__("Across the corpus: this result and the pins, per phone")
-        self.measure, self.phone_filter, self.window = measure, phone_filter, window
+        # (not ``self.window``: a widget's ``window()`` is Qt's, which the dialogs use)
+        self.measure, self.phone_filter, self.host = measure, phone_filter, window
         self.rows: list[ComparedPhone] = []
         self.recipes: list[Recipe] = []
         self.split = QComboBox()
@@ -168,12 +169,12 @@ class CorpusRun(QGroupBox):
         lay.addLayout(bottom)
 
     def ids(self) -> list[tuple[str, str]]:
-        info, n = self.window.corpus.info, self.count.value() or None
+        info, n = self.host.corpus.info, self.count.value() or None
         return [(s, u) for s in RUN_SPLITS[self.split.currentText()] for u in getattr(info, s)[:n]]
 
     def run(self) -> None:
         """Compare the results on the chosen utterances (in a worker; the status bar shows it)."""
-        w = self.window
+        w = self.host
         recipes, ids = self.measure.recipes(), self.ids() if w.corpus is not None else []
         if not recipes or not ids:
             w.show_status("nothing to compare: no result shown or no corpus", 6000)

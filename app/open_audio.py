@@ -197,6 +197,7 @@ class AudioHost(Protocol):
     def show_external(self, utt: Utterance, origin: LabelOrigin | None = None,
                       show: bool = True) -> None: ...
     def show_labels(self, utt: Utterance, origin: LabelOrigin, own: bool = False) -> None: ...
+    def when_model_ready(self, fn: Callable[[], object]) -> None: ...
 
 
 class AudioOpener(QObject):
@@ -222,11 +223,13 @@ class AudioOpener(QObject):
         """The File menu's "Open audio…": the file, then (if nothing is beside it) the sentence."""
         path, _ = QFileDialog.getOpenFileName(self.window, "Open audio for synthesis", "",
                                               "Audio (*.wav *.flac);;All files (*)")
-        if not path:
-            return
+        if path:         # with the model the user will see, if a corpus is on its way
+            self.window.when_model_ready(lambda: self._ask_labels(Path(path)))
+
+    def _ask_labels(self, path: Path) -> None:
+        """Open ``path``: with the labels or sentence beside it, else those the user chooses."""
         from facetraj_engine.io.label_rule import beside
 
-        path = Path(path)
         read = self._read(path)  # a corrupt file is reported before the sentence is asked for
         if read is None:
             return
@@ -344,8 +347,14 @@ class AudioOpener(QObject):
                                else f"internal error: {type(exc).__name__}: {exc}")
             self.finished.emit(str(audio_path), False)
 
-        win.run_task(work, lambda r: self._show(*r, show=show), "aligning the phones",
-                     on_error=failed)
+        def done(result) -> None:
+            if win.model is not model:     # another corpus opened meanwhile: its model's markers
+                self.open(audio_path, labels_path, text, recognize, acoustic_only,   # and rate
+                          sources.extra_dict, show)
+                return
+            self._show(*result, show=show)
+
+        win.run_task(work, done, "aligning the phones", on_error=failed)
 
     def _show(self, sources: LabelSources, source: str, beside: MarkersBeside | None,
               beside_error: str, show: bool = True) -> None:

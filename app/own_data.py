@@ -132,10 +132,10 @@ class ImportDialog(QDialog):
         self.fixed_list.setSelectionMode(QAbstractItemView.SelectionMode.NoSelection)
         self.fixed_list.setMaximumHeight(130)
         form.addRow("Fixed (head) markers", self.fixed_list)
-        self.upper = QComboBox()
-        self.lower = QComboBox()
-        form.addRow("Upper lip centre", self.upper)
-        form.addRow("Lower lip centre", self.lower)
+        self.upper_lip = QComboBox()
+        self.lower_lip = QComboBox()
+        form.addRow("Upper lip centre", self.upper_lip)
+        form.addRow("Lower lip centre", self.lower_lip)
         self.rate = QDoubleSpinBox()
         self.rate.setRange(10, 1000)
         self.rate.setValue(60)
@@ -223,7 +223,7 @@ class ImportDialog(QDialog):
             item.setFlags(item.flags() | Qt.ItemFlag.ItemIsUserCheckable)
             item.setCheckState(Qt.CheckState.Checked if name in fixed else Qt.CheckState.Unchecked)
             self.fixed_list.addItem(item)
-        for combo, pick in ((self.upper, upper), (self.lower, lower)):
+        for combo, pick in ((self.upper_lip, upper), (self.lower_lip, lower)):
             combo.clear()
             combo.addItems(scan.marker_names)
             combo.setCurrentText(pick)
@@ -307,8 +307,8 @@ class ImportDialog(QDialog):
             map_path = out.with_name(out.stem + ".labelmap.tsv")
             write_label_map(map_path, table)
             label_map = map_path.name
-        path, _ = init_corpus(folder, out, self.fixed_markers(), self.upper.currentText(),
-                              self.lower.currentText(), label_map=label_map,
+        path, _ = init_corpus(folder, out, self.fixed_markers(), self.upper_lip.currentText(),
+                              self.lower_lip.currentText(), label_map=label_map,
                               marker_rate=self.rate.value(), test_fraction=self.test_fraction.value(),
                               name=folder.name, channel_names=self.channel_names.text().split() or None,
                               head_corrected=self.head_corrected.isChecked())

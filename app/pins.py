@@ -18,7 +18,7 @@ import numpy as np
 
 from facetraj_engine.analysis.apertures import aperture
 
-from .provenance import settings_text
+from .provenance import synthesis_parts
 from .state import UtteranceView
 
 #: the pins' colours, in turn: apart from the original's blue, the synthesis's oranges, the
@@ -32,13 +32,14 @@ MAX_PINS = len(PIN_COLORS)
 @dataclass(frozen=True, eq=False)
 class Pin:
     """A result kept: its view (the synthesis and its tracks), its number and colour, how it was
-    made (``settings``), and the model it was made with (``model_name``: the corpus it was
-    trained on; ``marker_names``: its marker set)."""
+    made (``parts``: every setting that changes the synthesis, :func:`~facetraj_app.provenance.
+    synthesis_parts`), and the model it was made with (``model_name``: the corpus it was trained
+    on; ``marker_names``: its marker set)."""
 
     number: int
     view: UtteranceView
     color: str
-    settings: str
+    parts: tuple[str, ...]
     model_name: str = ""
     marker_names: tuple[str, ...] = ()
 
@@ -46,11 +47,16 @@ class Pin:
     def name(self) -> str:
         return f"pin {self.number}"
 
+    @property
+    def settings(self) -> str:
+        """How it was made, in full (its model included)."""
+        return ", ".join([*self.parts, *([f"model {self.model_name}"] if self.model_name else [])])
+
     def legend(self, model_name: str = "") -> str:
-        """The legend's entry: the pin and how it was made (its model too when it is not
-        ``model_name``, the current one)."""
+        """The pin and how it was made in full (its model too when it is not ``model_name``, the
+        current one); :meth:`PinBoard.describe` says only what differs."""
         other = f"; model {self.model_name}" if self.model_name and self.model_name != model_name else ""
-        return f"{self.name}: {self.settings}{other}"
+        return f"{self.name}: {', '.join(self.parts)}{other}"
 
     def matches(self, view: UtteranceView) -> bool:
         """Whether this pin is of ``view``'s utterance (same name, same length) and another
@@ -85,7 +91,7 @@ class PinBoard:
             used.discard(self.pins.pop(0).color)
         color = next(c for c in PIN_COLORS if c not in used)
         self._count += 1
-        pin = Pin(self._count, view, color, settings_text(view, short=True), self.model_name,
+        pin = Pin(self._count, view, color, tuple(synthesis_parts(view)), self.model_name,
                   self.marker_names)
         self.pins.append(pin)
         return pin
@@ -103,22 +109,34 @@ class PinBoard:
         return [p for p in self.pins
                 if p.matches(view) and (not p.marker_names or p.marker_names == self.marker_names)]
 
+    def describe(self, view: UtteranceView, pins: Sequence[Pin]) -> list[str]:
+        """What tells each of ``pins`` apart from ``view`` (the result on screen, made with the
+        current model) and from each other: the settings, the labels or the model that differ
+        (:func:`distinct_settings`); the toolbar's list and the lip panels' legend."""
+        own = [*synthesis_parts(view), f"model {self.model_name}"]
+        return distinct_settings([own, *([*p.parts, f"model {p.model_name or self.model_name}"]
+                                         for p in pins)])[1:]
+
     def __len__(self) -> int:
         return len(self.pins)
 
 
-def distinct_settings(texts: Sequence[str]) -> list[str]:
-    """Of each settings text (:func:`~facetraj_app.provenance.settings_text`, short), the parts
-    not common to all (how each result differs from the others), or the whole text where
-    nothing differs: the pins' list fits a laptop's toolbar.
+def distinct_settings(results: Sequence[Sequence[str] | str]) -> list[str]:
+    """Of each result's settings (its parts, :func:`~facetraj_app.provenance.synthesis_parts`, or
+    a text of parts joined by ", " or "; "), the parts not common to all (how each result differs
+    from the others), or all its parts where nothing differs: the pins' list fits a laptop's
+    toolbar.
 
     >>> distinct_settings(["robust, N=3, triangular; labels: aligned",
     ...                    "robust, N=3, triangular; labels: recognized"])
     ['labels: aligned', 'labels: recognized']
+    >>> distinct_settings([["phonetic", "N=2", "C=3"], ["phonetic", "N=2", "C=2"]])
+    ['C=3', 'C=2']
     """
-    parts = [[p.strip() for chunk in t.split("; ") for p in chunk.split(", ")] for t in texts]
+    parts = [[p.strip() for chunk in r.split("; ") for p in chunk.split(", ")] if isinstance(r, str)
+             else list(r) for r in results]
     common = set.intersection(*map(set, parts)) if parts else set()
-    return [", ".join(p for p in ps if p not in common) or t for ps, t in zip(parts, texts, strict=True)]
+    return [", ".join(p for p in ps if p not in common) or ", ".join(ps) for ps in parts]
 
 
 def aperture_difference(view: UtteranceView, pin: Pin, upper: int, lower: int) -> np.ndarray:

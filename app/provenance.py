@@ -109,17 +109,54 @@ def mode_reason(requested: SynthConfig, used: SynthConfig, reason: str) -> str:
 SMOOTHING_NAMES = {"triangular": "triangular", "spline": "spline", "none": "unsmoothed"}
 
 
+def closure_text(cfg: SynthConfig) -> str:
+    """The closure step's parts that are on (the settings' boxes), in words.
+
+    >>> closure_text(SynthConfig()), closure_text(SynthConfig(closure=False))
+    ('closure: /p b m/ + rest', 'closure: off')
+    >>> closure_text(SynthConfig(mode="acoustic", closure_detector=True))
+    'closure: /p b m/ + rest + detector'
+    """
+    on = [name for name, flag in (("/p b m/", cfg.closure_labels), ("rest", cfg.rest),
+                                  ("detector", cfg.closure_detector),
+                                  ("second opinion", cfg.closure_second_opinion)) if flag]
+    return f"closure: {' + '.join(on)}" if cfg.closure and on else "closure: off"
+
+
+def synthesis_parts(view) -> list[str]:
+    """Every setting that changes how ``view`` (an ``UtteranceView``) was synthesized, one short
+    part each, in the settings' order: the search, N, C, xi and nu where labels are searched
+    (eq 4; eq 3's nu "trained" when the model's own), the smoothing, the closure step's parts,
+    the labels and their source (file or transcript) -- what tells two pins apart
+    (:func:`facetraj_app.pins.distinct_settings`; the model is the pin's own part)."""
+    cfg, origin = view.synthesis.config, view.label_origin
+    parts = [search_title(cfg)]
+    if MODES[cfg.mode].needs_labels:
+        nu = "trained" if cfg.nu is None else f"{cfg.nu:g}"
+        parts += [f"N={cfg.n_context_phones}", f"C={cfg.context}", f"ξ={cfg.xi:g}", f"ν={nu}"]
+        labels = origin.short()
+        if origin.source == "file" and origin.file:
+            labels = origin.file
+        elif origin.transcript:
+            labels = f"{labels} from {origin.transcript}"
+        elif origin.file:
+            labels = f"{labels} ({origin.file})"
+    else:
+        labels = "not used" if origin.source not in ("", "none") else "none"
+    return [*parts, SMOOTHING_NAMES[cfg.smoothing], closure_text(cfg), f"labels: {labels}"]
+
+
 def settings_text(view, short: bool = False) -> str:
     """How a view was synthesized: the smoothing, the search the synthesis used
-    (``Synthesis.config``), N where labels are searched, and where the labels came from (in a
-    word or two with ``short``: a legend's entry); an acoustic-only search uses no labels, and
-    says so (an acoustic-only pin read "labels: label file"). ``view``: an ``UtteranceView``."""
+    (``Synthesis.config``), N where labels are searched, the closure step, and where the labels
+    came from; an acoustic-only search uses no labels, and says so (an acoustic-only pin read
+    "labels: label file"). ``short``: every part of :func:`synthesis_parts` (a pin's record,
+    from which its legend keeps what differs). ``view``: an ``UtteranceView``."""
+    if short:
+        return ", ".join(synthesis_parts(view))
     cfg, origin = view.synthesis.config, view.label_origin
     used = MODES[cfg.mode].needs_labels
     n = f", N={cfg.n_context_phones}" if used else ""
-    if short:
-        labels = origin.short() if used or origin.source in ("", "none") else "not used"
-        return f"{search_title(cfg)}{n}, {SMOOTHING_NAMES[cfg.smoothing]}; labels: {labels}"
     unused = "" if used or origin.source in ("", "none") else " (not used by this search)"
-    return (f"{SMOOTHING_NAMES[cfg.smoothing]} synthesis, {search_title(cfg)}{n};  "
-            f"labels: {origin.text()}{unused}")
+    return (f"{SMOOTHING_NAMES[cfg.smoothing]} synthesis, {search_title(cfg)}{n}, "
+            f"{closure_text(cfg)};  labels: {origin.text()}{unused}")

@@ -27,23 +27,29 @@ def recordings_in(path: Path) -> list[Path]:
 
 
 class RecordingQueue:
-    """Opens ``paths`` in ``window``, one after another once the model is ready: the first is
-    shown, the others only listed in the browser's "opened" group (each labelled in turn, the
-    next once the one before is done or failed), so that the window lands on the first (it
-    showed each in turn and ended on the last)."""
+    """Opens ``paths`` in ``window``, one after another once the model is ready (at once if it
+    is): the first is shown, the others only listed in the browser's "opened" group (each
+    labelled in turn, the next once the one before is done or failed), so that the window lands
+    on the first (it showed each in turn and ended on the last). Done, it lets go of the window."""
 
     def __init__(self, window, paths: list[Path]):
         self.window = window
         self.pending = list(paths)
         self.shown = False
-        window.state.show_default = False
-        window.modelReady.connect(self.next)
-        window.audio_opener.finished.connect(lambda _path, ok: self._done(ok))
+        if not window.state.ready:  # the coming model's first utterance is not shown: these are
+            window.state.show_default = False
+        window.audio_opener.finished.connect(self._done)
+        window.when_model_ready(self.next)
 
-    def _done(self, ok: bool) -> None:
+    def _done(self, _path: str, ok: bool) -> None:
         self.shown |= ok
         self.next()
 
     def next(self) -> None:
         if self.pending:             # a file that cannot be read: its error (finished), the next
             self.window.open_audio(self.pending.pop(0), show=not self.shown)
+            return
+        try:
+            self.window.audio_opener.finished.disconnect(self._done)
+        except TypeError:              # done already
+            pass

@@ -99,24 +99,50 @@ class ViewerModel:
     view: UtteranceView | None = None
     pending_utterance: str | None = None     # asked for before the model was ready
     pending_time: float | None = None        # where the first utterance starts
-    show_default: bool = True                # show a corpus utterance first (not: recordings)
+    show_default: bool = True                # the next model shows a corpus utterance first
+    #                                          (not: recordings opened with it; once)
     request: SynthRequest | None = None      # the latest utterance asked for
     generation: int = 0
     mode_chosen: bool = False                # the user picked a search mode in the settings
     pins: PinBoard = field(default_factory=PinBoard)   # results kept to compare (app/pins.py)
+    model_load: int = 0                      # the latest model asked for (a corpus opened)
+    loading: bool = False                    # whether that model is on its way
 
     # ------------------------------------------------------------------ corpus and model
+    def begin_model_load(self) -> int:
+        """A corpus was opened: its model is on its way. Returns its number; a model that
+        arrives for an older number (a corpus opened before the last one) is stale
+        (:meth:`is_latest_load`)."""
+        self.model_load += 1
+        self.loading = True
+        return self.model_load
+
+    def is_latest_load(self, number: int) -> bool:
+        return number == self.model_load
+
+    def end_model_load(self, number: int) -> None:
+        """The model ``number`` failed to load: the one in use stays (if it is the latest)."""
+        if self.is_latest_load(number):
+            self.loading = False
+
+    @property
+    def ready(self) -> bool:
+        """Whether a model is in use and no other is on its way (a recording opened now is
+        synthesized with the model the user sees)."""
+        return self.model is not None and not self.loading
+
     def set_model(self, corpus: Corpus, model: Model, texts: dict[str, str]) -> str | None:
         """Use a newly loaded corpus and model: forget the view, the request and the utterances
         opened from files. Returns the utterance to show first (the one asked for, or the default)."""
         self.corpus, self.model, self.texts = corpus, model, texts
+        self.loading = False
         self.pins.set_model(Path(corpus.root).name, model.marker_names)   # pins are kept
         self.external.clear()
         self.external_origin.clear()
         self.view = None
         self.request = None
         first = self.pending_utterance or (self.default_utterance() if self.show_default else None)
-        self.pending_utterance = None
+        self.pending_utterance, self.show_default = None, True
         return first
 
     def default_utterance(self) -> str | None:
@@ -145,6 +171,9 @@ class ViewerModel:
         """Keep an utterance opened from files (and where its labels came from) under a name no
         corpus utterance has (:meth:`external_name`); return it."""
         name = self.external_name(utt.name)
+        if utt.markers is None and self.model is not None:     # opened while another model
+            utt = replace(utt, marker_names=list(self.model.marker_names),   # was in use
+                          marker_rate=self.model.marker_rate)
         self.external[name] = replace(utt, name=name)
         self.external_origin[name] = origin or LabelOrigin(utt.label_source)
         return name

@@ -8,6 +8,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from PyQt6 import sip
 from PyQt6.QtCore import QEvent, QObject, QSize, Qt, QTimer
 from PyQt6.QtGui import QAction, QGuiApplication
 from PyQt6.QtWidgets import QDockWidget, QFrame, QMainWindow, QMenu, QScrollArea, QWidget
@@ -22,6 +23,14 @@ class WindowMenus:
         self.window = window
         self.on_error = on_error
         self.menus: dict[str, QMenu] = {}
+        self._watchers: list[Callable[[QMenu], None]] = []
+
+    def watch(self, fn: Callable[[QMenu], None]) -> None:
+        """Call ``fn(menu)`` for each menu, those made later included (e.g. to note which entry
+        the user chose last: ``app/exception_hook.py``)."""
+        self._watchers.append(fn)
+        for menu in self.menus.values():
+            fn(menu)
 
     def menu(self, name: str) -> QMenu:
         """The menu ``name`` ("File", "View", "Analysis", "Help"; another name: a new menu,
@@ -33,6 +42,8 @@ class WindowMenus:
             else:
                 self.menus[name] = QMenu(f"&{name}", self.window)
                 self.window.menuBar().insertMenu(help_menu.menuAction(), self.menus[name])
+            for fn in self._watchers:
+                fn(self.menus[name])
         return self.menus[name]
 
     def action(self, menu: str, text: str, slot: Callable[[], Any]) -> QAction:
@@ -127,7 +138,7 @@ class WindowDocks:
         scroll.setFrameShape(QFrame.Shape.NoFrame)
         dock = self.dock(scroll, title, area)
         previous = self.last.get(area)
-        if previous is not None:
+        if previous is not None and self._docked(previous, area):
             self.window.tabifyDockWidget(previous, dock)
         else:
             orientation = (Qt.Orientation.Horizontal
@@ -137,6 +148,12 @@ class WindowDocks:
             self.window.resizeDocks([dock], [dock_width(self.window.width())], orientation)
         self.last[area] = dock
         return dock
+
+
+    def _docked(self, dock: QDockWidget, area: Qt.DockWidgetArea) -> bool:
+        """Whether ``dock`` is still one of the window's, in ``area`` (a view's dock is removed
+        and deleted when another model is loaded: a new dock cannot be tabbed with it)."""
+        return not sip.isdeleted(dock) and self.window.dockWidgetArea(dock) == area
 
 
 def dock_width(window_width: int) -> int:

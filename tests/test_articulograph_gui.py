@@ -34,8 +34,8 @@ def test_import_dialog_on_mview_files(qtbot, toy_corpus_dir, tmp_path):
         assert f in dlg.findChildren(type(dlg.summary))[0].text()     # the intro lists the registry
     for i in range(dlg.fixed_list.count()):                           # none ticked: none needed
         dlg.fixed_list.item(i).setCheckState(dlg.fixed_list.item(i).checkState().Unchecked)
-    dlg.upper.setCurrentText("UL_C")
-    dlg.lower.setCurrentText("LL_C")
+    dlg.upper_lip.setCurrentText("UL_C")
+    dlg.lower_lip.setCurrentText("LL_C")
     dlg.output_edit.setText(str(tmp_path / "mv.json"))
     corpus = load_corpus(dlg.write_description())
     assert corpus.info.head_corrected and corpus.info.fixed_markers == []
@@ -46,11 +46,11 @@ def test_import_dialog_names_carstens_channels(qtbot, toy_corpus_dir, tmp_path):
     folder = write_folder("ag501", toy_corpus_dir, tmp_path / "pos", ["toy000", "toy001"])
     dlg = ImportDialog(folder=folder)
     qtbot.addWidget(dlg)
-    assert dlg.upper.itemText(0) == "Ch1" and not dlg.head_corrected.isChecked()
+    assert dlg.upper_lip.itemText(0) == "Ch1" and not dlg.head_corrected.isChecked()
     dlg.channel_names.setText(" ".join(f"Ch{i + 1}={n}" for i, n in enumerate(NAMES)))
     dlg.set_folder(folder)
     assert [dlg.fixed_list.item(i).text() for i in range(dlg.fixed_list.count())] == NAMES
-    assert dlg.upper.currentText() == "UL_C" and dlg.fixed_markers() == ["FH_L", "FH_R", "NB"]
+    assert dlg.upper_lip.currentText() == "UL_C" and dlg.fixed_markers() == ["FH_L", "FH_R", "NB"]
     nt = dlg.fixed_list.item(NAMES.index("NT"))                   # the user ticks the nose tip
     nt.setCheckState(nt.checkState().Checked)
     dlg.output_edit.setText(str(tmp_path / "pos.json"))

@@ -59,7 +59,7 @@ def test_pins_keep_three_in_distinct_colours_and_name_their_settings(default_mod
     assert len(pins) == MAX_PINS and kept[0] not in pins.pins      # the oldest went
     assert sorted(p.color for p in pins.pins) == sorted(PIN_COLORS)
     assert kept[3].color == kept[0].color                          # its colour reused
-    assert "N=1" in kept[1].legend("data_samples") and "model" not in kept[1].legend("data_samples")
+    assert "N=1" in kept[1].legend("data_samples") and "model " not in kept[1].legend("data_samples")
     assert kept[1].legend("my_corpus").endswith("; model data_samples")
     pins.set_model("other", ["A", "B"])                            # another marker set: not shown
     assert pins.shown(n1) == []
@@ -132,3 +132,41 @@ def test_the_readout_has_units_and_no_negative_zero(default_model, views):
     assert mm(-0.04, signed=True) == "0.0 mm" and mm(-0.06, signed=True) == "-0.1 mm"
     assert distinct_settings(["robust, N=3, triangular; labels: aligned",
                               "robust, N=1, triangular; labels: aligned"]) == ["N=3", "N=1"]
+
+
+def test_every_setting_that_changes_the_synthesis_tells_two_pins_apart(default_model, views):
+    """Issue 54, defect 5: pins at N=2, C=3 and N=2, C=2 both read "N=2"; a result with the
+    detector on read as the plain acoustic-only one. Each setting of the synthesis, the labels'
+    source and the model tell a pin apart from the result on screen and from the other pins."""
+    from facetraj_app.provenance import LabelOrigin, settings_text
+
+    _n3, n1 = views
+    base = n1.synthesis.config.with_(n_context_phones=2, context=3)
+
+    def made(view=n1, **changes):
+        return replace(view, synthesis=replace(view.synthesis, config=base.with_(**changes)))
+
+    screen = made()
+    variants = {"C=2": made(context=2), "N=1": made(n_context_phones=1), "ξ=12": made(xi=12.0),
+                "ν=4": made(nu=4.0), "spline": made(smoothing="spline"),
+                "closure: rest": made(closure_labels=False), "closure: off": made(closure=False),
+                "closure: /p b m/": made(rest=False),
+                "labels: aligned from s002.txt": replace(
+                    screen, utterance=replace(screen.utterance, label_source="aligned"),
+                    origin=LabelOrigin("aligned", transcript="s002.txt"))}
+    for differs, view in variants.items():
+        pins = PinBoard(model_name="data_samples", marker_names=tuple(default_model.marker_names))
+        pin = pins.pin(view)
+        assert pins.describe(screen, [pin]) == [differs], differs
+    acoustic = made(mode="acoustic")
+    detector = made(mode="acoustic", closure_detector=True)
+    pins = PinBoard(model_name="data_samples")
+    pin = pins.pin(detector)
+    assert pins.describe(acoustic, [pin]) == ["closure: /p b m/ + rest + detector"]
+    assert "detector" in settings_text(detector) and "detector" not in settings_text(acoustic)
+    pins.set_model("my_corpus", [])              # the same settings, another model
+    assert pins.describe(detector, [pin]) == ["model data_samples"]
+    # two pins and the screen: each pin says what sets it apart
+    pins = PinBoard(model_name="data_samples")
+    both = [pins.pin(made(context=2)), pins.pin(made(context=1))]
+    assert pins.describe(screen, both) == ["C=2", "C=1"]

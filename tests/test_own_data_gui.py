@@ -43,7 +43,7 @@ def test_import_dialog_writes_a_description(qtbot, tmp_path):
     qtbot.addWidget(dlg)
     assert "1 utterances, 9 midsagittal (2-D) markers" in dlg.summary.text()
     assert dlg.fixed_markers() == ["UI", "BN"]
-    assert dlg.upper.currentText() == "UL" and dlg.lower.currentText() == "LL"
+    assert dlg.upper_lip.currentText() == "UL" and dlg.lower_lip.currentText() == "LL"
     assert dlg.preset.currentIndex() == 1                          # MOCHA labels recognised
     table = dlg.label_map()
     assert table["@"] == "ah" and table["breath"] == "sil"

@@ -168,7 +168,9 @@ class KinematicsControls(QWidget):
 
         self.panel = VelocityPanel(self)
         if window is not None:
-            window.synthesisChanged.connect(lambda: self.set_view(window.view))
+            # a bound method, not a lambda: the connection ends with this view (another model
+            # deletes it; a lambda kept calling its deleted widgets)
+            window.synthesisChanged.connect(self._window_result)
             if window.view is not None:
                 self.set_view(window.view)
 
@@ -198,6 +200,9 @@ class KinematicsControls(QWidget):
             tl.relayout(tl.xlim(), soon=True)
 
     # ------------------------------------------------------------------ measuring
+    def _window_result(self) -> None:
+        self.set_view(self.window_.view)
+
     def set_view(self, view) -> None:
         self.view = view
         if view is not None:
