@@ -105,14 +105,14 @@ class Monkey:
         entry = entries[int(self.rng.integers(2))]
         self.note(f"Analysis > {entry}")
         if self.w.win.model is not None:
-            self.w.menu("Analysis", entry.rstrip("…"))
+            self.w.menu("Analysis", entry.rstrip("…"), enabled=False)
 
     def panel(self) -> None:
         from facetraj_app.analysis import PANELS
 
         text = list(PANELS.values())[int(self.rng.integers(len(PANELS)))]
         self.note(f"Analysis > Panel: {text}")
-        self.w.menu("Analysis", f"Panel: {text}")
+        self.w.menu("Analysis", f"Panel: {text}", enabled=False)
 
     def close_dock(self) -> None:
         docks = [d for d in self.w.win.findChildren(type(self.w.win.browser_dock)) if d.isVisible()]
@@ -129,7 +129,7 @@ class Monkey:
         if w.view is None or w.busy or (entry.endswith("original trajectories") and w.view.original is None):
             return
         self.note(f"File > {entry}")
-        self.w.menu("File", entry)
+        self.w.menu("File", entry, enabled=False)
 
     def resize(self) -> None:
         size = SIZES[int(self.rng.integers(len(SIZES)))]
@@ -144,7 +144,7 @@ class Monkey:
     def pins(self) -> None:
         entry = ["Pin this result", "Clear pins"][int(self.rng.integers(2))]
         self.note(f"View > {entry}")
-        self.w.menu("View", entry)
+        self.w.menu("View", entry, enabled=False)
 
     def settle(self) -> None:
         self.note("(wait until the window settles)")

@@ -153,14 +153,17 @@ class Walker:
         """Until the window's foreground work is done and its panels drawn."""
         self.wait(lambda: self.win.settled, "the window to settle")
 
-    def menu(self, menu: str, entry: str) -> None:
-        """Choose ``entry`` of ``menu`` as a user does (the action the menu shows, triggered)."""
+    def menu(self, menu: str, entry: str, enabled: bool = True) -> bool:
+        """Choose ``entry`` of ``menu`` as a user does (the action the menu shows, triggered);
+        ``enabled``: it must be enabled (else a disabled entry is left, as a user can only).
+        Whether it was chosen."""
         m = self.win.menu(menu)
         for action in m.actions():
             if action.text().replace("&", "").startswith(entry):
-                assert action.isEnabled(), f"{menu} > {entry} is disabled"
-                action.trigger()
-                return
+                assert action.isEnabled() or not enabled, f"{menu} > {entry} is disabled"
+                if action.isEnabled():
+                    action.trigger()
+                return action.isEnabled()
         raise AssertionError(f"no entry {entry!r} in {menu}: "
                              f"{[a.text() for a in m.actions() if a.text()]}")
 

@@ -201,6 +201,9 @@ class AnalysisViews(QObject):
             if panel in tl.panels:
                 tl.panels.remove(panel)
         self.panels.clear()
+        if self.controls is not None:       # made for the velocity panel alone, without a dock
+            self.controls.close_view()
+            self.controls.deleteLater()
         self.controls = None
         for key, act in self.panel_actions.items():
             if act.isChecked():

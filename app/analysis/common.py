@@ -243,6 +243,27 @@ def export_with_dialog(parent: QWidget, title: str, default: str, filters: str,
             top.show_status(f"wrote {written if isinstance(written, (str, Path)) else path}")
 
 
+class WindowLinks:
+    """The main window's signals a view follows, undone by :meth:`close` (the view's
+    ``close_view``, called when another model replaces the views): a view of the old model never
+    receives the new model's results."""
+
+    def __init__(self):
+        self.links: list[tuple[Any, Callable]] = []
+
+    def connect(self, signal: Any, slot: Callable) -> None:
+        signal.connect(slot)
+        self.links.append((signal, slot))
+
+    def close(self) -> None:
+        for signal, slot in self.links:
+            try:
+                signal.disconnect(slot)
+            except (TypeError, RuntimeError):      # gone with its sender already
+                pass
+        self.links.clear()
+
+
 def task_runner(owner: QWidget, window: Any = None) -> TaskRunner:
     """Where a view runs its background work: the main window's task runner (its status bar shows
     the work and closing the window stops it), or, for a view used on its own, a runner owned by

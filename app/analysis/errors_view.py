@@ -50,6 +50,7 @@ from ..tier_labels import Span, StackedLabels
 from .common import (
     Canvas,
     NumberItem,
+    WindowLinks,
     bar_labels,
     export_with_dialog,
     fill_table,
@@ -203,8 +204,9 @@ class ErrorView(QWidget):
         lay.addWidget(self.status)
         lay.addWidget(self.tabs, 1)
         self.jumpRequested.connect(self._jump)
+        self.links = WindowLinks()
         if window is not None:
-            window.synthesisChanged.connect(self._after_load)
+            self.links.connect(window.synthesisChanged, self._after_load)
 
     # ------------------------------------------------------------------ work
     def start(self) -> None:
@@ -300,6 +302,10 @@ class ErrorView(QWidget):
             t = self._pending_seek[1]
             self._pending_seek = None
             self.window_.seek(t)
+
+    def close_view(self) -> None:
+        """Stop following the window (another model replaces this view)."""
+        self.links.close()
 
     def closeEvent(self, event) -> None:
         stop_own_tasks(self, self.tasks)

@@ -31,7 +31,7 @@ from facetraj_engine.analysis.inspector import FrameInspection, inspect_frame
 from facetraj_engine.method.model import Model
 from facetraj_engine.method.pipeline import Synthesis
 
-from .common import Canvas, NumberItem, fill_table, heat_item, text_item
+from .common import Canvas, NumberItem, WindowLinks, fill_table, heat_item, text_item
 
 log = logging.getLogger(__name__)
 
@@ -101,10 +101,15 @@ class CodebookInspector(QWidget):
         lay = QVBoxLayout(self)
         lay.addWidget(split)
 
+        self.links = WindowLinks()
         if window is not None:
-            window.synthesisChanged.connect(self._from_window)
-            window.cursorMoved.connect(self.set_time)
+            self.links.connect(window.synthesisChanged, self._from_window)
+            self.links.connect(window.cursorMoved, self.set_time)
             self._from_window()
+
+    def close_view(self) -> None:
+        """Stop following the window (another model replaces this view)."""
+        self.links.close()
 
     # ------------------------------------------------------------------ input
     def _from_window(self) -> None:

@@ -49,7 +49,15 @@ from facetraj_engine.evaluation.kinematics import (
 )
 from facetraj_engine.method.model import Model
 
-from .common import Canvas, NumberItem, bar_labels, export_with_dialog, fill_table, text_item
+from .common import (
+    Canvas,
+    NumberItem,
+    WindowLinks,
+    bar_labels,
+    export_with_dialog,
+    fill_table,
+    text_item,
+)
 
 log = logging.getLogger(__name__)
 
@@ -167,10 +175,11 @@ class KinematicsControls(QWidget):
         self.rows: list[LandmarkError] = []
 
         self.panel = VelocityPanel(self)
+        self.links = WindowLinks()
         if window is not None:
-            # a bound method, not a lambda: the connection ends with this view (another model
-            # deletes it; a lambda kept calling its deleted widgets)
-            window.synthesisChanged.connect(self._window_result)
+            # undone by close_view (another model replaces the view: a lambda kept calling its
+            # deleted widgets with the new model's results)
+            self.links.connect(window.synthesisChanged, self._window_result)
             if window.view is not None:
                 self.set_view(window.view)
 
@@ -202,6 +211,10 @@ class KinematicsControls(QWidget):
     # ------------------------------------------------------------------ measuring
     def _window_result(self) -> None:
         self.set_view(self.window_.view)
+
+    def close_view(self) -> None:
+        """Stop following the window (another model replaces this view)."""
+        self.links.close()
 
     def set_view(self, view) -> None:
         self.view = view

@@ -65,8 +65,10 @@ def segment_errors(phones: Sequence[PhoneSegment], times: np.ndarray, error: np.
     """Mean of a per-frame error ``(T,)`` or ``(T, k)`` (averaged over columns) per phone segment;
     segments with no finite frame are left out."""
     e = np.asarray(error, dtype=np.float64)
-    if e.ndim == 2:
-        e = np.nanmean(e, axis=1) if np.isfinite(e).any() else e[:, 0]
+    if e.ndim == 2:                 # the mean of each frame's finite columns (NaN: none)
+        finite = np.isfinite(e)
+        count = finite.sum(axis=1)
+        e = np.where(count > 0, np.where(finite, e, 0.0).sum(axis=1) / np.maximum(count, 1), np.nan)
     seg = segment_index(phones, times[: len(e)])
     out = []
     for i, s in enumerate(phones):
