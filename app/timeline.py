@@ -48,6 +48,9 @@ from .style import (
 from .tier_labels import FittedLabels, Span
 from .workers import STEP_MS
 
+#: the lines the legend row may grow by when more panels are shown (their curves' entries)
+LEGEND_SWING_LINES = 2
+
 log = logging.getLogger(__name__)
 
 #: the timeline's bottom margin: the time tick labels and "time (s)"
@@ -376,12 +379,18 @@ class Timeline(QWidget):
         except (ValueError, IndexError):
             return None
 
-    def _heights(self, panels: list[Panel]) -> list[float | None]:
-        """Each panel's height in pixels at the figure's present size (None: left out)."""
+    def _heights(self, panels: list[Panel], slack: float = 0.0) -> list[float | None]:
+        """Each panel's height in pixels at the figure's present size less ``slack`` (None:
+        left out)."""
         fig = self.figure
-        room = fig.get_figheight() * fig.dpi - BOTTOM_MARGIN_PX - TOP_MARGIN_PX
+        room = fig.get_figheight() * fig.dpi - BOTTOM_MARGIN_PX - TOP_MARGIN_PX - slack
         return fit_heights([p.height for p in panels], [panel_min_px(p) for p in panels],
                            [panel_priority(p) for p in panels], room)
+
+    def _fitting(self, slack: float = 0.0) -> list[Panel]:
+        """The panels that fit the present size less ``slack``."""
+        return [p for p, h in zip(self.panels, self._heights(self.panels, slack), strict=True)
+                if h is not None]
 
     @property
     def building(self) -> bool:
@@ -502,11 +511,17 @@ class Timeline(QWidget):
         "upper lip" off its label); a relayout when the panels left out change."""
         if self._grid is None or not self.axes:
             return
-        heights = self._heights(self.panels)
-        if [p for p, h in zip(self.panels, heights, strict=True) if h is not None] != self.shown:
+        shown, fitting = set(self.shown), set(self._fitting())
+        # more panels fit: shown only when they fit with the legend row a few lines taller (it
+        # grows with their curves and shrinks with the note of those left out, and the panels'
+        # height with it: at 800 x 600 the layout flipped between 3 and 4 panels without end)
+        if fitting > shown:
+            line = self.legend_bar.fontMetrics().lineSpacing()
+            fitting = set(self._fitting(slack=LEGEND_SWING_LINES * line)) | shown
+        if fitting != shown:
             self.relayout(self.xlim(), soon=True)
             return
-        self._place_grid([h for h in heights if h is not None])
+        self._place_grid(self._heights(self.shown))
         for ax in self.axes:            # (GridSpec.update moves only pyplot's figures' axes)
             ax.set_position(ax.get_subplotspec().get_position(self.figure))
         refit_ylabels(self.axes)

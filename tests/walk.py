@@ -146,8 +146,19 @@ class Walker:
     def wait(self, condition: Callable[[], bool], what: str) -> None:
         try:
             self.qtbot.waitUntil(lambda: bool(self.errors.items) or condition(), timeout=WAIT_MS)
-        except Exception as exc:          # a hang: say what was awaited
-            raise AssertionError(f"waited in vain for {what}") from exc
+        except Exception as exc:          # a hang: say what was awaited, and where the window is
+            raise AssertionError(f"waited in vain for {what}; {self.state()}") from exc
+
+    def state(self) -> str:
+        """Where the window is, in a line (for a failure's message)."""
+        w = self.win
+        view, tl = w.view, w.timeline
+        return (f"shown: {view.utterance.name if view else None} ({view.split if view else ''}), "
+                f"corpus {w.corpus.root if w.corpus else None}, model loading {w.state.loading}, "
+                f"settled {w.settled}, busy {w.busy}, panels building {tl.building} "
+                f"({len(tl.shown)} shown, {len(tl.hidden)} left out), "
+                f"tasks {[t.label for t in w.tasks.tasks]}, status {w.status_label.text()!r}, "
+                f"window {w.width()}x{w.height()}, panels {tl.canvas.width()}x{tl.canvas.height()}")
 
     def settle(self) -> None:
         """Until the window's foreground work is done and its panels drawn."""
