@@ -96,6 +96,11 @@ class ClosureStream:
     def emitted(self) -> int:
         return self._emitted
 
+    def wait_s(self, decision_delay_s: float) -> float:
+        """The most audio after a frame's time before it is due, when a frame's speech or
+        silence is decided ``decision_delay_s`` after its time (the frames its rest reads)."""
+        return decision_delay_s + self.ahead / self.rate
+
     @property
     def lookback(self) -> int:
         """Frames before the next to emit whose silence the rest rule reads

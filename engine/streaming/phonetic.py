@@ -138,10 +138,14 @@ class PhoneticSynthesizer:
 
     @property
     def lookahead_s(self) -> float:
-        """The longest a frame waits after its time before it is emitted."""
+        """The longest a frame waits after its time before it is emitted (with the rest in
+        pauses, at least until the speech/silence decisions its rest reads are made)."""
         lsf = self.front.lookahead_s + self._ctx / self.rate
         t = self.timing
-        return max(t.wait_s, lsf) + (t.batch - 1 + self._smoother.lookahead + t.hold) / self.rate
+        search = max(t.wait_s, lsf) + (t.batch - 1 + self._smoother.lookahead + t.hold) / self.rate
+        if self._closure is None or not self.synth.rest:
+            return search
+        return max(search, self._closure.wait_s(self.speech.delay_s))
 
     @property
     def received_s(self) -> float:

@@ -128,9 +128,13 @@ class StreamingSynthesizer:
     @property
     def lookahead_s(self) -> float:
         """Audio needed after a frame's time before the frame is emitted (the algorithm's delay;
-        with ``batch_frames > 1`` the most: the first frame of a batch waits for its last)."""
+        with ``batch_frames > 1`` the most: the first frame of a batch waits for its last; with
+        the rest in pauses, at least the speech/silence decisions its rest reads)."""
         batch = (self.config.batch_frames - 1) / self.rate
-        return self.front.lookahead_s + batch + self._smoother.lookahead / self.rate
+        search = self.front.lookahead_s + batch + self._smoother.lookahead / self.rate
+        if self.closure is None or not self.synth.rest:
+            return search
+        return max(search, self.closure.step.wait_s(self.closure.speech.delay_s))
 
     @property
     def received_s(self) -> float:
