@@ -222,7 +222,7 @@ def test_arctic_files_rest_in_the_silences_they_begin_and_end_in(default_model, 
                                labels=known)
             markers, times = take.frames.markers, take.frames.times
         a = lip_aperture(markers, m.upper_lip, m.lower_lip)
-        if how == "offline":            # a stream's first frames: tests/test_closure_detector.py
+        if how == "offline":   # a stream's first frames follow its own first decisions
             assert a[0] == pytest.approx(rest, abs=1e-6), wav.name
         last = times[np.flatnonzero(speech_mask(audio, rate, times))[-1]]
         after = times >= last + 0.1 - 1e-9
