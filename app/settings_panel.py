@@ -100,9 +100,13 @@ class SynthSettingsPanel(QWidget):
             "close the lips at the labelled /p b m/, trusting each label as its source says "
             "(--no-closure-labels turns it off; docs/algorithm.md, the closure step)")
         self.rest = QCheckBox("rest in pauses")
+        rest = SynthConfig()
         self.rest.setToolTip(
-            "the face rests in pauses of 150 ms or more, and in the silences a recording begins "
-            "and ends in (--no-rest turns it off)")
+            f"the face rests in silences longer than a stop closure's "
+            f"({1000 * rest.rest_pause_s:.0f} ms), at the rest face "
+            f"{1000 * (rest.rest_pause_s + rest.rest_taper_s - rest.rest_lookahead_s):.0f} ms "
+            f"into them, the one a recording ends in too, and in the one it begins with from its "
+            f"first frame (--no-rest turns it off)")
         self.closure_detector = QCheckBox("detector (no labels)")
         self.closure_detector.setToolTip(
             "without phone labels, close the lips where the bilabial-closure detector finds a "

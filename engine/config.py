@@ -127,12 +127,13 @@ class SynthConfig:
         finds a closure and no /p b m/ is recognized, trusted as far as the voice matches the
         training voice (whose recognized labels the step trusts least). Off by default: on real
         talkers its closures fell where their lips were open (issue 46, docs/labels.md).
-    rest_pause_s, rest_taper_s : the face begins to rest once a pause has lasted this long, and
-        reaches the rest face over the taper.
-    rest_end_s : a silence the input ends in (the talker has finished, however short the
-        silence) reaches the rest face at its last frame, rising over this long at most: the
-        frames a live stream's triangular smoothing still holds when its input ends (half its
-        window), so that live rests them as offline does (issue 49); 0: off.
+    rest_pause_s : a silence is a pause, where the face rests, once it is longer than this: the
+        longest silence of a stop closure (a closure is not rested open).
+    rest_taper_s : past ``rest_pause_s`` the face reaches the rest face over this much more
+        silence.
+    rest_lookahead_s : the silence a frame's rest reads counts this much after the frame too
+        (the speech/silence decisions a live stream has when it shows the frame); the input's
+        end is silence after it.
     """
 
     n_context_phones: int = 3
@@ -162,9 +163,9 @@ class SynthConfig:
     closure_detector: bool = False
     closure_threshold: float = 0.12
     closure_second_opinion: bool = False
-    rest_pause_s: float = 0.15
+    rest_pause_s: float = 0.1
     rest_taper_s: float = 0.05
-    rest_end_s: float = 0.05
+    rest_lookahead_s: float = 0.05
 
     def with_(self, **changes) -> SynthConfig:
         """A copy with some fields changed."""

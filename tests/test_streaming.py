@@ -18,7 +18,12 @@ from facetraj_engine.method.lsf import (
 from facetraj_engine.method.pipeline import synthesize
 from facetraj_engine.method.smoothing import TriangularStream, triangular_smooth
 from facetraj_engine.method.speaker import choose_warp, warp_lsf
-from facetraj_engine.streaming.synthesizer import StreamConfig, StreamingSynthesizer, stream_synthesize
+from facetraj_engine.streaming.synthesizer import (
+    LIVE_BATCH_FRAMES,
+    StreamConfig,
+    StreamingSynthesizer,
+    stream_synthesize,
+)
 
 ACOUSTIC = SynthConfig(mode="acoustic", closure=False)   # the search alone (test_closure_detector: the step)
 
@@ -123,6 +128,33 @@ def test_frames_come_out_after_the_documented_lookahead(default_model):
     assert got.index.tolist() == list(range(27))
     rest = stream.feed(x[8000:]).index.tolist() + stream.flush().index.tolist()
     assert rest == list(range(27, 61))                  # 1 s of audio: 61 frames, as offline
+
+
+@pytest.mark.parametrize("batch", [1, LIVE_BATCH_FRAMES])
+def test_frames_wait_for_the_silence_their_rest_reads(default_model, utterance, batch):
+    """With the closure step a frame's rest reads the speech or silence of the 3 frames after it,
+    each decided at most 68 ms after its time (half the 112 ms median filter, half the energy
+    window, half a hop): a stream holds the frame until then, 118 ms, which live mode's batch of
+    5 frames waits already (129 ms); its lookahead says so, and no frame comes out later."""
+    from facetraj_engine.level import to_full_scale
+
+    audio, rate = utterance
+    audio = to_full_scale(audio)
+    step = SynthConfig(mode="acoustic")
+    stream = StreamingSynthesizer(default_model, StreamConfig(rate, step, batch))
+    search = StreamingSynthesizer(default_model, StreamConfig(rate, step.with_(rest=False),
+                                                              batch)).lookahead_s
+    assert search == pytest.approx(0.0125 + (batch - 1 + 3) / 60)
+    assert stream.closure.speech.delay_s == pytest.approx(0.068)
+    assert stream.lookahead_s == pytest.approx(max(search, 0.068 + 3 / 60))
+    block = rate // 100
+    late = []
+    for a in range(0, len(audio), block):
+        frames = stream.feed(audio[a:a + block])
+        late += list(stream.received_s - frames.times)
+    assert max(late) <= stream.lookahead_s + block / rate + 1e-9
+    if batch == 1:                                      # held beyond what the search needs
+        assert max(late) > search + block / rate
 
 
 def test_stream_refuses_spline_and_a_chosen_warp(default_model):

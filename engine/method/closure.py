@@ -15,11 +15,13 @@ them). This step, after eq 8 and the smoothing, leaves the paper's equations alo
    first frame, each frame by the smallest aperture of the closure so far, tapered after their end
    only -- so that ``facetraj live --acoustic-only`` and ``synth --mode acoustic`` make the same
    face (issue 46);
-2. **rests the face** in pauses (by energy, as the evaluation finds speech frames) once they have
-   lasted ``rest_pause_s``: the PCs blend towards the training talker's median face, reading only
-   each frame and those before it (:func:`rest_weights`: what a stream knows when it shows a
-   frame, so offline and live rest alike); the silence a recording starts with is rested from its
-   first frame, and no speech frame is rested.
+2. **rests the face** in pauses (by energy, as the evaluation finds speech frames): a silence is
+   a pause once it is longer than a stop closure's (``rest_pause_s``), and the PCs blend towards
+   the training talker's median face, reading only each frame, those before it and the
+   ``rest_lookahead_s`` after it (:func:`rest_weights`: what a stream knows when it shows a
+   frame, so offline and live rest alike). Outside the recording is silence: the silence it
+   starts with is rested from its first frame, and the one it ends in as any pause that goes
+   on; no speech frame is rested.
 
 The lip aperture (upper-lip centre y minus lower-lip centre y) is linear in the PCs,
 ``a(p) = a0 + p . g`` (:func:`aperture_functional`), so every move is exact.
@@ -63,6 +65,8 @@ class ClosurePlan:
     ``strengths`` ``(J,)`` in [0, 1]; ``silent`` ``(F,)`` whether each frame from frame
     ``silent_from`` on is decided silent (frames after the last decided one count as speech), and
     ``leading``: no frame before ``silent_from`` is speech (the input began in silence);
+    ``end``: the input's frame count once it is known to have ended (offline; a stream at its
+    last frames), from which on frames count as silent (``None``: not known);
     ``causal`` ``(J,)`` which intervals are closed as a stream closes them (the detector's,
     :func:`closure_moves`; ``None``: none); ``probability``: per frame, the bilabial-closure
     detector's (:mod:`facetraj_engine.method.closure_detector`) when it ran."""
@@ -74,6 +78,7 @@ class ClosurePlan:
     causal: np.ndarray | None = None
     silent_from: int = 0
     leading: bool = True
+    end: int | None = None
 
     @property
     def is_causal(self) -> np.ndarray:
@@ -339,59 +344,63 @@ def _support(times: np.ndarray, start: float, end: float, taper_s: float) -> sli
 
 
 def rest_weights(silent: np.ndarray, rate: float, min_s: float, taper_s: float,
-                 leading: bool = True, end_frames: int = 0) -> np.ndarray:
+                 leading: bool = True, ahead: int = 0, ended: bool = False) -> np.ndarray:
     """Per frame t of ``silent`` (whether each frame is silent), how far the face rests, read from
-    frame t and the frames before it alone (what a stream has decided when it shows frame t): 0
-    on a speech frame and until a silence has lasted ``min_s``, then a raised-cosine rise over
-    ``taper_s`` to 1. A silence from the input's start (``leading``: no speech before
-    ``silent``'s first frame) counts as long already: the talker rests before speaking.
-    ``end_frames``: ``silent`` ends where the input ends, and a silence it ends in (the talker
-    has finished) reaches the rest face at its last frame, by a raised-cosine rise over its last
-    ``end_frames`` frames at most (the frames a stream still holds when its input ends:
-    :func:`end_rest_frames`).
+    frame t, the frames before it and the ``ahead`` frames after it (what a stream has decided
+    when it shows frame t): 0 on a speech frame; on a silent frame, the silence *seen* -- its
+    frames up to t and those of the next ``ahead`` that are silent too -- counts: 0 until it is
+    longer than ``min_s`` (a stop closure's silence is not a pause), then a raised-cosine rise
+    over ``taper_s`` to 1. Outside the input is silence: a silence from the input's start
+    (``leading``: no speech before ``silent``'s first frame) counts as long already, and where
+    the input ends after ``silent``'s last frame (``ended``) the frames after it are silent
+    (else they are not decided yet, and count as speech).
 
     >>> s = np.array([1, 1, 0, 0, 1, 1, 1, 1, 1, 1, 0], dtype=bool)
     >>> rest_weights(s, 10.0, 0.15, 0.1).round(3).tolist()
     [1.0, 1.0, 0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0, 1.0, 0.0]
     >>> rest_weights(s, 10.0, 0.15, 0.1, leading=False)[:3].round(3).tolist()
     [0.0, 0.5, 0.0]
-    >>> rest_weights(np.array([0, 0, 1, 1, 1], dtype=bool), 100.0, 0.15, 0.1, end_frames=2).round(3).tolist()
-    [0.0, 0.0, 0.0, 0.5, 1.0]
-    >>> rest_weights(np.array([0, 1, 1, 1, 0], dtype=bool), 100.0, 0.15, 0.1, end_frames=2).tolist()
-    [0.0, 0.0, 0.0, 0.0, 0.0]
+    >>> rest_weights(s, 10.0, 0.15, 0.1, ahead=1).round(3).tolist()
+    [1.0, 1.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0, 1.0, 1.0, 0.0]
+    >>> e = np.array([0, 1, 1, 0, 1, 1, 1], dtype=bool)
+    >>> rest_weights(e, 10.0, 0.25, 0.1, ahead=2).round(3).tolist()
+    [0.0, 0.0, 0.0, 0.0, 0.5, 0.5, 0.5]
+    >>> rest_weights(e, 10.0, 0.25, 0.1, ahead=2, ended=True).round(3).tolist()
+    [0.0, 0.0, 0.0, 0.0, 0.5, 1.0, 1.0]
     """
     s = np.asarray(silent, dtype=bool)
-    if not len(s):
+    n = len(s)
+    if not n:
         return np.zeros(0)
-    idx = np.arange(len(s))
+    idx = np.arange(n)
     last_speech = np.maximum.accumulate(np.where(s, -1, idx))
     run = (idx - last_speech).astype(np.float64)            # silent frames ending at each frame
     if leading:
         run[last_speech < 0] = np.inf
-    lasted = run / float(rate)
+    next_speech = np.minimum.accumulate(np.where(s, n, idx)[::-1])[::-1]
+    after = next_speech - idx - 1                           # silent frames after it, in ``silent``
+    if ended:                                               # and after the input's end
+        after = np.where(next_speech == n, ahead, after)
+    lasted = (run + np.minimum(after, ahead)) / float(rate)
     x = (lasted - min_s) / taper_s if taper_s > 0 else np.where(lasted > min_s, 1.0, 0.0)
-    w = np.where(run > 0, ramp(np.where(np.isfinite(x), x, 1.0)), 0.0)
-    if end_frames > 0 and s[-1]:                          # the silence the input ends in
-        k = min(end_frames, len(s) - 1 - int(last_speech[-1]))
-        w[-k:] = np.maximum(w[-k:], ramp(np.arange(end_frames - k + 1, end_frames + 1) / end_frames))
-    return w
+    return np.where(s, ramp(np.where(np.isfinite(x), x, 1.0)), 0.0)
 
 
-def end_rest_frames(rest_end_s: float, rate: float) -> int:
-    """The frames over which a silence at the input's end reaches the rest face
-    (:func:`rest_weights`' ``end_frames``): ``rest_end_s`` at ``rate``, rounded.
+def rest_ahead_frames(rest_lookahead_s: float, rate: float) -> int:
+    """The frames after a frame whose silence its rest reads (:func:`rest_weights`' ``ahead``):
+    ``rest_lookahead_s`` at ``rate``, rounded.
 
-    >>> end_rest_frames(0.05, 60.0)
+    >>> rest_ahead_frames(0.05, 60.0)
     3
     """
-    return max(0, int(round(rest_end_s * rate)))
+    return max(0, int(round(rest_lookahead_s * rate)))
 
 
 def rest_in_pauses(pcs: np.ndarray, plan: ClosurePlan, stats: ClosureStats, rate: float,
-                   min_s: float, taper_s: float, end_frames: int = 0) -> np.ndarray:
-    """Step 2: the PCs ``(T, K)`` of frames 0 .. T-1 (the whole input) blend towards the rest
-    face with the weights of :func:`rest_weights` (the plan's silent frames, from its first on;
-    ``end_frames``: the rise of a silence the input ends in).
+                   min_s: float, taper_s: float, ahead: int = 0) -> np.ndarray:
+    """Step 2: the PCs ``(T, K)`` of frames 0 .. T-1 blend towards the rest face with the weights
+    of :func:`rest_weights` (the plan's silent frames, from its first on, each frame reading
+    ``ahead`` frames after it).
 
     >>> st = ClosureStats(1.0, np.array([1.0]), np.array([0.0]))
     >>> plan = ClosurePlan(np.zeros((0, 2)), np.zeros(0), np.array([0, 1, 1, 1, 1, 0], dtype=bool))
@@ -399,32 +408,34 @@ def rest_in_pauses(pcs: np.ndarray, plan: ClosurePlan, stats: ClosureStats, rate
     [2.0, 2.0, 1.0, 0.0, 0.0, 2.0]
     """
     pcs = np.asarray(pcs, dtype=np.float64)
-    b = frame_rest(plan, len(pcs), rate, min_s, taper_s, end_frames=end_frames)
+    b = frame_rest(plan, len(pcs), rate, min_s, taper_s, ahead=ahead)
     return pcs + b[:, None] * (stats.rest[None, :] - pcs)
 
 
 def frame_rest(plan: ClosurePlan, count: int, rate: float, min_s: float, taper_s: float,
-               first: int = 0, end_frames: int = 0) -> np.ndarray:
+               first: int = 0, ahead: int = 0) -> np.ndarray:
     """The rest weights (:func:`rest_weights`) of frames ``first .. first + count - 1`` from the
-    plan's silent frames (undecided ones speech); ``end_frames`` (the input ends at frame
-    ``first + count``): the rise of a silence it ends in."""
+    plan's silent frames, each frame reading ``ahead`` frames after it: those from the plan's
+    ``end`` on are silent (the input has ended), other undecided ones speech."""
     stop = first + count
-    silent = np.zeros(max(stop - plan.silent_from, 0), dtype=bool)
-    known = plan.silent[:len(silent)]
+    span = max(stop + ahead - plan.silent_from, 0)
+    silent = np.zeros(span, dtype=bool)
+    known = plan.silent[:span]
     silent[:len(known)] = known
-    w = rest_weights(silent, rate, min_s, taper_s, plan.leading, end_frames)
+    if plan.end is not None:
+        silent[max(plan.end - plan.silent_from, 0):] = True
+    w = rest_weights(silent, rate, min_s, taper_s, plan.leading, ahead)
     out = np.zeros(count)
     lo = max(first, plan.silent_from)
-    out[lo - first:] = w[lo - plan.silent_from:]
+    out[lo - first:] = w[lo - plan.silent_from:stop - plan.silent_from]
     return out
 
 
 def apply_closure(pcs: np.ndarray, times: np.ndarray, plan: ClosurePlan, stats: ClosureStats,
                   a0: float, g: np.ndarray, rate: float, closure_taper_s: float = 0.05,
-                  rest_pause_s: float = 0.15, rest_taper_s: float = 0.05,
-                  rest_end_s: float = 0.0) -> np.ndarray:
-    """The whole step on smoothed PCs ``(T, K)`` of frames 0 .. T-1 (the whole input) at
-    ``rate``: the lips close (:func:`close_lips`), then the face rests in pauses and in a silence
-    the input ends in (:func:`rest_in_pauses`)."""
+                  rest_pause_s: float = 0.1, rest_taper_s: float = 0.05,
+                  rest_lookahead_s: float = 0.05) -> np.ndarray:
+    """The whole step on smoothed PCs ``(T, K)`` of frames 0 .. T-1 at ``rate``: the lips close
+    (:func:`close_lips`), then the face rests in pauses (:func:`rest_in_pauses`)."""
     return rest_in_pauses(close_lips(pcs, times, plan, stats, a0, g, closure_taper_s), plan, stats,
-                          rate, rest_pause_s, rest_taper_s, end_rest_frames(rest_end_s, rate))
+                          rate, rest_pause_s, rest_taper_s, rest_ahead_frames(rest_lookahead_s, rate))

@@ -230,7 +230,7 @@ def _smoothed(model: Model, raw: np.ndarray, times: np.ndarray, config: SynthCon
     a0, g = aperture_functional(model.pca, model.upper_lip, model.lower_lip)
     return apply_closure(pcs, times, plan, model.closure, a0, g, model.marker_rate,
                          config.closure_taper_s, config.rest_pause_s, config.rest_taper_s,
-                         config.rest_end_s)
+                         config.rest_lookahead_s)
 
 
 def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,
@@ -278,7 +278,8 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
         strengths, causal = np.ones(len(intervals)), np.ones(len(intervals), dtype=bool)
         log.debug("closure step: the lips close at %d closures the detector found", len(intervals))
     silent = ~speech & ranged if config.rest else np.zeros(len(times), dtype=bool)
-    return ClosurePlan(intervals, strengths, silent, p, causal, leading=config.rest)
+    return ClosurePlan(intervals, strengths, silent, p, causal, leading=config.rest,
+                       end=len(times))
 
 
 def _detected(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarray,

@@ -12,15 +12,18 @@ aperture falls below what came before; frames before it (the first taper) close 
 their own aperture. With every frame known, the moves are the offline ones (tested). A /p b m/
 still going on when a frame is emitted has no end yet (its end is infinity).
 
-The detector's closures and the rest in pauses are defined causally offline too (issue 46:
-:func:`facetraj_engine.method.closure.closure_moves` with ``lead=False``,
-:func:`facetraj_engine.method.closure.rest_weights`), so a stream makes them as offline synthesis
-does, given the same probabilities and silent frames.
+The detector's closures and the rest in pauses are defined as a stream can make them offline
+too (issue 46: :func:`facetraj_engine.method.closure.closure_moves` with ``lead=False``;
+:func:`facetraj_engine.method.closure.rest_weights` reads a frame, those before it and the
+``rest_lookahead_s`` after it, for which a stream holds the frame), so a stream makes them as
+offline synthesis does, given the same probabilities and silent frames; once its input has ended
+the frames after the end are silent, as offline.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 
 import numpy as np
 
@@ -29,8 +32,8 @@ from ..method.closure import (
     ClosureStats,
     aperture_functional,
     closure_moves,
-    end_rest_frames,
     frame_rest,
+    rest_ahead_frames,
 )
 from ..method.model import Model
 from .speech import SILENT, SPEECH, UNRANGED
@@ -63,14 +66,15 @@ def decided_silence(decisions: Sequence[int], first: int,
 class ClosureStream:
     """Smoothed PCs in (:meth:`feed`, with what is known of the /p b m/ and pauses then), the
     closure step applied out; frames are held ``hold`` frames so that the minimum of a labelled
-    /p b m/ can see that far ahead (0: none held). The last ``KEEP_S`` of PCs are kept for the
-    minima."""
+    /p b m/ can see that far ahead (0: none held), and until the speech or silence of the
+    ``rest_lookahead_s`` after them is decided, which their rest reads. The last ``KEEP_S`` of PCs
+    are kept for the minima."""
 
     KEEP_S = 2.0
 
     def __init__(self, model: Model, hold: int = 0, closure_taper_s: float = 0.05,
-                 rest_taper_s: float = 0.05, rest_pause_s: float = 0.15,
-                 rest_end_s: float = 0.0):
+                 rest_taper_s: float = 0.05, rest_pause_s: float = 0.1,
+                 rest_lookahead_s: float = 0.05):
         if model.closure is None:
             raise ValueError("the model has no closure statistics: train it again")
         self.stats: ClosureStats = model.closure
@@ -79,7 +83,7 @@ class ClosureStream:
         self.hold = hold
         self.closure_taper_s, self.rest_taper_s = closure_taper_s, rest_taper_s
         self.rest_pause_s = rest_pause_s
-        self.end_frames = end_rest_frames(rest_end_s, self.rate)
+        self.ahead = rest_ahead_frames(rest_lookahead_s, self.rate)
         self._pcs = np.zeros((0, len(self.g)))      # pre-closure PCs from frame self._first on
         self._first = 0
         self._emitted = 0
@@ -92,6 +96,11 @@ class ClosureStream:
     def emitted(self) -> int:
         return self._emitted
 
+    def wait_s(self, decision_delay_s: float) -> float:
+        """The most audio after a frame's time before it is due, when a frame's speech or
+        silence is decided ``decision_delay_s`` after its time (the frames its rest reads)."""
+        return decision_delay_s + self.ahead / self.rate
+
     @property
     def lookback(self) -> int:
         """Frames before the next to emit whose silence the rest rule reads
@@ -101,14 +110,16 @@ class ClosureStream:
 
     def feed(self, pcs: np.ndarray, plan: ClosurePlan, final: bool = False,
              decided: int | None = None) -> np.ndarray:
-        """Take the next smoothed PCs; return the frames now due (all of them when ``final``),
-        with the moves of ``plan`` (its intervals and silent frames as known now); ``decided``:
-        the frames whose speech or silence is known, beyond which none is due (a frame rests by
-        its own silence)."""
+        """Take the next smoothed PCs; return the frames now due (all of them when ``final``: the
+        input ended after them), with the moves of ``plan`` (its intervals and silent frames as
+        known now); ``decided``: the frames whose speech or silence is known; a frame is due once
+        the ``ahead`` frames after it are among them (its rest reads them)."""
         self._pcs = np.concatenate([self._pcs, np.asarray(pcs, dtype=np.float64)])
         stop = self.received if final else self.received - self.hold
         if decided is not None and not final:
-            stop = min(stop, decided)
+            stop = min(stop, decided - self.ahead)
+        if final:
+            plan = replace(plan, end=self.received)
         if stop <= self._emitted:
             return np.zeros((0, self._pcs.shape[1]))
         frames = np.arange(self._first, self.received)
@@ -125,7 +136,7 @@ class ClosureStream:
         c = np.maximum(c, np.minimum(0.0, self.stats.closed - a[emit]))    # never past closed
         out = self._pcs[emit] + c[:, None] * self.stats.direction[None, :]
         b = frame_rest(plan, len(emit), self.rate, self.rest_pause_s, self.rest_taper_s,
-                       self._emitted, self.end_frames if final else 0)
+                       self._emitted, self.ahead)
         out = out + b[:, None] * (self.stats.rest[None, :] - out)
         self._emitted = stop
         drop = min(self._emitted, self.received - int(self.KEEP_S * self.rate)) - self._first

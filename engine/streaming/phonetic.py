@@ -16,10 +16,11 @@ Per frame t (at ``t / marker_rate``), in order:
 4. the closure step (``facetraj_engine.streaming.closure``): the lips close at the settled /p b m/ (trusted
    as far as the running voice match is low, :func:`facetraj_engine.method.closure.closure_strengths`),
    the face rests in the pauses found by energy (``facetraj_engine.streaming.speech``), ``hold`` frames
-   later.
+   later, and once the speech or silence of the frames its rest reads ahead is decided.
 
 So a frame is emitted at most ``lookahead_s`` after its time: ``max(wait_s, the LSF context)`` +
-``(batch - 1)`` frames + the smoothing's 3 frames + ``hold`` frames.
+``(batch - 1)`` frames + the smoothing's 3 frames + ``hold`` frames (the rest's decisions come
+sooner).
 """
 
 from __future__ import annotations
@@ -122,7 +123,7 @@ class PhoneticSynthesizer:
         self._smoother = TriangularStream(self.rate, synth.triangle_s if synth.smoothing ==
                                           "triangular" else 0.0)
         self._closure = ClosureStream(model, self.timing.hold, synth.closure_taper_s,
-                                      synth.rest_taper_s, synth.rest_pause_s, synth.rest_end_s) \
+                                      synth.rest_taper_s, synth.rest_pause_s, synth.rest_lookahead_s) \
             if synth.closure and model.closure else None
         self._gammas = gamma_grid(synth.gamma_min, synth.gamma_max, synth.gamma_steps)
         self._grouped = model.lsf_index().grouped(cb.lsf)
@@ -137,10 +138,14 @@ class PhoneticSynthesizer:
 
     @property
     def lookahead_s(self) -> float:
-        """The longest a frame waits after its time before it is emitted."""
+        """The longest a frame waits after its time before it is emitted (with the rest in
+        pauses, at least until the speech/silence decisions its rest reads are made)."""
         lsf = self.front.lookahead_s + self._ctx / self.rate
         t = self.timing
-        return max(t.wait_s, lsf) + (t.batch - 1 + self._smoother.lookahead + t.hold) / self.rate
+        search = max(t.wait_s, lsf) + (t.batch - 1 + self._smoother.lookahead + t.hold) / self.rate
+        if self._closure is None or not self.synth.rest:
+            return search
+        return max(search, self._closure.wait_s(self.speech.delay_s))
 
     @property
     def received_s(self) -> float:

@@ -59,6 +59,14 @@ class SpeechStream:
         return len(self.decisions)
 
     @property
+    def delay_s(self) -> float:
+        """The most audio after a marker frame's time before its decision: half the median
+        filter and the energy window's second half, from the hop frame nearest the marker frame
+        (at most half a hop after it)."""
+        hop = self.config.energy_hop_s
+        return (self._k // 2 + 0.5) * hop + (self._n - self._n // 2) / self.rate
+
+    @property
     def filtered(self) -> np.ndarray:
         """The filtered energy (dB) of the hop frames kept (the last ``HISTORY_S``)."""
         return self._filtered

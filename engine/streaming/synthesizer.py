@@ -14,11 +14,12 @@ The frames emitted by the blocks and :meth:`StreamingSynthesizer.flush` together
 offline synthesis of the whole audio, frame for frame (to rounding).
 
 With ``synth.closure`` (live mode, ``facetraj live --acoustic-only``) the closure step follows
-the smoothing (:mod:`facetraj_engine.streaming.closure`, no frames held): the lips close where
-the model's bilabial-closure detector finds a closure (:mod:`facetraj_engine.streaming.detector`:
-its probabilities need the frames up to 3 after a frame, which the smoothing has waited for
-already, so it adds no lookahead) and the face rests in the pauses found by energy so far
-(:mod:`facetraj_engine.streaming.speech`).
+the smoothing (:mod:`facetraj_engine.streaming.closure`): the lips close where the model's
+bilabial-closure detector finds a closure (:mod:`facetraj_engine.streaming.detector`: its
+probabilities need the frames up to 3 after a frame, which the smoothing has waited for already,
+so it adds no lookahead) and the face rests in the pauses found by energy so far
+(:mod:`facetraj_engine.streaming.speech`): a frame is shown once the speech or silence of the 3
+frames after it is decided, 118 ms after its time at most, within live mode's 129 ms.
 
 Spline smoothing needs the whole utterance and is not available here.
 """
@@ -127,9 +128,13 @@ class StreamingSynthesizer:
     @property
     def lookahead_s(self) -> float:
         """Audio needed after a frame's time before the frame is emitted (the algorithm's delay;
-        with ``batch_frames > 1`` the most: the first frame of a batch waits for its last)."""
+        with ``batch_frames > 1`` the most: the first frame of a batch waits for its last; with
+        the rest in pauses, at least the speech/silence decisions its rest reads)."""
         batch = (self.config.batch_frames - 1) / self.rate
-        return self.front.lookahead_s + batch + self._smoother.lookahead / self.rate
+        search = self.front.lookahead_s + batch + self._smoother.lookahead / self.rate
+        if self.closure is None or not self.synth.rest:
+            return search
+        return max(search, self.closure.step.wait_s(self.closure.speech.delay_s))
 
     @property
     def received_s(self) -> float:
@@ -208,7 +213,7 @@ class StreamClosure:
     """The closure step of an acoustic-only stream: the silent frames by energy, the detector's
     closures (the search's opinion counting by the running voice match from the frame after the
     voice has been heard, :func:`facetraj_engine.method.voice_match.match_from`, as offline), and
-    the step on the smoothed frames (none held)."""
+    the step on the smoothed frames (held until the silence their rest reads is decided)."""
 
     def __init__(self, model: Model, sample_rate: int, synth: SynthConfig):
         self.model, self.synth, self.rate = model, synth, model.marker_rate
@@ -219,7 +224,7 @@ class StreamClosure:
         self.voice = VoiceTracker(model, self.speech) if searching else None
         self._bilabial = bilabial_codewords(model) if searching else None
         self.step = ClosureStream(model, 0, synth.closure_taper_s, synth.rest_taper_s,
-                                  synth.rest_pause_s, synth.rest_end_s)
+                                  synth.rest_pause_s, synth.rest_lookahead_s)
         self._final = False
 
     @property
