@@ -97,6 +97,7 @@ class ViewBar(QWidget):
             cb.toggled.connect(lambda _c: face.set_sets_visible(self.show_original.isChecked(),
                                                                 self.show_synth.isChecked()))
         self._original_wanted = True
+        self._surface_wanted = True
         self.surface = QCheckBox("surface")
         self.surface.setChecked(True)
         self.surface.toggled.connect(face.set_surface)
@@ -125,11 +126,20 @@ class ViewBar(QWidget):
 
     def set_planar(self, planar: bool) -> None:
         """Midsagittal (2-D) markers or articulograph sensors: the profile camera, and no face
-        surface to offer."""
-        self.surface.setEnabled(not planar)
-        self.surface.setToolTip("midsagittal (2-D) markers or articulograph sensors: no face "
-                                "surface to draw" if planar
-                                else "the synthesized face as a surface through its markers")
+        surface to offer: the "surface" box off and unticked (it stayed ticked, greyed, as if a
+        surface were drawn); a face again, as the user left it."""
+        box = self.surface
+        if planar == box.isEnabled():
+            box.blockSignals(True)          # the scene keeps the user's choice for a face
+            if planar:
+                self._surface_wanted = box.isChecked()
+                box.setChecked(False)
+            else:
+                box.setChecked(self._surface_wanted)
+            box.blockSignals(False)
+            box.setEnabled(not planar)
+        box.setToolTip("midsagittal (2-D) markers or articulograph sensors: no face surface to "
+                       "draw" if planar else "the synthesized face as a surface through its markers")
         if planar:
             self.set_camera("profile")
 
