@@ -109,8 +109,6 @@ class SynthSettingsPanel(QWidget):
             "closure (--closure-detector). Off by default: on real lips its closures lowered "
             "the lip correlation (issue 46, docs/algorithm.md)")
         self.reset = QPushButton("Paper defaults")
-        self.status = QLabel("")
-        self.status.setWordWrap(True)
 
     def _build_layout(self) -> None:
         """The settings in two forms with the search's notes between them, in the panel's own
@@ -147,7 +145,6 @@ class SynthSettingsPanel(QWidget):
         lay.addLayout(bottom)
         lay.addWidget(self.reset)
         lay.addWidget(self.tuned_label)
-        lay.addWidget(self.status)
         lay.addStretch(1)
 
     def _connect(self) -> None:
