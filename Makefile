@@ -74,4 +74,4 @@ check-install: $(VENV)/.installed-test
 	$(BIN)/python packaging/check_install.py
 
 clean:
-	rm -rf $(VENV) build dist *.egg-info $(APP)/build $(APP)/*.egg-info .pytest_cache .ruff_cache
+	rm -rf $(VENV) build dist packaging/engine/*.egg-info $(APP)/build $(APP)/src/*.egg-info .pytest_cache .ruff_cache

@@ -7,8 +7,17 @@ import logging
 import math
 
 from PyQt6.QtCore import Qt, pyqtSignal
-from PyQt6.QtWidgets import QHeaderView, QLineEdit, QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget
+from PyQt6.QtWidgets import (
+    QHeaderView,
+    QLineEdit,
+    QStyledItemDelegate,
+    QTreeWidget,
+    QTreeWidgetItem,
+    QVBoxLayout,
+    QWidget,
+)
 
+from .elided import distinct_names
 from .viewer_model import normalise_text
 
 log = logging.getLogger(__name__)
@@ -16,6 +25,19 @@ log = logging.getLogger(__name__)
 __all__ = ["UtteranceBrowser", "normalise_text"]
 
 ID_ROLE = Qt.ItemDataRole.UserRole
+#: how an item's text is elided where it does not fit (default: at its end)
+ELIDE_ROLE = Qt.ItemDataRole.UserRole + 1
+
+
+class _ElideDelegate(QStyledItemDelegate):
+    """Draws an item's text elided as its ``ELIDE_ROLE`` says (an opened recording's name in
+    the middle: its end tells it apart)."""
+
+    def initStyleOption(self, option, index) -> None:
+        super().initStyleOption(option, index)
+        mode = index.data(ELIDE_ROLE)
+        if mode is not None:
+            option.textElideMode = Qt.TextElideMode(mode)
 
 
 class UtteranceBrowser(QWidget):
@@ -37,6 +59,7 @@ class UtteranceBrowser(QWidget):
         self.tree.setRootIsDecorated(True)
         self.tree.setUniformRowHeights(True)
         self.tree.setAlternatingRowColors(True)
+        self.tree.setItemDelegateForColumn(0, _ElideDelegate(self.tree))
         header = self.tree.header()
         header.setStretchLastSection(False)
         header.setSectionResizeMode(0, QHeaderView.ResizeMode.Stretch)
@@ -87,7 +110,10 @@ class UtteranceBrowser(QWidget):
         self.apply_filter(self.filter.text())
 
     def add_external(self, utt_id: str) -> None:
-        """Add an utterance opened from files (no original markers) to an "opened" group."""
+        """Add an utterance opened from files (no original markers) to an "opened" group. Names
+        that start alike show the part that tells them apart (``distinct_names``; elided in the
+        middle where still too long), the whole name in the tooltip: three ARCTIC files read
+        ``cmu_arctic_us_ae...`` alike."""
         group = self.groups.get("opened")
         if group is None:
             group = QTreeWidgetItem(["opened", "", ""])
@@ -97,8 +123,13 @@ class UtteranceBrowser(QWidget):
         if utt_id not in self.items:
             item = QTreeWidgetItem([utt_id, "–", "–"])
             item.setData(0, ID_ROLE, utt_id)
+            item.setData(0, ELIDE_ROLE, Qt.TextElideMode.ElideMiddle)
+            item.setToolTip(0, utt_id)
             group.addChild(item)
             self.items[utt_id] = item
+        names = [str(group.child(k).data(0, ID_ROLE)) for k in range(group.childCount())]
+        for k, shown in enumerate(distinct_names(names).values()):
+            group.child(k).setText(0, shown)
         group.setExpanded(True)
 
     def set_current(self, utt_id: str) -> None:

@@ -13,15 +13,18 @@ from __future__ import annotations
 from html import escape
 
 import numpy as np
-from PyQt6.QtCore import QObject, QSize, Qt, pyqtSignal
+from PyQt6.QtCore import QObject, QSize, Qt, QTimer, pyqtSignal
 from PyQt6.QtGui import QKeySequence
 from PyQt6.QtWidgets import QLabel
 
 from .pins import aperture_difference
 
 #: the widest the pins' list asks to be in the toolbar (it dropped into the toolbar's overflow
-#: menu on a laptop screen); the legend row and the tooltip name each pin in full
-PIN_LIST_PX = 380
+#: menu on a laptop screen when it asked for its whole text); narrower, it is elided, and the
+#: legend row and the tooltip name each pin in full
+PIN_LIST_PX = 900
+#: between two pins in the list
+PIN_GAP = "  "
 
 
 class PinDifferencePanel:
@@ -53,30 +56,88 @@ class PinDifferencePanel:
 
 class PinList(QLabel):
     """The pins shown, in the toolbar: each one's colour, name and how it differs from the
-    others (``distinct_settings``), never asking for more than :data:`PIN_LIST_PX`."""
+    others (``distinct_settings``), never asking for more than :data:`PIN_LIST_PX`; what does not
+    fit the width it gets is elided ("…", the whole list in the tooltip: on a laptop its end was
+    cut off without a sign)."""
 
     def __init__(self):
         super().__init__("")
         self.setTextFormat(Qt.TextFormat.RichText)
         self.setStyleSheet("padding-left: 6px; color: #444444;")
+        self.parts: list[tuple[str, str]] = []      # (colour, "pin k: how it differs") or ("", note)
 
     def sizeHint(self) -> QSize:
         hint = super().sizeHint()
-        return QSize(min(hint.width(), PIN_LIST_PX), hint.height())
+        full = self.fontMetrics().horizontalAdvance(self.plain_text()) + self._padding()
+        return QSize(min(full, PIN_LIST_PX), hint.height())
 
     def minimumSizeHint(self) -> QSize:
-        return QSize(min(super().minimumSizeHint().width(), 120), super().minimumSizeHint().height())
+        return QSize(120, super().minimumSizeHint().height())
 
     def show_pins(self, shown: list, parts: list[str], note: str) -> None:
         """``shown``: the pins drawn with the result on screen, ``parts`` what tells each apart
         (``PinBoard.describe``); else ``note`` says why none is."""
         if not shown:
-            self.setText(escape(note))
+            self.parts = [("", note)] if note else []
             self.setToolTip(note)
-            return
-        self.setText("  ".join(f'<span style="color:{p.color}">■</span> {p.name}: {escape(part)}'
-                               for p, part in zip(shown, parts, strict=True)))
-        self.setToolTip("\n".join(f"{p.name}: {p.settings}" for p in shown))
+        else:
+            self.parts = [(p.color, f"{p.name}: {part}") for p, part in zip(shown, parts, strict=True)]
+            self.setToolTip("\n".join(f"{p.name}: {p.settings}" for p in shown))
+        self.setText(self._html(self.parts))        # whole, until the toolbar has laid it out
+        self.updateGeometry()
+        QTimer.singleShot(0, self._fit)
+
+    def plain_text(self) -> str:
+        """The whole list as words (each pin's colour a square)."""
+        return PIN_GAP.join(("■ " if colour else "") + text for colour, text in self.parts)
+
+    def shown_text(self) -> str:
+        """The list as drawn now, elided to the width (each pin's colour a square)."""
+        return PIN_GAP.join(("■ " if colour else "") + text for colour, text in self._elided())
+
+    def _padding(self) -> int:
+        return 6 + 2 * self.margin() + 2
+
+    def _elided(self) -> list[tuple[str, str]]:
+        """The parts that fit the label's width: whole as long as they fit, then the next one cut
+        with an ellipsis ("…" alone when not even its square fits)."""
+        fm = self.fontMetrics()
+        room = self.width() - self._padding()
+        out: list[tuple[str, str]] = []
+        for k, (colour, text) in enumerate(self.parts):
+            gap = fm.horizontalAdvance(PIN_GAP) if out else 0
+            square = fm.horizontalAdvance("■ ") if colour else 0
+            need = gap + square + fm.horizontalAdvance(text)
+            last = k == len(self.parts) - 1
+            if need <= room and (last or need + fm.horizontalAdvance(PIN_GAP + "…") <= room):
+                out.append((colour, text))
+                room -= need
+                continue
+            left = room - gap - square
+            if fm.horizontalAdvance(text) <= left:      # it fits, what follows does not: say so
+                left = fm.horizontalAdvance(text) - 1
+            cut = fm.elidedText(text, Qt.TextElideMode.ElideRight, max(left, 0))
+            if left < fm.horizontalAdvance("…") or not cut or cut == "…":
+                out.append(("", "…"))
+            else:
+                out.append((colour, cut))
+            break
+        return out
+
+    @staticmethod
+    def _html(parts: list[tuple[str, str]]) -> str:
+        return ("&nbsp;" * len(PIN_GAP)).join(
+            (f'<span style="color:{colour}">■</span> ' if colour else "") + escape(text)
+            for colour, text in parts)
+
+    def _fit(self) -> None:
+        text = self._html(self._elided())
+        if text != self.text():
+            self.setText(text)
+
+    def resizeEvent(self, event) -> None:
+        super().resizeEvent(event)
+        self._fit()
 
 
 class Compare(QObject):

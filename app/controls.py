@@ -29,6 +29,7 @@ from PyQt6.QtWidgets import (
 )
 
 from .face_scene import CAMERA_PRESETS, CLOSE_UP
+from .flow_layout import FlowLayout, flow_row
 from .style import ORIGINAL_COLOR, SYNTH_COLOR
 from .timeline import Timeline
 from .transport import PlaybackClock
@@ -46,6 +47,8 @@ CAMERA_TIPS = {"three-quarter": "camera: three-quarter view",
 #: the read-out the time label is sized for (``MainWindow._show_time`` writes it); a longer one
 #: (a file over 100 s) widens it once
 TIME_TEMPLATE = "00.000 / 00.000 s  frame 0000  /xxx/"
+#: the frame slider's least width: narrower, the transport bar puts it on a row of its own
+SLIDER_LEAST_PX = 160
 
 
 def colour_dot(colour: str, size: int = 14) -> QIcon:
@@ -63,14 +66,12 @@ def colour_dot(colour: str, size: int = 14) -> QIcon:
 
 class ViewBar(QWidget):
     """Camera presets, which point sets (each check box with its colour: the legend) and the
-    surface to show."""
+    surface to show; in rows as many as the 3-D view's width needs (:class:`FlowLayout`)."""
 
     def __init__(self, face: FaceView, parent: QWidget | None = None):
         super().__init__(parent)
         self.face = face
-        lay = QHBoxLayout(self)
-        lay.setContentsMargins(4, 0, 4, 0)
-        lay.setSpacing(3)                   # the bar is the 3-D view's least width: short
+        lay = FlowLayout(self, spacing=6, margins=(4, 0, 4, 0))
         self.camera_buttons: dict[str, QToolButton] = {}
         for name in CAMERA_PRESETS:
             b = QToolButton()
@@ -79,10 +80,9 @@ class ViewBar(QWidget):
             b.setCheckable(True)
             b.setAutoExclusive(True)
             b.clicked.connect(lambda _c=False, n=name: face.set_camera(n))
-            lay.addWidget(b)
             self.camera_buttons[name] = b
+        lay.add(flow_row(list(self.camera_buttons.values())))
         self.camera_buttons[face.preset].setChecked(True)
-        lay.addSpacing(4)
         self.side_by_side = QCheckBox("side by side")
         self.side_by_side.toggled.connect(face.set_side_by_side)
         # the check boxes of the two point sets carry their colours: they are the legend too
@@ -97,13 +97,13 @@ class ViewBar(QWidget):
             cb.toggled.connect(lambda _c: face.set_sets_visible(self.show_original.isChecked(),
                                                                 self.show_synth.isChecked()))
         self._original_wanted = True
+        self._surface_wanted = True
         self.surface = QCheckBox("surface")
         self.surface.setChecked(True)
         self.surface.toggled.connect(face.set_surface)
         for w in (self.show_original, self.show_synth, self.side_by_side, self.surface):
             w.setFocusPolicy(Qt.FocusPolicy.NoFocus)
-            lay.addWidget(w)
-        lay.addStretch(1)
+            lay.add(w)
 
     def set_has_original(self, has: bool) -> None:
         """An utterance without original markers (a recording opened for synthesis): the
@@ -125,11 +125,20 @@ class ViewBar(QWidget):
 
     def set_planar(self, planar: bool) -> None:
         """Midsagittal (2-D) markers or articulograph sensors: the profile camera, and no face
-        surface to offer."""
-        self.surface.setEnabled(not planar)
-        self.surface.setToolTip("midsagittal (2-D) markers or articulograph sensors: no face "
-                                "surface to draw" if planar
-                                else "the synthesized face as a surface through its markers")
+        surface to offer: the "surface" box off and unticked (it stayed ticked, greyed, as if a
+        surface were drawn); a face again, as the user left it."""
+        box = self.surface
+        if planar == box.isEnabled():
+            box.blockSignals(True)          # the scene keeps the user's choice for a face
+            if planar:
+                self._surface_wanted = box.isChecked()
+                box.setChecked(False)
+            else:
+                box.setChecked(self._surface_wanted)
+            box.blockSignals(False)
+            box.setEnabled(not planar)
+        box.setToolTip("midsagittal (2-D) markers or articulograph sensors: no face surface to "
+                       "draw" if planar else "the synthesized face as a surface through its markers")
         if planar:
             self.set_camera("profile")
 
@@ -230,7 +239,8 @@ class NoticeBar(QFrame):
 
 
 class TransportBar(QWidget):
-    """Play / stop / frame steps, the frame slider, the time read-out, speed and loop."""
+    """Play / stop / frame steps, the frame slider, the time read-out, speed and loop; in rows as
+    many as the width needs (:class:`FlowLayout`: the slider takes the rest of its row)."""
 
     playClicked = pyqtSignal()
     stopClicked = pyqtSignal()
@@ -239,16 +249,17 @@ class TransportBar(QWidget):
 
     def __init__(self, parent: QWidget | None = None):
         super().__init__(parent)
-        lay = QHBoxLayout(self)
-        lay.setContentsMargins(4, 0, 4, 0)
+        lay = FlowLayout(self, spacing=6, margins=(4, 0, 4, 0))
         SP = QStyle.StandardPixmap
-        self.play_button = self._button(lay, SP.SP_MediaPlay, "play / pause (space)", self.playClicked.emit)
-        self._button(lay, SP.SP_MediaStop, "stop", self.stopClicked.emit)
-        self._button(lay, SP.SP_MediaSeekBackward, "previous frame (left)", lambda: self.stepClicked.emit(-1))
-        self._button(lay, SP.SP_MediaSeekForward, "next frame (right)", lambda: self.stepClicked.emit(1))
+        self.play_button = self._button(SP.SP_MediaPlay, "play / pause (space)", self.playClicked.emit)
+        lay.add(flow_row([
+            self.play_button,
+            self._button(SP.SP_MediaStop, "stop", self.stopClicked.emit),
+            self._button(SP.SP_MediaSeekBackward, "previous frame (left)", lambda: self.stepClicked.emit(-1)),
+            self._button(SP.SP_MediaSeekForward, "next frame (right)", lambda: self.stepClicked.emit(1))]))
         self.slider = QSlider(Qt.Orientation.Horizontal)
         self.slider.setFocusPolicy(Qt.FocusPolicy.NoFocus)
-        lay.addWidget(self.slider, 1)
+        lay.add(self.slider, stretch=SLIDER_LEAST_PX)
         self.time_label = QLabel("0.000 s")
         self.time_label.setStyleSheet("font-family: monospace;")
         # a fixed size: a new text every frame then repaints the label without laying out the
@@ -256,18 +267,16 @@ class TransportBar(QWidget):
         self.time_label.ensurePolished()
         width = self.time_label.fontMetrics().horizontalAdvance(TIME_TEMPLATE)
         self.time_label.setFixedSize(width, self.time_label.sizeHint().height())
-        lay.addWidget(self.time_label)
+        lay.add(self.time_label)
         self.speed = QComboBox()
         for s in SPEEDS:
             self.speed.addItem(f"{s:g}x", s)
         self.speed.setFocusPolicy(Qt.FocusPolicy.NoFocus)
         self.speed.setToolTip("playback speed")
         self.speed.currentIndexChanged.connect(lambda _i: self.speedChanged.emit(self.speed.currentData()))
-        lay.addWidget(self.speed)
         self.loop_box = QCheckBox("loop")
         self.loop_box.setFocusPolicy(Qt.FocusPolicy.NoFocus)
         self.loop_box.setToolTip("loop the selected range (drag on the panels to select; Esc clears)")
-        lay.addWidget(self.loop_box)
         # the 3-D view over the panels' room too, as a video player's full-screen button (a
         # laptop screen: the faces two or three times as tall); the window connects it
         # (``PanelSplit.enlarge``)
@@ -277,16 +286,15 @@ class TransportBar(QWidget):
         self.enlarge.setFocusPolicy(Qt.FocusPolicy.NoFocus)
         self.enlarge.setToolTip("enlarge the 3-D view: it takes the panels' room too (press again "
                                 "for the panels)")
-        lay.addWidget(self.enlarge)
+        lay.add(flow_row([self.speed, self.loop_box, self.enlarge], spacing=6))
 
-    def _button(self, lay: QHBoxLayout, icon: QStyle.StandardPixmap, tip: str, slot) -> QToolButton:
+    def _button(self, icon: QStyle.StandardPixmap, tip: str, slot) -> QToolButton:
         b = QToolButton()
         b.setIcon(self.style().standardIcon(icon))
         b.setAutoRaise(False)
         b.setToolTip(tip)
         b.setFocusPolicy(Qt.FocusPolicy.NoFocus)
         b.clicked.connect(lambda _c=False: slot())
-        lay.addWidget(b)
         return b
 
     def set_playing(self, playing: bool) -> None:

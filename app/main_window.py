@@ -63,7 +63,6 @@ from PyQt6.QtWidgets import (
     QMenu,
     QMessageBox,
     QSplitter,
-    QVBoxLayout,
     QWidget,
 )
 
@@ -113,12 +112,12 @@ from .viewer_model import (
     voice_match_tip,
 )
 from .window_frame import (
-    DockWidth,
+    Column,
+    LeftDocks,
     PanelSplit,
     WindowDocks,
     WindowMenus,
     fit_to_screen,
-    share_left_docks,
     text_scroll,
 )
 from .workers import Progress, Task, TaskRunner
@@ -133,6 +132,8 @@ log = logging.getLogger(__name__)
 PNG_QUALITY = 80
 #: the largest share of the height the panels take from the 3-D view to show every panel
 PANELS_SHARE = 0.72
+#: the 3-D view's least height (a small window with the view's bars on several rows kept none)
+FACE_LEAST_PX = 80
 
 class MainWindow(QMainWindow):
     """Speech plays while original and synthesized face points move, with the lip trajectories."""
@@ -189,6 +190,7 @@ class MainWindow(QMainWindow):
     # ================================================================== construction
     def _build_widgets(self) -> None:
         self.face = FaceView(self)
+        self.face.setMinimumHeight(FACE_LEAST_PX)
         self.plotter = self.face.plotter
         # a click on the 3-D view or the panels takes the keyboard focus from a spin box or a
         # filter box (which keep the arrows, space, Home and End to themselves): the playback
@@ -207,8 +209,8 @@ class MainWindow(QMainWindow):
         self.transport = _build_transport(self)
         self.title = TitleBar()
         self.notice = NoticeBar()
-        self.splitter = _split(_column([self.view_bar, self.face, self.transport], 2, stretch=self.face),
-                               _column([self.notice, self.title, self.timeline], 0, stretch=self.timeline))
+        self.splitter = _split(Column([self.view_bar, self.face, self.transport], 2, stretch=self.face),
+                               Column([self.notice, self.title, self.timeline], 0, stretch=self.timeline))
         self.setCentralWidget(self.splitter)
         # panels left out for lack of room: more of the height for them; kept through resizes
         self.panel_split = PanelSplit(self.splitter, self.timeline, most=PANELS_SHARE)
@@ -223,7 +225,9 @@ class MainWindow(QMainWindow):
         self.settings.searchChosen.connect(lambda cfg: self.set_synth_config(cfg, explicit=True))
         self.settings_dock = self.docks.dock(text_scroll(self.settings), "Synthesis settings",
                                         Qt.DockWidgetArea.LeftDockWidgetArea)
-        self.dock_width = DockWidth(self, self.browser_dock, 400)
+        self.dock_width = self.docks.width_of(Qt.DockWidgetArea.LeftDockWidgetArea)
+        self.dock_width.place(400)
+        self.left_docks = LeftDocks(self, self.browser_dock, self.settings_dock, self.settings)
         self.status = StatusArea(self.statusBar(), self.tasks)
         self.status_label, self.progress = self.status.label, self.status.progress
         self.dimensions_label = self.status.dimensions_label
@@ -234,7 +238,7 @@ class MainWindow(QMainWindow):
         the browser dock a quarter of the width (at most 400 px): a laptop keeps room for the face."""
         width = fit_to_screen(self, wanted)[2]
         self.dock_width.place(min(400, width // 4))
-        share_left_docks(self, self.browser_dock, self.settings_dock, self.settings)
+        self.left_docks.apply()
 
     # ================================================================== public contract
     def menu(self, name: str) -> QMenu:
@@ -659,17 +663,6 @@ def _split(top: QWidget, bottom: QWidget) -> QSplitter:
     split.setSizes([480, 520])
     split.setChildrenCollapsible(False)
     return split
-
-
-def _column(widgets: list[QWidget], spacing: int, stretch: QWidget) -> QWidget:
-    """Widgets stacked vertically without margins; ``stretch`` takes the spare height."""
-    box = QWidget()
-    lay = QVBoxLayout(box)
-    lay.setContentsMargins(0, 0, 0, 0)
-    lay.setSpacing(spacing)
-    for w in widgets:
-        lay.addWidget(w, 1 if w is stretch else 0)
-    return box
 
 
 KEYS_HELP = """space\tplay / pause

@@ -42,13 +42,30 @@ from facetraj_engine.analysis.phone_compare import (
     write_comparison_csv,
 )
 
-from .analysis.common import NumberItem, export_with_dialog, fill_table, text_item
+from .analysis.common import NumberItem, compact_headers, export_with_dialog, fill_table, text_item
 from .measure_model import TABLE_COLUMNS, Measure
 
 #: the table's columns up to the minima's (the pins' columns follow them)
 MIN_COLUMNS = 1 + max(i for i, c in enumerate(TABLE_COLUMNS) if c[1].startswith("min_"))
 #: the splits a corpus-wide comparison runs over
 RUN_SPLITS = {"test": ("test",), "train": ("train",), "train + test": ("test", "train")}
+
+
+def two_lines(heading: str) -> str:
+    r"""A table heading as shown: on two lines, as narrow as its longer line (the columns then
+    fit a laptop's dock); a pin's difference column without its "min: " (its pin's column
+    beside it says so). The whole heading is the header's tooltip.
+
+    >>> two_lines("min: this − pin 1"), two_lines("start (s)"), two_lines("min: synth."), two_lines("phone")
+    ('this −\npin 1', 'start\n(s)', 'min:\nsynth.', 'phone')
+    """
+    words = heading.removeprefix("min: this − ").split(" ")
+    if len(words) < len(heading.split(" ")):
+        words = ["this", "−", *words]
+    if len(words) < 2:
+        return heading
+    best = min(range(1, len(words)), key=lambda k: max(len(" ".join(words[:k])), len(" ".join(words[k:]))))
+    return " ".join(words[:best]) + "\n" + " ".join(words[best:])
 
 
 class ApertureTable(QWidget):
@@ -77,6 +94,7 @@ class ApertureTable(QWidget):
         self.table.cellClicked.connect(self._clicked)
         self.corpus = CorpusRun(measure, self.filter, window) if window is not None else None
         lay = QVBoxLayout(self)
+        lay.setContentsMargins(4, 4, 4, 4)          # the table as wide as the dock allows
         lay.addLayout(top)
         lay.addWidget(self.note)
         lay.addWidget(self.table, 1)
@@ -85,6 +103,11 @@ class ApertureTable(QWidget):
             self.filter.textChanged.connect(lambda _t: self.corpus.show_summary())
 
     def refresh(self) -> None:
+        """The rows of the filter's phones; the headings on two lines, and a column no row has a
+        value in left out of view (the words of recognized phones, the original's and the
+        errors of a recording without markers), so that a laptop's dock shows the pins' columns
+        beside the minima (they were past its edge: 434 of 779 px in view, the word column
+        empty)."""
         items = []
         rows = self.measure.rows(self.filter.text())
         for r, mins in zip(rows, self.measure.pin_minima(rows), strict=True):
@@ -99,7 +122,13 @@ class ApertureTable(QWidget):
             items.append(row)
         heads = [c[0] for c in TABLE_COLUMNS]
         heads[MIN_COLUMNS:MIN_COLUMNS] = self.measure.pin_columns()
-        fill_table(self.table, heads, items)
+        fill_table(self.table, [two_lines(h) for h in heads], items)
+        for c, head in enumerate(heads):
+            self.table.horizontalHeaderItem(c).setToolTip(head)
+        for c in range(self.table.columnCount()):       # no words, no original: no column
+            self.table.setColumnHidden(c, bool(items) and not any(row[c].text() for row in items))
+        compact_headers(self.table)
+        words = any(r.word for r in rows)
         view = self.measure.view
         has_original = view is not None and view.original is not None
         pins = ("; pins: their least aperture over the same segment, and this minus it"
@@ -108,7 +137,13 @@ class ApertureTable(QWidget):
                           "and midpoint, original (orig.) and synthesized (synth.); error = "
                           "synthesized − original" + pins + ". A click on "
                           "a row goes to its minimum." + ("" if has_original or view is None else
-                                                          " No original markers here."))
+                                                          " No original markers here.")
+                          + ("" if words or not rows else " No words: the labels are phones alone."))
+
+    def column(self, heading: str) -> int:
+        """The table's column of ``heading`` (as ``TABLE_COLUMNS`` and ``pin_columns`` name it)."""
+        heads = [self.table.horizontalHeaderItem(c).toolTip() for c in range(self.table.columnCount())]
+        return heads.index(heading)
 
     def _clicked(self, row: int, _col: int) -> None:
         item = self.table.item(row, 0)

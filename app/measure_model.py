@@ -50,16 +50,20 @@ TABLE_COLUMNS: tuple[tuple[str, str, str], ...] = (      # short: a laptop's doc
 
 
 def mm(value: float, signed: bool = False) -> str:
-    """A length in mm for the readout ("—" when there is none).
+    """A length in mm for the readout ("—" when there is none); a value that rounds to zero
+    reads 0.0, whatever its sign (a jaw a hair above its highest position read "-0.0 mm").
 
     >>> mm(11.234), mm(-0.26, signed=True), mm(-0.04, signed=True), mm(float("nan"))
     ('11.2 mm', '-0.3 mm', '0.0 mm', '—')
+    >>> mm(-0.04), mm(-0.049), mm(0.04, signed=True), mm(-0.06)
+    ('0.0 mm', '0.0 mm', '0.0 mm', '-0.1 mm')
     """
     if not math.isfinite(value):
         return "—"
-    if signed and abs(value) < 0.05:          # no "-0.0 mm"
+    text = f"{value:+.1f}" if signed else f"{value:.1f}"
+    if float(text) == 0.0:                    # no "-0.0 mm" (nor "+0.0 mm")
         return "0.0 mm"
-    return f"{value:+.1f} mm" if signed else f"{value:.1f} mm"
+    return f"{text} mm"
 
 
 @dataclass

@@ -23,8 +23,9 @@ from .state import UtteranceView
 
 #: the pins' colours, in turn: apart from the original's blue, the synthesis's oranges, the
 #: cursor, the closed line and the loop range (a teal third was hard to tell from the original's
-#: blue dashes): green, purple, brown
-PIN_COLORS = ("#2f9e44", "#9c36b5", "#7c4a03")
+#: blue dashes; a brown one from the spline's dark orange, 16 CIEDE2000 units): green, purple,
+#: cyan (33 units or more from each of them)
+PIN_COLORS = ("#2f9e44", "#9c36b5", "#00b5d8")
 #: the most pins kept at once (the oldest goes)
 MAX_PINS = len(PIN_COLORS)
 

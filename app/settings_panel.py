@@ -113,33 +113,42 @@ class SynthSettingsPanel(QWidget):
             "closure (--closure-detector). Off by default: on real lips its closures lowered "
             "the lip correlation (issue 46, docs/algorithm.md)")
         self.reset = QPushButton("Paper defaults")
-        self.status = QLabel("")
-        self.status.setWordWrap(True)
 
     def _build_layout(self) -> None:
-        form = QFormLayout()
-        form.addRow("N (context-phones)", self.n)
-        form.addRow("C (context)", self.c)
-        form.addRow("ξ (eq 4)", self.xi)
+        """The settings in two forms with the search's notes between them, in the panel's own
+        column: a form's rows of wrapped text were laid out for a wider panel after the dock
+        narrowed (the notes cut to three lines of four, run into the rows around them). Both
+        forms' labels are as wide as the widest, so that their fields line up."""
+        names = ("N (context-phones)", "C (context)", "ξ (eq 4)", "ν (eq 3)", "search", "smoothing",
+                 "closure step")
+        width = max(self.fontMetrics().horizontalAdvance(n) for n in names)
+        labels = {}
+        for n in names:
+            labels[n] = QLabel(n)
+            labels[n].setMinimumWidth(width)
+        top, bottom = QFormLayout(), QFormLayout()
+        top.addRow(labels["N (context-phones)"], self.n)
+        top.addRow(labels["C (context)"], self.c)
+        top.addRow(labels["ξ (eq 4)"], self.xi)
         nu_row = QHBoxLayout()
         nu_row.addWidget(self.nu, 1)
         nu_row.addWidget(self.nu_default)
-        form.addRow("ν (eq 3)", nu_row)
-        form.addRow("search", self.mode)
-        form.addRow(self.mode_note)
-        form.addRow(self.mode_reason)
-        form.addRow("smoothing", self.smoothing)
+        top.addRow(labels["ν (eq 3)"], nu_row)
+        top.addRow(labels["search"], self.mode)
+        bottom.addRow(labels["smoothing"], self.smoothing)
         lips = QVBoxLayout()
         lips.setSpacing(0)
         for box in (self.closure_labels, self.rest, self.closure_detector):
             lips.addWidget(box)
-        form.addRow("closure step", lips)
+        bottom.addRow(labels["closure step"], lips)
         lay = QVBoxLayout(self)
         self._layout = lay
-        lay.addLayout(form)
+        lay.addLayout(top)
+        lay.addWidget(self.mode_note)
+        lay.addWidget(self.mode_reason)
+        lay.addLayout(bottom)
         lay.addWidget(self.reset)
         lay.addWidget(self.tuned_label)
-        lay.addWidget(self.status)
         lay.addStretch(1)
 
     def _connect(self) -> None:

@@ -1,11 +1,14 @@
 """The main window's status bar: a message, a note for midsagittal data and articulograph sensors,
 and the progress of the task runner's work (foreground work owns the bar; background work shows
-when nothing else runs)."""
+when nothing else runs). The message and the note are elided to their room (the whole text in
+the tooltip): a long message never sets the window's least width (a summary 901 px long kept the
+window from being narrower, and its end was cut off on a laptop)."""
 
 from __future__ import annotations
 
-from PyQt6.QtWidgets import QLabel, QProgressBar, QStatusBar
+from PyQt6.QtWidgets import QProgressBar, QStatusBar
 
+from .elided import ElidedLabel
 from .workers import Task, TaskRunner
 
 
@@ -15,12 +18,12 @@ class StatusArea:
     def __init__(self, bar: QStatusBar, tasks: TaskRunner):
         self.bar = bar
         self.tasks = tasks
-        self.label = QLabel("")
+        self.label = ElidedLabel("")
         self.progress = QProgressBar()
         self.progress.setRange(0, 1000)
         self.progress.setFixedWidth(300)
         self.progress.setVisible(False)
-        self.dimensions_label = QLabel("midsagittal (2-D) data: profile view, y up, z forward")
+        self.dimensions_label = ElidedLabel("midsagittal (2-D) data: profile view, y up, z forward")
         self.dimensions_label.setStyleSheet("font-weight: 600; padding: 0 8px;")
         self.dimensions_label.hide()
         bar.addWidget(self.label, 1)

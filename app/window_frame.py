@@ -11,7 +11,7 @@ from typing import Any
 from PyQt6 import sip
 from PyQt6.QtCore import QEvent, QObject, QSize, Qt, QTimer
 from PyQt6.QtGui import QAction, QGuiApplication
-from PyQt6.QtWidgets import QDockWidget, QFrame, QMainWindow, QMenu, QScrollArea, QWidget
+from PyQt6.QtWidgets import QDockWidget, QFrame, QMainWindow, QMenu, QScrollArea, QVBoxLayout, QWidget
 
 from facetraj_engine.errors import FacetrajError
 
@@ -60,6 +60,48 @@ class WindowMenus:
         return action
 
 
+def rows_height(layout, width: int) -> int:
+    """The least height of ``layout`` at ``width`` px where its rows wrap (a
+    :class:`~facetraj_app.flow_layout.FlowLayout`, word-wrapped text: its
+    ``minimumHeightForWidth``); 0 when its height does not depend on its width."""
+    if layout is None or not layout.hasHeightForWidth():
+        return 0
+    return getattr(layout, "minimumHeightForWidth", layout.heightForWidth)(width)
+
+
+def least_size(widget: QWidget, width: int, least: QSize | None = None) -> QSize:
+    """The least size of ``widget`` at ``width`` px: ``least`` (its ``minimumSizeHint``), taller
+    where its rows wrap at that width (:func:`rows_height`)."""
+    if least is None:
+        least = widget.minimumSizeHint().expandedTo(widget.minimumSize())
+    least.setHeight(max(least.height(), rows_height(widget.layout(), max(width, least.width()))))
+    return least
+
+
+class Column(QWidget):
+    """Widgets stacked vertically without margins, the spare height to ``stretch``; its least
+    height is what its rows need at its width (:func:`rows_height`), so that a splitter never
+    squeezes a bar that wrapped onto more rows (the transport bar's last row was cut off)."""
+
+    def __init__(self, widgets: list[QWidget], spacing: int, stretch: QWidget):
+        super().__init__()
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(0, 0, 0, 0)
+        lay.setSpacing(spacing)
+        for w in widgets:
+            lay.addWidget(w, 1 if w is stretch else 0)
+        self._width = -1
+
+    def minimumSizeHint(self) -> QSize:
+        return least_size(self, self.width(), self.layout().totalMinimumSize())
+
+    def resizeEvent(self, event) -> None:
+        super().resizeEvent(event)
+        if self.width() != self._width:         # its rows may wrap otherwise: a new least height
+            self._width = self.width()
+            self.updateGeometry()
+
+
 class FillScrollArea(QScrollArea):
     """The scroll area of a dock: its view fills the viewport (its tables, plots and splitters
     stretch or shrink to the dock) and is never made smaller than its least size
@@ -87,8 +129,8 @@ class FillScrollArea(QScrollArea):
         widget = self.widget()
         if widget is None:
             return
-        least = widget.minimumSizeHint().expandedTo(widget.minimumSize())
         room = self.viewport().size()
+        least = least_size(widget, room.width())       # rows that wrap at the viewport's width
         size = QSize(max(room.width(), least.width()), max(room.height(), least.height()))
         if widget.size() != size:
             widget.resize(size)
@@ -110,12 +152,24 @@ def text_scroll(widget: QWidget) -> QScrollArea:
     return scroll
 
 
+#: the most of the window's width the docks of a side take when the window is resized
+DOCK_SHARES = {Qt.DockWidgetArea.LeftDockWidgetArea: 0.25, Qt.DockWidgetArea.RightDockWidgetArea: 0.4}
+
+
 class WindowDocks:
-    """The docks of ``window``: movable, floatable, closable; extra docks in one area tabbed."""
+    """The docks of ``window``: movable, floatable, closable; extra docks in one area tabbed; the
+    width of the left and of the right docks kept through resizes (:class:`DockWidth`)."""
 
     def __init__(self, window: QMainWindow):
         self.window = window
         self.last: dict[Qt.DockWidgetArea, QDockWidget] = {}
+        self.widths: dict[Qt.DockWidgetArea, DockWidth] = {}
+
+    def width_of(self, area: Qt.DockWidgetArea) -> DockWidth:
+        """The kept width of the docks of ``area`` (the left or the right side)."""
+        if area not in self.widths:
+            self.widths[area] = DockWidth(self.window, area, 0, DOCK_SHARES.get(area, 0.4))
+        return self.widths[area]
 
     def dock(self, widget: QWidget, title: str, area: Qt.DockWidgetArea) -> QDockWidget:
         dock = QDockWidget(title, self.window)
@@ -125,6 +179,8 @@ class WindowDocks:
                          | QDockWidget.DockWidgetFeature.DockWidgetFloatable
                          | QDockWidget.DockWidgetFeature.DockWidgetClosable)
         self.window.addDockWidget(area, dock)
+        if area in DOCK_SHARES:
+            self.width_of(area).watch(dock)
         return dock
 
     def add(self, widget: QWidget, title: str, area: Qt.DockWidgetArea) -> QDockWidget:
@@ -132,7 +188,7 @@ class WindowDocks:
         scroll area (``dock.widget().widget()``): a view wider than its dock scrolls instead of
         widening the window (a main window grows to fit the minimum widths of its docks: four
         analysis views took it from 1600 to 1864 px and it stayed so after they closed). The
-        first dock of an area gets :func:`dock_width` of the window."""
+        first dock of an area gets :func:`dock_width` of the window, kept through resizes."""
         scroll = FillScrollArea()
         scroll.setWidget(widget)
         scroll.setFrameShape(QFrame.Shape.NoFrame)
@@ -140,12 +196,10 @@ class WindowDocks:
         previous = self.last.get(area)
         if previous is not None and self._docked(previous, area):
             self.window.tabifyDockWidget(previous, dock)
+        elif area in DOCK_SHARES:
+            self.width_of(area).place(dock_width(self.window.width()))
         else:
-            orientation = (Qt.Orientation.Horizontal
-                           if area in (Qt.DockWidgetArea.LeftDockWidgetArea,
-                                       Qt.DockWidgetArea.RightDockWidgetArea)
-                           else Qt.Orientation.Vertical)
-            self.window.resizeDocks([dock], [dock_width(self.window.width())], orientation)
+            self.window.resizeDocks([dock], [dock_width(self.window.width())], Qt.Orientation.Vertical)
         self.last[area] = dock
         return dock
 
@@ -274,55 +328,113 @@ class PanelSplit(QObject):
 
 
 class DockWidth(QObject):
-    """The width of ``dock`` (the left docks' column) kept through resizes of ``window``: the
-    width placed (or the user's, dragging its edge), but at most ``share`` of the window. A
-    window made smaller squeezes the dock; made larger again, the dock gets its width back (it
-    stayed squeezed, the settings clipped)."""
+    """The width of the docks on one side of ``window`` (``area``: the left docks' column, the
+    analysis docks on the right) kept through resizes of the window: the width placed (or the
+    user's, dragging the docks' edge), but at most ``share`` of the window. A window made smaller
+    squeezes the docks; made larger again, they get their width back (the left column stayed
+    squeezed, the settings clipped; a right dock stayed 68 px wide instead of 560). A dock shown
+    again (reopened, another tab) gets it too."""
 
-    def __init__(self, window: QMainWindow, dock: QDockWidget, width: int, share: float = 0.25):
+    def __init__(self, window: QMainWindow, area: Qt.DockWidgetArea, width: int, share: float = 0.25):
         super().__init__(window)
-        self.window, self.dock, self.share = window, dock, share
+        self.window, self.area, self.share = window, area, share
         self.width = width
+        self.docks: list[QDockWidget] = []
         self._window_width = window.width()
         self._applying = False
-        dock.installEventFilter(self)
         window.installEventFilter(self)
 
+    def watch(self, dock: QDockWidget) -> None:
+        """Keep the width of ``dock`` (one of the side's)."""
+        self.docks.append(dock)
+        dock.installEventFilter(self)
+
+    def dock(self) -> QDockWidget | None:
+        """The side's dock to resize: the one shown (a tab group's current one), else the last
+        one added that is docked there."""
+        docked = [d for d in self.docks if not d.isFloating() and self.window.dockWidgetArea(d) == self.area]
+        shown = [d for d in docked if d.isVisible()]
+        on_top = [d for d in shown if not d.visibleRegion().isEmpty()]    # a tab behind is "visible"
+        return (on_top or shown or docked[-1:] or [None])[0]
+
     def place(self, width: int) -> None:
-        """The dock ``width`` px wide (what the window asks for when it is placed)."""
+        """The docks ``width`` px wide (what the window asks for when it is placed)."""
         self.width = width
         self.apply()
 
+    def wanted(self) -> int:
+        """The width the docks get at the window's present width."""
+        return min(self.width, int(self.share * self.window.width()))
+
     def apply(self) -> None:
         self._window_width = self.window.width()
-        want = min(self.width, int(self.share * self.window.width()))
-        if abs(self.dock.width() - want) > 1:
+        dock = self.dock()
+        if dock is None or self.width <= 0:
+            return
+        want = self.wanted()
+        if abs(dock.width() - want) > 1:
             self._applying = True
             try:
-                self.window.resizeDocks([self.dock], [want], Qt.Orientation.Horizontal)
+                self.window.resizeDocks([dock], [want], Qt.Orientation.Horizontal)
             finally:
                 self._applying = False
 
     def eventFilter(self, obj, event) -> bool:
-        if event.type() == QEvent.Type.Resize:
-            if obj is self.window:
+        kind = event.type()
+        if obj is self.window:
+            if kind == QEvent.Type.Resize:
                 QTimer.singleShot(0, self.apply)        # once the docks have their new size
-            elif not self._applying and self.window.width() == self._window_width \
-                    and self.dock.isVisible():
-                self.width = self.dock.width()          # the user's drag
+        elif kind == QEvent.Type.Show:
+            QTimer.singleShot(0, self.apply)
+        elif kind == QEvent.Type.Resize and not self._applying and obj.isVisible() \
+                and self.window.width() == self._window_width \
+                and QGuiApplication.mouseButtons() != Qt.MouseButton.NoButton:
+            self.width = obj.width()                    # the user's drag of the docks' edge
         return False
 
 
-def share_left_docks(window: QMainWindow, top: QDockWidget, bottom: QDockWidget,
-                     panel: QWidget, least_top: int = 150) -> None:
+class LeftDocks(QObject):
     """Two docks one above the other: ``bottom`` (holding ``panel``, controls and wrapped text)
     the height its text needs at its width, ``top`` (a list, which scrolls) the rest but at
-    least ``least_top`` px (a laptop screen: the settings' lines all in view)."""
-    needed = panel.heightForWidth(max(bottom.width(), 200))
-    needed = needed if needed > 0 else panel.sizeHint().height()
-    total = top.height() + bottom.height()
-    if total <= 0:
-        return
-    # (+80: the notes the settings add once a synthesis is shown, a line or four)
-    low = max(total // 2, min(needed + 80, total - least_top))
-    window.resizeDocks([top, bottom], [total - low, low], Qt.Orientation.Vertical)
+    least ``least_top`` px; again whenever the window is resized or the panel's text changes
+    (a note added after a synthesis: on a laptop the settings' last line was cut off, to be
+    scrolled to)."""
+
+    def __init__(self, window: QMainWindow, top: QDockWidget, bottom: QDockWidget, panel: QWidget,
+                 least_top: int = 150):
+        super().__init__(window)
+        self.window, self.top, self.bottom, self.panel = window, top, bottom, panel
+        self.least_top = least_top
+        self._due = False
+        window.installEventFilter(self)
+        panel.installEventFilter(self)
+
+    def needed(self) -> int:
+        """The bottom dock's height that shows all of the panel (its title bar included)."""
+        scroll = self.bottom.widget()
+        width = max(scroll.width() - 2 * scroll.frameWidth(), 200)   # no scroll bar then
+        text = self.panel.heightForWidth(width)
+        text = text if text > 0 else self.panel.sizeHint().height()
+        chrome = self.bottom.height() - scroll.viewport().height() if scroll.viewport().height() > 0 else 0
+        return text + max(chrome, 0)
+
+    def apply(self) -> None:
+        self._due = False
+        top, bottom = self.top, self.bottom
+        total = top.height() + bottom.height()
+        area = self.window.dockWidgetArea
+        if (total <= 0 or not top.isVisible() or not bottom.isVisible() or top.isFloating()
+                or bottom.isFloating() or area(top) != area(bottom)):
+            return
+        low = max(total // 2, min(self.needed(), total - self.least_top))
+        if abs(bottom.height() - low) > 1:
+            self.window.resizeDocks([top, bottom], [total - low, low], Qt.Orientation.Vertical)
+
+    def eventFilter(self, obj, event) -> bool:
+        kind = event.type()
+        if (obj is self.window and kind == QEvent.Type.Resize) or \
+                (obj is self.panel and kind == QEvent.Type.LayoutRequest):
+            if not self._due:
+                self._due = True
+                QTimer.singleShot(0, self.apply)        # once the docks have their new size
+        return False

@@ -187,8 +187,7 @@ def test_the_b_of_boy_aligned_against_recognized_from_the_window(screen, opening
     text = w.extension("measure").readout.text()
     assert "/b/" in text and f"aperture {this:.1f} mm" in text and "original" in text
     assert re.search(rf"pin 1 /\w+/ {pinned:.1f} mm \(this − pin 1 (0\.0|[+-]\d+\.\d) mm\)", text), text
-    heads = [table.table.horizontalHeaderItem(c).text() for c in range(table.table.columnCount())]
-    column = heads.index("min: pin 1")
+    column = table.column("min: pin 1")
     least = minimum_within(pin.view.times, aperture(pin.view.shown, up, lo), first.start, first.end)
     assert table.table.item(0, column).value == pytest.approx(least)
     w.view_bar.side_by_side.setChecked(True)

@@ -25,13 +25,34 @@ def packages_under(folder: str, name: str) -> set[str]:
 def test_every_package_folder_is_in_a_distribution():
     engine = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
     app = tomllib.loads((APP / "pyproject.toml").read_text())["tool"]["setuptools"]
-    assert engine["package-dir"] == {"facetraj_engine": "engine", "facetraj": "facetraj"}
+    assert engine["package-dir"] == {"": "packaging/engine"}
+    assert app["package-dir"] == {"": "src"}
     assert set(engine["packages"]) == packages_under("engine", "facetraj_engine") | \
         packages_under("facetraj", "facetraj")
     assert set(app["packages"]) == packages_under("app", "facetraj_app") | {"facetraj_app.corpus"}
-    for link, target in {"facetraj_app": ROOT / "app", "corpus": ROOT / "data_samples",
-                         "engine_version.py": ROOT / "engine" / "__init__.py"}.items():
-        assert (APP / link).resolve() == target.resolve(), link
+    links = {ROOT / "packaging" / "engine" / "facetraj_engine": ROOT / "engine",
+             ROOT / "packaging" / "engine" / "facetraj": ROOT / "facetraj",
+             APP / "src" / "facetraj_app": ROOT / "app", ROOT / "app" / "corpus": ROOT / "data_samples",
+             APP / "engine_version.py": ROOT / "engine" / "__init__.py"}
+    for link, target in links.items():
+        assert link.is_symlink() and link.resolve() == target.resolve(), link
+
+
+def test_the_editable_installs_are_quiet():
+    """Every package sits in a folder of its import name under one root (the links above), so
+    that setuptools' editable install puts that root on the path with a .pth file; a package
+    mapped from a folder of another name made it install an import hook and print, for each
+    distribution at every ``make run`` on a fresh clone, "BuildBackendWarning ... folders in
+    your working directory with the same name as your package" (issue 54). Nothing else is in
+    the root: the path gets no other name."""
+    for project in (ROOT, APP):
+        config = tomllib.loads((project / "pyproject.toml").read_text())["tool"]["setuptools"]
+        assert set(config["package-dir"]) == {""}, project       # one root for every package
+        root = project / config["package-dir"][""]
+        for package in config["packages"]:
+            assert root.joinpath(*package.split(".")).is_dir(), package     # by its own name
+        assert sorted(p.name for p in root.iterdir() if not p.name.endswith(".egg-info")) == \
+            sorted({p.split(".")[0] for p in config["packages"]})
 
 
 def test_the_version_is_written_once_and_the_app_pins_that_engine(monkeypatch):

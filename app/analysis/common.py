@@ -12,13 +12,14 @@ from typing import Any
 import numpy as np
 from matplotlib import colormaps
 from matplotlib.figure import Figure
-from PyQt6.QtCore import QEvent, QObject, Qt, QTimer
-from PyQt6.QtGui import QColor
+from PyQt6.QtCore import QEvent, QObject, QSize, Qt, QTimer
+from PyQt6.QtGui import QColor, QFont, QFontMetrics
 from PyQt6.QtWidgets import (
     QFileDialog,
     QMessageBox,
     QSizePolicy,
     QSplitter,
+    QStyle,
     QTableWidget,
     QTableWidgetItem,
     QWidget,
@@ -191,10 +192,11 @@ class _ColumnStretcher(QObject):
         t = self.table
         if not self.widths or len(self.widths) != t.columnCount():
             return
-        room = t.viewport().width() - sum(self.widths)
-        extra = max(room, 0) // len(self.widths)
-        for c, w in enumerate(self.widths):
-            t.setColumnWidth(c, w + extra)
+        shown = [c for c in range(t.columnCount()) if not t.isColumnHidden(c)]
+        room = t.viewport().width() - sum(self.widths[c] for c in shown)
+        extra = max(room, 0) // max(len(shown), 1)
+        for c in shown:
+            t.setColumnWidth(c, self.widths[c] + extra)
 
     def eventFilter(self, obj, event) -> bool:
         if event.type() == QEvent.Type.Resize:
@@ -204,16 +206,45 @@ class _ColumnStretcher(QObject):
 
 def stretch_columns(table: QTableWidget) -> None:
     """Columns share the table's width (no empty strip on the right), each at least as wide as
-    its contents (after ``resizeColumnsToContents``)."""
+    its contents (after ``resizeColumnsToContents``); hidden columns get none of it (called
+    again after a column is hidden or shown)."""
     stretcher = table.findChild(_ColumnStretcher) or _ColumnStretcher(table)
-    stretcher.widths = [table.columnWidth(c) for c in range(table.columnCount())]
-    table.horizontalHeader().setStretchLastSection(False)
+    header = table.horizontalHeader()
+    stretcher.widths = [max(table.sizeHintForColumn(c), header.sectionSizeHint(c))   # its contents'
+                        for c in range(table.columnCount())]
+    header.setStretchLastSection(False)
     # a table of a few columns asks for their whole width (a splitter or dock then shows them all);
     # a wide one (the similarity matrix) scrolls instead
-    need = (sum(stretcher.widths) + 2 * table.frameWidth()
-            + table.verticalScrollBar().sizeHint().width())
+    need = (sum(w for c, w in enumerate(stretcher.widths) if not table.isColumnHidden(c))
+            + 2 * table.frameWidth() + table.verticalScrollBar().sizeHint().width())
     table.setMinimumWidth(need if need <= MAX_TABLE_MIN_WIDTH else 0)
     stretcher.apply()
+
+
+#: the room a header keeps for its sort arrow (the style reserves the header's whole height:
+#: 30 px and more for a heading on two lines)
+SORT_ARROW_PX = 10
+
+
+def compact_headers(table: QTableWidget) -> None:
+    """The table's headings as narrow as their longest line and the sort arrow (each heading's
+    ``SizeHintRole``), then its columns fitted again (:func:`stretch_columns`): headings on two
+    lines then make narrow columns."""
+    header = table.horizontalHeader()
+    font = QFont(header.font())
+    font.setBold(True)                      # as the header measures its sections
+    fm = QFontMetrics(font)
+    margin = header.style().pixelMetric(QStyle.PixelMetric.PM_HeaderMargin, None, header)
+    for c in range(table.columnCount()):
+        item = table.horizontalHeaderItem(c)
+        if item is None:
+            continue
+        lines = item.text().split("\n")
+        width = max(fm.horizontalAdvance(line) for line in lines) + 2 * margin + SORT_ARROW_PX
+        item.setData(Qt.ItemDataRole.SizeHintRole,
+                     QSize(width, fm.lineSpacing() * len(lines) + 2 * margin))
+    table.resizeColumnsToContents()
+    stretch_columns(table)
 
 
 def ask_save_path(parent: QWidget, title: str, default: str, filters: str) -> Path | None:

@@ -19,7 +19,6 @@ from PyQt6.QtGui import QColor
 from PyQt6.QtWidgets import (
     QCheckBox,
     QComboBox,
-    QGridLayout,
     QGroupBox,
     QHBoxLayout,
     QLabel,
@@ -50,6 +49,7 @@ from facetraj_engine.evaluation.scores import METRICS, EvalResult, sweep_n, tabl
 from facetraj_engine.io.corpus import Corpus
 from facetraj_engine.method.model import Model
 
+from ..flow_layout import FlowLayout, flow_row
 from .common import (
     Canvas,
     NumberItem,
@@ -163,8 +163,10 @@ class MetricsView(QWidget):
         self.progress.setRange(0, 1000)
         self.status = QLabel("")
         self.status.setWordWrap(True)
-        exp = [("Table 2 CSV…", self._export_table2), ("per sensor CSV…", self._export_sensors),
-               ("N sweep CSV…", self._export_sweep), ("PNG…", self._export_png)]
+        exp = [("Table 2 CSV…", "export Table 2 as CSV", self._export_table2),
+               ("per sensor CSV…", "export the per-sensor table as CSV", self._export_sensors),
+               ("N sweep CSV…", "export the N sweep as CSV", self._export_sweep),
+               ("PNG…", "export the two plots as a PNG image", self._export_png)]
 
         self.table = QTableWidget()
         self.table.setSortingEnabled(False)             # ours, each followed by the paper's
@@ -210,26 +212,27 @@ class MetricsView(QWidget):
         return tab
 
     def _options(self, exports: list) -> QGroupBox:
-        """The run options in short rows (they fit a dock of 420 px), the progress and export."""
+        """The run options, the progress and export, in rows that wrap to the dock's width
+        (:class:`FlowLayout`: on a laptop "baselines" and "PNG…" were past the dock's edge, the
+        plots beside them cut)."""
         opts = QGroupBox("Run")
-        g = QGridLayout(opts)
-        g.addWidget(QLabel("utterances per split:"), 0, 0)
-        g.addWidget(self.per_split, 0, 1)
-        g.addWidget(self.acoustic, 0, 2)
-        g.addWidget(self.baselines, 0, 3)
-        g.addWidget(self.run_table2, 1, 0)
-        g.addWidget(self.run_sweep, 1, 1, 1, 2)
-        g.addWidget(self.max_n, 1, 3)
-        g.addWidget(self.progress, 2, 0, 1, 4)
-        g.addWidget(self.status, 3, 0, 1, 4)
-        buttons = QHBoxLayout()
-        buttons.addWidget(QLabel("export:"))
-        for text, slot in exports:
+        options = FlowLayout(spacing=8, row_spacing=4)
+        options.add(flow_row([QLabel("utterances per split:"), self.per_split]))
+        options.add(self.acoustic)
+        options.add(self.baselines)
+        options.add(self.run_table2)
+        options.add(flow_row([self.run_sweep, self.max_n]))
+        buttons = FlowLayout(spacing=6, row_spacing=4)      # one row in a laptop's dock
+        for text, tip, slot in exports:
             b = QPushButton(text)
+            b.setToolTip(tip)
             b.clicked.connect(slot)
-            buttons.addWidget(b)
-        buttons.addStretch(1)
-        g.addLayout(buttons, 4, 0, 1, 4)
+            buttons.add(b)
+        lay = QVBoxLayout(opts)
+        lay.addLayout(options)
+        lay.addWidget(self.progress)
+        lay.addWidget(self.status)
+        lay.addLayout(buttons)
         return opts
 
     # ------------------------------------------------------------------ work
