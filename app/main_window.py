@@ -55,7 +55,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from PyQt6.QtCore import QEvent, Qt, QTimer, pyqtSignal
+from PyQt6.QtCore import QEvent, Qt, pyqtSignal
 from PyQt6.QtGui import QKeySequence
 from PyQt6.QtWidgets import (
     QDockWidget,
@@ -70,9 +70,8 @@ from facetraj_engine.analysis.lips import ClosedLips, closed_lips
 from facetraj_engine.config import SynthConfig
 from facetraj_engine.data import Utterance
 from facetraj_engine.errors import FacetrajError
-from facetraj_engine.io.corpus import Corpus, load_corpus
+from facetraj_engine.io.corpus import Corpus
 from facetraj_engine.method.model import Model
-from facetraj_engine.workflow.model_cache import load_or_train
 
 from .articulators import dimensions_note
 from .browser import UtteranceBrowser
@@ -89,13 +88,13 @@ from .controls import (
     playback_shortcuts,
 )
 from .correlations import BrowserScores
+from .data_opener import DataOpener
 from .marker_panels import MarkerPanels
 from .open_audio import AudioOpener
 from .phases import mark
 from .playback import PlaybackScheduler
 from .plotter_widget import grab_with_3d
 from .provenance import LabelOrigin
-from .recordings import RecordingQueue, recordings_in
 from .settings_panel import SynthSettingsPanel
 from .state import UtteranceView
 from .status import StatusArea
@@ -106,7 +105,6 @@ from .viewer_model import (
     DEFAULT_SENTENCE,
     SynthRequest,
     ViewerModel,
-    load_model,
     view_summary,
     view_title,
     voice_match_tip,
@@ -161,7 +159,6 @@ class MainWindow(QMainWindow):
         self._error_handler: Callable[[str], None] | None = None
         self.closed_lips: ClosedLips | None = None      # the talker's lips at closure (per model)
         self._extensions: dict[str, object] = {}
-        self._after_model: list[Callable[[], Any]] = []   # asked for while a model loads
         self.menus = WindowMenus(self, self.report_error)
         self.docks = WindowDocks(self)
         self._build_widgets()
@@ -169,8 +166,9 @@ class MainWindow(QMainWindow):
         self.settings.add_widget(self.audio_opener.box)
         _build_menus(self)
         self._shortcuts = playback_shortcuts(self)
+        self.opener = DataOpener(self)               # corpora, recordings, the model on its way
         if corpus_path is not None:
-            self._open_first_corpus(Path(corpus_path), model_path)
+            self.opener.open_first_corpus(Path(corpus_path), model_path)
 
     # ================================================================== state (read-only views)
     model = property(lambda self: self.state.model, doc="The model (None until one is loaded).")
@@ -314,83 +312,21 @@ class MainWindow(QMainWindow):
 
     # ================================================================== corpus and model
     def open_corpus(self, path: Path, model_path: Path | None = None) -> None:
-        """Open a corpus folder; its model is loaded from ``model_path``, the cache, or trained.
-        A folder of recordings (audio, no ``corpus.json``) is opened as such
-        (:meth:`open_recordings`)."""
-        try:
-            if recordings_in(Path(path)):
-                self.open_recordings(Path(path))
-                return
-            corpus = load_corpus(path)
-        except FacetrajError as exc:
-            self.report_error(exc)
-            return
-        self._load_model(corpus, model_path)
+        """Open a corpus folder (a folder of recordings: :meth:`open_recordings`); its model is
+        loaded from ``model_path``, the cache, or trained (``app/data_opener.py``)."""
+        self.opener.open_corpus(Path(path), model_path)
 
     def open_recordings(self, path: Path) -> None:
-        """Synthesize the recordings of a folder (or one audio file) with the model in use,
-        each with its labels by the one label rule (as ``facetraj gui folder/`` does): the first
-        shown, the others listed in the browser."""
-        try:
-            paths = recordings_in(Path(path))
-        except FacetrajError as exc:
-            self.report_error(exc)
-            return
-        if not paths:
-            self.report_error(FacetrajError(f"{path}: a corpus folder, not a folder of recordings "
-                                            "(File > Open corpus folder opens it)"))
-            return
-        if self.model is None and not self.state.loading:
-            self.report_error(FacetrajError("no model yet: open a corpus first"))
-            return
-        self.show_status(f"opening {len(paths)} recordings of {path} …")
-        self.add_extension("recordings", RecordingQueue(self, paths))     # kept while it works
-
-    def _open_first_corpus(self, path: Path, model_path: Path | None) -> None:
-        """The corpus given to the constructor: its model starts loading at once, beside the
-        window's first paint; an error is reported once the event loop runs (after the caller
-        has set its error handler)."""
-        try:
-            corpus = load_corpus(path)
-        except FacetrajError as exc:
-            QTimer.singleShot(0, lambda e=exc: self.report_error(e))
-            return
-        self._load_model(corpus, model_path)
-
-    def _load_model(self, corpus: Corpus, model_path: Path | None) -> None:
-        """Load or train ``corpus``'s model in the background; a model of a corpus opened
-        before the last one is dropped when it arrives (the last one opened is shown)."""
-        mark("corpus index read")
-        self.status_label.setText(f"opening {corpus.root} …")
-        number = self.state.begin_model_load()
-
-        def failed(exc: BaseException) -> None:
-            self.state.end_model_load(number)
-            self.report_error(exc)
-            self._run_after_model()           # with the model in use, if any
-
-        def done(result: tuple[Model, dict[str, str]]) -> None:
-            if self.state.is_latest_load(number):
-                self._on_model_ready(corpus, *result)
-
-        self.run_task(lambda p: load_model(corpus, model_path, p, load_or_train), done,
-                      "preparing the model (first run trains it)", on_error=failed)
+        """Synthesize the recordings of a folder (or one audio file) with the model in use."""
+        self.opener.open_recordings(Path(path))
 
     def when_model_ready(self, fn: Callable[[], Any]) -> None:
-        """``fn()`` now if a model is in use and none is on its way, else once the model on its
-        way is ready (a recording opened while a corpus loads is synthesized with that corpus's
-        model, the one the user will see)."""
-        if self.state.ready:
-            fn()
-        else:
-            self._after_model.append(fn)
+        """``fn()`` now if a model is in use and none is on its way, else once it is ready."""
+        self.opener.when_model_ready(fn)
 
-    def _run_after_model(self) -> None:
-        waiting, self._after_model = self._after_model, []
-        for fn in waiting:
-            fn()
-
-    def _on_model_ready(self, corpus: Corpus, model: Model, texts: dict[str, str]) -> None:
+    def use_model(self, corpus: Corpus, model: Model, texts: dict[str, str]) -> None:
+        """The model of ``corpus`` is ready (``app/data_opener.py``): forget the old model's
+        view, show the new corpus and its first utterance."""
         mark("model ready")
         self.stop()
         self._forget_view()
@@ -409,7 +345,7 @@ class MainWindow(QMainWindow):
         if first:
             self.set_utterance(first)
         self._start_sweep()
-        self._run_after_model()
+        self.opener.run_after_model()
 
     def _forget_view(self) -> None:
         """Before another model is used: the panels and the title drop the utterance shown (its
@@ -557,7 +493,7 @@ class MainWindow(QMainWindow):
     def open_audio(self, audio_path: Path, labels_path: Path | None = None, **kw) -> bool:
         """Synthesize from an audio file (its labels: ``labels_path``, ``text=``, ``recognize=True``,
         ``acoustic_only=True`` or beside it; markers beside it: ``AudioOpener.open``)."""
-        if not self.state.ready and self.state.loading:
+        if self.state.loading:      # with the model the user will see
             self.when_model_ready(lambda: self.audio_opener.open(Path(audio_path), labels_path, **kw))
             return True
         return self.audio_opener.open(Path(audio_path), labels_path, **kw)
