@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 XVFB   := $(if $(DISPLAY),,xvfb-run -a -s "-screen 0 1600x1200x24")
 
-.PHONY: run test lint bench fuzz corpus report clean dist check-install
+.PHONY: run test lint bench fuzz monkey corpus report clean dist check-install
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -50,6 +50,12 @@ FUZZ_CASES ?= 3300
 FUZZ_SEED  ?= 14
 fuzz: $(VENV)/.installed-test
 	$(XVFB) $(BIN)/python tests/fuzzing.py --cases $(FUZZ_CASES) --seed $(FUZZ_SEED)
+
+# the monkey test (tests/test_monkey_gui.py) for longer than make test runs it, with a new seed each
+# time (FACETRAJ_MONKEY_SEED=<seed> replays a run): random sequences of the window's own actions
+MONKEY_SECONDS ?= 600
+monkey: $(VENV)/.installed-test
+	$(XVFB) env FACETRAJ_MONKEY_SECONDS=$(MONKEY_SECONDS) $(BIN)/python -m pytest -q -p no:cacheprovider tests/test_monkey_gui.py
 
 corpus: $(VENV)/.installed-corpus
 	$(BIN)/facetraj corpus build data_samples

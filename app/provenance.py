@@ -43,6 +43,19 @@ def search_title(config: SynthConfig) -> str:
     return f"{name} (K = {config.acoustic_prefilter})" if key == "acoustic" else name
 
 
+def search_short(config: SynthConfig) -> str:
+    """The search of ``config`` in a word or two (a pin's part).
+
+    >>> search_short(SynthConfig()), search_short(SynthConfig(mode="acoustic"))
+    ('phonetic', 'acoustic K=128')
+    >>> search_short(SynthConfig(mode="acoustic", acoustic_prefilter=None))
+    'acoustic, all codewords'
+    """
+    key = search_key(config)
+    return {"acoustic": f"acoustic K={config.acoustic_prefilter}",
+            "acoustic-full": "acoustic, all codewords"}.get(key, key)
+
+
 @dataclass(frozen=True)
 class LabelOrigin:
     """Where an utterance's phone labels came from.
@@ -130,7 +143,7 @@ def synthesis_parts(view) -> list[str]:
     the labels and their source (file or transcript) -- what tells two pins apart
     (:func:`facetraj_app.pins.distinct_settings`; the model is the pin's own part)."""
     cfg, origin = view.synthesis.config, view.label_origin
-    parts = [search_title(cfg)]
+    parts = [search_short(cfg)]
     if MODES[cfg.mode].needs_labels:
         nu = "trained" if cfg.nu is None else f"{cfg.nu:g}"
         parts += [f"N={cfg.n_context_phones}", f"C={cfg.context}", f"ξ={cfg.xi:g}", f"ν={nu}"]
@@ -148,7 +161,8 @@ def synthesis_parts(view) -> list[str]:
 
 def settings_text(view, short: bool = False) -> str:
     """How a view was synthesized: the smoothing, the search the synthesis used
-    (``Synthesis.config``), N where labels are searched, the closure step, and where the labels
+    (``Synthesis.config``), N where labels are searched, the closure step where it is not the
+    default, and where the labels
     came from; an acoustic-only search uses no labels, and says so (an acoustic-only pin read
     "labels: label file"). ``short``: every part of :func:`synthesis_parts` (a pin's record,
     from which its legend keeps what differs). ``view``: an ``UtteranceView``."""
@@ -158,5 +172,7 @@ def settings_text(view, short: bool = False) -> str:
     used = MODES[cfg.mode].needs_labels
     n = f", N={cfg.n_context_phones}" if used else ""
     unused = "" if used or origin.source in ("", "none") else " (not used by this search)"
-    return (f"{SMOOTHING_NAMES[cfg.smoothing]} synthesis, {search_title(cfg)}{n}, "
-            f"{closure_text(cfg)};  labels: {origin.text()}{unused}")
+    closure = closure_text(cfg)
+    closure = "" if closure == closure_text(SynthConfig()) else f", {closure}"    # the default: unsaid
+    return (f"{SMOOTHING_NAMES[cfg.smoothing]} synthesis, {search_title(cfg)}{n}{closure};  "
+            f"labels: {origin.text()}{unused}")

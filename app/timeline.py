@@ -348,6 +348,7 @@ class Timeline(QWidget):
         self._press: tuple[float, float, int] | None = None   # (xdata, xpixel, button)
         self._drag_span: tuple[float, float] | None = None
         self._building = None                   # the relayout being built over several passes
+        self.layouts = 0                        # relayouts finished (tests)
         self._grid = None                       # the panels' grid (its margins follow resizes)
         self.canvas.drawn.connect(self._on_draw)
         self.canvas.mpl_connect("resize_event", self._on_resize)
@@ -472,6 +473,7 @@ class Timeline(QWidget):
             fig.add_artist(self._cursor)
             self._draw_loop_spans()
             first.set_xlim(*self._range)
+            self.layouts += 1
         finally:
             self.canvas.release()
 

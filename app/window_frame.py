@@ -345,14 +345,20 @@ class DockWidth(QObject):
         window.installEventFilter(self)
 
     def watch(self, dock: QDockWidget) -> None:
-        """Keep the width of ``dock`` (one of the side's)."""
+        """Keep the width of ``dock`` (one of the side's) while it lives (an analysis view's
+        dock is deleted when another model is loaded)."""
         self.docks.append(dock)
         dock.installEventFilter(self)
+        dock.destroyed.connect(self._forget)
+
+    def _forget(self) -> None:
+        self.docks = [d for d in self.docks if not sip.isdeleted(d)]
 
     def dock(self) -> QDockWidget | None:
         """The side's dock to resize: the one shown (a tab group's current one), else the last
         one added that is docked there."""
-        docked = [d for d in self.docks if not d.isFloating() and self.window.dockWidgetArea(d) == self.area]
+        docked = [d for d in self.docks if not sip.isdeleted(d) and not d.isFloating()
+                  and self.window.dockWidgetArea(d) == self.area]
         shown = [d for d in docked if d.isVisible()]
         on_top = [d for d in shown if not d.visibleRegion().isEmpty()]    # a tab behind is "visible"
         return (on_top or shown or docked[-1:] or [None])[0]

@@ -168,8 +168,10 @@ def walker(qtbot, monkeypatch, tmp_path, trained_cache):
     win.place_on_screen(WINDOW_SIZE)
     win.show()
     walker = Walker(win, qtbot, kinds, dialogs, errors)
-    walker.wait(lambda: walker.shows("default"), "the default corpus")
-    yield walker
+    with qtbot.captureExceptions() as raised:       # a slot's exception fails the step it is in
+        errors.raised = raised
+        walker.wait(lambda: walker.shows("default"), "the default corpus")
+        yield walker
     logging.getLogger().removeHandler(errors)
     win.extension("analysis").close()
     win.close()

@@ -179,7 +179,7 @@ def test_choosing_the_search_shown_is_explicit_and_the_title_names_the_search_us
     assert "“" not in view_title(view) and "recognized from the speech" in view_title(view)
     state.set_config(state.synth_config.with_(mode="acoustic", acoustic_prefilter=None), explicit=True)
     view = state.request.run()
-    assert "acoustic only, whole codebook (the paper), closure: /p b m/ + rest;  labels:" in view_title(view)
+    assert "acoustic only, whole codebook (the paper);  labels:" in view_title(view)
 
 
 def test_provenance_doctests():

@@ -65,21 +65,31 @@ def data_available() -> bool:
 
 class Errors(logging.Handler):
     """Every error the window shows (its error handler, a dialog) or logs (facetraj's loggers at
-    ERROR and above, tracebacks included)."""
+    ERROR and above, tracebacks included), and every exception raised in a slot (``raised``: the
+    list of pytest-qt's ``qtbot.captureExceptions()``, so that a walk fails at the step that
+    raised, not at the test's end)."""
 
     def __init__(self):
         super().__init__(logging.ERROR)
-        self.items: list[str] = []
+        self.logged: list[str] = []
+        self.raised: list = []
+
+    @property
+    def items(self) -> list[str]:
+        import traceback
+
+        return self.logged + ["raised in the event loop:\n" + "".join(traceback.format_exception(*e))
+                              for e in self.raised]
 
     def emit(self, record: logging.LogRecord) -> None:
         if record.name.startswith("facetraj"):
             text = record.getMessage()
             if record.exc_info:
                 text += "\n" + logging.Formatter().formatException(record.exc_info)
-            self.items.append(f"log {record.name}: {text}")
+            self.logged.append(f"log {record.name}: {text}")
 
     def shown(self, message: str) -> None:
-        self.items.append(f"shown: {message}")
+        self.logged.append(f"shown: {message}")
 
 
 @dataclass
