@@ -349,6 +349,7 @@ class Timeline(QWidget):
         self._drag_span: tuple[float, float] | None = None
         self._building = None                   # the relayout being built over several passes
         self.layouts = 0                        # relayouts finished (tests)
+        self._executing = False                 # a build's step runs now (on the call stack)
         self._grid = None                       # the panels' grid (its margins follow resizes)
         self.canvas.drawn.connect(self._on_draw)
         self.canvas.mpl_connect("resize_event", self._on_resize)
@@ -402,26 +403,38 @@ class Timeline(QWidget):
         """Rebuild the figure (one axes per panel, shared time axis) and draw it in the
         background. Now (the axes are there on return), or with ``soon`` one panel per pass of
         the event loop, after a draw that is running (a view adding panels)."""
+        if self._executing:     # asked for by what a build does (its legend resizing the
+            # panels): after it, never inside it (a second build removed the first one's axes)
+            QTimer.singleShot(0, lambda: self.relayout(self.xlim() if self.axes else xlim, soon=True))
+            return
         self._stop_building()
         steps = self._build_steps(xlim)
         if not soon:
             self.canvas.wait()
-            for _ in steps:
-                pass
+            self._advance(steps, to_end=True)
             return
         self._building = steps
 
         def step() -> None:
             if self._building is not steps:
                 return                  # replaced by a newer relayout
-            try:
-                next(steps)
-            except StopIteration:
+            if not self._advance(steps):
                 self._building = None
                 return
             QTimer.singleShot(STEP_MS, step)
 
         self.canvas.when_idle(step)
+
+    def _advance(self, steps, to_end: bool = False) -> bool:
+        """Run a build's next step (``to_end``: all of them); whether steps are left."""
+        self._executing = True
+        try:
+            for _ in steps:
+                if not to_end:
+                    return True
+            return False
+        finally:
+            self._executing = False
 
     def _stop_building(self) -> None:
         steps, self._building = self._building, None
@@ -429,18 +442,19 @@ class Timeline(QWidget):
             steps.close()
 
     def _finish_building(self) -> None:
+        if self._executing:
+            return                      # (the build on the stack finishes by itself)
         steps, self._building = self._building, None
         if steps is not None:
-            for _ in steps:
-                pass
+            self._advance(steps, to_end=True)
 
     def _build_steps(self, xlim: tuple[float, float] | None):
         """The relayout, a step per panel (a generator); no draw starts until it ends."""
         self.canvas.hold()
         try:
             fig = self.figure
-            for ax in list(fig.axes):          # one at a time (fig.clear() clears each axes
-                ax.remove()                     # first: 70 ms for eight panels)
+            while fig.axes:                     # one at a time (fig.clear() clears each axes
+                fig.axes[0].remove()            # first: 70 ms for eight panels)
                 yield
             fig.clear()
             self.axes, self.shown, self.hidden, self._spans, self._cursor = [], [], [], [], None
@@ -589,7 +603,9 @@ class Timeline(QWidget):
 
     def _on_resize(self, event) -> None:
         self._bg = None
-        if self._building is None:
+        if self._executing:             # a build resized the panels (its legend): after it
+            QTimer.singleShot(0, lambda: self._on_resize(event))
+        elif self._building is None:
             self.canvas.when_idle(self._fit_to_size)
 
     def set_cursor(self, t: float, follow: bool = False) -> None:

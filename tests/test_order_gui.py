@@ -96,6 +96,8 @@ def test_every_kind_of_data_after_every_other(walker, capsys):
         assert_no_errors(walker.errors, f"{where}, opening")
         for action in (walker.play, walker.seek, walker.pin, walker.open_docks, walker.run_views):
             timed(action)
+        lo, hi = walker.zoom_in()                    # the panels (and a video) over 0.8 s
+        assert hi - lo < 0.3 * walker.win.view.duration + 0.05, (lo, hi)
         written = timed(walker.exports)
         timed(walker.close_panels)
         assert_no_errors(walker.errors, where)

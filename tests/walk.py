@@ -318,7 +318,7 @@ class Walker:
         w = self.win
         widgets = w.extension("analysis").widgets
         metrics = widgets["metrics"]
-        metrics.per_split.setValue(2)
+        metrics.per_split.setValue(1)
         metrics.max_n.setValue(2)
         for text in ("Compute Table 2", "Run N sweep"):
             b = button(metrics, text)
@@ -334,10 +334,26 @@ class Walker:
         table.filter.setText("b p m")
         corpus_run = table.corpus
         if w.corpus is not None and button(corpus_run, "Run") is not None:
-            corpus_run.count.setValue(2)
+            corpus_run.count.setValue(1)
             self.click(corpus_run.run_button)
             self.wait(lambda: corpus_run.run_button.isEnabled(), "Measure across the corpus")
         self.wait(lambda: not w.tasks.busy and not w.tasks.tasks, "the views' work")
+
+    def zoom_in(self, steps: int = 6) -> tuple[float, float]:
+        """The mouse wheel turned forward over the middle of the panels, ``steps`` notches (the
+        time range shown narrows around it: a video exports that range). The range shown."""
+        from PyQt6.QtCore import QPointF
+        from PyQt6.QtGui import QWheelEvent
+
+        canvas = self.win.timeline.canvas
+        self.wait(lambda: self.win.timeline.axes and not self.win.timeline.building, "the panels")
+        at = QPointF(canvas.width() / 2, canvas.height() / 2)
+        for _ in range(steps):
+            event = QWheelEvent(at, canvas.mapToGlobal(at), QPoint(0, 0), QPoint(0, 120),
+                                Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier,
+                                Qt.ScrollPhase.NoScrollPhase, False)
+            QApplication.sendEvent(canvas, event)
+        return self.win.timeline.xlim()
 
     def exports(self) -> list[Path]:
         """Every export the window offers: the File menu's and each view's button that saves a
