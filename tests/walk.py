@@ -158,6 +158,8 @@ class Walker:
             self.qtbot.waitUntil(lambda: bool(self.errors.items) or condition(), timeout=WAIT_MS)
         except Exception as exc:          # a hang: say what was awaited, and where the window is
             raise AssertionError(f"waited in vain for {what}; {self.state()}") from exc
+        if self.errors.items:
+            raise AssertionError(f"while waiting for {what}:\n" + "\n".join(self.errors.items))
 
     def state(self) -> str:
         """Where the window is, in a line (for a failure's message)."""
