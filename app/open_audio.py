@@ -197,6 +197,7 @@ class AudioHost(Protocol):
     def show_external(self, utt: Utterance, origin: LabelOrigin | None = None,
                       show: bool = True) -> None: ...
     def show_labels(self, utt: Utterance, origin: LabelOrigin, own: bool = False) -> None: ...
+    def may_leave(self, what: str) -> bool: ...
 
 
 class AudioOpener(QObject):
@@ -400,6 +401,9 @@ class AudioOpener(QObject):
         if sources is None:
             return
         win = self.window
+        if not win.may_leave("switching to other labels"):
+            self._refresh_box()
+            return
         from facetraj_engine.labels.alignment import MissingWordsError
 
         def work(progress) -> tuple[Utterance, LabelOrigin]:

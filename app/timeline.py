@@ -10,7 +10,9 @@ changed (a relayout waits for it), and panels added by a view are built one per 
 loop (``relayout(soon=True)``), so that opening a view never freezes the window.
 
 Mouse: click to seek, drag to select a loop range, wheel to zoom the time axis around the pointer,
-right or middle drag to pan, double-click to show the whole utterance.
+right or middle drag to pan, double-click to show the whole utterance. A panel may take a press
+of the left button itself (``mouse_press(event)`` returning an object with ``move(event)`` and
+``release(event)``: the phone tier's boundary drags, ``app/tier_edit.py``).
 """
 
 from __future__ import annotations
@@ -77,8 +79,11 @@ class _Canvas(BackgroundCanvas):
 class Panel(Protocol):
     """A time-aligned panel. Optional attributes: ``min_px`` (the least height it is readable at,
     default 48) and ``priority`` (panels of low priority are left out first when the timeline is
-    short: ``app/panel_layout.py``). Curves named with a matplotlib ``label`` appear in the
-    timeline's legend row, never in a legend over the panel."""
+    short: ``app/panel_layout.py``), and ``mouse_press(event)``: a left-button press in the
+    panel, which the panel takes by returning an object with ``move(event)`` and
+    ``release(event)`` (else ``None``: the timeline seeks or selects a loop range). Curves named
+    with a matplotlib ``label`` appear in the timeline's legend row, never in a legend over the
+    panel."""
 
     title: str
     height: float
@@ -342,6 +347,7 @@ class Timeline(QWidget):
         self._cursor_x: float | None = None
         self._bg_bounds: tuple[float, ...] = ()
         self._press: tuple[float, float, int] | None = None   # (xdata, xpixel, button)
+        self._grab = None                       # a panel's own drag (``mouse_press``)
         self._drag_span: tuple[float, float] | None = None
         self._building = None                   # the relayout being built over several passes
         self._grid = None                       # the panels' grid (its margins follow resizes)
@@ -608,6 +614,11 @@ class Timeline(QWidget):
     def _cursor_px(self, t: float) -> float:
         return float(self.axes[0].transData.transform((t, 0))[0])
 
+    def redraw(self) -> None:
+        """A full draw soon, the panels kept (a panel's artist changed: the tier's selection)."""
+        if self.axes:
+            self._request_draw()
+
     def set_loop(self, loop: tuple[float, float] | None) -> None:
         self.loop = loop
         self._draw_loop_spans()
@@ -637,9 +648,17 @@ class Timeline(QWidget):
         if event.dblclick:
             self.reset_zoom()
             return
+        panel = self.shown[self.axes.index(event.inaxes)] if event.inaxes in self.axes else None
+        if int(event.button) == 1 and hasattr(panel, "mouse_press"):
+            self._grab = panel.mouse_press(event)
+            if self._grab is not None:
+                return
         self._press = (float(event.xdata), float(event.x), int(event.button))
 
     def _on_motion(self, event) -> None:
+        if self._grab is not None:
+            self._grab.move(event)
+            return
         if self._press is None or event.x is None:
             return
         x0, px0, button = self._press
@@ -657,6 +676,10 @@ class Timeline(QWidget):
             self._press = (x0, float(event.x), button)
 
     def _on_release(self, event) -> None:
+        if self._grab is not None:
+            grab, self._grab = self._grab, None
+            grab.release(event)
+            return
         if self._press is None:
             return
         x0, _px0, button = self._press
