@@ -11,6 +11,20 @@ from PyQt6.QtWidgets import QApplication
 from facetraj_engine.labels.editing import PHONES
 
 
+def active(win, wait_ms: int = 10_000) -> None:
+    """The window active (its keys go to it), as a person's window is when she types."""
+    from PyQt6.QtCore import QDeadlineTimer
+
+    if win.isActiveWindow():
+        return
+    win.raise_()
+    win.activateWindow()
+    deadline = QDeadlineTimer(wait_ms)
+    while not win.isActiveWindow() and not deadline.hasExpired():
+        QApplication.processEvents()
+    assert win.isActiveWindow(), "the window could not be made active"
+
+
 def tier_panel(win):
     return win.extension("labels").panel
 
@@ -53,6 +67,7 @@ def key(win, sequence: str) -> None:
     panels after a click on them)."""
     from PyQt6.QtGui import QKeySequence
 
+    active(win)
     combo = QKeySequence(sequence)[0]
     target = QApplication.focusWidget() or win
     QTest.keyClick(target, combo.key(), combo.keyboardModifiers())
