@@ -303,9 +303,9 @@ class LabelEditing(QObject):
         redo.setEnabled(bool(doc and doc.redo_text))
         undo.setText(f"&Undo {doc.undo_text}" if doc and doc.undo_text else "&Undo")
         redo.setText(f"&Redo {doc.redo_text}" if doc and doc.redo_text else "&Redo")
-        self.window.setWindowModified(bool(doc and doc.dirty))
         self.window.setWindowTitle(f"{self.base_title} — {s.name}: labels edited, not saved[*]"
                                    if doc is not None and doc.dirty else self.base_title)
+        self.window.setWindowModified(bool(doc and doc.dirty))
         self.panel.show_selection()
         if redraw:
             self.redraw()

@@ -52,6 +52,8 @@ from .workers import STEP_MS
 
 log = logging.getLogger(__name__)
 
+#: the loop range's spans are told from the panels' own artists by this id
+LOOP_GID = "loop range"
 #: the timeline's bottom margin: the time tick labels and "time (s)"
 BOTTOM_MARGIN_PX = 40.0
 #: the timeline's top margin (px)
@@ -95,6 +97,7 @@ class Panel(Protocol):
 class WaveformPanel:
     """The speech signal (min/max envelope per pixel column)."""
 
+    audio_only = True           # the same for every result of a recording
     title = "waveform"
     height = 0.8
     min_px = 24.0
@@ -140,6 +143,7 @@ def spectrogram(x: np.ndarray, rate: float, nperseg: int, hop: int,
 class SpectrogramPanel:
     """A wide-band spectrogram (grey scale, 0 to 8 kHz)."""
 
+    audio_only = True
     title = "spectrogram"
     height = 1.3
     min_px = 40.0
@@ -281,6 +285,31 @@ class LipPanel:
         fit_ylabel(ax, f"{self.which} lip\ny (mm)")
 
 
+def place_grid(fig: Figure, grid, heights: list[float]) -> None:
+    """The panels' ``grid`` in pixels: the margins (the y labels and tick labels; the time
+    axis) and the gaps fixed whatever the size, each panel its height of ``heights``."""
+    width, height = max(fig.get_figwidth() * fig.dpi, 1.0), max(fig.get_figheight() * fig.dpi, 1.0)
+    mean = max(sum(heights) / max(len(heights), 1), 1.0)
+    grid.set_height_ratios(heights)
+    grid.update(left=min(0.3, LABEL_MARGIN_PX / width), right=1 - min(0.05, 8 / width),
+                top=1 - min(0.05, TOP_MARGIN_PX / height),
+                bottom=min(0.3, BOTTOM_MARGIN_PX / height), hspace=GAP_PX / mean)
+
+
+def redraw_in_place(panels: Sequence[Panel], axes: Sequence, view: UtteranceView) -> None:
+    """Each panel drawn again in its axes for another result of the same recording (a label
+    edit, other settings): the artists it drew removed (the loop range's kept), the axes kept
+    (made anew they cost 40 ms each), the panels of the audio alone (``audio_only``) as they
+    are."""
+    for i, (panel, ax) in enumerate(zip(panels, axes, strict=True)):
+        if getattr(panel, "audio_only", False):
+            continue
+        for artist in [*ax.lines, *ax.collections, *ax.patches, *ax.texts, *ax.images, *ax.artists]:
+            if artist.get_gid() != LOOP_GID:
+                artist.remove()
+        draw_panel(panel, ax, view, last=i == len(axes) - 1)
+
+
 def draw_panel(panel: Panel, ax, view: UtteranceView, last: bool) -> None:
     """Draw ``panel`` in ``ax`` as the timeline does (the window's and exported figures): its
     content, its y label fitted, small ticks, the time labels under the last panel only."""
@@ -369,9 +398,16 @@ class Timeline(QWidget):
             self.relayout(self.xlim() if self.axes else None, soon=soon)
 
     def set_view(self, view: UtteranceView | None, keep_zoom: bool = False) -> None:
-        xlim = self._range if keep_zoom else None
-        self.view = view
-        self.relayout(xlim)
+        """Show ``view``; another result of the recording shown (``keep_zoom``) is drawn in the
+        panels' axes as they are (:func:`redraw_in_place`), else the panels are laid out anew."""
+        old, self.view = self.view, view
+        if keep_zoom and self._building is None and self.axes and view is not None and \
+                old is not None and old.utterance.audio is view.utterance.audio:
+            shown, axes = list(self.shown), list(self.axes)
+            self.canvas.when_idle(lambda: self.view is view and axes == self.axes and (
+                redraw_in_place(shown, axes, view) or self._request_draw()))
+            return
+        self.relayout(self._range if keep_zoom else None)
 
     def axes_of(self, panel: Panel):
         """The matplotlib axes a panel was drawn in (None before the first layout, or while it is
@@ -453,7 +489,7 @@ class Timeline(QWidget):
             self.hidden = [p for p, h in zip(panels, heights, strict=True) if h is None]
             grid = fig.add_gridspec(len(self.shown), 1, height_ratios=[h for h in heights if h is not None])
             self._grid = grid
-            self._place_grid([h for h in heights if h is not None])
+            place_grid(self.figure, self._grid, [h for h in heights if h is not None])
             first = None
             for i, panel in enumerate(self.shown):
                 ax = fig.add_subplot(grid[i, 0], sharex=first)
@@ -470,17 +506,6 @@ class Timeline(QWidget):
             first.set_xlim(*self._range)
         finally:
             self.canvas.release()
-
-    def _place_grid(self, heights: list[float]) -> None:
-        """The panels' grid in pixels: the margins (the y labels and tick labels; the time axis)
-        and the gaps fixed whatever the size, each panel its height of ``heights``."""
-        fig = self.figure
-        width, height = max(fig.get_figwidth() * fig.dpi, 1.0), max(fig.get_figheight() * fig.dpi, 1.0)
-        mean = max(sum(heights) / max(len(heights), 1), 1.0)
-        self._grid.set_height_ratios(heights)
-        self._grid.update(left=min(0.3, LABEL_MARGIN_PX / width), right=1 - min(0.05, 8 / width),
-                          top=1 - min(0.05, TOP_MARGIN_PX / height),
-                          bottom=min(0.3, BOTTOM_MARGIN_PX / height), hspace=GAP_PX / mean)
 
     def _show_legend(self) -> None:
         """The legend row: every named curve of the panels, and the panels left out for lack of
@@ -511,7 +536,7 @@ class Timeline(QWidget):
         if [p for p, h in zip(self.panels, heights, strict=True) if h is not None] != self.shown:
             self.relayout(self.xlim(), soon=True)
             return
-        self._place_grid([h for h in heights if h is not None])
+        place_grid(self.figure, self._grid, [h for h in heights if h is not None])
         for ax in self.axes:            # (GridSpec.update moves only pyplot's figures' axes)
             ax.set_position(ax.get_subplotspec().get_position(self.figure))
         refit_ylabels(self.axes)
@@ -524,7 +549,8 @@ class Timeline(QWidget):
         if span is None:
             return
         for ax in self.axes:
-            self._spans.append(ax.axvspan(span[0], span[1], color=LOOP_COLOR, alpha=0.18, lw=0))
+            self._spans.append(ax.axvspan(span[0], span[1], color=LOOP_COLOR, alpha=0.18, lw=0,
+                                          gid=LOOP_GID))
 
     # ------------------------------------------------------------------ cursor (blitting)
     @property

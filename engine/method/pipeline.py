@@ -29,6 +29,7 @@ from .closure_search import search_rows
 from .context import segment_index
 from .model import Model, analysed_frames
 from .modes import mode_of
+from .resynthesis import SynthesisMemo
 from .search import SearchInput, SegmentChoice
 from .selection import mean_normalise
 from .smoothing import smooth
@@ -109,7 +110,8 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                source: str | None = None, lsf: np.ndarray | None = None,
                audio_source: str | None = None,
                confidence: Sequence[float] | np.ndarray | None = None,
-               provenance: Provenance | None = None, voice: bool = False) -> Synthesis:
+               provenance: Provenance | None = None, voice: bool = False,
+               memo: SynthesisMemo | None = None) -> Synthesis:
     """Synthesize face point trajectories from speech (paper section 2.3).
 
     With ``phones`` and ``mode="phonetic"``: per input phone, the top-N context-phones by eq 4,
@@ -130,17 +132,38 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     ``lsf`` may pass the input LSFs already computed by :meth:`Model.input_lsf`
     for these frames (when one utterance is synthesized under several configs). ``voice``: the
     input's voice match is computed even when the synthesis does not need it (to show it).
-    The input's speech energy (pauses, speech frames) is computed once for both.
+    The input's speech energy (pauses, speech frames) is computed once for both. ``memo``: the
+    same recording's last synthesis, whose work is reused where the labels leave it unchanged
+    (:mod:`facetraj_engine.method.resynthesis`: the same result, sooner).
     """
     config = config or SynthConfig()
+    if memo is None:
+        return _synthesize(model, audio, sample_rate, phones, config, n_frames, label_map, source,
+                           lsf, audio_source, confidence, provenance, voice, None)
+    with memo.lock:
+        memo.bind(model, audio, sample_rate, n_frames, config)
+        return _synthesize(model, audio, sample_rate, phones, config, n_frames, label_map, source,
+                           lsf, audio_source, confidence, provenance, voice, memo)
+
+
+def _synthesize(model: Model, audio: np.ndarray, sample_rate: int,
+                phones: Sequence[PhoneSegment] | None, config: SynthConfig, n_frames: int | None,
+                label_map: Mapping[str, str] | None, source: str | None, lsf: np.ndarray | None,
+                audio_source: str | None, confidence: Sequence[float] | np.ndarray | None,
+                provenance: Provenance | None, voice: bool, memo: SynthesisMemo | None
+                ) -> Synthesis:
+    """:func:`synthesize`'s steps (``memo``: bound to this input, or ``None``)."""
     mode = mode_of(config)
-    times, w, warp, analysed, energy_db = _input(model, audio, sample_rate, n_frames, lsf, config,
-                                                 audio_source or source,
-                                                 detector_may_run(model, config, provenance))
-    energy = SpeechEnergy(audio, sample_rate)
-    ratio = _voice_ratio(model, energy, times, w, config, provenance, voice) \
+    remember = memo.remember if memo is not None else (lambda _key, compute: compute())
+    detecting = detector_may_run(model, config, provenance)
+    times, w, warp, analysed, energy_db = remember(("input", detecting), lambda: _input(
+        model, audio, sample_rate, n_frames, lsf, config, audio_source or source, detecting))
+    energy = remember("energy", lambda: SpeechEnergy(audio, sample_rate))
+    recognized = provenance is not None and provenance.kind == "recognized"
+    ratio = remember(("voice", recognized, voice), lambda: _voice_ratio(
+        model, energy, times, w, config, provenance, voice)) \
         if mode.weighs_labels else float("nan")             # the search weighs by it
-    job = SearchInput(model, w, times, config, voice_ratio=ratio)
+    job = SearchInput(model, w, times, config, voice_ratio=ratio, memo=memo)
     if mode.needs_labels:
         if not phones:
             raise InputError(source, f"{config.mode} mode needs phone labels (or use acoustic mode)")
