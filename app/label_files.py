@@ -25,6 +25,9 @@ from .label_session import LabelSession, save_path, stamp
 
 log = logging.getLogger(__name__)
 
+#: a watched file is looked at this long after its last change (a writer's several changes: one)
+SETTLE_MS = 150
+
 
 def praat_script(audio: Path, labels: Path) -> str:
     """A Praat script that opens ``audio`` and ``labels`` together in Praat's TextGrid editor.
@@ -54,7 +57,14 @@ class LabelFiles(QObject):
         self.window, self.editor = window, editor
         self.praat = shutil.which("praat")
         self.watcher = QFileSystemWatcher(self)
-        self.watcher.fileChanged.connect(self._changed)
+        self.watcher.fileChanged.connect(self._poke)
+        self.watcher.directoryChanged.connect(self._poke)     # a file replaced (Praat, an editor)
+        self._settle = QTimer(self)     # a writer's several changes in a row read once, after them
+        self._settle.setSingleShot(True)
+        self._settle.setInterval(SETTLE_MS)
+        self._settle.timeout.connect(self._check)
+        self._path: Path | None = None
+        self._seen: tuple[int, int] | None = None    # the stamp of the file last looked at
         self._asking = False
         menu, before = window.menu("File"), window.action_screenshot
         self.save_action = _action(window, menu, before, "Save &labels", self.save, "Ctrl+S")
@@ -175,22 +185,35 @@ class LabelFiles(QObject):
                          corpus.data_root if corpus is not None and view.split != "external" else None)
 
     def _watch(self) -> None:
+        """Watch the label file of the labels on screen (and its folder: a file replaced by
+        another is seen too)."""
         path = self.watched_path()
-        files = self.watcher.files()
-        if files:
-            self.watcher.removePaths(files)
-        if path is not None and path.exists():
-            self.watcher.addPath(str(path))
+        if path != self._path:
+            self._path, self._seen = path, (stamp(path) if path is not None else None)
+        wanted = [] if path is None else [str(p) for p in (path, path.parent) if p.exists()]
+        have = self.watcher.files() + self.watcher.directories()
+        if sorted(have) != sorted(wanted):
+            if have:
+                self.watcher.removePaths(have)
+            if wanted:
+                self.watcher.addPaths(wanted)
 
-    def _changed(self, name: str) -> None:
-        """A watched TextGrid changed: read again unless it is this window's own save (the
-        file is watched anew: a save that replaces the file ends the watch)."""
-        path = Path(name)
-        QTimer.singleShot(0, self._watch)
-        if not path.exists() or self._asking:
+    def _poke(self, _name: str = "") -> None:
+        self._settle.start()
+
+    def _check(self) -> None:
+        """The watched file as it is now: changed since it was last looked at, and not by this
+        window's own save, it is read again."""
+        path = self._path
+        self._watch()
+        if path is None or self._asking:
             return
+        now = stamp(path)
+        if now is None or now == self._seen:
+            return
+        self._seen = now
         s = self.editor.session
-        if s is not None and s.path == path and s.on_disk == stamp(path):
+        if s is not None and s.path == path and s.on_disk == now:
             return                               # what this window wrote
         self.reload(path)
 

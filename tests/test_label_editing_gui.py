@@ -106,17 +106,21 @@ def close_without_asking(w) -> None:
     w.close()
 
 
-def show(w, qtbot, name: str) -> None:
-    """Click ``name`` in the browser's "opened" group; wait for its face (shown already: as is)."""
-    if w.view is not None and w.view.utterance.name == name:
-        return
+def click_browser(w, name: str) -> None:
+    """A click on ``name`` in the browser's "opened" group."""
     item = w.browser.items[name]
     tree = w.browser.tree
     tree.scrollToItem(item)
-    rect = tree.visualItemRect(item)
+    QTest.mouseClick(tree.viewport(), Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier,
+                     tree.visualItemRect(item).center())
+
+
+def show(w, qtbot, name: str) -> None:
+    """Click ``name`` in the browser; wait for its face (shown already: as is)."""
+    if w.view is not None and w.view.utterance.name == name:
+        return
     with qtbot.waitSignal(w.synthesisChanged, timeout=WAIT_MS):
-        QTest.mouseClick(tree.viewport(), Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier,
-                         rect.center())
+        click_browser(w, name)
     qtbot.waitUntil(lambda: w.settled, timeout=WAIT_MS)
 
 
@@ -200,3 +204,145 @@ def test_six_arctic_recordings_corrected_in_the_window_close_every_bilabial(
     assert np.sum(np.abs(pooled.minima - pooled.closed) <= 1.0) == 13
     assert pooled.consonants_shut == 0.0
     assert len(pooled.consonant_minima) == 81 and pooled.vowels_shut == 0.0
+
+
+# ---------------------------------------------------------------------------- on a laptop
+def answer(text: str) -> list[str]:
+    """Click the button ``text`` of the next modal dialog once it shows (polled by a timer);
+    returns a list the dialog's text is put in."""
+    from PyQt6.QtCore import QTimer
+    from PyQt6.QtWidgets import QAbstractButton, QApplication, QMessageBox
+
+    said: list[str] = []
+
+    def click() -> None:
+        box = QApplication.activeModalWidget()
+        if box is None:
+            QTimer.singleShot(20, click)
+            return
+        said.append(box.text() if isinstance(box, QMessageBox) else box.windowTitle())
+        button = next(b for b in box.findChildren(QAbstractButton) if b.text().replace("&", "") == text)
+        button.click()
+
+    QTimer.singleShot(0, click)
+    return said
+
+
+def praat_sets(path: Path, tier: int, interval: int, label: str) -> None:
+    """Praat itself changes a label of ``path`` and saves it (as a phonetician does in Praat)."""
+    import subprocess
+
+    script = path.with_name("change.praat")
+    script.write_text(f'grid = Read from file: "{path}"\nSet interval text: {tier}, {interval}, '
+                      f'"{label}"\nSave as text file: "{path}"\n', encoding="utf-8")
+    subprocess.run(["praat", "--run", str(script)], check=True, capture_output=True, timeout=60)
+
+
+@pytest.fixture
+def im_glad(tmp_path) -> Path:
+    """axb_a0004 "Lord, but I'm glad to see you again, Phil." alone in a folder."""
+    if not ARCTIC.is_dir():
+        pytest.skip(f"{ARCTIC} is not here")
+    wav = tmp_path / "cmu_arctic_us_axb_a0004.wav"
+    shutil.copy(ARCTIC / wav.name, wav)
+    return wav
+
+
+@pytest.mark.parametrize("screen", ["1366x768"], indirect=True)
+def test_the_m_of_im_heard_as_n_fixed_with_the_lips_before_and_after(screen, qtbot, im_glad):
+    """docs/app.md's walk-through: the /m/ of "I'm" was heard as /n/: fix it and show the lips
+    before and after, from the window alone on a 1366 x 768 laptop."""
+    import time
+
+    from facetraj_engine.analysis.apertures import aperture
+
+    w = folder_window(qtbot, [im_glad])
+    editor = w.extension("labels")
+    started = time.perf_counter()
+    try:
+        key(w, "Ctrl+P")                                   # 1. the recognized result pinned
+        click(w, 1.17)                                     # 2. the /n/ of "I'm" selected
+        assert "phone 10 of 24 /n/ 1.100-1.240 s, recognized, confidence 0.16" in editor.bar.info.text()
+        with qtbot.waitSignal(editor.followed, timeout=WAIT_MS):
+            rename(w, "m")                                 # 3. F2, m, Enter
+        qtbot.waitUntil(lambda: w.settled, timeout=WAIT_MS)
+        w.view_bar.side_by_side.setChecked(True)           # 4. the lips side by side, close up
+        qtbot.mouseClick(w.camera_buttons["lips"], Qt.MouseButton.LeftButton)
+        table = w.extension("measure").open_table()        # 5. the per-phone table, /m/ only
+        qtbot.keyClicks(table.filter, "m")
+        machine = time.perf_counter() - started
+        heads = [table.table.horizontalHeaderItem(c).text() for c in range(table.table.columnCount())]
+        row = next(r for r in range(table.table.rowCount())
+                   if table.table.item(r, heads.index("start (s)")).text() == "1.100")
+        this = float(table.table.item(row, heads.index("min: synth.")).text())
+        pinned = float(table.table.item(row, heads.index("min: pin 1")).text())
+        # the engine's numbers: the least aperture over the /m/ of each result
+        frames = np.flatnonzero((w.view.times >= 1.1) & (w.view.times < 1.24))   # as the table
+        up, low = w.model.upper_lip, w.model.lower_lip
+        pin = w.pins.shown(w.view)[0]
+        assert this == pytest.approx(np.nanmin(aperture(w.view.shown, up, low)[frames]), abs=0.05)
+        assert pinned == pytest.approx(np.nanmin(aperture(pin.view.shown, up, low)[frames]), abs=0.05)
+        closed = float(w.closed_lips.gap(up, low))         # the talker's lips at closure
+        assert this == pytest.approx(closed, abs=1.0)       # closed as /m/
+        assert pinned - closed > 5.0                        # open as /n/
+        assert machine < 60.0
+        shot = w.save_screenshot(im_glad.with_name("im_glad.png"))
+        assert shot.stat().st_size > 10_000
+    finally:
+        close_without_asking(w)
+
+
+@pytest.mark.parametrize("screen", ["1366x768"], indirect=True)
+def test_unsaved_edits_are_never_lost_silently(screen, qtbot, im_glad, recordings):
+    """Quitting, switching recording and the file changed on disk (by Praat) with edits not
+    saved: each asks; Cancel keeps them, Save writes them, Discard lets them go."""
+    other = recordings[1]
+    w = folder_window(qtbot, [im_glad, other])
+    editor, files = w.extension("labels"), w.extension("label_files")
+    grid = im_glad.with_suffix(".TextGrid")
+    try:
+        click(w, 1.17)
+        with qtbot.waitSignal(editor.followed, timeout=WAIT_MS):
+            rename(w, "m")
+        assert "not saved" in w.windowTitle()
+        said = answer("Cancel")                                # quit: asked, Cancel stays
+        w.close()
+        assert said and "edits that are not saved (rename /n/ → /m/ at 1.100 s)" in said[0]
+        assert w.isVisible() and editor.session.doc.dirty
+        said = answer("Cancel")                                # another recording: stays
+        click_browser(w, other.stem)
+        assert said and w.view.utterance.name == im_glad.stem
+        assert w.browser.tree.currentItem() is w.browser.items[im_glad.stem]
+        said = answer("Save")                                  # another recording: saved
+        show(w, qtbot, other.stem)
+        assert said and w.view.utterance.name == other.stem and grid.is_file()
+        show(w, qtbot, im_glad.stem)                           # back: the saved labels
+        assert [p.label for p in w.view.utterance.phones][9] == "m"
+        # an edit here, then Praat changes the file: asked; No keeps the edit
+        click(w, 1.5)
+        with qtbot.waitSignal(editor.followed, timeout=WAIT_MS):
+            rename(w, "t")
+        said = answer("No")
+        praat_sets(grid, 1, 2, "l")                             # the /n/ of "Lord" is an /l/
+        qtbot.waitUntil(lambda: bool(said), timeout=WAIT_MS)
+        assert "changed outside facetraj" in said[0]
+        assert [p.label for p in w.view.utterance.phones][12] == "t"
+        # undone to the saved labels, a change on disk is read at once, and said
+        key(w, "Ctrl+Z")
+        qtbot.waitUntil(lambda: not editor.session.doc.dirty, timeout=WAIT_MS)
+        with qtbot.waitSignal(files.reloaded, timeout=WAIT_MS):
+            praat_sets(grid, 1, 3, "ao")
+        qtbot.waitUntil(lambda: w.settled and w.view.utterance.phones[2].label == "ao",
+                        timeout=WAIT_MS)
+        assert w.view.utterance.phones[1].label == "l"
+        assert "changed on disk: read again" in w.statusBar().currentMessage()
+        # quitting with an edit, Discard: the window closes
+        click(w, 1.5)
+        with qtbot.waitSignal(editor.followed, timeout=WAIT_MS):
+            rename(w, "d")
+        said = answer("Discard")
+        w.close()
+        assert said and not w.isVisible()
+    finally:
+        if w.isVisible():
+            close_without_asking(w)
