@@ -49,12 +49,14 @@ class LabelOrigin:
 
     ``source``: ``Utterance.label_source`` (``file``, ``aligned``, ``recognized``, ``none``, or
     any other the engine names); ``file``: the label file they were read from (a name);
-    ``transcript``: what was aligned (``s001.txt``, or ``the sentence typed``).
+    ``transcript``: what was aligned (``s001.txt``, or ``the sentence typed``); ``corrected``:
+    the phones of automatic labels corrected by hand since.
     """
 
     source: str
     file: str = ""
     transcript: str = ""
+    corrected: int = 0
 
     def text(self) -> str:
         """In words, for the title, the status bar and the phone tier.
@@ -69,7 +71,15 @@ class LabelOrigin:
         'aligned (label file s001.TextGrid)'
         >>> LabelOrigin("hand-corrected", file="x.TextGrid").text()
         'hand-corrected (label file x.TextGrid)'
+        >>> LabelOrigin("recognized", corrected=3).text()
+        'recognized from the speech (no text), 3 phones corrected by hand'
         """
+        text = self._text()
+        if self.corrected:
+            text += f", {self.corrected} phone{'s' * (self.corrected != 1)} corrected by hand"
+        return text
+
+    def _text(self) -> str:
         src = self.source or "none"
         if src == "none":
             return "none: acoustic-only synthesis"
@@ -86,8 +96,11 @@ class LabelOrigin:
 
         >>> LabelOrigin("file").short(), LabelOrigin("aligned").short(), LabelOrigin("x-y").short()
         ('label file', 'aligned', 'x-y')
+        >>> LabelOrigin("recognized", corrected=2).short()
+        'recognized, 2 corrected'
         """
-        return {"file": "label file", "none": "none"}.get(self.source or "none", self.source)
+        word = {"file": "label file", "none": "none"}.get(self.source or "none", self.source)
+        return f"{word}, {self.corrected} corrected" if self.corrected else word
 
 
 def mode_reason(requested: SynthConfig, used: SynthConfig, reason: str) -> str:

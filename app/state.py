@@ -64,10 +64,12 @@ class UtteranceView:
     @property
     def label_origin(self) -> LabelOrigin:
         """Where the phone labels came from (at least their source)."""
-        source = self.utterance.label_source if self.utterance.phones else "none"
+        utt = self.utterance
+        source = utt.label_source if utt.phones else "none"
+        corrected = utt.provenance.corrected if utt.phones and not utt.provenance.hand_checked else 0
         if self.origin is None:
-            return LabelOrigin(source)
-        return LabelOrigin(source, self.origin.file, self.origin.transcript)
+            return LabelOrigin(source, corrected=corrected)
+        return LabelOrigin(source, self.origin.file, self.origin.transcript, corrected)
 
     @property
     def shown(self) -> np.ndarray:

@@ -346,3 +346,52 @@ def test_unsaved_edits_are_never_lost_silently(screen, qtbot, im_glad, recording
     finally:
         if w.isVisible():
             close_without_asking(w)
+
+
+@pytest.mark.parametrize("screen", ["1920x1200"], indirect=True)
+def test_the_review_list_leads_to_an_error_and_praat_opens_the_labels(screen, qtbot, im_glad,
+                                                                    monkeypatch):
+    import subprocess
+
+    from facetraj_app import label_files
+    from facetraj_engine.labels.editing import PHONES, Selection
+
+    w = folder_window(qtbot, [im_glad])
+    editor, review = w.extension("labels"), w.extension("review")
+    try:
+        key(w, "Ctrl+R")                                  # Edit → Review list
+        assert review.dock.isVisible() and review.list.table.hasFocus()
+        first = [(it.segment.label, round(it.segment.start, 2)) for it in review.list.items[:2]]
+        assert first == [("m", 0.8), ("p", 1.44)]         # the recognizer's doubted bilabials
+        QTest.keyClick(review.list.table, Qt.Key.Key_Return)
+        assert editor.session.doc.selection == Selection(PHONES, 5)
+        assert w.current_time() == pytest.approx(0.8, abs=0.02)
+        with qtbot.waitSignal(editor.followed, timeout=WAIT_MS):
+            key(w, "Delete")                              # the false /m/ of "but" deleted
+        qtbot.waitUntil(lambda: w.settled, timeout=WAIT_MS)
+        left = [(it.segment.label, round(it.segment.start, 2)) for it in review.list.items]
+        assert ("m", 0.8) not in left and ("p", 1.44) in left
+        # File → Open in Praat: the labels saved first (no file yet: nothing asked), then the
+        # sound and the TextGrid sent to Praat's editor
+        launched: list = []
+        monkeypatch.setattr(label_files.subprocess, "Popen", lambda args, **kw: launched.append(args))
+        files = w.extension("label_files")
+        assert files.praat_action.isEnabled() == bool(shutil.which("praat"))
+        if not shutil.which("praat"):
+            return
+        files.praat_action.trigger()
+        monkeypatch.undo()                                # (subprocess.Popen is the module's)
+        grid = im_glad.with_suffix(".TextGrid")
+        assert grid.is_file() and not editor.session.doc.dirty
+        assert launched and launched[0][1] == "--send"
+        script = Path(launched[0][2]).read_text(encoding="utf-8")
+        assert f'Read from file: "{im_glad}"' in script and f'Read from file: "{grid}"' in script
+        # Praat itself runs the script (in batch, a look at what it selected for its editor)
+        check = grid.with_name("check.praat")
+        check.write_text(script.replace("View & Edit", 'writeInfoLine: numberOfSelected(), " ", '
+                                        'selected$("Sound"), " ", selected$("TextGrid")'))
+        out = subprocess.run(["praat", "--run", str(check)], capture_output=True, text=True,
+                             timeout=60, check=True).stdout.split()
+        assert out == ["2", im_glad.stem, im_glad.stem]
+    finally:
+        close_without_asking(w)
