@@ -395,3 +395,39 @@ def test_the_review_list_leads_to_an_error_and_praat_opens_the_labels(screen, qt
         assert out == ["2", im_glad.stem, im_glad.stem]
     finally:
         close_without_asking(w)
+
+
+@pytest.mark.parametrize("screen", ["1920x1200"], indirect=True)
+def test_a_corpus_utterance_corrected_is_saved_into_the_corpus(screen, qtbot, toy_corpus_dir,
+                                                               tmp_path, monkeypatch):
+    """A corpus utterance's labels corrected in the window are saved as its label file in the
+    corpus folder (after the user agrees to replace it): what train and eval read."""
+    from conftest import shown_corpus_window
+
+    from facetraj_engine.io.corpus import label_path, load_corpus
+
+    root = tmp_path / "toy"
+    shutil.copytree(toy_corpus_dir, root)
+    w = shown_corpus_window(qtbot, root, monkeypatch)
+    editor = w.extension("labels")
+    try:
+        name = w.view.utterance.name
+        k = next(i for i, p in enumerate(w.view.utterance.phones) if p.label not in ("sil", "m"))
+        seg = w.view.utterance.phones[k]
+        w.activateWindow()
+        click(w, 0.5 * (seg.start + seg.end))
+        with qtbot.waitSignal(editor.followed, timeout=WAIT_MS):
+            rename(w, "m")
+        grid = label_path(load_corpus(root).data_root, name)
+        before = grid.read_bytes()
+        said = answer("No")                                 # the corpus's file: asked first
+        key(w, "Ctrl+S")
+        assert said and "exists. Replace it" in said[0] and grid.read_bytes() == before
+        said = answer("Yes")
+        key(w, "Ctrl+S")
+        assert said and grid.read_bytes() != before and not editor.session.doc.dirty
+        read = load_corpus(root).utterance(name)
+        assert read.phones[k].label == "m" and read.provenance.hand_checked
+        assert [p.label for p in read.phones[:k]] == [p.label for p in w.view.utterance.phones[:k]]
+    finally:
+        close_without_asking(w)
