@@ -50,6 +50,7 @@ EDIT_KEYS = (
     ("silence", "Mark as silence", ("0",)),
     ("previous", "Select the previous segment", ("Ctrl+Left",)),
     ("next", "Select the next segment", ("Ctrl+Right",)),
+    ("word", "Add a word over the loop range or the phone selected…", ("W",)),
 )
 
 
@@ -211,6 +212,9 @@ class LabelEditing(QObject):
         if name in ("previous", "next"):
             self.step(-1 if name == "previous" else 1)
             return
+        if name == "word":
+            self.add_word()
+            return
         s = self.ensure()
         if s is None:
             self.bar.refuse("no labels to edit here")
@@ -232,6 +236,29 @@ class LabelEditing(QObject):
             return
         if self._run(lambda: s.doc.rename(text)):
             self._focus_panels()
+
+    def add_word(self, text: str | None = None) -> None:
+        """A word over the loop range (a drag on the panels), else over the phone selected
+        (recognized labels have no words); its text asked for when not given."""
+        s = self.ensure()
+        if s is None:
+            return
+        span = self.window.timeline.loop
+        sel = s.doc.selection
+        if span is None and sel is not None and sel.tier == PHONES:
+            seg = s.doc.phones[sel.index]
+            span = (seg.start, seg.end)
+        if span is None:
+            self.bar.refuse("select a phone, or drag over the phones of the word, first")
+            return
+        if text is None:
+            from PyQt6.QtWidgets import QInputDialog
+
+            text, ok = QInputDialog.getText(self.window, "Add a word",
+                                            f"The word spoken {span[0]:.3f}-{span[1]:.3f} s:")
+            if not ok:
+                return
+        self._run(lambda: s.doc.add_word(span[0], span[1], text))
 
     def drag_boundary(self, tier: str, index: int, side: str, t: float) -> None:
         s = self.ensure()

@@ -228,6 +228,26 @@ def answer(text: str) -> list[str]:
     return said
 
 
+def type_into_dialog(text: str) -> list[str]:
+    """Type ``text`` into the next input dialog and accept it (a timer polls for it)."""
+    from PyQt6.QtCore import QTimer
+    from PyQt6.QtWidgets import QApplication, QInputDialog
+
+    done: list[str] = []
+
+    def fill() -> None:
+        box = QApplication.activeModalWidget()
+        if not isinstance(box, QInputDialog):
+            QTimer.singleShot(20, fill)
+            return
+        box.setTextValue(text)
+        done.append(box.labelText())
+        box.accept()
+
+    QTimer.singleShot(0, fill)
+    return done
+
+
 def praat_sets(path: Path, tier: int, interval: int, label: str) -> None:
     """Praat itself changes a label of ``path`` and saves it (as a phonetician does in Praat)."""
     import subprocess
@@ -371,6 +391,17 @@ def test_the_review_list_leads_to_an_error_and_praat_opens_the_labels(screen, qt
         qtbot.waitUntil(lambda: w.settled, timeout=WAIT_MS)
         left = [(it.segment.label, round(it.segment.start, 2)) for it in review.list.items]
         assert ("m", 0.8) not in left and ("p", 1.44) in left
+        # a word over the phones of "but" (recognized labels have none): a drag over them on
+        # the phones row (the loop range), W, the word typed
+        drag(w, 0.75, 0.93)
+        assert w.timeline.loop is not None
+        typed = type_into_dialog("but")
+        with qtbot.waitSignal(editor.followed, timeout=WAIT_MS):
+            key(w, "W")
+        assert typed and [(x.label, round(x.start, 2)) for x in w.view.utterance.words] == \
+            [("but", 0.75)]
+        qtbot.waitUntil(lambda: w.settled, timeout=WAIT_MS)
+        assert editor.panel.row_of("words") is not None      # the words row drawn
         # File → Open in Praat: the labels saved first (no file yet: nothing asked), then the
         # sound and the TextGrid sent to Praat's editor
         launched: list = []
