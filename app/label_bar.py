@@ -44,12 +44,13 @@ class LabelBar(QWidget):
         lay.setSpacing(4)
         self.info = QLabel("")
         self.info.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Fixed)
+        self.info.setMinimumWidth(60)
         self.field = QLineEdit()
         self.field.setPlaceholderText("label (F2)")
         self.field.setToolTip("rename the segment selected (F2, or Enter on the panels): a phone "
                               "of the model (offered as you type), or a word's text; Enter "
                               "applies it, Esc leaves it")
-        self.field.setMaximumWidth(110)
+        self.field.setMaximumWidth(80)
         self.field.setEnabled(False)
         self.phones = QStringListModel([])
         self.completer = QCompleter(self.phones, self.field)
@@ -60,9 +61,9 @@ class LabelBar(QWidget):
         lay.addWidget(self.info)
         lay.addWidget(self.field)
         self.buttons: dict[str, QToolButton] = {}
-        for name, text, key, tip in BUTTONS:
+        for name, text, _key, tip in BUTTONS:
             b = QToolButton()
-            b.setText(f"{text} ({key})")
+            b.setText(text)
             b.setToolTip(tip)
             b.setEnabled(False)
             b.clicked.connect(lambda _c=False, n=name: self.edit.emit(n))

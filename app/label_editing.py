@@ -275,6 +275,7 @@ class LabelEditing(QObject):
             done = edit()
         except EditRefused as why:
             self.bar.refuse(str(why))
+            self.window.show_status(f"not done: {why}", 10000)
             self.refresh(redraw=False)
             return False
         text = f"{'undone' if verb == 'undo' else 'redone' if verb == 'redo' else ''}"
@@ -338,21 +339,22 @@ class LabelEditing(QObject):
             self.redraw()
 
     def _describe(self, s: LabelSession) -> str:
-        """The segment selected in words: ``phone 12 of 35 /n/ 1.100-1.240 s, recognized
-        (confidence 0.16)``."""
+        """The segment selected in words: ``/n/ 1.100-1.240 s, recognized 0.16`` (its maker and
+        confidence; the tooltip says which phone of how many)."""
         doc, sel = s.doc, s.doc.selection
         seg = doc.segments(sel.tier)[sel.index]
         n = len(doc.segments(sel.tier))
+        self.bar.info.setToolTip(f"{sel.tier[:-1]} {sel.index + 1} of {n}")
         if sel.tier == WORDS:
-            return f"word {sel.index + 1} of {n} “{seg.label}” {seg.start:.3f}-{seg.end:.3f} s"
+            return f"“{seg.label}” {seg.start:.3f}-{seg.end:.3f} s"
         labels = doc.labels_now()
         if labels.provenance.hand_checked or labels.hand_checked[sel.index]:
             how = "checked by hand"
         else:
             c = float(labels.confidence[sel.index])
-            how = f"{labels.provenance.kind}" + (f", confidence {c:.2f}" if c == c else "")
+            how = f"{labels.provenance.kind}" + (f" {c:.2f}" if c == c else "")
         name = "silence" if is_silence(seg.label) else shown(seg.label)
-        return f"phone {sel.index + 1} of {n} {name} {seg.start:.3f}-{seg.end:.3f} s, {how}"
+        return f"{name} {seg.start:.3f}-{seg.end:.3f} s, {how}"
 
     def _focus_panels(self) -> None:
         self.window.timeline.canvas.setFocus(Qt.FocusReason.OtherFocusReason)

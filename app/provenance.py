@@ -96,11 +96,8 @@ class LabelOrigin:
 
         >>> LabelOrigin("file").short(), LabelOrigin("aligned").short(), LabelOrigin("x-y").short()
         ('label file', 'aligned', 'x-y')
-        >>> LabelOrigin("recognized", corrected=2).short()
-        'recognized, 2 corrected'
         """
-        word = {"file": "label file", "none": "none"}.get(self.source or "none", self.source)
-        return f"{word}, {self.corrected} corrected" if self.corrected else word
+        return {"file": "label file", "none": "none"}.get(self.source or "none", self.source)
 
 
 def mode_reason(requested: SynthConfig, used: SynthConfig, reason: str) -> str:
@@ -132,6 +129,7 @@ def settings_text(view, short: bool = False) -> str:
     n = f", N={cfg.n_context_phones}" if used else ""
     if short:
         labels = origin.short() if used or origin.source in ("", "none") else "not used"
+        labels += f", {origin.corrected} corrected" if used and origin.corrected else ""
         return f"{search_title(cfg)}{n}, {SMOOTHING_NAMES[cfg.smoothing]}; labels: {labels}"
     unused = "" if used or origin.source in ("", "none") else " (not used by this search)"
     return (f"{SMOOTHING_NAMES[cfg.smoothing]} synthesis, {search_title(cfg)}{n};  "

@@ -299,7 +299,8 @@ def choose_mode(config: SynthConfig, phones: Sequence[PhoneSegment] | None,
         robust = tuned_config(config.with_(mode=FOR_AUTOMATIC_LABELS), tuned, keep)
         reason = f"{provenance.kind} labels are not hand-checked"
         if provenance.corrected:
-            reason += f" ({provenance.corrected} phones corrected by hand count as checked)"
+            n = provenance.corrected
+            reason += f" ({n} phone{'s' * (n != 1)} corrected by hand count{'s' * (n == 1)} as checked)"
         return ModeChoice(robust, reason + (", settings cross-validated at training" if tuned else ""))
     if config.mode == FOR_CHECKED_LABELS:
         return ModeChoice(config, "hand-checked labels (the paper)")
