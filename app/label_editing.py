@@ -283,8 +283,8 @@ class LabelEditing(QObject):
         self.bar.say(said)
         self._synthesize()
         self.edited.emit(said)
-        self.refresh(redraw=True)
-        return True
+        self.refresh()            # the panels are drawn again with the edit's result (no draw
+        return True               # now: it would compete with the synthesis for the CPU)
 
     def _synthesize(self) -> None:
         """The face of the labels on screen: a new request (a stale one is dropped)."""

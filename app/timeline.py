@@ -310,6 +310,25 @@ def redraw_in_place(panels: Sequence[Panel], axes: Sequence, view: UtteranceView
         draw_panel(panel, ax, view, last=i == len(axes) - 1)
 
 
+def redraw_soon(timeline: Timeline, view: UtteranceView) -> None:
+    """:func:`redraw_in_place` of ``timeline``'s panels for ``view`` at the event loop's next
+    pass (the window shows the new faces first), then a full draw; the canvas is busy
+    meanwhile (``building``), so what waits for the panels waits for these."""
+    shown, axes, canvas = list(timeline.shown), list(timeline.axes), timeline.canvas
+    canvas.hold()
+
+    def redo() -> None:
+        if timeline.view is view and axes == timeline.axes:
+            redraw_in_place(shown, axes, view)
+            timeline.redraw()
+
+    def later() -> None:
+        canvas.release(draw=False)
+        canvas.when_idle(redo)
+
+    QTimer.singleShot(0, later)
+
+
 def draw_panel(panel: Panel, ax, view: UtteranceView, last: bool) -> None:
     """Draw ``panel`` in ``ax`` as the timeline does (the window's and exported figures): its
     content, its y label fitted, small ticks, the time labels under the last panel only."""
@@ -403,9 +422,7 @@ class Timeline(QWidget):
         old, self.view = self.view, view
         if keep_zoom and self._building is None and self.axes and view is not None and \
                 old is not None and old.utterance.audio is view.utterance.audio:
-            shown, axes = list(self.shown), list(self.axes)
-            self.canvas.when_idle(lambda: self.view is view and axes == self.axes and (
-                redraw_in_place(shown, axes, view) or self._request_draw()))
+            redraw_soon(self, view)
             return
         self.relayout(self._range if keep_zoom else None)
 
