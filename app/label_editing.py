@@ -84,6 +84,7 @@ class LabelEditing(QObject):
         self.actions = _edit_menu(window, self)
         self._shortcuts = _keys(window, self)
         window.synthesisChanged.connect(self._on_result)
+        window.cursorMoved.connect(self._on_frame)     # the first frame of a result: its faces
         window.leave_checks.append(self.may_leave)
         window.installEventFilter(self)         # quitting with unsaved edits asks
 
@@ -138,6 +139,13 @@ class LabelEditing(QObject):
             return view
         return replace(view, utterance=replace(view.utterance, phones=list(s.doc.phones),
                                                words=list(s.doc.words)))
+
+    def _on_frame(self, _t: float) -> None:
+        """A frame on screen: the first of the edit's result is its faces (``followed``)."""
+        s = self.session
+        if self._asked_at is not None and s is not None and s.matches(self.window.view):
+            self.followed.emit(time.perf_counter() - self._asked_at)
+            self._asked_at = None
 
     def _on_result(self) -> None:
         """A new result on screen: the session goes when it is of other labels (another

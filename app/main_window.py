@@ -406,12 +406,12 @@ class MainWindow(QMainWindow):
         self.playback.set_frames(view.n_frames, view.rate)
         self.view_bar.set_has_original(view.original is not None)
         self.face.set_view(view)
-        self.timeline.set_view(view, keep_zoom=not new_utterance)
-        mark("timeline drawn")
         self.transport.set_frames(view.n_frames)
         self._show_titles(view)
         self.clock.seek(t)
-        self._show_time(t, force=True)
+        self._show_time(t, force=True)          # the new faces on screen, then the panels
+        self.timeline.set_view(view, keep_zoom=not new_utterance)
+        mark("timeline drawn")
         if was_playing and not self.clock.playing:
             self.clock.play()
         if new_utterance:

@@ -311,22 +311,16 @@ def redraw_in_place(panels: Sequence[Panel], axes: Sequence, view: UtteranceView
 
 
 def redraw_soon(timeline: Timeline, view: UtteranceView) -> None:
-    """:func:`redraw_in_place` of ``timeline``'s panels for ``view`` at the event loop's next
-    pass (the window shows the new faces first), then a full draw; the canvas is busy
-    meanwhile (``building``), so what waits for the panels waits for these."""
-    shown, axes, canvas = list(timeline.shown), list(timeline.axes), timeline.canvas
-    canvas.hold()
+    """:func:`redraw_in_place` of ``timeline``'s panels for ``view`` (now, or right after the
+    background draw running), then a full draw in the background."""
+    shown, axes = list(timeline.shown), list(timeline.axes)
 
     def redo() -> None:
         if timeline.view is view and axes == timeline.axes:
             redraw_in_place(shown, axes, view)
             timeline.redraw()
 
-    def later() -> None:
-        canvas.release(draw=False)
-        canvas.when_idle(redo)
-
-    QTimer.singleShot(0, later)
+    timeline.canvas.when_idle(redo)
 
 
 def draw_panel(panel: Panel, ax, view: UtteranceView, last: bool) -> None:
