@@ -139,3 +139,31 @@ def test_a_label_file_without_changes_is_not_searched_again(default_model, defau
                confidence=conf, provenance=prov, memo=memo)
     assert memo.searched == 0
     assert isinstance(moved[k], PhoneSegment)
+
+
+def test_a_synthesis_that_fails_half_way_leaves_nothing_kept(default_model, default_corpus,
+                                                            monkeypatch):
+    import facetraj_engine.method.resynthesis as resynthesis
+
+    model = default_model
+    utt = default_corpus.utterance(default_corpus.info.test[0])
+    prov, conf = Provenance("recognized", "test"), np.full(len(utt.phones), 0.5)
+    memo = SynthesisMemo()
+    synthesize(model, utt.audio, utt.sample_rate, utt.phones, SynthConfig(mode="robust"),
+               confidence=conf, provenance=prov, memo=memo)
+    moved = list(utt.phones)
+    moved[3] = replace(moved[3], label="m")
+
+    def broken(*args, **kwargs):
+        raise MemoryError("the chain")
+
+    monkeypatch.setattr(resynthesis, "chained_pcs", broken)
+    with pytest.raises(MemoryError):
+        synthesize(model, utt.audio, utt.sample_rate, moved, SynthConfig(mode="robust"),
+                   confidence=conf, provenance=prov, memo=memo)
+    assert memo.bound == () and memo.robust is None
+    monkeypatch.undo()
+    same(synthesize(model, utt.audio, utt.sample_rate, moved, SynthConfig(mode="robust"),
+                    confidence=conf, provenance=prov, memo=memo),
+         synthesize(model, utt.audio, utt.sample_rate, moved, SynthConfig(mode="robust"),
+                    confidence=conf, provenance=prov))

@@ -109,7 +109,8 @@ def _backward(s: ChainState, start: int, old: np.ndarray | None = None,
 
 
 def chain_marginals(log_target: np.ndarray, log_join: np.ndarray,
-                    previous: ChainState | None = None, keep: list | None = None) -> np.ndarray:
+                    previous: ChainState | None = None, keep: list | None = None,
+                    joins_changed: np.ndarray | None = None) -> np.ndarray:
     """Per-frame marginals ``(T, I)`` (rows sum to 1) of the chain with target terms
     ``log_target`` ``(T, I)`` (``-inf``: an entry that does not count) and join terms
     ``log_join`` ``(T-1, I, I)``, by forward-backward normalised per frame (any length is safe).
@@ -117,7 +118,8 @@ def chain_marginals(log_target: np.ndarray, log_join: np.ndarray,
     With ``previous`` (the :class:`ChainState` of the same chain with other terms over some
     frames), the messages are computed again only from the first frame whose terms differ
     until they are the previous ones to the bit (the same result as without it); the new
-    state is appended to ``keep`` when given.
+    state is appended to ``keep`` when given. ``joins_changed``: the join terms that differ
+    from the previous state's, when the caller knows (it may then have changed them in place).
 
     >>> lt = np.log(np.array([[0.5, 0.5], [0.9, 0.1]]))
     >>> chain_marginals(lt, np.zeros((1, 2, 2))).round(3).tolist()      # no join: the targets
@@ -131,7 +133,12 @@ def chain_marginals(log_target: np.ndarray, log_join: np.ndarray,
         if same:
             rows = ~np.all((log_target == previous.log_target) |
                            (np.isnan(log_target) & np.isnan(previous.log_target)), axis=1)
-            joins = ~np.all(log_join == previous.log_join, axis=(1, 2)) if n > 1 else np.zeros(0, bool)
+            if joins_changed is not None:
+                joins = np.zeros(max(n - 1, 0), bool)
+                joins[np.asarray(joins_changed, dtype=np.int64)] = True
+            else:
+                joins = ~np.all(log_join == previous.log_join, axis=(1, 2)) if n > 1 else \
+                    np.zeros(0, bool)
             changed = np.union1d(np.flatnonzero(rows), np.flatnonzero(joins) + 1)
             if changed.size:        # the frames whose target or join into them changed
                 first, last = int(changed[0]), int(changed[-1])
@@ -152,16 +159,18 @@ def chain_marginals(log_target: np.ndarray, log_join: np.ndarray,
 
 def chain_pcs(weights: np.ndarray, candidates: np.ndarray, cb_pcs: np.ndarray, beta: float,
               scale: float, previous: ChainState | None = None, keep: list | None = None,
-              joins: np.ndarray | None = None) -> np.ndarray:
+              joins: np.ndarray | None = None, joins_changed: np.ndarray | None = None
+              ) -> np.ndarray:
     """Eq 8 with the chain's marginals: ``p-hat(t) = sum_i q_t(i) F_i``, ``q`` from
     :func:`chain_marginals` with ``log v_t`` (the eq 6 ``weights`` ``(T, I)`` of the
     ``candidates`` ``(T, I)``) as target terms and :func:`join_log_potentials` as join terms.
     ``beta = 0`` is eq 8: ``sum_i v_t(i) F_i``. ``previous``, ``keep``: the chain summed again
-    only where it changed (:func:`chain_marginals`); ``joins``: its join terms when known."""
+    only where it changed (:func:`chain_marginals`); ``joins``: its join terms when known (and
+    ``joins_changed``, those that changed since ``previous``)."""
     cand_pcs = cb_pcs[candidates]
     if beta == 0:
         return np.einsum("ti,tik->tk", weights, cand_pcs)
     with np.errstate(divide="ignore"):
         lj = join_log_potentials(cand_pcs, beta, scale) if joins is None else joins
-        q = chain_marginals(np.log(weights), lj, previous, keep)
+        q = chain_marginals(np.log(weights), lj, previous, keep, joins_changed)
     return np.einsum("ti,tik->tk", q, cand_pcs)

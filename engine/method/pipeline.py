@@ -142,8 +142,12 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                            lsf, audio_source, confidence, provenance, voice, None)
     with memo.lock:
         memo.bind(model, audio, sample_rate, n_frames, config)
-        return _synthesize(model, audio, sample_rate, phones, config, n_frames, label_map, source,
-                           lsf, audio_source, confidence, provenance, voice, memo)
+        try:
+            return _synthesize(model, audio, sample_rate, phones, config, n_frames, label_map,
+                               source, lsf, audio_source, confidence, provenance, voice, memo)
+        except BaseException:
+            memo.forget()               # half updated: the next synthesis starts again
+            raise
 
 
 def _synthesize(model: Model, audio: np.ndarray, sample_rate: int,

@@ -46,6 +46,10 @@ class SynthesisMemo:
                                         and self.bound[2:] == now[2:]):
             self.bound, self.values, self.robust, self.chain = now, {}, None, None
 
+    def forget(self) -> None:
+        """Keep nothing (a synthesis failed half-way: what is kept may be of two label sets)."""
+        self.bound, self.values, self.robust, self.chain = (), {}, None, None
+
     def remember(self, key, compute: Callable[[], Any]) -> Any:
         """``compute()``'s value, computed once for this input."""
         if key not in self.values:
@@ -97,22 +101,22 @@ def _copy(frames: Any) -> Any:
 
 
 def join_terms_again(memo: SynthesisMemo, candidates: np.ndarray,
-                     compute: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+                     compute: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, np.ndarray | None]:
     """The chain's join terms (:func:`~facetraj_engine.method.chain.join_log_potentials`):
-    ``compute(pairs)`` for the frame pairs ``t-1, t`` (``pairs``: the ``t - 1``) whose candidates
-    changed, the others as they were."""
+    ``compute(pairs)`` for the frame pairs ``t, t+1`` (``pairs``: the ``t``) whose candidates
+    changed, the others as they were (the array kept is changed in place: one array of the
+    terms, ``(T-1, I, I)``, however many edits); and those pairs (``None``: all computed anew)."""
     kept = memo.values.get("joins")
     if kept is None or kept[0].shape != candidates.shape:
-        pairs = np.arange(max(len(candidates) - 1, 0))
-        joins = compute(pairs)
+        joins, pairs = compute(np.arange(max(len(candidates) - 1, 0))), None
     else:
-        old_cand, joins = kept[0], kept[1].copy()
+        old_cand, joins = kept
         moved = np.any(old_cand != candidates, axis=1)
         pairs = np.flatnonzero(moved[:-1] | moved[1:])
         if pairs.size:
             joins[pairs] = compute(pairs)
     memo.values["joins"] = (np.array(candidates), joins)
-    return joins
+    return joins, pairs
 
 
 def chained_pcs(memo: SynthesisMemo, weights: np.ndarray, candidates: np.ndarray,
@@ -121,10 +125,11 @@ def chained_pcs(memo: SynthesisMemo, weights: np.ndarray, candidates: np.ndarray
     messages of the last label set reused where they are unchanged."""
     from .chain import chain_pcs, joins_between
 
-    joins = join_terms_again(memo, candidates, lambda t: joins_between(
-        cb_pcs[candidates[t]], cb_pcs[candidates[t + 1]], beta, scale)) if beta else None
+    joins, changed = join_terms_again(memo, candidates, lambda t: joins_between(
+        cb_pcs[candidates[t]], cb_pcs[candidates[t + 1]], beta, scale)) if beta else (None, None)
+    previous = memo.chain if changed is not None else None    # terms all new: summed anew
     keep: list = []
-    pcs = chain_pcs(weights, candidates, cb_pcs, beta, scale, memo.chain, keep, joins)
+    pcs = chain_pcs(weights, candidates, cb_pcs, beta, scale, previous, keep, joins, changed)
     memo.chain = keep[0] if keep else None
     return pcs
 
