@@ -40,7 +40,9 @@ def labels_from_utterance(utt: Utterance) -> Labels:
             scores = SCORE_SCALE * np.log(np.clip(np.asarray(conf, float), 1e-9, 1.0))
     source = utt.label_source if utt.label_source in SOURCES else "file"
     return Labels(list(utt.phones), list(utt.words), source, scores, utt.text,
-                  provenance=utt.provenance)
+                  provenance=utt.provenance,
+                  checked=utt.checked if utt.checked is not None and
+                  len(utt.checked) == len(utt.phones) else None)
 
 
 def labels_of_view(view: UtteranceView, made: Labels | None = None,
@@ -121,7 +123,8 @@ class LabelSession:
         """The recording with the labels on screen (what the window synthesizes)."""
         labels = self.doc.labels_now()
         return replace(self.base, phones=list(labels.phones), words=list(labels.words),
-                       provenance=labels.provenance, confidence=labels.trust())
+                       provenance=labels.provenance, confidence=labels.trust(),
+                       checked=None if labels.provenance.hand_checked else labels.hand_checked)
 
     def origin_now(self) -> LabelOrigin:
         """Where the labels on screen came from (the file once saved)."""

@@ -105,7 +105,7 @@ def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig,
     n_frames = utt.n_frames or None
     res = synthesize(model, utt.audio, utt.sample_rate, utt.phones if utt.phones else None,
                      config, n_frames=n_frames, source=utt.name, confidence=utt.confidence,
-                     provenance=utt.provenance, voice=True, memo=memo)
+                     provenance=utt.provenance, voice=True, memo=memo, checked=utt.checked)
     original = model.normalise_markers(utt.markers) if utt.markers is not None else None
     triangular, spline, speech = _tracks(model, res, utt.audio, utt.sample_rate, memo)
     return UtteranceView(utterance=utt, split=split, synthesis=res, original=original,

@@ -167,3 +167,31 @@ def test_a_synthesis_that_fails_half_way_leaves_nothing_kept(default_model, defa
                     confidence=conf, provenance=prov, memo=memo),
          synthesize(model, utt.audio, utt.sample_rate, moved, SynthConfig(mode="robust"),
                     confidence=conf, provenance=prov))
+
+
+def test_a_bilabial_corrected_by_hand_closes_on_the_training_voice(default_model, default_corpus):
+    """Recognized /p b m/ are not trusted on the voice the model was trained on (its voice
+    match 1: the codebook knows its sounds); a /b/ a person corrected is, whatever the voice."""
+    from facetraj_engine.evaluation.closure import lip_aperture, segment_values
+
+    model = default_model
+    utt = default_corpus.utterance(default_corpus.info.test[0])
+    phones = list(utt.phones)
+    k = next(i for i, p in enumerate(phones) if p.label in ("t", "d", "k", "g") and i > 1)
+    phones[k] = replace(phones[k], label="b")
+    conf = np.full(len(phones), 0.5)
+    conf[k] = 1.0
+    checked = np.zeros(len(phones), dtype=bool)
+    checked[k] = True
+    prov = Provenance("recognized", "test", corrected=1)
+
+    def least(flags):
+        res = synthesize(model, utt.audio, utt.sample_rate, phones, SynthConfig(mode="robust"),
+                         confidence=conf, provenance=prov, voice=True, checked=flags)
+        assert res.voice_match > 0.9
+        ap = lip_aperture(res.markers, model.upper_lip, model.lower_lip)
+        return segment_values(ap, res.times, [phones[k]], "min")[0]
+
+    closed = model.closure.closed
+    assert least(None) - closed > 1.0                 # the recognizer's word: not trusted here
+    assert abs(least(checked) - closed) <= 1.0        # the phonetician's: the lips close
