@@ -19,7 +19,6 @@ from PyQt6.QtGui import QKeySequence
 from PyQt6.QtWidgets import QFileDialog, QMessageBox
 
 from facetraj_engine.errors import FacetrajError
-from facetraj_engine.io.labelling import write_labels
 
 from .label_session import LabelSession, save_path, stamp
 
@@ -92,6 +91,8 @@ class LabelFiles(QObject):
             return self.save_as()
         if path.exists() and path not in s.replace_ok and not self._agree_replace(path):
             return False
+        from facetraj_engine.io.labelling import write_labels  # not for the first frame
+
         labels = s.doc.labels_now()
         try:
             write_labels(path, labels, s.base.duration, overwrite=True)
