@@ -100,8 +100,14 @@ class LabelBar(QWidget):
         self.field.setFocus(Qt.FocusReason.ShortcutFocusReason)
         self.field.selectAll()
 
+    @property
+    def refusing(self) -> bool:
+        """Whether the message shown is a refusal."""
+        return self.message.styleSheet() == REFUSED_STYLE and bool(self.message.text())
+
     def refuse(self, why: str) -> None:
         """Why the last edit was refused (one line, in red)."""
+        self.setVisible(True)
         self.message.setStyleSheet(REFUSED_STYLE)
         self.message.setText(why)
         self.message.setToolTip(why)

@@ -154,6 +154,7 @@ class LabelEditing(QObject):
         s, view = self.session, self.window.view
         if s is not None and not (s.same_place(view) and (s.matches(view) or self._asked_at)):
             self.session = None
+            self.bar.say("")
             self.sessionChanged.emit()
         elif s is not None and self._asked_at is not None and s.matches(view):
             self.followed.emit(time.perf_counter() - self._asked_at)
@@ -326,6 +327,9 @@ class LabelEditing(QObject):
         s = self.session
         doc = s.doc if s is not None else None
         sel = doc.selection if doc is not None else None
+        # the row over the panels only while labels are being edited (a laptop's panels keep
+        # their height until then)
+        self.bar.setVisible(sel is not None or bool(doc and doc.dirty) or self.bar.refusing)
         if sel is None:
             self.bar.show_selection("click a phone or a word to correct it" if
                                     self.editable(self.window.view) else "", None)

@@ -90,17 +90,19 @@ class LabelReview(QObject):
         self.window, self.editor = window, editor
         self.list = ReviewList()
         self.list.jump.connect(self.go_to)
-        self.dock = window.add_dock(self.list, "Review labels")
-        self.dock.hide()
+        self.dock = None                # made when first opened (no dock tabbed with the views')
         self.action = editor.menu.addAction("Review list (where to look first)", self.open)
         self.action.setShortcut(QKeySequence("Ctrl+R"))
         window.synthesisChanged.connect(self.refresh)
         editor.sessionChanged.connect(self.refresh)
 
     def open(self) -> None:
-        self.refresh()
+        """Show the review list's dock (made on first use)."""
+        if self.dock is None:
+            self.dock = self.window.add_dock(self.list, "Review labels")
         self.dock.show()
         self.dock.raise_()
+        self.refresh()
         self.list.table.setFocus()
         if self.list.table.currentRow() < 0 and self.list.items:
             self.list.table.setCurrentCell(0, 0)
@@ -109,6 +111,8 @@ class LabelReview(QObject):
         """The list of the labels on screen (the editor's when it is editing them)."""
         w = self.window
         view, model = w.view, w.model
+        if self.dock is None or not self.dock.isVisible():
+            return                      # made again when shown
         if view is None or model is None or not view.utterance.phones:
             self.list.show_items([], "no phone labels on screen")
             return
