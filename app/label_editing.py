@@ -81,6 +81,7 @@ class LabelEditing(QObject):
         self.bar.cancelled.connect(self._focus_panels)
         self.bar.edit.connect(lambda name: self.do(name))
         _place_over_panels(window, self.bar)
+        self.bar.hide()                 # until labels are edited (``refresh``)
         self.actions = _edit_menu(window, self)
         self._shortcuts = _keys(window, self)
         window.synthesisChanged.connect(self._on_result)
