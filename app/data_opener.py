@@ -40,6 +40,8 @@ class DataOpener:
             if recordings_in(path):
                 self.open_recordings(path)
                 return
+            if not w.may_leave("opening another corpus"):     # unsaved label edits
+                return
             corpus = load_corpus(path)
         except FacetrajError as exc:
             w.report_error(exc)
@@ -73,6 +75,8 @@ class DataOpener:
             return
         if w.model is None and not w.state.loading:
             w.report_error(FacetrajError("no model yet: open a corpus first"))
+            return
+        if not w.may_leave(f"opening the recordings of {path.name}"):      # unsaved label edits
             return
         w.show_status(f"opening {len(paths)} recordings of {path} …")
         w.add_extension("recordings", RecordingQueue(w, paths))     # kept while it works

@@ -13,9 +13,10 @@ into one WAV); the dialogs of *Open audio* (the sentence, words missing from the
 error of a corrupt WAV) and the synthesis settings with each search mode's note, each shown
 non-modally and grabbed; frames of ``facetraj video``; the mouth at a /b/ before and after the
 lips' strips; the Live window; and the analysis views
-(:func:`facetraj_app.analysis.figures.make_figures`). Scratch files go to a temporary folder, never into
-the repository. The results figures come from ``make report``, the corpus figure from
-``docs/figures/make_corpus_figures.py`` (``make figures`` runs that too).
+(:func:`facetraj_app.analysis.figures.make_figures`); the label editor at work on a CMU ARCTIC
+recording (its phones recognized, one corrected, the next being typed). Scratch files go to a
+temporary folder, never into the repository. The results figures come from ``make report``, the
+corpus figure from ``docs/figures/make_corpus_figures.py`` (``make figures`` runs that too).
 """
 
 from __future__ import annotations
@@ -459,6 +460,49 @@ def measure_figures(out: Path) -> list[Path]:
     return written
 
 
+def label_edit_figures(out: Path, scratch: Path) -> list[Path]:
+    """docs/app.md's label editing on a 1366 x 768 laptop: CMU ARCTIC ``axb_a0004`` ("Lord, but
+    I'm glad to see you again, Phil.", ``../shared``) opened with its phones recognized and
+    pinned; the /m/ of "I'm", heard as /n/, renamed; the lips of both results side by side in
+    the close-up, the review list docked, and the next edit in progress: the /p/ of "glad to"
+    selected, a /t/ typed in the rename field (``label_edit.png``)."""
+    import shutil
+
+    from .analysis.figures import draw_plots, settle, wait_until
+
+    source = SHARED / "data" / "arctic_samples" / "cmu_arctic_us_axb_a0004.wav"
+    if not source.is_file():
+        log.warning("%s is not here: no label editing figure", source)
+        return []
+    wav = scratch / source.name
+    shutil.copy(source, wav)                      # alone: no transcript beside it (recognized)
+    win = _window(DEFAULT_CORPUS, LAPTOP)
+    _open_audio(win, wav)
+    editor, review = win.extension("labels"), win.extension("review")
+    win.extension("compare").pin()
+    done: list = []
+    editor.followed.connect(lambda _s: done.append(1))
+    editor.select("phones", 9)                    # the /n/ of "I'm", 1.100-1.240 s
+    editor.rename("m")
+    wait_until(lambda: bool(done) and win.settled, 600)
+    win.view_bar.side_by_side.setChecked(True)
+    win.view_bar.set_camera("lips")
+    review.open()
+    win.seek(1.17)
+    editor.select("phones", 12)                   # the /p/ of "glad to": a /t/ being typed
+    editor.bar.start_rename()
+    editor.bar.field.setText("t")
+    settle(300)
+    draw_plots(win, 200)
+    path = out / "label_edit.png"
+    win.save_screenshot(path)
+    log.info("wrote %s", path)
+    editor.discard()
+    win.extension("analysis").close()
+    win.close()
+    return [path]
+
+
 def make_gallery(out: Path, analysis: bool = True) -> list[Path]:
     """Every screenshot of the docs, into ``out``."""
     from .analysis.figures import make_figures
@@ -472,6 +516,7 @@ def make_gallery(out: Path, analysis: bool = True) -> list[Path]:
         written += articulator_figures(out, Path(tmp))
         written += laptop_figures(out)
         written += measure_figures(out)
+        written += label_edit_figures(out, Path(tmp))
         written += dialog_figures(out, Path(tmp))
     if analysis:
         written += make_figures(DEFAULT_CORPUS, out)
@@ -487,7 +532,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--only-dialogs", action="store_true",
                    help="just the dialogs and the settings panel (a quick look)")
     p.add_argument("--only", choices=["video", "mouth", "live", "app", "articulators", "laptop",
-                                      "measure"],
+                                      "measure", "labels"],
                    action="append", help="just these pictures (a quick look)")
     args = p.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
@@ -501,7 +546,8 @@ def main(argv: list[str] | None = None) -> int:
         makers = {"video": video_figures, "mouth": mouth_figure, "live": live_figure,
                   "laptop": laptop_figures, "measure": measure_figures}
         with tempfile.TemporaryDirectory(prefix="facetraj-gallery-") as tmp:
-            with_scratch = {"app": app_figures, "articulators": articulator_figures}
+            with_scratch = {"app": app_figures, "articulators": articulator_figures,
+                            "labels": label_edit_figures}
             paths = [p for name in args.only for p in
                      (with_scratch[name](args.out, Path(tmp)) if name in with_scratch
                       else makers[name](args.out))]

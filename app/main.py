@@ -64,14 +64,15 @@ def build_window(corpus: Path | str | None, model: Path | None = None, utterance
     A view set that fails to install is logged and left out; the window still opens.
     """
     with matplotlib_without_property_docs():
-        from . import analysis, compare, live, measure, own_data
+        from . import analysis, compare, label_editing, label_files, live, measure, own_data, review_dock
         from .main_window import MainWindow
 
     mark("window modules imported")
     window = MainWindow(None if corpus is None else Path(corpus), model_path=model, utterance=utterance,
                         start_time=time, use_audio=use_audio)
     mark("main window built")
-    for extension in (own_data, analysis, live, compare, measure):
+    for extension in (own_data, analysis, live, compare, measure, label_editing, label_files,
+                      review_dock):
         try:
             extension.install(window)
         except Exception:

@@ -34,7 +34,9 @@ Methods
     set with ``set_error_handler(fn)``); ``set_correlation_sweep(on)`` (the browser's background
     lip correlations); ``show_status(text, timeout_ms=0)``;
     ``add_extension(name, obj)`` / ``extension(name)``; ``set_utterance(utt_id)``, ``seek(t)``,
-    ``current_time()``, ``open_corpus(path)``, ``open_audio(path, labels)``.
+    ``current_time()``, ``open_corpus(path)``, ``open_audio(path, labels)``;
+    ``leave_checks`` (a list) / ``may_leave(what)``: each ``check(what)`` is asked before the
+    labels on screen are left (another utterance or corpus, quitting); one False stays.
 
 Adding a feature
     Write an object that takes the window (like ``OwnData``): its menu entries go into
@@ -159,6 +161,7 @@ class MainWindow(QMainWindow):
         self._error_handler: Callable[[str], None] | None = None
         self.closed_lips: ClosedLips | None = None      # the talker's lips at closure (per model)
         self._extensions: dict[str, object] = {}
+        self.leave_checks: list[Callable[[str], bool]] = []     # see may_leave
         self.menus = WindowMenus(self, self.report_error)
         self.docks = WindowDocks(self)
         self._build_widgets()
@@ -291,9 +294,16 @@ class MainWindow(QMainWindow):
         """The extension installed under ``name`` (KeyError if none)."""
         return self._extensions[name]
 
+    def may_leave(self, what: str) -> bool:
+        """Whether every one of ``leave_checks`` lets the labels on screen go for ``what``."""
+        return all(check(what) for check in self.leave_checks)
+
     def set_utterance(self, utt_id: str) -> None:
         """Show utterance ``utt_id`` (of the corpus, or opened from files): loaded and synthesized in
         the background; ``utteranceChanged`` follows."""
+        shown = self.view.utterance.name if self.view is not None else utt_id
+        if utt_id != shown and not self.may_leave(f"showing {utt_id}"):
+            return self.browser.set_current(shown)
         try:
             request = self.state.request_utterance(utt_id)
         except FacetrajError as exc:
@@ -400,12 +410,12 @@ class MainWindow(QMainWindow):
         self.playback.set_frames(view.n_frames, view.rate)
         self.view_bar.set_has_original(view.original is not None)
         self.face.set_view(view)
-        self.timeline.set_view(view, keep_zoom=not new_utterance)
-        mark("timeline drawn")
         self.transport.set_frames(view.n_frames)
         self._show_titles(view)
         self.clock.seek(t)
-        self._show_time(t, force=True)
+        self._show_time(t, force=True)          # the new faces on screen, then the panels
+        self.timeline.set_view(view, keep_zoom=not new_utterance)
+        mark("timeline drawn")
         if was_playing and not self.clock.playing:
             self.clock.play()
         if new_utterance:

@@ -198,6 +198,7 @@ class AudioHost(Protocol):
                       show: bool = True) -> None: ...
     def show_labels(self, utt: Utterance, origin: LabelOrigin, own: bool = False) -> None: ...
     def when_model_ready(self, fn: Callable[[], object]) -> None: ...
+    def may_leave(self, what: str) -> bool: ...
 
 
 class AudioOpener(QObject):
@@ -409,6 +410,9 @@ class AudioOpener(QObject):
         if sources is None:
             return
         win = self.window
+        if not win.may_leave("switching to other labels"):
+            self._refresh_box()
+            return
         from facetraj_engine.labels.alignment import MissingWordsError
 
         def work(progress) -> tuple[Utterance, LabelOrigin]:

@@ -62,12 +62,14 @@ class LabelOrigin:
 
     ``source``: ``Utterance.label_source`` (``file``, ``aligned``, ``recognized``, ``none``, or
     any other the engine names); ``file``: the label file they were read from (a name);
-    ``transcript``: what was aligned (``s001.txt``, or ``the sentence typed``).
+    ``transcript``: what was aligned (``s001.txt``, or ``the sentence typed``); ``corrected``:
+    the phones of automatic labels corrected by hand since.
     """
 
     source: str
     file: str = ""
     transcript: str = ""
+    corrected: int = 0
 
     def text(self) -> str:
         """In words, for the title, the status bar and the phone tier.
@@ -82,7 +84,15 @@ class LabelOrigin:
         'aligned (label file s001.TextGrid)'
         >>> LabelOrigin("hand-corrected", file="x.TextGrid").text()
         'hand-corrected (label file x.TextGrid)'
+        >>> LabelOrigin("recognized", corrected=3).text()
+        'recognized from the speech (no text), 3 phones corrected by hand'
         """
+        text = self._text()
+        if self.corrected:
+            text += f", {self.corrected} phone{'s' * (self.corrected != 1)} corrected by hand"
+        return text
+
+    def _text(self) -> str:
         src = self.source or "none"
         if src == "none":
             return "none: acoustic-only synthesis"
@@ -154,6 +164,8 @@ def synthesis_parts(view) -> list[str]:
             labels = f"{labels} from {origin.transcript}"
         elif origin.file:
             labels = f"{labels} ({origin.file})"
+        if origin.corrected:            # the phones corrected by hand (the label editor)
+            labels += f", {origin.corrected} corrected"
     else:
         labels = "not used" if origin.source not in ("", "none") else "none"
     return [*parts, SMOOTHING_NAMES[cfg.smoothing], closure_text(cfg), f"labels: {labels}"]

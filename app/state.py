@@ -15,6 +15,7 @@ from facetraj_engine.data import Utterance
 from facetraj_engine.evaluation.scores import speech_mask
 from facetraj_engine.method.model import Model
 from facetraj_engine.method.pipeline import Synthesis, resmooth, synthesize
+from facetraj_engine.method.resynthesis import SynthesisMemo
 
 from .provenance import LabelOrigin
 
@@ -63,10 +64,12 @@ class UtteranceView:
     @property
     def label_origin(self) -> LabelOrigin:
         """Where the phone labels came from (at least their source)."""
-        source = self.utterance.label_source if self.utterance.phones else "none"
+        utt = self.utterance
+        source = utt.label_source if utt.phones else "none"
+        corrected = utt.provenance.corrected if utt.phones and not utt.provenance.hand_checked else 0
         if self.origin is None:
-            return LabelOrigin(source)
-        return LabelOrigin(source, self.origin.file, self.origin.transcript)
+            return LabelOrigin(source, corrected=corrected)
+        return LabelOrigin(source, self.origin.file, self.origin.transcript, corrected)
 
     @property
     def shown(self) -> np.ndarray:
@@ -92,31 +95,38 @@ class UtteranceView:
 
 
 def build_view(model: Model, utt: Utterance, split: str, config: SynthConfig,
-               mode_reason: str = "", origin: LabelOrigin | None = None) -> UtteranceView:
+               mode_reason: str = "", origin: LabelOrigin | None = None,
+               memo: SynthesisMemo | None = None) -> UtteranceView:
     """Synthesize ``utt`` with ``config`` (its labels weighed by their confidence) and derive
-    every track the window shows (slow: run in a worker). Raises the engine's
+    every track the window shows (slow: run in a worker). ``memo``: the recording's last
+    synthesis (another label set: only what the labels change is computed again,
+    ``facetraj_engine.method.resynthesis``). Raises the engine's
     :class:`~facetraj_engine.errors.FacetrajError` on bad input."""
     n_frames = utt.n_frames or None
     res = synthesize(model, utt.audio, utt.sample_rate, utt.phones if utt.phones else None,
                      config, n_frames=n_frames, source=utt.name, confidence=utt.confidence,
-                     provenance=utt.provenance, voice=True)
+                     provenance=utt.provenance, voice=True, memo=memo, checked=utt.checked)
     original = model.normalise_markers(utt.markers) if utt.markers is not None else None
-    triangular, spline, speech = _tracks(model, res, utt.audio, utt.sample_rate)
+    triangular, spline, speech = _tracks(model, res, utt.audio, utt.sample_rate, memo)
     return UtteranceView(utterance=utt, split=split, synthesis=res, original=original,
                          triangular=triangular, spline=spline, speech=speech, times=res.times,
                          mode_reason=mode_reason, voice_match=res.voice_match, origin=origin)
 
 
 def _tracks(model: Model, synthesis: Synthesis, audio: np.ndarray | None,
-            sample_rate: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            sample_rate: int, memo: SynthesisMemo | None = None
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The triangular and the spline smoothing of ``synthesis`` (its markers for the smoothing it
-    was made with) and the speech frames of ``audio`` (none without it)."""
+    was made with) and the speech frames of ``audio`` (none without it; the ``memo``'s, kept)."""
     made = synthesis.config.smoothing
     triangular, spline = (synthesis.markers if made == kind else resmooth(model, synthesis, kind)
                           for kind in ("triangular", "spline"))
     if audio is None:
         return triangular, spline, np.zeros(len(synthesis.times), dtype=bool)
-    return triangular, spline, speech_mask(audio, sample_rate, synthesis.times)
+    speech = memo.remember("speech frames", lambda: speech_mask(audio, sample_rate, synthesis.times)) \
+        if memo is not None and memo.bound and memo.bound[1] is audio else \
+        speech_mask(audio, sample_rate, synthesis.times)
+    return triangular, spline, speech
 
 
 def view_of_synthesis(model: Model, synthesis: Synthesis, audio: np.ndarray | None = None,

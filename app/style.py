@@ -3,6 +3,7 @@ the placing of the panels' y labels."""
 
 from __future__ import annotations
 
+import functools
 from typing import TYPE_CHECKING
 from weakref import WeakKeyDictionary
 
@@ -81,6 +82,7 @@ def refit_ylabels(axes) -> None:
 _LABELS: WeakKeyDictionary = WeakKeyDictionary()     # axes -> its full y label
 
 
+@functools.lru_cache(maxsize=512)
 def text_width_px(text: str, size_pt: float, dpi: float = 100.0) -> float:
     """How wide ``text`` is at ``size_pt`` in matplotlib's default font, in pixels at ``dpi``
     (from the glyphs' outlines: no renderer needed).

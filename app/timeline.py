@@ -10,7 +10,9 @@ changed (a relayout waits for it), and panels added by a view are built one per 
 loop (``relayout(soon=True)``), so that opening a view never freezes the window.
 
 Mouse: click to seek, drag to select a loop range, wheel to zoom the time axis around the pointer,
-right or middle drag to pan, double-click to show the whole utterance.
+right or middle drag to pan, double-click to show the whole utterance. A panel may take a press
+of the left button itself (``mouse_press(event)`` returning an object with ``move(event)`` and
+``release(event)``: the phone tier's boundary drags, ``app/tier_edit.py``).
 """
 
 from __future__ import annotations
@@ -53,6 +55,8 @@ LEGEND_SWING_LINES = 2
 
 log = logging.getLogger(__name__)
 
+#: the loop range's spans are told from the panels' own artists by this id
+LOOP_GID = "loop range"
 #: the timeline's bottom margin: the time tick labels and "time (s)"
 BOTTOM_MARGIN_PX = 40.0
 #: the timeline's top margin (px)
@@ -80,8 +84,11 @@ class _Canvas(BackgroundCanvas):
 class Panel(Protocol):
     """A time-aligned panel. Optional attributes: ``min_px`` (the least height it is readable at,
     default 48) and ``priority`` (panels of low priority are left out first when the timeline is
-    short: ``app/panel_layout.py``). Curves named with a matplotlib ``label`` appear in the
-    timeline's legend row, never in a legend over the panel."""
+    short: ``app/panel_layout.py``), and ``mouse_press(event)``: a left-button press in the
+    panel, which the panel takes by returning an object with ``move(event)`` and
+    ``release(event)`` (else ``None``: the timeline seeks or selects a loop range). Curves named
+    with a matplotlib ``label`` appear in the timeline's legend row, never in a legend over the
+    panel."""
 
     title: str
     height: float
@@ -93,6 +100,7 @@ class Panel(Protocol):
 class WaveformPanel:
     """The speech signal (min/max envelope per pixel column)."""
 
+    audio_only = True           # the same for every result of a recording
     title = "waveform"
     height = 0.8
     min_px = 24.0
@@ -138,6 +146,7 @@ def spectrogram(x: np.ndarray, rate: float, nperseg: int, hop: int,
 class SpectrogramPanel:
     """A wide-band spectrogram (grey scale, 0 to 8 kHz)."""
 
+    audio_only = True
     title = "spectrogram"
     height = 1.3
     min_px = 40.0
@@ -280,6 +289,44 @@ class LipPanel:
         fit_ylabel(ax, f"{self.which} lip\ny (mm)")
 
 
+def place_grid(fig: Figure, grid, heights: list[float]) -> None:
+    """The panels' ``grid`` in pixels: the margins (the y labels and tick labels; the time
+    axis) and the gaps fixed whatever the size, each panel its height of ``heights``."""
+    width, height = max(fig.get_figwidth() * fig.dpi, 1.0), max(fig.get_figheight() * fig.dpi, 1.0)
+    mean = max(sum(heights) / max(len(heights), 1), 1.0)
+    grid.set_height_ratios(heights)
+    grid.update(left=min(0.3, LABEL_MARGIN_PX / width), right=1 - min(0.05, 8 / width),
+                top=1 - min(0.05, TOP_MARGIN_PX / height),
+                bottom=min(0.3, BOTTOM_MARGIN_PX / height), hspace=GAP_PX / mean)
+
+
+def redraw_in_place(panels: Sequence[Panel], axes: Sequence, view: UtteranceView) -> None:
+    """Each panel drawn again in its axes for another result of the same recording (a label
+    edit, other settings): the artists it drew removed (the loop range's kept), the axes kept
+    (made anew they cost 40 ms each), the panels of the audio alone (``audio_only``) as they
+    are."""
+    for i, (panel, ax) in enumerate(zip(panels, axes, strict=True)):
+        if getattr(panel, "audio_only", False):
+            continue
+        for artist in [*ax.lines, *ax.collections, *ax.patches, *ax.texts, *ax.images, *ax.artists]:
+            if artist.get_gid() != LOOP_GID:
+                artist.remove()
+        draw_panel(panel, ax, view, last=i == len(axes) - 1)
+
+
+def redraw_soon(timeline: Timeline, view: UtteranceView) -> None:
+    """:func:`redraw_in_place` of ``timeline``'s panels for ``view`` (now, or right after the
+    background draw running), then a full draw in the background."""
+    shown, axes = list(timeline.shown), list(timeline.axes)
+
+    def redo() -> None:
+        if timeline.view is view and axes == timeline.axes:
+            redraw_in_place(shown, axes, view)
+            timeline.redraw()
+
+    timeline.canvas.when_idle(redo)
+
+
 def draw_panel(panel: Panel, ax, view: UtteranceView, last: bool) -> None:
     """Draw ``panel`` in ``ax`` as the timeline does (the window's and exported figures): its
     content, its y label fitted, small ticks, the time labels under the last panel only."""
@@ -346,6 +393,7 @@ class Timeline(QWidget):
         self._cursor_x: float | None = None
         self._bg_bounds: tuple[float, ...] = ()
         self._press: tuple[float, float, int] | None = None   # (xdata, xpixel, button)
+        self._grab = None                       # a panel's own drag (``mouse_press``)
         self._drag_span: tuple[float, float] | None = None
         self._building = None                   # the relayout being built over several passes
         self.layouts = 0                        # relayouts finished (tests)
@@ -369,9 +417,14 @@ class Timeline(QWidget):
             self.relayout(self.xlim() if self.axes else None, soon=soon)
 
     def set_view(self, view: UtteranceView | None, keep_zoom: bool = False) -> None:
-        xlim = self._range if keep_zoom else None
-        self.view = view
-        self.relayout(xlim)
+        """Show ``view``; another result of the recording shown (``keep_zoom``) is drawn in the
+        panels' axes as they are (:func:`redraw_in_place`), else the panels are laid out anew."""
+        old, self.view = self.view, view
+        if keep_zoom and self._building is None and self.axes and view is not None and \
+                old is not None and old.utterance.audio is view.utterance.audio:
+            redraw_soon(self, view)
+            return
+        self.relayout(self._range if keep_zoom else None)
 
     def axes_of(self, panel: Panel):
         """The matplotlib axes a panel was drawn in (None before the first layout, or while it is
@@ -472,7 +525,7 @@ class Timeline(QWidget):
             self.hidden = [p for p, h in zip(panels, heights, strict=True) if h is None]
             grid = fig.add_gridspec(len(self.shown), 1, height_ratios=[h for h in heights if h is not None])
             self._grid = grid
-            self._place_grid([h for h in heights if h is not None])
+            place_grid(self.figure, self._grid, [h for h in heights if h is not None])
             first = None
             for i, panel in enumerate(self.shown):
                 ax = fig.add_subplot(grid[i, 0], sharex=first)
@@ -490,17 +543,6 @@ class Timeline(QWidget):
             self.layouts += 1
         finally:
             self.canvas.release()
-
-    def _place_grid(self, heights: list[float]) -> None:
-        """The panels' grid in pixels: the margins (the y labels and tick labels; the time axis)
-        and the gaps fixed whatever the size, each panel its height of ``heights``."""
-        fig = self.figure
-        width, height = max(fig.get_figwidth() * fig.dpi, 1.0), max(fig.get_figheight() * fig.dpi, 1.0)
-        mean = max(sum(heights) / max(len(heights), 1), 1.0)
-        self._grid.set_height_ratios(heights)
-        self._grid.update(left=min(0.3, LABEL_MARGIN_PX / width), right=1 - min(0.05, 8 / width),
-                          top=1 - min(0.05, TOP_MARGIN_PX / height),
-                          bottom=min(0.3, BOTTOM_MARGIN_PX / height), hspace=GAP_PX / mean)
 
     def _show_legend(self) -> None:
         """The legend row: every named curve of the panels, and the panels left out for lack of
@@ -537,7 +579,7 @@ class Timeline(QWidget):
         if fitting != shown:
             self.relayout(self.xlim(), soon=True)
             return
-        self._place_grid(self._heights(self.shown))
+        place_grid(self.figure, self._grid, self._heights(self.shown))
         for ax in self.axes:            # (GridSpec.update moves only pyplot's figures' axes)
             ax.set_position(ax.get_subplotspec().get_position(self.figure))
         refit_ylabels(self.axes)
@@ -550,7 +592,8 @@ class Timeline(QWidget):
         if span is None:
             return
         for ax in self.axes:
-            self._spans.append(ax.axvspan(span[0], span[1], color=LOOP_COLOR, alpha=0.18, lw=0))
+            self._spans.append(ax.axvspan(span[0], span[1], color=LOOP_COLOR, alpha=0.18, lw=0,
+                                          gid=LOOP_GID))
 
     # ------------------------------------------------------------------ cursor (blitting)
     @property
@@ -642,6 +685,11 @@ class Timeline(QWidget):
     def _cursor_px(self, t: float) -> float:
         return float(self.axes[0].transData.transform((t, 0))[0])
 
+    def redraw(self) -> None:
+        """A full draw soon, the panels kept (a panel's artist changed: the tier's selection)."""
+        if self.axes:
+            self._request_draw()
+
     def set_loop(self, loop: tuple[float, float] | None) -> None:
         self.loop = loop
         self._draw_loop_spans()
@@ -671,9 +719,17 @@ class Timeline(QWidget):
         if event.dblclick:
             self.reset_zoom()
             return
+        panel = self.shown[self.axes.index(event.inaxes)] if event.inaxes in self.axes else None
+        if int(event.button) == 1 and hasattr(panel, "mouse_press"):
+            self._grab = panel.mouse_press(event)
+            if self._grab is not None:
+                return
         self._press = (float(event.xdata), float(event.x), int(event.button))
 
     def _on_motion(self, event) -> None:
+        if self._grab is not None:
+            self._grab.move(event)
+            return
         if self._press is None or event.x is None:
             return
         x0, px0, button = self._press
@@ -691,6 +747,10 @@ class Timeline(QWidget):
             self._press = (x0, float(event.x), button)
 
     def _on_release(self, event) -> None:
+        if self._grab is not None:
+            grab, self._grab = self._grab, None
+            grab.release(event)
+            return
         if self._press is None:
             return
         x0, _px0, button = self._press

@@ -32,6 +32,7 @@ from facetraj_engine.io.corpus import Corpus, held_transcript, label_source
 from facetraj_engine.io.labelfiles import LABEL_SUFFIXES
 from facetraj_engine.method.model import Model
 from facetraj_engine.method.modes import choose_mode
+from facetraj_engine.method.resynthesis import SynthesisMemo
 from facetraj_engine.progress import Progress
 
 from .phases import mark
@@ -71,6 +72,7 @@ class SynthRequest:
     mode_chosen: bool = False
     origin: LabelOrigin | None = None      # the label file or transcript, when known
     relabelled: bool = False               # other labels than the utterance's own (labels box)
+    memo: SynthesisMemo | None = None      # the recording's last synthesis (another label set)
 
     def run(self, progress: Progress | None = None) -> UtteranceView:
         """Load and synthesize (slow: run in a worker). Without phone labels the synthesis is
@@ -83,7 +85,7 @@ class SynthRequest:
         choice = choose_mode(self.config, utt.phones, utt.provenance, explicit=self.mode_chosen,
                              tuned=self.model.tuned)
         return build_view(self.model, utt, self.split, choice.config, choice.describe(),
-                          self.origin)
+                          self.origin, self.memo)
 
 
 @dataclass
@@ -107,6 +109,7 @@ class ViewerModel:
     pins: PinBoard = field(default_factory=PinBoard)   # results kept to compare (app/pins.py)
     model_load: int = 0                      # the latest model asked for (a corpus opened)
     loading: bool = False                    # whether that model is on its way
+    memo: SynthesisMemo = field(default_factory=SynthesisMemo)  # the recording on screen's
 
     # ------------------------------------------------------------------ corpus and model
     def begin_model_load(self) -> int:
@@ -248,10 +251,14 @@ class ViewerModel:
 
     def _new_request(self, load: Callable[[], Utterance], split: str, new_utterance: bool,
                      origin: LabelOrigin | None = None, relabelled: bool = False) -> SynthRequest:
+        """The next request; another utterance gets a memo of its own (the last one's work is
+        of no use to it), the utterance shown keeps its memo (a label edit, other settings)."""
         assert self.model is not None
         self.generation += 1
+        if new_utterance:
+            self.memo = SynthesisMemo()
         self.request = SynthRequest(load, split, new_utterance, self.model, self.synth_config,
-                                    self.generation, self.mode_chosen, origin, relabelled)
+                                    self.generation, self.mode_chosen, origin, relabelled, self.memo)
         return self.request
 
     @property

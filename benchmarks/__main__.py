@@ -1,9 +1,9 @@
 """``python -m benchmarks [--smoke] [--corpus DIR] [--out FILE] [--only GROUP ...]``
 
-Runs the training, synthesis, scaling, corpus scaling and phone-labelling benchmarks (and the app
-playback benchmark,
-``benchmarks/playback.py``, when it exists and a display is available), prints one table and
-writes it, with the machine described, to ``docs/benchmarks.md``.
+Runs the training, synthesis, scaling, corpus scaling and phone-labelling benchmarks (and the app's
+playback and label-edit benchmarks, ``benchmarks/playback.py`` and ``benchmarks/label_edit.py``,
+when a display is available), prints one table and writes it, with the machine described, to
+``docs/benchmarks.md``.
 
 ``--smoke`` runs a tiny size (a few utterances, short inputs) that CI can afford in well under a
 minute; it writes the Markdown only when ``--out`` is given, so that it never replaces the
@@ -40,7 +40,7 @@ from .common import (
 log = logging.getLogger("benchmarks")
 
 GROUPS = ("train", "synth", "cli", "scaling", "corpus", "eval", "labels", "playback", "startup",
-          "live")
+          "live", "edit")
 DEFAULT_OUT = REPO / "docs" / "benchmarks.md"
 #: hand-written profile notes (per stage, before and after a change), copied into the Markdown
 NOTES = REPO / "benchmarks" / "profile_notes.md"
@@ -78,6 +78,20 @@ def run_playback(smoke: bool, corpus: Path | None = None) -> list[BenchRow]:
                      note=f"benchmarks.playback.main returned {out!r}")]
 
 
+def run_edit(smoke: bool, corpus: Path | None = None) -> list[BenchRow]:
+    """The label editor's edit-to-face benchmark (``benchmarks/label_edit.py``) when a display
+    is available."""
+    ok, reason = display_available()
+    if not ok:
+        print(f"label edit benchmark skipped: {reason}")
+        return [BenchRow("edit", "label edit to the new faces on screen", float("nan"), "",
+                         note=f"skipped: {reason}")]
+    from . import label_edit
+
+    argv = (["--corpus", str(corpus)] if corpus is not None else []) + (["--smoke"] if smoke else [])
+    return label_edit.main(argv)
+
+
 def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS, factors: Sequence[int] | None = None,
             prefilters: Sequence[int] | None = None) -> list[BenchRow]:
     """Run the selected benchmark groups on ``ctx``; return all rows in order."""
@@ -107,6 +121,8 @@ def run_all(ctx: BenchContext, only: Sequence[str] = GROUPS, factors: Sequence[i
             "startup", "cold start", float("nan"), "", note="skipped: no display")]
     if "live" in only:
         rows += live.run(ctx)
+    if "edit" in only:
+        rows += run_edit(ctx.smoke, ctx.corpus.root)
     return rows
 
 

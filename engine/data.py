@@ -100,6 +100,9 @@ class Utterance:
     provenance : how ``phones`` were made (a label file records it; else hand-checked).
     confidence : per phone, how sure their maker was, in (0, 1] (NaN: no score); ``None`` for
         hand-checked labels.
+    checked : per phone of automatic labels, whether a person corrected it since (trusted as
+        hand-checked: the closure step closes a corrected /p b m/ whatever the voice); ``None``:
+        none.
     """
 
     name: str
@@ -114,6 +117,7 @@ class Utterance:
     label_source: str = "file"
     provenance: Provenance = field(default_factory=Provenance)
     confidence: np.ndarray | None = None
+    checked: np.ndarray | None = None
 
     @property
     def duration(self) -> float:

@@ -69,7 +69,8 @@ def relabelled(utt: Utterance, labels) -> Utterance:
                    words=list(labels.words) if labels else [],
                    label_source=labels.source if labels else "none",
                    provenance=labels.provenance if labels else Provenance(),
-                   confidence=labels.trust() if labels else None)
+                   confidence=labels.trust() if labels else None,
+                   checked=labels.checked if labels else None)
 
 
 def minimum_within(times: np.ndarray, values: np.ndarray, start: float, end: float) -> float:

@@ -190,7 +190,8 @@ def evaluate_utterance(model: Model, utt: Utterance, split: str = "test",
         original = model.normalise_markers(utt.markers)
     res = synthesis or synthesize(model, utt.audio, utt.sample_rate, utt.phones, config,
                                   n_frames=utt.n_frames, source=utt.name, lsf=lsf,
-                                  confidence=utt.confidence, provenance=utt.provenance)
+                                  confidence=utt.confidence, provenance=utt.provenance,
+                                  checked=utt.checked)
     mask = speech if speech is not None else speech_mask(utt.audio, utt.sample_rate, res.times,
                                                          eval_config)
     out = []

@@ -425,7 +425,8 @@ def load_utterance(root: str | os.PathLike[str], utt_id: str, info: CorpusInfo,
                      markers=markers, marker_rate=info.marker_rate,
                      marker_names=list(mdata.names), words=labels.words,
                      text=_transcript(root, utt_id) or mdata.transcript,
-                     provenance=labels.provenance, confidence=labels.trust())
+                     provenance=labels.provenance, confidence=labels.trust(),
+                     checked=labels.checked)
 
 
 def _fit_to_audio(mpath: Path, markers: np.ndarray, marker_rate: float, duration: float

@@ -100,7 +100,7 @@ def with_labels(utt: Utterance, labels: Labels) -> Utterance:
     """``utt`` with its phones (and words, when any) replaced by ``labels``."""
     return replace(utt, phones=list(labels.phones), words=list(labels.words) or utt.words,
                    label_source=labels.source, provenance=labels.provenance,
-                   confidence=labels.trust())
+                   confidence=labels.trust(), checked=labels.checked)
 
 
 @dataclass

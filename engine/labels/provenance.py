@@ -64,6 +64,9 @@ class Labels:
     provenance : how the phones were made: by default ``aligned`` or ``recognized`` for those
         sources, hand-checked for a file (a TextGrid written by facetraj records its own,
         :func:`facetraj_engine.io.labelfiles.read_label_file`).
+    checked : ``(len(phones),)`` bool: the phones of automatic labels checked by hand since they
+        were made (corrected in Praat or in the app: no longer as their ``confidence`` interval
+        records them); ``None``: none.
     """
 
     phones: list[PhoneSegment]
@@ -72,6 +75,7 @@ class Labels:
     scores: np.ndarray | None = None
     text: str = ""
     provenance: Provenance | None = None
+    checked: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.source not in SOURCES:
@@ -84,6 +88,19 @@ class Labels:
         if self.scores.shape != (len(self.phones),):
             raise ValueError(f"one score per phone: {len(self.phones)} phones, "
                              f"scores {self.scores.shape}")
+        if self.checked is not None:
+            self.checked = np.asarray(self.checked, dtype=bool)
+            if self.checked.shape != (len(self.phones),):
+                raise ValueError(f"one checked flag per phone: {len(self.phones)} phones, "
+                                 f"flags {self.checked.shape}")
+
+    @property
+    def hand_checked(self) -> np.ndarray:
+        """Per phone, whether a person checked it: every phone of hand-checked labels, else the
+        phones corrected by hand since the labels were made (:attr:`checked`)."""
+        if self.provenance.hand_checked:
+            return np.ones(len(self.phones), dtype=bool)
+        return self.checked if self.checked is not None else np.zeros(len(self.phones), dtype=bool)
 
     @property
     def confidence(self) -> np.ndarray:
@@ -103,13 +120,16 @@ class Labels:
     def tiers(self) -> dict[str, list[PhoneSegment]]:
         """The TextGrid tiers: ``words`` (when any), ``phones``, and for labels that are not
         hand-checked their record (``facetraj_engine.labels.provenance``): ``provenance`` and
-        ``confidence``."""
+        ``confidence``, which holds no interval for a phone checked by hand (:attr:`checked`:
+        read back, it counts as checked again)."""
         tiers = {"words": list(self.words)} if self.words else {}
         tiers["phones"] = list(self.phones)
         if not self.provenance.hand_checked and self.phones:
             end = self.phones[-1].end
             tiers[PROVENANCE_TIER] = [PhoneSegment(0.0, end, provenance_text(self.provenance))]
-            tiers[CONFIDENCE_TIER] = confidence_intervals(self.phones, self.confidence)
+            made = confidence_intervals(self.phones, self.confidence)
+            tiers[CONFIDENCE_TIER] = [s for s, hand in zip(made, self.hand_checked, strict=True)
+                                      if not hand]
         return tiers
 
     def to_json(self) -> dict:
@@ -270,4 +290,4 @@ def labels_from_tiers(phones: Sequence[PhoneSegment], words: Sequence[PhoneSegme
     provenance = Provenance(found.kind, found.tool, found.origin, int((~kept).sum()))
     with np.errstate(divide="ignore"):
         scores = SCORE_SCALE * np.log(np.clip(conf, 1e-9, 1.0))
-    return Labels(list(phones), list(words), "file", scores, provenance=provenance)
+    return Labels(list(phones), list(words), "file", scores, provenance=provenance, checked=~kept)

@@ -130,6 +130,7 @@ class Robust(Mode):
 
     def search(self, job: SearchInput) -> SearchResult:
         from .chain import chain_pcs
+        from .resynthesis import chained_pcs
         from .search import SearchResult, eq4, robust_weights
         from .voice_match import label_weight_scale, trust_by_voice
 
@@ -138,8 +139,11 @@ class Robust(Mode):
         conf = trust_by_voice(job.confidence, job.voice_ratio, config.label_weight_by_voice)
         conf[job.unlabelled[frame_seg]] = 0.0
         scale = label_weight_scale(job.voice_ratio, config.label_weight_by_voice)
-        fw = robust_weights(model, job.w, candidates, conf, config, scale)
-        if config.chain_beta > 0:                 # the weights made consistent over time
+        fw = robust_weights(model, job.w, candidates, conf, config, scale, memo=job.memo)
+        if config.chain_beta > 0 and job.memo is not None:     # only what the edit changed
+            fw.pcs = chained_pcs(job.memo, fw.weights, fw.candidates, model.codebook.pcs,
+                                 config.chain_beta, model.join_scale)
+        elif config.chain_beta > 0:                 # the weights made consistent over time
             fw.pcs = chain_pcs(fw.weights, fw.candidates, model.codebook.pcs, config.chain_beta,
                                model.join_scale)
         return SearchResult(fw, segments, frame_seg)
@@ -295,7 +299,8 @@ def choose_mode(config: SynthConfig, phones: Sequence[PhoneSegment] | None,
         robust = tuned_config(config.with_(mode=FOR_AUTOMATIC_LABELS), tuned, keep)
         reason = f"{provenance.kind} labels are not hand-checked"
         if provenance.corrected:
-            reason += f" ({provenance.corrected} phones corrected by hand count as checked)"
+            n = provenance.corrected
+            reason += f" ({n} phone{'s' * (n != 1)} corrected by hand count{'s' * (n == 1)} as checked)"
         return ModeChoice(robust, reason + (", settings cross-validated at training" if tuned else ""))
     if config.mode == FOR_CHECKED_LABELS:
         return ModeChoice(config, "hand-checked labels (the paper)")

@@ -29,6 +29,7 @@ from .closure_search import search_rows
 from .context import segment_index
 from .model import Model, analysed_frames
 from .modes import mode_of
+from .resynthesis import SynthesisMemo
 from .search import SearchInput, SegmentChoice
 from .selection import mean_normalise
 from .smoothing import smooth
@@ -109,7 +110,8 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
                source: str | None = None, lsf: np.ndarray | None = None,
                audio_source: str | None = None,
                confidence: Sequence[float] | np.ndarray | None = None,
-               provenance: Provenance | None = None, voice: bool = False) -> Synthesis:
+               provenance: Provenance | None = None, voice: bool = False,
+               memo: SynthesisMemo | None = None, checked: np.ndarray | None = None) -> Synthesis:
     """Synthesize face point trajectories from speech (paper section 2.3).
 
     With ``phones`` and ``mode="phonetic"``: per input phone, the top-N context-phones by eq 4,
@@ -130,17 +132,46 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
     ``lsf`` may pass the input LSFs already computed by :meth:`Model.input_lsf`
     for these frames (when one utterance is synthesized under several configs). ``voice``: the
     input's voice match is computed even when the synthesis does not need it (to show it).
-    The input's speech energy (pauses, speech frames) is computed once for both.
+    The input's speech energy (pauses, speech frames) is computed once for both. ``memo``: the
+    same recording's last synthesis, whose work is reused where the labels leave it unchanged
+    (:mod:`facetraj_engine.method.resynthesis`: the same result, sooner). ``checked``: per phone
+    of automatic labels, corrected by hand since (the closure step trusts those fully).
     """
     config = config or SynthConfig()
+    trusted = _checked(phones, checked)
+    if memo is None:
+        return _synthesize(model, audio, sample_rate, phones, config, n_frames, label_map, source,
+                           lsf, audio_source, confidence, provenance, voice, None, trusted)
+    with memo.lock:
+        memo.bind(model, audio, sample_rate, n_frames, config)
+        try:
+            return _synthesize(model, audio, sample_rate, phones, config, n_frames, label_map,
+                               source, lsf, audio_source, confidence, provenance, voice, memo,
+                               trusted)
+        except BaseException:
+            memo.forget()               # half updated: the next synthesis starts again
+            raise
+
+
+def _synthesize(model: Model, audio: np.ndarray, sample_rate: int,
+                phones: Sequence[PhoneSegment] | None, config: SynthConfig, n_frames: int | None,
+                label_map: Mapping[str, str] | None, source: str | None, lsf: np.ndarray | None,
+                audio_source: str | None, confidence: Sequence[float] | np.ndarray | None,
+                provenance: Provenance | None, voice: bool, memo: SynthesisMemo | None,
+                trusted: list[PhoneSegment] | None = None) -> Synthesis:
+    """:func:`synthesize`'s steps (``memo``: bound to this input, or ``None``; ``trusted``: the
+    phones corrected by hand)."""
     mode = mode_of(config)
-    times, w, warp, analysed, energy_db = _input(model, audio, sample_rate, n_frames, lsf, config,
-                                                 audio_source or source,
-                                                 detector_may_run(model, config, provenance))
-    energy = SpeechEnergy(audio, sample_rate)
-    ratio = _voice_ratio(model, energy, times, w, config, provenance, voice) \
+    remember = memo.remember if memo is not None else (lambda _key, compute: compute())
+    detecting = detector_may_run(model, config, provenance)
+    times, w, warp, analysed, energy_db = remember(("input", detecting), lambda: _input(
+        model, audio, sample_rate, n_frames, lsf, config, audio_source or source, detecting))
+    energy = remember("energy", lambda: SpeechEnergy(audio, sample_rate))
+    recognized = provenance is not None and provenance.kind == "recognized"
+    ratio = remember(("voice", recognized, voice), lambda: _voice_ratio(
+        model, energy, times, w, config, provenance, voice)) \
         if mode.weighs_labels else float("nan")             # the search weighs by it
-    job = SearchInput(model, w, times, config, voice_ratio=ratio)
+    job = SearchInput(model, w, times, config, voice_ratio=ratio, memo=memo)
     if mode.needs_labels:
         if not phones:
             raise InputError(source, f"{config.mode} mode needs phone labels (or use acoustic mode)")
@@ -153,7 +184,7 @@ def synthesize(model: Model, audio: np.ndarray, sample_rate: int,
         ratio = _voice_ratio(model, energy, times, w, config, provenance, voice, found.nearest)
     plan = plan_closure(model, audio, sample_rate, times, job.segs, provenance,
                         voice_match(ratio, 1.0), config, energy.filtered if config.closure else None,
-                        analysed, found.frames, energy_db)
+                        analysed, found.frames, energy_db, trusted)
     res = _finish(model, times, w, found.frames, config, found.segments, found.frame_segment,
                   warp, plan)
     res.voice_match, res.voice_ratio = voice_match(ratio, 1.0), ratio
@@ -237,7 +268,8 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
                  segs: Sequence[PhoneSegment] | None, provenance: Provenance | None,
                  match: float, config: SynthConfig, filtered: np.ndarray | None = None,
                  lsf: np.ndarray | None = None, frames: FrameWeights | None = None,
-                 energy_db: np.ndarray | None = None) -> ClosurePlan | None:
+                 energy_db: np.ndarray | None = None,
+                 trusted: Sequence[PhoneSegment] | None = None) -> ClosurePlan | None:
     """Where the closure step acts (``None``: off, or a model file without its statistics): the
     labelled /p b m/ (``config.closure_labels``), trusted as
     :func:`~facetraj_engine.method.closure.closure_strengths` says (for recognized labels by the
@@ -250,7 +282,8 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
     frame a stream would have measured it; ``energy_db``: the detector's frame energies of
     ``lsf``'s analysis, when computed with it); and the silent frames by energy, where the face
     rests (``config.rest``; ``filtered``: :func:`~facetraj_engine.method.speech.filtered_energy_db`
-    of the audio, when already computed)."""
+    of the audio, when already computed); ``trusted``: phones corrected by hand, whose /p b m/
+    close fully whatever their labels' kind."""
     if not config.closure or model.closure is None:
         return None
     intervals, strengths, p = np.zeros((0, 2)), np.zeros(0), None
@@ -262,6 +295,8 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
         kind = (provenance or Provenance()).kind
         if config.closure_labels:
             trust = closure_strengths(len(segs), kind, match if np.isfinite(match) else 1.0)
+            if trusted:
+                trust = np.where(_among(segs, trusted), 1.0, trust)
             intervals, strengths = closure_intervals(segs, trust)
             causal = np.zeros(len(intervals), dtype=bool)
         if model.detector is not None and kind == "recognized" and \
@@ -304,6 +339,28 @@ def _detected(model: Model, audio: np.ndarray, sample_rate: int, times: np.ndarr
     p = input_probability(det, model.config, audio, sample_rate, times, lsf, search, m, energy_db)
     runs = closure_runs(p, times, config.closure_threshold, det.spec.min_frames)
     return p, causal_closures(runs, model.marker_rate, det.spec.min_frames)
+
+
+def _checked(phones: Sequence[PhoneSegment] | None, checked: np.ndarray | None
+             ) -> list[PhoneSegment] | None:
+    """The phones of ``phones`` that ``checked`` marks (``None``: none; flags of other phones
+    than these, left over from labels replaced, count for none)."""
+    if phones is None or checked is None:
+        return None
+    flags = np.asarray(checked, dtype=bool)
+    if flags.shape != (len(phones),):
+        log.debug("%d checked flags for %d phones: left out", flags.size, len(phones))
+        return None
+    return [p for p, c in zip(phones, flags, strict=True) if c] or None
+
+
+def _among(segs: Sequence[PhoneSegment], trusted: Sequence[PhoneSegment]) -> np.ndarray:
+    """Per segment (the labels checked and mapped onto the model's phones), whether it is one of
+    ``trusted`` (the same times, within half a millisecond)."""
+    starts = np.array([p.start for p in trusted])
+    ends = np.array([p.end for p in trusted])
+    return np.array([bool(np.any((np.abs(starts - s.start) < 5e-4) & (np.abs(ends - s.end) < 5e-4)))
+                     for s in segs], dtype=bool)
 
 
 def detector_may_run(model: Model, config: SynthConfig, provenance: Provenance | None) -> bool:

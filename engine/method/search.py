@@ -16,7 +16,8 @@ from ..labels.phoneset import SILENCE
 from ..threads import frame_threads, map_spans
 from .context import context_ids, segment_index
 from .model import Model
-from .selection import robust_frames
+from .resynthesis import SynthesisMemo, robust_frames_again
+from .selection import context_frames, robust_frames
 from .similarity import top_context_phones
 from .synthesis import FrameWeights, gamma_grid, nearest_codewords, weight_frames
 from .voice_match import PROBE as VOICE_PROBE
@@ -47,6 +48,7 @@ class SearchInput:
     unlabelled: np.ndarray | None = None
     confidence: np.ndarray | None = None
     voice_ratio: float = float("nan")
+    memo: SynthesisMemo | None = None       # the last label set's work (a label edited)
 
 
 @dataclass
@@ -78,17 +80,30 @@ def eq4(model: Model, segs: list[PhoneSegment], times: np.ndarray, config: Synth
 
 
 def robust_weights(model: Model, w: np.ndarray, candidates: np.ndarray, conf: np.ndarray,
-                   config: SynthConfig, scale: float = 1.0, w_ctx: np.ndarray | None = None
-                   ) -> FrameWeights:
+                   config: SynthConfig, scale: float = 1.0, w_ctx: np.ndarray | None = None,
+                   memo: SynthesisMemo | None = None) -> FrameWeights:
     """The robust mode's eqs 5-8 (``facetraj_engine.method.selection``), its label weight times
     ``scale`` (the voice's distance ratio: eq 5's distances grow with it); ``w_ctx``: the input
     frames at :func:`context_offsets` when ``w`` is part of a longer input (a stream). The chain
-    over frames (``facetraj_engine.method.chain``) is the search's, on the whole input."""
+    over frames (``facetraj_engine.method.chain``) is the search's, on the whole input. With a
+    ``memo`` (``facetraj_engine.method.resynthesis``), the nearest codewords are the audio's
+    kept and only the frames whose candidates or confidence changed are weighted again."""
     cb = model.codebook
-    near = model.lsf_index().nearest(w, cb.lsf, config.robust_candidates, config.acoustic_probe or 8)
-    return robust_frames(w, candidates, near, conf, cb.lsf, cb.pcs, gammas(config),
-                         config.label_weight * scale, cb.lsf_context, context_offsets(model),
-                         config.context_weight, w_ctx=w_ctx)
+    k, probe = config.robust_candidates, config.acoustic_probe or 8
+
+    def nearest() -> np.ndarray:
+        return model.lsf_index().nearest(w, cb.lsf, k, probe)
+
+    near = nearest() if memo is None else memo.remember(("nearest", k, probe), nearest)
+    kappa = config.label_weight * scale
+    offsets = context_offsets(model)
+    if memo is None:
+        return robust_frames(w, candidates, near, conf, cb.lsf, cb.pcs, gammas(config), kappa,
+                             cb.lsf_context, offsets, config.context_weight, w_ctx=w_ctx)
+    ctx = memo.remember("context frames", lambda: context_frames(w, offsets))
+    return robust_frames_again(memo, candidates, conf, kappa, lambda rows: robust_frames(
+        w[rows], candidates[rows], near[rows], conf[rows], cb.lsf, cb.pcs, gammas(config), kappa,
+        cb.lsf_context, offsets, config.context_weight, w_ctx=ctx[rows]))
 
 
 def context_offsets(model: Model) -> np.ndarray:

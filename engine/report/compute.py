@@ -144,12 +144,16 @@ def _minutes(corpus: Corpus, ids: Sequence[str]) -> float:
 
 
 def corpus_summary(corpus: Corpus) -> CorpusSummary:
-    """The corpus's folder, name, markers, and utterances and minutes per split."""
+    """The corpus's folder, name, markers, utterances and minutes per split, and how its labels
+    were made, phone by phone (:func:`facetraj_engine.io.label_census.label_census`)."""
+    from ..io.label_census import label_census
+
     info = corpus.info
     return CorpusSummary(
         root=str(corpus.root), name=info.name, n_markers=len(info.marker_names),
         marker_rate=info.marker_rate, n_train=len(info.train), n_test=len(info.test),
-        train_minutes=_minutes(corpus, info.train), test_minutes=_minutes(corpus, info.test))
+        train_minutes=_minutes(corpus, info.train), test_minutes=_minutes(corpus, info.test),
+        labels=label_census(corpus).to_json())
 
 
 def model_summary(model: Model, baselines: Baselines) -> ModelSummary:

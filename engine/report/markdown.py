@@ -38,8 +38,22 @@ def header_section(data: ReportData) -> list[str]:
         f"{m.n_phones} phones. All correlations are Pearson correlations between original and "
         f"synthesized head-normalised trajectories on speech frames only (section 3), averaged over "
         f"utterances (± one standard deviation over utterances). All numbers are in "
-        f"[`results.json`](results.json)." + _skipped(c.skipped),
+        f"[`results.json`](results.json)." + _labels(c.labels) + _skipped(c.skipped),
     ]
+
+
+def _labels(census: dict) -> str:
+    """The sentence saying how the corpus's labels were made, phone by phone.
+
+    >>> _labels({"phones": {"hand-checked": 40, "aligned": 0, "recognized": 960},
+    ...          "corrected": {"a": 30, "b": 10}})
+    ' Its phone labels: 1000 phones: 40 hand-checked (40 corrected by hand in 2 utterances), 960 recognized.'
+    """
+    if not census:
+        return ""
+    from ..io.label_census import LabelCensus
+
+    return f" Its phone labels: {LabelCensus(census['phones'], {}, census.get('corrected', {})).describe()}."
 
 
 def _skipped(skipped: dict[str, str]) -> str:

@@ -141,6 +141,7 @@ class CorpusSummary:
     train_minutes: float
     test_minutes: float
     skipped: dict[str, str] = field(default_factory=dict)   # utterance -> its bad file's message
+    labels: dict = field(default_factory=dict)   # phones per kind (facetraj_engine.io.label_census)
 
 
 @dataclass

@@ -89,7 +89,8 @@ def synthesize_recording(model: Model, audio_path: str | os.PathLike[str],
     res = synthesize(model, samples, rate, labels.phones if labels else None, choice.config,
                      label_map=label_map, source=str(found.file or audio_path),
                      audio_source=str(audio_path), confidence=labels.trust() if labels else None,
-                     provenance=labels.provenance if labels else None, voice=True)
+                     provenance=labels.provenance if labels else None, voice=True,
+                     checked=labels.checked if labels else None)
     if progress is not None:
         progress(1.0, f"{len(res.times)} frames synthesized")
     return RecordingSynthesis(res, found, choice, res.voice_match, audio_path)

@@ -44,10 +44,14 @@ def cmd_corpus_init(args: argparse.Namespace) -> int:
                             channel_names=args.channel_names, head_corrected=args.head_corrected)
     log.info("%d train and %d test utterances, %d markers (%d-D): %s", len(info.train),
              len(info.test), len(info.marker_names), info.dimensions, " ".join(info.marker_names))
-    kinds = label_kinds(load_corpus(out))
+    corpus = load_corpus(out)
+    kinds = label_kinds(corpus)
     log.info("labels: %s%s", ", ".join(f"{n} {k}" for k, n in sorted(kinds.items())),
              "" if set(kinds) <= {"hand-checked"} else
              " (train tunes the robust mode for them; synth and eval use it)")
+    from .train import log_label_census
+
+    log_label_census(corpus)
     print(out)
     return 0
 

@@ -26,6 +26,9 @@ def mode_rule(args: argparse.Namespace, model, corpus, splits) -> EvalConfig:
     from facetraj_engine.errors import FacetrajError
     from facetraj_engine.method.modes import TUNED_FIELDS, choose_mode
 
+    from .train import log_label_census
+
+    log_label_census(corpus)
     explicit = getattr(args, "mode", None) is not None
     keep = tuple(f for f in TUNED_FIELDS if getattr(args, f, None) is not None)
     first = next((u for sp in splits for u in getattr(corpus.info, sp)), None)

@@ -20,6 +20,7 @@ def cmd_train(args: argparse.Namespace) -> int:
 
     check_output_path(args.output, args.overwrite, probe=True)  # before training, not after
     corpus = load_corpus(args.corpus)
+    log_label_census(corpus)
     skipped = skips(args)
     model = train(corpus, config=train_config(args), progress=TerminalProgress("train"),
                   workers=jobs(args), skip=skipped)
@@ -40,6 +41,15 @@ def cmd_train(args: argparse.Namespace) -> int:
              model.pca.n_components, 100 * model.pca.explained_ratio.sum(), len(model.phones))
     print(out)
     return finish(skipped)
+
+
+def log_label_census(corpus) -> None:
+    """How the corpus's labels were made, phone by phone (the label files as training and
+    evaluation read them: corrections made in the app or in Praat count as hand-checked)."""
+    from facetraj_engine.io.label_census import label_census
+
+    log.info("%s: labels of %d utterances, %s", corpus.root.name, len(corpus.info.ids),
+             label_census(corpus).describe())
 
 
 def tune_folds(args: argparse.Namespace, trained_labels: dict[str, int], n_train: int = 2) -> int:
