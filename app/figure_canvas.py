@@ -31,6 +31,8 @@ from PyQt6 import sip
 from PyQt6.QtCore import QObject, QRectF, QSize, QTimer, pyqtSignal
 from PyQt6.QtGui import QColor, QImage, QPainter
 
+from .workers import STEP_MS
+
 log = logging.getLogger(__name__)
 
 #: one thread draws every figure (figures draw one at a time anyway: ``Figure._render_lock``)
@@ -276,3 +278,64 @@ class BackgroundCanvas(FigureCanvasQTAgg):
                 painter.drawImage(QRectF(self.rect()), self._last)
         finally:
             painter.end()
+
+
+class SteppedBuild:
+    """A figure's build run a step per pass of the event loop (a generator whose steps change the
+    figure), after the background draw running (:meth:`BackgroundCanvas.when_idle`): a newer
+    build replaces it (closed), :meth:`finish` runs the rest now, and none ever runs inside
+    another (``executing``: its step is on the call stack; the owner defers what a step causes,
+    e.g. a resize, until after it)."""
+
+    def __init__(self, canvas: BackgroundCanvas):
+        self.canvas = canvas
+        self.steps = None               # the build under way (None: none)
+        self.executing = False
+
+    @property
+    def running(self) -> bool:
+        return self.steps is not None
+
+    def start(self, steps, soon: bool) -> None:
+        """Replace the build under way with ``steps``: run now to the end, or with ``soon`` a
+        step per pass of the event loop."""
+        self.stop()
+        if not soon:
+            self.canvas.wait()
+            self.advance(steps, to_end=True)
+            return
+        self.steps = steps
+
+        def step() -> None:
+            if self.steps is not steps:
+                return                  # replaced by a newer build
+            if not self.advance(steps):
+                self.steps = None
+                return
+            QTimer.singleShot(STEP_MS, step)
+
+        self.canvas.when_idle(step)
+
+    def advance(self, steps, to_end: bool = False) -> bool:
+        """Run a build's next step (``to_end``: all of them); whether steps are left."""
+        self.executing = True
+        try:
+            for _ in steps:
+                if not to_end:
+                    return True
+            return False
+        finally:
+            self.executing = False
+
+    def stop(self) -> None:
+        steps, self.steps = self.steps, None
+        if steps is not None:
+            steps.close()
+
+    def finish(self) -> None:
+        """The build under way run to its end now (none inside a step: it ends by itself)."""
+        if self.executing:
+            return
+        steps, self.steps = self.steps, None
+        if steps is not None:
+            self.advance(steps, to_end=True)

@@ -338,8 +338,11 @@ class MainWindow(QMainWindow):
         """The model of ``corpus`` is ready (``app/data_opener.py``): forget the old model's
         view, show the new corpus and its first utterance."""
         mark("model ready")
-        self.stop()
-        self._forget_view()
+        self.stop()         # the old utterance is of the old marker set: the panels, the transport and
+        self.playback.set_frames(0, 60.0)   # the title drop it (the 3-D scene: set_model)
+        self.transport.set_frames(0)
+        self.timeline.set_view(None)
+        self.title.setText("")
         first = self.state.set_model(corpus, model, texts)
         self.closed_lips = closed_lips(model)     # the 3-D mouth shuts there; the lip panels' line
         self.face.set_model(model, self.closed_lips)
@@ -356,16 +359,6 @@ class MainWindow(QMainWindow):
             self.set_utterance(first)
         self._start_sweep()
         self.opener.run_after_model()
-
-    def _forget_view(self) -> None:
-        """Before another model is used: the panels and the title drop the utterance shown (its
-        markers are of the old model's marker set; the 3-D scene drops it in ``set_model``), so
-        that nothing draws it with the new model's markers while the new first utterance is
-        synthesized."""
-        self.playback.set_frames(0, self.view.rate if self.view is not None else 60.0)
-        self.transport.set_frames(0)
-        self.timeline.set_view(None)
-        self.title.setText("")
 
     def set_correlation_sweep(self, on: bool) -> None:
         """Whether every corpus utterance's lip correlations are computed in the background (the

@@ -31,7 +31,7 @@ from PyQt6.QtWidgets import QLabel, QSizePolicy, QVBoxLayout, QWidget
 
 from facetraj_engine.analysis.apertures import SILENT_LABELS
 
-from .figure_canvas import BackgroundCanvas
+from .figure_canvas import BackgroundCanvas, SteppedBuild
 from .panel_layout import GAP_PX, fit_heights, legend_entries, legend_html, panel_min_px, panel_priority
 from .state import UtteranceView
 from .style import (
@@ -48,7 +48,6 @@ from .style import (
     text_width_px,
 )
 from .tier_labels import FittedLabels, Span
-from .workers import STEP_MS
 
 #: the lines the legend row may grow by when more panels are shown (their curves' entries)
 LEGEND_SWING_LINES = 2
@@ -395,9 +394,8 @@ class Timeline(QWidget):
         self._press: tuple[float, float, int] | None = None   # (xdata, xpixel, button)
         self._grab = None                       # a panel's own drag (``mouse_press``)
         self._drag_span: tuple[float, float] | None = None
-        self._building = None                   # the relayout being built over several passes
+        self.builds = SteppedBuild(self.canvas)  # the relayout built over several passes
         self.layouts = 0                        # relayouts finished (tests)
-        self._executing = False                 # a build's step runs now (on the call stack)
         self._grid = None                       # the panels' grid (its margins follow resizes)
         self.canvas.drawn.connect(self._on_draw)
         self.canvas.mpl_connect("resize_event", self._on_resize)
@@ -420,7 +418,7 @@ class Timeline(QWidget):
         """Show ``view``; another result of the recording shown (``keep_zoom``) is drawn in the
         panels' axes as they are (:func:`redraw_in_place`), else the panels are laid out anew."""
         old, self.view = self.view, view
-        if keep_zoom and self._building is None and self.axes and view is not None and \
+        if keep_zoom and not self.builds.running and self.axes and view is not None and \
                 old is not None and old.utterance.audio is view.utterance.audio:
             redraw_soon(self, view)
             return
@@ -450,56 +448,17 @@ class Timeline(QWidget):
     @property
     def building(self) -> bool:
         """Whether a relayout is being built (``relayout(soon=True)``) or drawn."""
-        return self._building is not None or self.canvas.busy
+        return self.builds.running or self.canvas.busy
 
     def relayout(self, xlim: tuple[float, float] | None = None, soon: bool = False) -> None:
         """Rebuild the figure (one axes per panel, shared time axis) and draw it in the
         background. Now (the axes are there on return), or with ``soon`` one panel per pass of
         the event loop, after a draw that is running (a view adding panels)."""
-        if self._executing:     # asked for by what a build does (its legend resizing the
+        if self.builds.executing:   # asked for by what a build does (its legend resizing the
             # panels): after it, never inside it (a second build removed the first one's axes)
             QTimer.singleShot(0, lambda: self.relayout(self.xlim() if self.axes else xlim, soon=True))
             return
-        self._stop_building()
-        steps = self._build_steps(xlim)
-        if not soon:
-            self.canvas.wait()
-            self._advance(steps, to_end=True)
-            return
-        self._building = steps
-
-        def step() -> None:
-            if self._building is not steps:
-                return                  # replaced by a newer relayout
-            if not self._advance(steps):
-                self._building = None
-                return
-            QTimer.singleShot(STEP_MS, step)
-
-        self.canvas.when_idle(step)
-
-    def _advance(self, steps, to_end: bool = False) -> bool:
-        """Run a build's next step (``to_end``: all of them); whether steps are left."""
-        self._executing = True
-        try:
-            for _ in steps:
-                if not to_end:
-                    return True
-            return False
-        finally:
-            self._executing = False
-
-    def _stop_building(self) -> None:
-        steps, self._building = self._building, None
-        if steps is not None:
-            steps.close()
-
-    def _finish_building(self) -> None:
-        if self._executing:
-            return                      # (the build on the stack finishes by itself)
-        steps, self._building = self._building, None
-        if steps is not None:
-            self._advance(steps, to_end=True)
+        self.builds.start(self._build_steps(xlim), soon)
 
     def _build_steps(self, xlim: tuple[float, float] | None):
         """The relayout, a step per panel (a generator); no draw starts until it ends."""
@@ -608,7 +567,7 @@ class Timeline(QWidget):
         zoomed, loop range changed; a background draw running is waited for). Otherwise the
         canvas already holds that draw with the cursor blitted at ``cursor_time``, pixel for
         pixel what a new full draw gives (``test_a_moved_cursor_leaves_no_trace``)."""
-        self._finish_building()
+        self.builds.finish()
         self.canvas.wait()
         if not self.cursor_ready or tuple(self.figure.bbox.bounds) != self._bg_bounds:
             self.canvas.finish()
@@ -622,7 +581,7 @@ class Timeline(QWidget):
         self.canvas.draw_idle()
 
     def _on_draw(self) -> None:
-        if self._building is not None:
+        if self.builds.running:
             return                      # a relayout is on its way: its draw follows
         self._bg = self.canvas.copy_from_bbox(self.figure.bbox)
         self._bg_bounds = tuple(self.figure.bbox.bounds)
@@ -646,9 +605,9 @@ class Timeline(QWidget):
 
     def _on_resize(self, event) -> None:
         self._bg = None
-        if self._executing:             # a build resized the panels (its legend): after it
+        if self.builds.executing:       # a build resized the panels (its legend): after it
             QTimer.singleShot(0, lambda: self._on_resize(event))
-        elif self._building is None:
+        elif not self.builds.running:
             self.canvas.when_idle(self._fit_to_size)
 
     def set_cursor(self, t: float, follow: bool = False) -> None:

@@ -1,6 +1,7 @@
 """The seeded monkey test (issue 54): random sequences of the window's own actions -- data of every
 kind opened from the File menu, utterances chosen in the browser, keys, play, pins, settings,
-docks and panels opened and closed, exports to a temporary folder, resizes, Live on and off --
+docks and panels opened and closed, phones corrected on the label editor's rows (and saved to a
+temporary folder), exports to a temporary folder, resizes, Live on and off --
 for a fixed time, many without waiting for the one before to finish (as an impatient user
 clicks). After each action no error may have reached the error handler, a dialog or the log.
 
@@ -14,6 +15,7 @@ import logging
 import os
 import random
 import time
+from collections import Counter
 
 import numpy as np
 import pytest
@@ -52,7 +54,7 @@ class Monkey:
         self.actions = [(3, self.open_data), (4, self.choose_utterance), (8, self.key),
                         (3, self.play), (4, self.setting), (3, self.view), (3, self.panel),
                         (2, self.close_dock), (3, self.export), (2, self.resize), (1, self.live),
-                        (2, self.pins), (3, self.settle)]
+                        (2, self.pins), (3, self.settle), (4, self.labels), (1, self.save_labels_as)]
 
     def step(self) -> None:
         weights = np.array([w for w, _ in self.actions], float)
@@ -146,6 +148,15 @@ class Monkey:
         self.note(f"View > {entry}")
         self.w.menu("View", entry, enabled=False)
 
+    def labels(self) -> None:
+        if self.w.win.model is not None:
+            done = self.w.edit_labels(self.rng)
+            self.note(f"labels: {done or '(no phones row)'}")
+
+    def save_labels_as(self) -> None:
+        self.note("File > Save labels as…")
+        self.w.menu("File", "Save labels as", enabled=False)
+
     def settle(self) -> None:
         self.note("(wait until the window settles)")
         self.w.wait(lambda: self.w.win.settled or (self.w.win.view is None and not self.w.win.busy),
@@ -194,5 +205,7 @@ def test_random_actions_never_fail(walker, capsys):
         sequence = "\n".join(f"  {i + 1}. {a}" for i, a in enumerate(monkey.done))
         print(f"monkey: seed {seed}; the actions (replay: FACETRAJ_MONKEY_SEED={seed}):\n{sequence}")
         raise
+    kinds = Counter(a.split(":")[0].split(" (")[0].split(" to ")[0] for a in monkey.done)
     with capsys.disabled():
-        print(f"monkey: {len(monkey.done)} actions, no error (seed {seed})")
+        print(f"monkey: {len(monkey.done)} actions, no error (seed {seed}): "
+              + ", ".join(f"{k} {n}" for k, n in kinds.most_common()))

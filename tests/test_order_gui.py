@@ -2,7 +2,8 @@
 of the others -- every ordered pair of the default corpus, a face corpus of the user's own (C3D),
 the MOCHA-TIMIT sample (2-D EMA), an MVIEW articulograph corpus (3-D EMA, another sensor count),
 a single recording and a folder of recordings -- through the File menu, and on each plays, seeks,
-pins, opens every dock and panel, runs the views' work and every export. No error reaches the
+pins, corrects a phone (left unsaved: the next opening asks, and the edit is discarded), opens
+every dock and panel, runs the views' work and every export. No error reaches the
 error handler, a dialog or the log, and the window shows the data just opened.
 
 The 30 ordered pairs are walked as one circuit (each pair once: an Eulerian circuit of the
@@ -94,7 +95,8 @@ def test_every_kind_of_data_after_every_other(walker, capsys):
             spent["open"] = spent.get("open", 0.0) + time.perf_counter() - t0
         where = f"step {step}: {' -> '.join(walk[max(0, step - 1):step + 1])}"
         assert_no_errors(walker.errors, f"{where}, opening")
-        for action in (walker.play, walker.seek, walker.pin, walker.open_docks, walker.run_views):
+        for action in (walker.play, walker.seek, walker.pin, walker.edit_labels, walker.open_docks,
+                       walker.run_views):
             timed(action)
         lo, hi = walker.zoom_in()                    # the panels (and a video) over 0.8 s
         assert hi - lo < 0.3 * walker.win.view.duration + 0.05, (lo, hi)

@@ -113,6 +113,7 @@ class ScriptedDialogs:
         mp.setattr(QMessageBox, "warning", staticmethod(self._error))
         mp.setattr(QMessageBox, "information", staticmethod(lambda *a, **k: QMessageBox.StandardButton.Ok))
         mp.setattr(QMessageBox, "question", staticmethod(self._question))
+        mp.setattr(QMessageBox, "exec", lambda box: self._box(box))
         mp.setattr(QDialog, "exec", lambda dialog: QDialog.DialogCode.Accepted)
         return self
 
@@ -131,9 +132,28 @@ class ScriptedDialogs:
         self.errors.shown(f"{title}: {text}")
         return QMessageBox.StandardButton.Ok
 
-    def _question(self, _parent, title, text, *_a, **_k):
+    def _question(self, _parent, title, text, _buttons=None, default=None, *_a, **_k):
+        """A question answered by its default, else No (never a file replaced unasked)."""
         self.asked.append(f"{title}: {text}")
-        return QMessageBox.StandardButton.Yes
+        return default if default is not None else QMessageBox.StandardButton.No
+
+    def _box(self, box: QMessageBox) -> int:
+        """A message box with its own buttons (unsaved label edits: Save, Discard, Cancel)
+        answered Discard where it offers it (a walk never writes beside the data), else Ok."""
+        self.asked.append(f"{box.windowTitle()}: {box.text()}")
+        buttons = box.standardButtons()
+        for answer in (QMessageBox.StandardButton.Discard, QMessageBox.StandardButton.Ok):
+            if buttons & answer:
+                return answer.value
+        return QMessageBox.StandardButton.Cancel.value
+
+
+def tier_row(win) -> int | None:
+    """The row of the phones on the editable phone tier, None where it is not shown."""
+    from facetraj_engine.labels.editing import PHONES
+
+    panel = win.extension("labels").panel
+    return panel.row_of(PHONES) if panel in win.timeline.shown else None
 
 
 def button(root: QWidget, text: str) -> QPushButton | None:
@@ -284,6 +304,41 @@ class Walker:
         self.qtbot.wait(400)            # the settings' debounce, then the new synthesis
         self.settle()
         assert w.view is not None
+
+    def edit_labels(self, rng: np.random.Generator | None = None) -> str:
+        """A phone of the phones row clicked and edited as a phonetician does (renamed with F2 to
+        a phone of the model, split, merged, deleted, made silence, a boundary dragged, undone,
+        redone); what was done ("" where the row is not shown: no labels, or left out)."""
+        import label_gui
+
+        w = self.win
+        editor = w.extension("labels")
+        view = w.view
+        self.settle()
+        if view is None or not view.utterance.phones or tier_row(w) is None:
+            return ""
+        phones = [p for p in view.utterance.phones if p.end - p.start > 0.05]
+        if not phones:
+            return ""
+        pick = int(rng.integers(len(phones))) if rng is not None else len(phones) // 2
+        seg = phones[pick]
+        label_gui.click(w, (seg.start + seg.end) / 2)
+        if editor.selected_span() is None:
+            return ""
+        choice = int(rng.integers(8)) if rng is not None else 0
+        if choice == 0:
+            known = sorted(set(w.model.phones) - {"sil"})
+            to = "m" if "m" in known else known[int(rng.integers(len(known))) if rng is not None else 0]
+            label_gui.rename(w, to)
+            done = f"rename to /{to}/"
+        elif choice == 7:
+            label_gui.drag(w, seg.end, seg.end - 0.02)
+            done = "drag a boundary 20 ms"
+        else:
+            keys = {1: "S", 2: "M", 3: "Delete", 4: "0", 5: "Ctrl+Z", 6: "Ctrl+Shift+Z"}
+            label_gui.key(w, keys[choice])
+            done = f"key {keys[choice]}"
+        return f"{done} at /{seg.label}/ {seg.start:.2f} s"
 
     def open_docks(self) -> list[str]:
         """Every Analysis view, Measure's table and each panel, through the Analysis menu; the
