@@ -402,9 +402,11 @@ class Walker:
         from PyQt6.QtCore import QPointF
         from PyQt6.QtGui import QWheelEvent
 
-        canvas = self.win.timeline.canvas
-        self.wait(lambda: self.win.timeline.axes and not self.win.timeline.building, "the panels")
-        at = QPointF(canvas.width() / 2, canvas.height() / 2)
+        tl = self.win.timeline
+        canvas = tl.canvas
+        self.wait(lambda: tl.axes and not tl.building, "the panels")
+        box, ratio = tl.axes[len(tl.axes) // 2].bbox, canvas.device_pixel_ratio   # inside a panel
+        at = QPointF((box.x0 + box.x1) / 2 / ratio, canvas.height() - (box.y0 + box.y1) / 2 / ratio)
         for _ in range(steps):
             event = QWheelEvent(at, canvas.mapToGlobal(at), QPoint(0, 0), QPoint(0, 120),
                                 Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier,
