@@ -6,7 +6,7 @@ from __future__ import annotations
 import logging
 import math
 
-from PyQt6.QtCore import Qt, pyqtSignal
+from PyQt6.QtCore import Qt, QTimer, pyqtSignal
 from PyQt6.QtWidgets import (
     QHeaderView,
     QLineEdit,
@@ -140,6 +140,11 @@ class UtteranceBrowser(QWidget):
         self.tree.setCurrentItem(item)
         self.tree.scrollToItem(item, QTreeWidget.ScrollHint.PositionAtCenter)
         self.tree.blockSignals(False)
+
+    def restore_current(self, utt_id: str) -> None:
+        """Make ``utt_id`` current again once the click (or key) that chose another has been
+        handled: set inside it, the view's own selection would follow the click."""
+        QTimer.singleShot(0, lambda: self.set_current(utt_id))
 
     def set_scores(self, utt_id: str, lower: float, upper: float) -> None:
         item = self.items.get(utt_id)

@@ -74,15 +74,15 @@ class PinList(QLabel):
     def minimumSizeHint(self) -> QSize:
         return QSize(120, super().minimumSizeHint().height())
 
-    def show_pins(self, shown: list, parts: list[str], note: str) -> None:
-        """``shown``: the pins drawn with the result on screen, ``parts`` what tells each apart
-        (``PinBoard.describe``); else ``note`` says why none is."""
-        if not shown:
+    def show_pins(self, named: list, note: str) -> None:
+        """``named``: the pins drawn with the result on screen, each with its text
+        (``PinBoard.named``); else ``note`` says why none is."""
+        if not named:
             self.parts = [("", note)] if note else []
             self.setToolTip(note)
         else:
-            self.parts = [(p.color, f"{p.name}: {part}") for p, part in zip(shown, parts, strict=True)]
-            self.setToolTip("\n".join(f"{p.name}: {p.settings}" for p in shown))
+            self.parts = [(p.color, text) for p, text in named]
+            self.setToolTip("\n".join(f"{p.name}: {p.settings}" for p, _text in named))
         self.setText(self._html(self.parts))        # whole, until the toolbar has laid it out
         self.updateGeometry()
         QTimer.singleShot(0, self._fit)
@@ -195,7 +195,7 @@ class Compare(QObject):
         shown = w.pins.shown(w.view)
         changed, self._shown = shown != self._shown, shown
         self.clear_action.setEnabled(len(w.pins) > 0)
-        self.label.show_pins(shown, w.pins.describe(w.view, shown) if shown else [], self._note())
+        self.label.show_pins(w.pins.named(w.view), self._note())
         w.face.set_pins(shown)
         tl = w.timeline
         if shown and self.panel not in tl.panels:

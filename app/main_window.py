@@ -303,7 +303,7 @@ class MainWindow(QMainWindow):
         the background; ``utteranceChanged`` follows."""
         shown = self.view.utterance.name if self.view is not None else utt_id
         if utt_id != shown and not self.may_leave(f"showing {utt_id}"):
-            return self.browser.set_current(shown)
+            return self.browser.restore_current(shown)
         try:
             request = self.state.request_utterance(utt_id)
         except FacetrajError as exc:

@@ -345,7 +345,7 @@ def export_figure(window, path: Path) -> Path:
     time range shown, the cursor where it is), every one of them (also those the window has no
     room for), with a caption naming the utterance, its labels and how it was synthesized, and
     the legend above them."""
-    from .screen_export import caption_text, panels_figure
+    from .screen_export import panels_figure
 
     suffix = path.suffix.lower().lstrip(".")
     if suffix not in ("png", "svg", "pdf"):
@@ -357,10 +357,18 @@ def export_figure(window, path: Path) -> Path:
     size = (max(tl.width(), EXPORT_MIN_WIDTH), int(max(tl.height(), tl.needed_height()) + 160))
     fig, _layout = panels_figure(list(tl.panels), view, size, xlim=tl.xlim(),
                                  cursor=window.current_time(),
-                                 caption=caption_text(view, window.pins.shown(view)))
+                                 caption=window_caption(window))
     with atomic_write(path) as tmp:
         fig.savefig(tmp, format=suffix, dpi=150, facecolor="white")
     return path
+
+
+def window_caption(window) -> str:
+    """The caption of what the window shows: the utterance, how it was synthesized, and the
+    pins shown with it by what tells them apart (as the toolbar names them)."""
+    from .screen_export import caption_text
+
+    return caption_text(window.view, [text for _pin, text in window.pins.named(window.view)])
 
 
 def screen_of(window) -> tuple[str, object]:
@@ -369,13 +377,12 @@ def screen_of(window) -> tuple[str, object]:
     camera, the time range shown)."""
     import copy
 
-    from .screen_export import caption_text
     from .video import Screen
 
     view, tl = window.view, window.timeline
     tl.ensure_drawn()      # panels being built finished: the ones shown are known
     span = tl.xlim()
-    caption = caption_text(view, window.pins.shown(view))
+    caption = window_caption(window)
     if span[0] > 0.0 or span[1] < view.times[-1]:
         caption += f"  ·  {span[0]:.2f}–{span[1]:.2f} s"
     return caption, Screen(tuple(copy.copy(p) for p in tl.shown), window.face.options(),

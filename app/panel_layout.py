@@ -33,6 +33,22 @@ def panel_priority(panel) -> int:
     return int(getattr(panel, "priority", DEFAULT_PRIORITY))
 
 
+def min_scale_to_fit(min_px: Sequence[float], available_px: float, floor: float,
+                     gap_px: float = GAP_PX) -> float:
+    """The scale (at most 1, at least ``floor``) of the panels' least heights ``min_px`` at
+    which all of them fit ``available_px`` with their gaps: a video keeps every panel the window
+    shows, each a little lower, before :func:`fit_heights` leaves one out.
+
+    >>> min_scale_to_fit([100, 100], 300, 0.45), min_scale_to_fit([100, 100], 106, 0.45)
+    (1.0, 0.5)
+    >>> min_scale_to_fit([100, 100], 50, 0.45)
+    0.45
+    """
+    need = float(sum(min_px))
+    room = available_px - gap_px * max(len(min_px) - 1, 0)
+    return float(min(1.0, max(floor, room / need))) if need > 0 else 1.0
+
+
 def fit_heights(heights: Sequence[float], min_px: Sequence[float], priority: Sequence[int],
                 available_px: float, gap_px: float = GAP_PX) -> list[float | None]:
     """The height in pixels of each panel (``None``: left out for lack of room).

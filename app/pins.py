@@ -118,6 +118,13 @@ class PinBoard:
         return distinct_settings([own, *([*p.parts, f"model {p.model_name or self.model_name}"]
                                          for p in pins)])[1:]
 
+    def named(self, view: UtteranceView | None) -> list[tuple[Pin, str]]:
+        """The pins shown with ``view``, each with its name and what tells it apart
+        (:meth:`describe`): "pin 1: C=3" in the toolbar, the lip panels' legend and captions."""
+        shown = self.shown(view)
+        return [(p, f"{p.name}: {part}") for p, part in zip(shown, self.describe(view, shown), strict=True)] \
+            if shown else []
+
     def __len__(self) -> int:
         return len(self.pins)
 

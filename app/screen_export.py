@@ -49,13 +49,14 @@ class PanelContext:
     pins: PinBoard = field(default_factory=PinBoard)
 
 
-def caption_text(view: UtteranceView, pins: Sequence = (), heading: str | None = None) -> str:
+def caption_text(view: UtteranceView, pins: Sequence[str] = (), heading: str | None = None) -> str:
     """The utterance, its sentence (not for recognized labels), how it was synthesized and where
-    the labels came from, and each pinned result shown with it; ``heading``: written in place of
-    the utterance and its sentence ("": nothing)."""
+    the labels came from, and each pinned result shown with it (``pins``: their texts,
+    ``PinBoard.named``, what tells each apart, as the toolbar says); ``heading``: written in
+    place of the utterance and its sentence ("": nothing)."""
     head = view_heading(view, " ") if heading is None else heading
     parts = ([head] if head else []) + [f"synthesized: {settings_text(view)}"]
-    return CAPTION_SEPARATOR.join(parts + [f"{pin.name}: {pin.settings}" for pin in pins])
+    return CAPTION_SEPARATOR.join(parts + list(pins))
 
 
 def main_panels(context) -> list:

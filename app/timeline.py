@@ -265,12 +265,9 @@ class LipPanel:
             orig = view.original[:, k, 1]
             ax.plot(t, orig, color=ORIGINAL_COLOR, lw=1.5, ls=(0, (2, 1.5)), label="original")
             ys.append(orig)
-        pins = self.context.pins
-        shown = pins.shown(view)
-        for pin, differs in zip(shown, pins.describe(view, shown), strict=True):
+        for pin, text in self.context.pins.named(view):
             y = pin.view.shown[:, k, 1]
-            ax.plot(pin.view.times[:len(y)], y, color=pin.color, lw=1.4, ls=(0, (6, 2)),
-                    label=f"{pin.name}: {differs}")
+            ax.plot(pin.view.times[:len(y)], y, color=pin.color, lw=1.4, ls=(0, (6, 2)), label=text)
             ys.append(y)
         closed = self.context.closed_lips
         closed_y = float(closed.markers[k, 1]) if closed is not None else None

@@ -121,13 +121,19 @@ class _Panels:
                  xlim: tuple[float, float] | None = None):
         from matplotlib.backends.backend_agg import FigureCanvasAgg
 
+        from .panel_layout import min_scale_to_fit, panel_min_px
         from .screen_export import panels_figure
+        from .timeline import BOTTOM_MARGIN_PX, TOP_MARGIN_PX
 
         self.width, self.height = width, height
         self.panels = panels
-        # a small frame's panels as small as they can be read (a 640 x 320 video keeps both lips)
+        # a small frame's panels as small as they can be read (a 640 x 320 video keeps both
+        # lips), and every panel the window shows kept, a little lower, where they can be
+        floor = float(np.clip(height / 420, 0.45, 1.0))
+        scale = min_scale_to_fit([panel_min_px(p) for p in panels],
+                                 height - TOP_MARGIN_PX - BOTTOM_MARGIN_PX, min(floor, 0.6))
         self.fig, self.layout = panels_figure(self.panels, view, (width, height), legend=False,
-                                              xlim=xlim, min_scale=float(np.clip(height / 420, 0.45, 1.0)))
+                                              xlim=xlim, min_scale=min(floor, scale))
         self.canvas = FigureCanvasAgg(self.fig)
         self.cursors = [ax.axvline(view.times[0], color=CURSOR_COLOR, lw=1.2, animated=True)
                         for ax in self.layout.axes]

@@ -292,11 +292,10 @@ def test_the_m_of_im_heard_as_n_fixed_with_the_lips_before_and_after(screen, qtb
         table = w.extension("measure").open_table()        # 5. the per-phone table, /m/ only
         qtbot.keyClicks(table.filter, "m")
         machine = time.perf_counter() - started
-        heads = [table.table.horizontalHeaderItem(c).text() for c in range(table.table.columnCount())]
         row = next(r for r in range(table.table.rowCount())
-                   if table.table.item(r, heads.index("start (s)")).text() == "1.100")
-        this = float(table.table.item(row, heads.index("min: synth.")).text())
-        pinned = float(table.table.item(row, heads.index("min: pin 1")).text())
+                   if table.table.item(r, table.column("start (s)")).text() == "1.100")
+        this = float(table.table.item(row, table.column("min: synth.")).text())
+        pinned = float(table.table.item(row, table.column("min: pin 1")).text())
         # the engine's numbers: the least aperture over the /m/ of each result
         frames = np.flatnonzero((w.view.times >= 1.1) & (w.view.times < 1.24))   # as the table
         up, low = w.model.upper_lip, w.model.lower_lip
@@ -333,7 +332,9 @@ def test_unsaved_edits_are_never_lost_silently(screen, qtbot, im_glad, recording
         said = answer("Cancel")                                # another recording: stays
         click_browser(w, other.stem)
         assert said and w.view.utterance.name == im_glad.stem
-        assert w.browser.tree.currentItem() is w.browser.items[im_glad.stem]
+        kept = w.browser.items[im_glad.stem]                   # the browser back on it, alone
+        qtbot.waitUntil(lambda: w.browser.tree.currentItem() is kept, timeout=WAIT_MS)
+        assert w.browser.tree.selectedItems() == [kept]
         said = answer("Save")                                  # another recording: saved
         show(w, qtbot, other.stem)
         assert said and w.view.utterance.name == other.stem and grid.is_file()

@@ -200,7 +200,8 @@ def test_the_video_is_what_the_screen_shows(screen, win, qtbot, tmp_path, monkey
                         screen=screen_state)
     try:
         lay = video.layout
-        assert lay.panels == tuple(shown) and lay.span == pytest.approx((0.1, 0.8))
+        assert lay.panels == tuple(shown) and lay.span == pytest.approx((0.1, 0.8)), (lay.panels, caption)
+        assert "pin 1: N=3  ·" in caption       # what tells the pin apart, as the toolbar says
         assert "0.10–0.80 s" in caption
         # the 3-D half of the frame at 0.4 s against the window's 3-D view at 0.4 s
         k = int(round((0.4 - 0.1) * VideoSettings().fps))

@@ -211,10 +211,21 @@ class Walker:
                              f"{[a.text() for a in m.actions() if a.text()]}")
 
     def key(self, key: Qt.Key, modifier: Qt.KeyboardModifier = Qt.KeyboardModifier.NoModifier) -> None:
-        """A key pressed over the 3-D view (where a click leaves the focus: the window's keys)."""
+        """A key pressed over the 3-D view (where a click leaves the focus: the window's keys),
+        the window active first (a shortcut reaches only the active window; after a dialog
+        closes none may be until the window manager, here the X server, says so)."""
         self.win.activateWindow()
+        self.qtbot.waitUntil(self.win.isActiveWindow, timeout=WAIT_MS)
         self.win.face.setFocus()
         self.qtbot.keyClick(QApplication.focusWidget() or self.win, key, modifier)
+
+    def choose(self, combo, text: str) -> None:
+        """Pick the entry of ``combo`` that contains ``text``, as the user's pick in its list
+        does (its ``activated``, not only its current index)."""
+        index = combo.findText(text, Qt.MatchFlag.MatchContains)
+        assert index >= 0, (text, [combo.itemText(i) for i in range(combo.count())])
+        combo.setCurrentIndex(index)
+        combo.activated.emit(index)
 
     def click(self, widget: QWidget) -> None:
         self.qtbot.mouseClick(widget, Qt.MouseButton.LeftButton)

@@ -343,6 +343,40 @@ def _support(times: np.ndarray, start: float, end: float, taper_s: float) -> sli
     return slice(int(lo), int(np.searchsorted(times, end + taper, side="right")))
 
 
+def labelled_speech(segments: Sequence[PhoneSegment], times: np.ndarray) -> np.ndarray:
+    """Per frame time of ``times``, whether a phone of ``segments`` that is not a silence
+    (``sil``, ``sp``, ``pau``, ...) holds it: a silence there that speech follows is a
+    consonant's closure (the /θ t/ of "twentieth time" is 150 ms without energy), not a pause,
+    and offline, where the labels of the whole input are known, the face does not rest in it.
+
+    >>> segs = [PhoneSegment(0.0, 0.2, "sil"), PhoneSegment(0.2, 0.35, "t"), PhoneSegment(0.35, 0.6, "sp")]
+    >>> labelled_speech(segs, np.array([0.1, 0.25, 0.34, 0.4, 0.7])).tolist()
+    [False, True, True, False, False]
+    """
+    from ..labels.phoneset import SILENCE_LABELS
+
+    t = np.asarray(times, dtype=np.float64)
+    out = np.zeros(len(t), dtype=bool)
+    for s in segments:
+        if s.label.lower() not in SILENCE_LABELS:
+            out |= (t >= s.start) & (t < s.end)
+    return out
+
+
+def outer_silence(silent: np.ndarray) -> np.ndarray:
+    """Per frame, whether it belongs to the silence the input begins or ends in (it and every
+    frame before it, or after it, silent): the talker has not started or has finished, whatever
+    the labels say of it.
+
+    >>> outer_silence(np.array([1, 0, 1, 1, 0, 1, 1], dtype=bool)).tolist()
+    [True, False, False, False, False, True, True]
+    """
+    s = np.asarray(silent, dtype=bool)
+    if not len(s):
+        return s.copy()
+    return np.logical_and.accumulate(s) | np.logical_and.accumulate(s[::-1])[::-1]
+
+
 def rest_weights(silent: np.ndarray, rate: float, min_s: float, taper_s: float,
                  leading: bool = True, ahead: int = 0, ended: bool = False) -> np.ndarray:
     """Per frame t of ``silent`` (whether each frame is silent), how far the face rests, read from

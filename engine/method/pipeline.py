@@ -23,7 +23,15 @@ from ..errors import InputError, warn_file
 from ..io.labelfiles import validate_phones
 from ..labels.phoneset import SILENCE, map_labels, normalise_label
 from ..threads import above_blas, frame_threads
-from .closure import ClosurePlan, aperture_functional, apply_closure, closure_intervals, closure_strengths
+from .closure import (
+    ClosurePlan,
+    aperture_functional,
+    apply_closure,
+    closure_intervals,
+    closure_strengths,
+    labelled_speech,
+    outer_silence,
+)
 from .closure_detector import beside, causal_closures, closure_runs, frame_energy_db, input_probability
 from .closure_search import search_rows
 from .context import segment_index
@@ -313,6 +321,8 @@ def plan_closure(model: Model, audio: np.ndarray, sample_rate: int, times: np.nd
         strengths, causal = np.ones(len(intervals)), np.ones(len(intervals), dtype=bool)
         log.debug("closure step: the lips close at %d closures the detector found", len(intervals))
     silent = ~speech & ranged if config.rest else np.zeros(len(times), dtype=bool)
+    if segs:       # a labelled consonant's silence inside speech is its closure, not a pause
+        silent &= ~(labelled_speech(segs, times) & ~outer_silence(silent))
     return ClosurePlan(intervals, strengths, silent, p, causal, leading=config.rest,
                        end=len(times))
 
