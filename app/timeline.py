@@ -315,8 +315,9 @@ def redraw_soon(timeline: Timeline, view: UtteranceView) -> None:
     background draw running), then a full draw in the background."""
     shown, axes = list(timeline.shown), list(timeline.axes)
 
-    def redo() -> None:
-        if timeline.view is view and axes == timeline.axes:
+    def redo() -> None:      # not over a layout being built since (its axes taken off the figure)
+        if timeline.view is view and axes == timeline.axes and \
+                all(ax.figure is timeline.figure for ax in axes):
             redraw_in_place(shown, axes, view)
             timeline.redraw()
 
