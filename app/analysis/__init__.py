@@ -197,9 +197,8 @@ class AnalysisViews(QObject):
         self.docks.clear()
         self.widgets.clear()
         tl = self.window.timeline
-        for panel in self.panels.values():
-            if panel in tl.panels:
-                tl.panels.remove(panel)
+        for panel in self.panels.values():      # a build under way drawing them replaced (the
+            tl.remove_panel(panel, soon=True)   # velocity panel's controls are deleted below)
         self.panels.clear()
         if self.controls is not None:       # made for the velocity panel alone, without a dock
             self.controls.close_view()
