@@ -318,3 +318,17 @@ def concatenate_input(utts: Sequence[Utterance], seconds: float) -> tuple[np.nda
     cut = [s for s in phones if s.start < end - 1e-3]
     cut[-1] = PhoneSegment(cut[-1].start, end, cut[-1].label)
     return audio, rate, cut
+
+
+def wait_for_window(cond, timeout: float, poll_ms: int = 20, what: str = "ready") -> None:
+    """Run the Qt event loop in ``poll_ms`` passes until ``cond()`` holds (the app's window
+    benchmarks); a TimeoutError after ``timeout`` seconds."""
+    from PyQt6.QtCore import QEventLoop, QTimer
+
+    end = time.monotonic() + timeout
+    while not cond():
+        if time.monotonic() > end:
+            raise TimeoutError(f"the window did not get {what} in time")
+        loop = QEventLoop()
+        QTimer.singleShot(poll_ms, loop.quit)
+        loop.exec()

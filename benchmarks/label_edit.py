@@ -68,21 +68,17 @@ def recordings(folder: Path, corpus: Path) -> dict[int, Path]:
 
 def measure(corpus: Path, paths: dict[int, Path], edits: int, size: tuple[int, int]) -> dict:
     """Open the window, each recording (recognized), and time ``edits`` edits of each."""
-    from PyQt6.QtCore import QElapsedTimer, QEventLoop, QTimer
+    from PyQt6.QtCore import QElapsedTimer, QTimer
     from PyQt6.QtWidgets import QApplication
 
     from facetraj_app.main import build_window
 
     app = QApplication.instance() or QApplication(sys.argv[:1])
 
+    from benchmarks.common import wait_for_window
+
     def wait_for(cond, timeout: float) -> None:
-        end = time.monotonic() + timeout
-        while not cond():
-            if time.monotonic() > end:
-                raise TimeoutError("the window did not get there in time")
-            loop = QEventLoop()
-            QTimer.singleShot(2, loop.quit)
-            loop.exec()
+        wait_for_window(cond, timeout, 2, "there")
 
     win = build_window(corpus, use_audio=False)
     win.set_correlation_sweep(False)

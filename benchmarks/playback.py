@@ -41,21 +41,16 @@ def measure(corpus: Path, seconds: float, utterance: str | None = None, during_c
             speed: float = 1.0, size: tuple[int, int] = (1600, 1000)) -> dict:
     """Open the window on ``corpus``, play ``seconds`` of audio clock and return the statistics."""
     os.environ.setdefault("QT_LOGGING_RULES", "qt.multimedia.*=false")
-    from PyQt6.QtCore import QEventLoop, QTimer
     from PyQt6.QtWidgets import QApplication
 
     from facetraj_app.main_window import MainWindow
 
     app = QApplication.instance() or QApplication(sys.argv[:1])
 
+    from benchmarks.common import wait_for_window
+
     def wait_for(cond, timeout: float) -> None:
-        end = time.monotonic() + timeout
-        while not cond():
-            if time.monotonic() > end:
-                raise TimeoutError("the window did not get ready in time")
-            loop = QEventLoop()
-            QTimer.singleShot(20, loop.quit)
-            loop.exec()
+        wait_for_window(cond, timeout, 20, "ready")
 
     t0 = time.monotonic()
     win = MainWindow(corpus, utterance=utterance)
