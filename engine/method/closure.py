@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..data import PhoneSegment
+from ..labels.phoneset import SILENCE, normalise_label
 from .moments import Moments
 from .pca import PCA
 
@@ -353,12 +354,10 @@ def labelled_speech(segments: Sequence[PhoneSegment], times: np.ndarray) -> np.n
     >>> labelled_speech(segs, np.array([0.1, 0.25, 0.34, 0.4, 0.7])).tolist()
     [False, True, True, False, False]
     """
-    from ..labels.phoneset import SILENCE_LABELS
-
     t = np.asarray(times, dtype=np.float64)
     out = np.zeros(len(t), dtype=bool)
     for s in segments:
-        if s.label.lower() not in SILENCE_LABELS:
+        if normalise_label(s.label) != SILENCE:
             out |= (t >= s.start) & (t < s.end)
     return out
 
